@@ -1,0 +1,38 @@
+# curvefair - the two commands a new user needs:  make demo  /  make test
+PYTHON ?= python3
+VENV   ?= .venv
+PY     := $(VENV)/bin/python
+PIP    := $(VENV)/bin/pip
+
+.PHONY: demo test bench bench-quality clean venv
+
+$(VENV)/.stamp-base: pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(PIP) install --upgrade --quiet pip
+	$(PIP) install --quiet -e .
+	touch $@
+
+$(VENV)/.stamp-test: pyproject.toml $(VENV)/.stamp-base
+	$(PIP) install --quiet -e ".[test]"
+	touch $@
+
+$(VENV)/.stamp-bench: pyproject.toml $(VENV)/.stamp-test
+	$(PIP) install --quiet -e ".[bench]"
+	touch $@
+
+venv: $(VENV)/.stamp-base
+
+## demo: fair the bundled example curve, print a before/after summary, write demo_out/report.json
+demo: $(VENV)/.stamp-base
+	$(PY) examples/demo.py --out demo_out/report.json
+
+## test: the whole test suite
+test: $(VENV)/.stamp-test
+	$(PY) -m pytest -q
+
+## bench: speed benchmarks (figures quoted in README.md)
+bench: $(VENV)/.stamp-bench
+	$(PY) benchmarks/run_all.py
+
+clean:
+	rm -rf $(VENV) demo_out .pytest_cache .hypothesis

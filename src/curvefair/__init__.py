@@ -1,0 +1,36 @@
+"""curvefair: fairing of spline curves by the published local methods, within a tolerance.
+
+Curves: :class:`CubicHermite`, :class:`QuinticHermite` (and :class:`BSplineCurve`), built by
+:func:`interpolate_cubic`, :func:`interpolate_quintic`. Analysis: :func:`energy`,
+:func:`curvature`, :func:`analyze`, :func:`deviation`. Fairing: :mod:`curvefair.steps` (one
+local step per published method) and :func:`fair` (the automatic loop).
+
+Indices are 0-based everywhere; the papers number from 1.
+"""
+
+from ._version import __version__
+from .curves import (
+    CubicHermite,
+    PiecewiseCurve,
+    PiecewisePolynomial,
+    QuinticHermite,
+    interpolate_cubic,
+    interpolate_quintic,
+    parameterize,
+)
+from .errors import CurvefairError, FileFormatError, InputError, MissingDependencyError
+
+__all__ = [
+    "__version__",
+    "CubicHermite",
+    "QuinticHermite",
+    "PiecewiseCurve",
+    "PiecewisePolynomial",
+    "interpolate_cubic",
+    "interpolate_quintic",
+    "parameterize",
+    "CurvefairError",
+    "InputError",
+    "FileFormatError",
+    "MissingDependencyError",
+]

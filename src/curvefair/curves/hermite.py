@@ -1,0 +1,238 @@
+"""Parametric Hermite splines: C1 cubic (seed 001) and C2 quintic (seed 000).
+
+Indices are 0-based here; the papers number points from 1 (paper's ``P_k`` is our ``points[k-1]``).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from .._typing import ArrayLike, FloatArray
+from .._validate import as_params, as_points, as_vectors
+from ..errors import InputError
+from .piecewise import PiecewiseCurve, PiecewisePolynomial, readonly
+
+__all__ = ["CubicHermite", "QuinticHermite", "HermiteSpline"]
+
+
+def _check_closed(name: str, arrs: list[tuple[str, FloatArray]]) -> None:
+    for label, a in arrs:
+        scale = max(float(np.abs(a).max()), 1.0)
+        if not np.allclose(a[0], a[-1], rtol=0.0, atol=1e-10 * scale):
+            raise InputError(
+                f"closed {name}: {label}[0] = {a[0].tolist()} must equal {label}[-1] = "
+                f"{a[-1].tolist()} (a closed curve repeats its first point last)"
+            )
+        a[-1] = a[0]
+
+
+class HermiteSpline(PiecewiseCurve):
+    """Common machinery of :class:`CubicHermite` and :class:`QuinticHermite`.
+
+    Data are held per point: ``points`` and the derivative arrays (``_derivs``), ``params``.
+    A closed curve repeats its first point (and derivatives) as the last one; its distinct data
+    points are ``0 .. n-2``.
+    """
+
+    _deriv_names: tuple[str, ...] = ()
+
+    def _init(self, points: ArrayLike, derivs: list[ArrayLike], params: ArrayLike,
+              closed: bool) -> None:
+        pts = as_points(points, "points", min_points=2)
+        n, dim = pts.shape
+        ders = [as_vectors(d, (n, dim), name) for d, name in zip(derivs, self._deriv_names)]
+        t = as_params(params, n, "params")
+        closed = bool(closed)
+        if closed:
+            if n < 3:
+                raise InputError(f"a closed curve needs at least 3 points (first repeated last), got {n}")
+            _check_closed(type(self).__name__, [("points", pts)] + list(zip(self._deriv_names, ders)))
+        self._points = readonly(pts)
+        self._derivs = [readonly(d) for d in ders]
+        self._params = readonly(t)
+        self._closed = closed
+
+    # -- data -------------------------------------------------------------------------------
+    @property
+    def points(self) -> FloatArray:
+        """Data points, shape ``(n, dim)`` (read-only)."""
+        return self._points
+
+    @property
+    def params(self) -> FloatArray:
+        """Parameter values ``t_i``, shape ``(n,)`` (read-only)."""
+        return self._params
+
+    @property
+    def dim(self) -> int:
+        return int(self._points.shape[1])
+
+    @property
+    def closed(self) -> bool:
+        return self._closed
+
+    @property
+    def n_points(self) -> int:
+        """Number of stored data points (a closed curve counts its repeated first point twice)."""
+        return int(self._points.shape[0])
+
+    def __len__(self) -> int:
+        return self.n_points
+
+    def __repr__(self) -> str:
+        return (f"{type(self).__name__}(n={self.n_points}, dim={self.dim}, "
+                f"closed={self.closed}, domain={self.domain})")
+
+    def replace(self, **changes: Any) -> "HermiteSpline":
+        """A new curve with some data replaced (``points=``, derivative arrays, ``params=``)."""
+        kw: dict[str, Any] = {"points": self._points, "params": self._params, "closed": self._closed}
+        kw.update(dict(zip(self._deriv_names, self._derivs)))
+        unknown = set(changes) - set(kw)
+        if unknown:
+            raise InputError(f"replace() got unknown fields {sorted(unknown)}; valid: {sorted(kw)}")
+        kw.update(changes)
+        return type(self)(**kw)
+
+    def coefficients(self) -> FloatArray:
+        """Per-segment power coefficients ``a[i, j]``, shape ``(n-1, degree+1, dim)``.
+
+        ``r(t) = sum_j a[i, j] (t - t_i)**j`` on ``[t_i, t_{i+1}]`` (seed 001 eq. (6) for
+        cubics, seed 000 eq. (2) for quintics). Returns a copy.
+        """
+        return np.array(self.piecewise.coeffs)
+
+
+class CubicHermite(HermiteSpline):
+    """C1 parametric cubic Hermite spline through ``points`` with ``tangents`` at ``params``.
+
+    Parameters
+    ----------
+    points : array_like, shape (n, dim)
+        Data points ``r_i``, dim 2 or 3.
+    tangents : array_like, shape (n, dim)
+        First derivatives ``r'_i`` with respect to the parameter.
+    params : array_like, shape (n,)
+        Strictly increasing parameters ``t_i``.
+    closed : bool
+        Closed curve: ``points[-1]`` must repeat ``points[0]`` (and the tangents too).
+
+    Notes
+    -----
+    On segment ``i`` with ``D_i = t_{i+1} - t_i`` (Wang & Cao 2006, eq. (6)):
+
+    ``a_{i,0} = r_i``, ``a_{i,1} = r'_i``,
+    ``a_{i,2} = 3 (r_{i+1} - r_i) / D_i^2 - (2 r'_i + r'_{i+1}) / D_i``,
+    ``a_{i,3} = 2 (r_i - r_{i+1}) / D_i^3 + (r'_i + r'_{i+1}) / D_i^2``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from curvefair import CubicHermite
+    >>> c = CubicHermite([[0, 0], [1, 1]], [[1, 0], [1, 0]], [0.0, 1.0])
+    >>> c(0.5).round(3).tolist()
+    [0.5, 0.5]
+    """
+
+    degree = 3
+    _deriv_names = ("tangents",)
+
+    def __init__(self, points: ArrayLike, tangents: ArrayLike, params: ArrayLike,
+                 closed: bool = False) -> None:
+        self._init(points, [tangents], params, closed)
+
+    @property
+    def tangents(self) -> FloatArray:
+        """First derivatives ``r'_i``, shape ``(n, dim)`` (read-only)."""
+        return self._derivs[0]
+
+    def _make_piecewise(self) -> PiecewisePolynomial:
+        return PiecewisePolynomial(np.array(self._params),
+                                   cubic_hermite_coefficients(self._points, self.tangents, self._params))
+
+
+class QuinticHermite(HermiteSpline):
+    """C2 parametric quintic Hermite spline (position, first and second derivative per point).
+
+    Parameters
+    ----------
+    points, d1, d2 : array_like, shape (n, dim)
+        ``r_i``, ``r'_i``, ``r''_i``.
+    params : array_like, shape (n,)
+        Strictly increasing parameters.
+    closed : bool
+        As for :class:`CubicHermite`.
+
+    Notes
+    -----
+    Wang 2005, eq. (2): with ``b1 = r_{i+1} - r_i - r'_i D - r''_i D^2/2``,
+    ``b2 = r'_{i+1} - r'_i - r''_i D``, ``b3 = r''_{i+1} - r''_i``:
+    ``a_{i,3} = (10 b1 - 4 b2 D + b3 D^2/2) / D^3``,
+    ``a_{i,4} = (-15 b1 + 7 b2 D - b3 D^2) / D^4``,
+    ``a_{i,5} = (6 b1 - 3 b2 D + b3 D^2/2) / D^5``.
+
+    Examples
+    --------
+    >>> from curvefair import QuinticHermite
+    >>> q = QuinticHermite([[0, 0], [1, 0]], [[1, 0], [1, 0]], [[0, 0], [0, 0]], [0, 1])
+    >>> q(0.25).tolist()
+    [0.25, 0.0]
+    """
+
+    degree = 5
+    _deriv_names = ("d1", "d2")
+
+    def __init__(self, points: ArrayLike, d1: ArrayLike, d2: ArrayLike, params: ArrayLike,
+                 closed: bool = False) -> None:
+        self._init(points, [d1, d2], params, closed)
+
+    @property
+    def d1(self) -> FloatArray:
+        """First derivatives, shape ``(n, dim)`` (read-only)."""
+        return self._derivs[0]
+
+    @property
+    def d2(self) -> FloatArray:
+        """Second derivatives, shape ``(n, dim)`` (read-only)."""
+        return self._derivs[1]
+
+    @property
+    def tangents(self) -> FloatArray:
+        """Alias of :attr:`d1`."""
+        return self._derivs[0]
+
+    def _make_piecewise(self) -> PiecewisePolynomial:
+        return PiecewisePolynomial(
+            np.array(self._params),
+            quintic_hermite_coefficients(self._points, self.d1, self.d2, self._params),
+        )
+
+
+def cubic_hermite_coefficients(p: FloatArray, m: FloatArray, t: FloatArray) -> FloatArray:
+    """Seed 001 eq. (6), vectorised: ``(n-1, 4, dim)``."""
+    D = np.diff(t)[:, None]
+    dp = p[1:] - p[:-1]
+    c = np.empty((p.shape[0] - 1, 4, p.shape[1]))
+    c[:, 0] = p[:-1]
+    c[:, 1] = m[:-1]
+    c[:, 2] = 3.0 * dp / D**2 - (2.0 * m[:-1] + m[1:]) / D
+    c[:, 3] = -2.0 * dp / D**3 + (m[:-1] + m[1:]) / D**2
+    return c
+
+
+def quintic_hermite_coefficients(p: FloatArray, m: FloatArray, s: FloatArray,
+                                 t: FloatArray) -> FloatArray:
+    """Seed 000 eq. (2), vectorised: ``(n-1, 6, dim)``."""
+    D = np.diff(t)[:, None]
+    b1 = p[1:] - p[:-1] - m[:-1] * D - 0.5 * s[:-1] * D**2
+    b2 = m[1:] - m[:-1] - s[:-1] * D
+    b3 = s[1:] - s[:-1]
+    c = np.empty((p.shape[0] - 1, 6, p.shape[1]))
+    c[:, 0] = p[:-1]
+    c[:, 1] = m[:-1]
+    c[:, 2] = 0.5 * s[:-1]
+    c[:, 3] = (10.0 * b1 - 4.0 * b2 * D + 0.5 * b3 * D**2) / D**3
+    c[:, 4] = (-15.0 * b1 + 7.0 * b2 * D - b3 * D**2) / D**4
+    c[:, 5] = (6.0 * b1 - 3.0 * b2 * D + 0.5 * b3 * D**2) / D**5
+    return c

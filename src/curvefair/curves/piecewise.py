@@ -1,0 +1,197 @@
+"""Piecewise-polynomial form shared by every curve type.
+
+Every curve in curvefair (cubic and quintic Hermite splines, B-splines) can hand out its
+*local power form*: breakpoints ``t_0 < ... < t_m`` and coefficients ``a[i, j]`` with
+
+    r(t) = sum_j a[i, j] (t - t_i)**j     for t_i <= t <= t_{i+1}
+
+(seed 001 eq. (6), seed 000 eq. (2)). All exact analysis (energies, jumps, curvature
+polynomials) works on this form, vectorised over segments.
+"""
+
+from __future__ import annotations
+
+import abc
+from dataclasses import dataclass
+from functools import cached_property
+from math import factorial
+
+import numpy as np
+
+from .._typing import ArrayLike, FloatArray
+from ..errors import InputError
+
+__all__ = ["PiecewisePolynomial", "PiecewiseCurve", "readonly"]
+
+
+def readonly(arr: FloatArray) -> FloatArray:
+    """Mark ``arr`` read-only and return it."""
+    arr.setflags(write=False)
+    return arr
+
+
+def derivative_coefficients(coeffs: FloatArray, nu: int) -> FloatArray:
+    """Coefficients of the ``nu``-th derivative in the same local power basis.
+
+    ``coeffs`` has shape ``(m, p+1, dim)``; the result has shape ``(m, max(p+1-nu, 1), dim)``.
+    """
+    p1 = coeffs.shape[1]
+    if nu == 0:
+        return coeffs
+    if nu >= p1:
+        return np.zeros((coeffs.shape[0], 1, coeffs.shape[2]))
+    j = np.arange(nu, p1)
+    fac = np.array([factorial(int(k)) // factorial(int(k - nu)) for k in j], dtype=float)
+    return coeffs[:, nu:, :] * fac[None, :, None]
+
+
+@dataclass(frozen=True, eq=False)
+class PiecewisePolynomial:
+    """Local power form of a piecewise-polynomial curve.
+
+    Attributes
+    ----------
+    breaks : ndarray, shape (m+1,)
+        Strictly increasing breakpoints.
+    coeffs : ndarray, shape (m, p+1, dim)
+        ``coeffs[i, j]`` multiplies ``(t - breaks[i])**j`` on segment ``i``.
+    """
+
+    breaks: FloatArray
+    coeffs: FloatArray
+
+    @property
+    def degree(self) -> int:
+        return self.coeffs.shape[1] - 1
+
+    @property
+    def dim(self) -> int:
+        return self.coeffs.shape[2]
+
+    @property
+    def n_segments(self) -> int:
+        return self.coeffs.shape[0]
+
+    @property
+    def widths(self) -> FloatArray:
+        return np.diff(self.breaks)
+
+    def segment_of(self, u: FloatArray) -> np.ndarray:
+        """Index of the segment containing each parameter (right-continuous, last segment closed)."""
+        i = np.searchsorted(self.breaks, u, side="right") - 1
+        return np.clip(i, 0, self.n_segments - 1)
+
+    def evaluate(self, u: ArrayLike, nu: int = 0, segment: np.ndarray | None = None) -> FloatArray:
+        """Value (``nu=0``) or ``nu``-th derivative at parameters ``u``; shape ``u.shape + (dim,)``.
+
+        ``segment`` forces the segment used (e.g. the left limit at a breakpoint).
+        """
+        u = np.asarray(u, dtype=float)
+        shape = u.shape
+        uf = u.reshape(-1)
+        seg = self.segment_of(uf) if segment is None else np.asarray(segment).reshape(-1)
+        c = derivative_coefficients(self.coeffs, nu)
+        s = (uf - self.breaks[seg])[:, None]
+        out = c[seg, -1, :].copy()
+        for j in range(c.shape[1] - 2, -1, -1):
+            out *= s
+            out += c[seg, j, :]
+        return out.reshape(shape + (self.dim,))
+
+    def evaluate_local(self, s: FloatArray, nu: int = 0) -> FloatArray:
+        """Evaluate every segment at local offsets ``s`` (shape ``(k,)``): result ``(m, k, dim)``."""
+        c = derivative_coefficients(self.coeffs, nu)
+        s = np.asarray(s, dtype=float)
+        out = np.broadcast_to(c[:, -1:, :], (c.shape[0], s.shape[0], c.shape[2])).copy()
+        for j in range(c.shape[1] - 2, -1, -1):
+            out *= s[None, :, None]
+            out += c[:, j : j + 1, :]
+        return out
+
+    def segment_values(self, frac: FloatArray, nu: int = 0) -> FloatArray:
+        """Evaluate segment ``i`` at ``breaks[i] + frac * width_i`` for each ``frac``: ``(m, k, dim)``."""
+        c = derivative_coefficients(self.coeffs, nu)
+        s = self.widths[:, None] * np.asarray(frac, dtype=float)[None, :]
+        out = np.repeat(c[:, -1:, :], s.shape[1], axis=1)
+        for j in range(c.shape[1] - 2, -1, -1):
+            out *= s[:, :, None]
+            out += c[:, j : j + 1, :]
+        return out
+
+
+class PiecewiseCurve(abc.ABC):
+    """Base of every curvefair curve: immutable, parametric, piecewise polynomial.
+
+    Subclasses provide :meth:`_make_piecewise`; evaluation and all analysis go through
+    :attr:`piecewise`.
+    """
+
+    degree: int
+
+    @property
+    @abc.abstractmethod
+    def dim(self) -> int:
+        """Space dimension, 2 or 3."""
+
+    @property
+    @abc.abstractmethod
+    def closed(self) -> bool:
+        """True for a closed (periodic) curve."""
+
+    @abc.abstractmethod
+    def _make_piecewise(self) -> PiecewisePolynomial: ...
+
+    @cached_property
+    def piecewise(self) -> PiecewisePolynomial:
+        """The local power form (cached; the curve is immutable)."""
+        pp = self._make_piecewise()
+        readonly(pp.breaks)
+        readonly(pp.coeffs)
+        return pp
+
+    @property
+    def domain(self) -> tuple[float, float]:
+        """``(t_start, t_end)`` of the parameter range."""
+        b = self.piecewise.breaks
+        return float(b[0]), float(b[-1])
+
+    @property
+    def max_derivative(self) -> int:
+        return self.degree
+
+    def __call__(self, u: ArrayLike, nu: int = 0) -> FloatArray:
+        """Evaluate the curve (``nu=0``) or its ``nu``-th derivative at parameters ``u``.
+
+        Parameters
+        ----------
+        u : float or array_like
+            Parameters in :attr:`domain`. Closed curves wrap around periodically; on an open
+            curve a parameter outside the domain raises :class:`~curvefair.errors.InputError`.
+        nu : int
+            Derivative order, ``0 <= nu <= degree``.
+
+        Returns
+        -------
+        ndarray, shape ``np.shape(u) + (dim,)``
+        """
+        if not isinstance(nu, (int, np.integer)) or nu < 0 or nu > self.max_derivative:
+            raise InputError(f"nu must be an integer in [0, {self.max_derivative}], got {nu!r}")
+        u = np.asarray(u, dtype=float)
+        if not np.all(np.isfinite(u)):
+            raise InputError("u contains a non-finite parameter")
+        t0, t1 = self.domain
+        if self.closed:
+            u = t0 + np.mod(u - t0, t1 - t0)
+        else:
+            slack = 1e-12 * (t1 - t0)
+            bad = (u < t0 - slack) | (u > t1 + slack)
+            if np.any(bad):
+                v = u.reshape(-1)[np.flatnonzero(bad.reshape(-1))[0]]
+                raise InputError(f"u = {v!r} is outside the curve's domain [{t0!r}, {t1!r}]")
+            u = np.clip(u, t0, t1)
+        return self.piecewise.evaluate(u, int(nu))
+
+    def sample(self, n: int = 200) -> FloatArray:
+        """``n`` points at equally spaced parameters over the domain, shape ``(n, dim)``."""
+        t0, t1 = self.domain
+        return self(np.linspace(t0, t1, int(n)))
