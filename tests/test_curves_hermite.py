@@ -1,0 +1,150 @@
+"""Hermite splines and interpolation, checked against scipy's independent implementations."""
+
+import numpy as np
+import pytest
+from scipy.interpolate import BPoly, CubicHermiteSpline
+
+import curvefair as cf
+from curvefair.errors import CurvefairError, InputError
+
+
+def _random_data(rng, n, dim):
+    t = np.cumsum(rng.uniform(0.2, 2.0, n))
+    return rng.normal(size=(n, dim)), rng.normal(size=(n, dim)), rng.normal(size=(n, dim)), t
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_cubic_hermite_matches_scipy(dim):
+    rng = np.random.default_rng(1)
+    p, m, _, t = _random_data(rng, 9, dim)
+    c = cf.CubicHermite(p, m, t)
+    ref = CubicHermiteSpline(t, p, m, axis=0)
+    u = np.linspace(t[0], t[-1], 777)
+    for nu in range(4):
+        np.testing.assert_allclose(c(u, nu), ref(u, nu), rtol=1e-11, atol=1e-11)
+    assert c.degree == 3 and c.coefficients().shape == (8, 4, dim)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_quintic_hermite_matches_scipy_bpoly(dim):
+    rng = np.random.default_rng(2)
+    p, m, s, t = _random_data(rng, 7, dim)
+    q = cf.QuinticHermite(p, m, s, t)
+    ref = BPoly.from_derivatives(t, np.stack([p, m, s], axis=1))
+    u = np.linspace(t[0], t[-1], 555)
+    for nu in range(6):
+        np.testing.assert_allclose(q(u, nu), ref(u, nu), rtol=1e-9, atol=1e-9)
+    assert q.degree == 5 and q.coefficients().shape == (6, 6, dim)
+
+
+def _jumps(curve, nu):
+    pp = curve.piecewise
+    b = pp.breaks[1:-1]
+    seg = np.arange(b.size)
+    return np.abs(pp.evaluate(b, nu, segment=seg) - pp.evaluate(b, nu, segment=seg + 1)).max()
+
+
+@pytest.mark.parametrize("param", ["uniform", "chord", "centripetal"])
+@pytest.mark.parametrize("dim", [2, 3])
+def test_interpolate_cubic_natural_is_c2_and_natural(param, dim):
+    rng = np.random.default_rng(3)
+    pts = np.cumsum(rng.normal(size=(12, dim)), axis=0)
+    c = cf.interpolate_cubic(pts, param=param)
+    np.testing.assert_allclose(c(c.params), pts, atol=1e-12)
+    scale = np.abs(c.piecewise.coeffs[:, 2]).max()
+    assert _jumps(c, 1) < 1e-10 * scale and _jumps(c, 2) < 1e-10 * scale
+    np.testing.assert_allclose(c(np.array(c.domain), 2), 0, atol=1e-10 * scale)
+
+
+def test_interpolate_cubic_bcs():
+    rng = np.random.default_rng(4)
+    pts = np.cumsum(rng.normal(size=(10, 2)), axis=0)
+    left, right = np.array([1.0, 2.0]), np.array([-3.0, 0.5])
+    c = cf.interpolate_cubic(pts, bc="clamped", end_tangents=[left, right])
+    np.testing.assert_allclose(c(np.array(c.domain), 1), [left, right], atol=1e-12)
+    c = cf.interpolate_cubic(pts, bc=((2, [0.3, 0.1]), (1, right)))
+    np.testing.assert_allclose(c(c.domain[0], 2), [0.3, 0.1], atol=1e-10)
+    np.testing.assert_allclose(c(c.domain[1], 1), right, atol=1e-12)
+    c = cf.interpolate_cubic(pts, bc="not-a-knot")
+    pp = c.piecewise
+    np.testing.assert_allclose(pp.coeffs[0, 3], pp.coeffs[1, 3], rtol=1e-9, atol=1e-9)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_interpolate_periodic_closes_and_is_smooth_across_seam(dim):
+    s = np.linspace(0, 2 * np.pi, 13)[:-1]
+    pts = np.column_stack([np.cos(s), 0.6 * np.sin(s)] + ([0.1 * np.sin(2 * s)] if dim == 3 else []))
+    for build, order in ((cf.interpolate_cubic, 2), (cf.interpolate_quintic, 4)):
+        c = build(pts, bc="periodic")
+        assert c.closed and c.n_points == 13
+        np.testing.assert_array_equal(c.points[0], c.points[-1])
+        t0, t1 = c.domain
+        pp = c.piecewise
+        for nu in range(order + 1):
+            a = pp.evaluate(np.array([t0]), nu, segment=np.array([0]))
+            b = pp.evaluate(np.array([t1]), nu, segment=np.array([pp.n_segments - 1]))
+            np.testing.assert_allclose(a, b, atol=1e-8)
+        # periodic evaluation wraps
+        np.testing.assert_allclose(c(t0 + 0.3), c(t1 + 0.3), atol=1e-12)
+
+
+def test_interpolate_quintic_natural_c4():
+    rng = np.random.default_rng(5)
+    pts = np.cumsum(rng.normal(size=(11, 3)), axis=0)
+    q = cf.interpolate_quintic(pts)
+    np.testing.assert_allclose(q(q.params), pts, atol=1e-11)
+    scale = np.abs(q.piecewise.coeffs).max()
+    for nu in range(5):
+        assert _jumps(q, nu) < 1e-8 * scale
+    ends = np.array(q.domain)
+    np.testing.assert_allclose(q(ends, 3), 0, atol=1e-8 * scale)
+    np.testing.assert_allclose(q(ends, 4), 0, atol=1e-8 * scale)
+    tan = np.array([[1.0, 0, 0], [0, 1.0, 0]])
+    q = cf.interpolate_quintic(pts, bc="clamped", end_tangents=tan)
+    np.testing.assert_allclose(q(ends, 1), tan, atol=1e-10)
+    q = cf.interpolate_quintic(pts, bc=((2, [1.0, 0, 0]), "natural"))
+    np.testing.assert_allclose(q(ends[0], 2), [1.0, 0, 0], atol=1e-9)
+
+
+def test_parameterize():
+    pts = [[0, 0], [3, 4], [3, 5]]
+    np.testing.assert_allclose(cf.parameterize(pts, "chord"), [0, 5, 6])
+    np.testing.assert_allclose(cf.parameterize(pts, "centripetal"), [0, np.sqrt(5), np.sqrt(5) + 1])
+    np.testing.assert_allclose(cf.parameterize(pts, "uniform"), [0, 1, 2])
+
+
+def test_immutable():
+    c = cf.interpolate_cubic([[0, 0], [1, 1], [2, 0]])
+    for arr in (c.points, c.tangents, c.params, c.piecewise.coeffs):
+        with pytest.raises(ValueError):
+            arr[0] = 1.0
+    c2 = c.replace(points=c.points + 1.0)
+    assert c2 is not c and np.allclose(c2.points, c.points + 1.0)
+
+
+@pytest.mark.parametrize(
+    "call, fragment",
+    [
+        (lambda: cf.interpolate_cubic([[0, 0], [np.nan, 1], [2, 2]]), "row 1"),
+        (lambda: cf.interpolate_cubic([[0, 0], [1, 1], [1, 1], [2, 0]]), "indices 1 and 2"),
+        (lambda: cf.interpolate_cubic([[0, 0, 0, 0], [1, 1, 1, 1]]), "columns"),
+        (lambda: cf.interpolate_cubic([[0, 0]]), "at least 2"),
+        (lambda: cf.interpolate_cubic([0, 1, 2]), "shape (n, dim)"),
+        (lambda: cf.interpolate_cubic([[0, 0], [1, 1], [2, 0]], param="foo"), "'chord'"),
+        (lambda: cf.interpolate_cubic([[0, 0], [1, 1], [2, 0]], bc="bar"), "'natural'"),
+        (lambda: cf.interpolate_cubic([[0, 0], [1, 1], [2, 0]], param=[0, 2, 1]), "param[1]"),
+        (lambda: cf.interpolate_cubic([[0, 0], [1, 1], [2, 0]], bc="clamped"), "end_tangents"),
+        (lambda: cf.CubicHermite([[0, 0], [1, 1]], [[1, 0]], [0, 1]), "tangents"),
+        (lambda: cf.CubicHermite([[0, 0], [1, 1]], [[1, 0], [1, 0]], [0, np.inf]), "params"),
+        (lambda: cf.CubicHermite([[0, 0], [1, 1], [2, 0]], [[1, 0]] * 3, [0, 1, 2], closed=True),
+         "points[0]"),
+        (lambda: cf.interpolate_cubic([[0, 0], [1, 1], [2, 0]])(99.0), "outside"),
+        (lambda: cf.interpolate_cubic([[0, 0], [1, 1], [2, 0]])(0.5, nu=4), "nu"),
+        (lambda: cf.interpolate_quintic(np.eye(3)[:, :2], bc="not-a-knot"), "at least 6"),
+    ],
+)
+def test_bad_input_errors(call, fragment):
+    with pytest.raises(CurvefairError) as exc:
+        call()
+    assert isinstance(exc.value, (InputError, ValueError))
+    assert fragment in str(exc.value)
