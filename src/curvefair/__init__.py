@@ -10,10 +10,13 @@ Indices are 0-based everywhere; the papers number from 1.
 
 from ._version import __version__
 from .curves import (
+    BSplineCurve,
     CubicHermite,
     PiecewiseCurve,
     PiecewisePolynomial,
     QuinticHermite,
+    fit_bspline,
+    interpolate_bspline,
     interpolate_cubic,
     interpolate_quintic,
     parameterize,
@@ -24,6 +27,9 @@ __all__ = [
     "__version__",
     "CubicHermite",
     "QuinticHermite",
+    "BSplineCurve",
+    "interpolate_bspline",
+    "fit_bspline",
     "PiecewiseCurve",
     "PiecewisePolynomial",
     "interpolate_cubic",

@@ -1,0 +1,593 @@
+"""B-spline curves of any degree >= 2: clamped open curves and periodic (closed) curves.
+
+Representation
+--------------
+*Open* curves are clamped: ``n`` control points ``d_0 .. d_{n-1}``, ``n + degree + 1`` knots
+``t_0 <= ... <= t_{n+p}`` (``p = degree``) with ``t_0 = ... = t_p`` and
+``t_n = ... = t_{n+p}``; the domain is ``[t_p, t_n]`` and ``r(t) = sum_i d_i N_{i,p}(t)``.
+
+*Closed* curves store the ``n`` DISTINCT control points in :attr:`BSplineCurve.control_points`
+and the full periodic knot vector of length ``n + 2p + 1`` in :attr:`BSplineCurve.knots`:
+the spline is ``r(t) = sum_{i=0}^{n+p-1} d_{i mod n} N_{i,p}(t)`` on ``[t_p, t_{p+n}]`` (the
+first ``p`` control points wrapped at the end, exactly scipy's periodic ``BSpline`` layout), and
+``t_{i+n} - t_i = T`` (the period) for every ``i``. The constructor also accepts only one period
+of knots (``n + 1`` values ``t_p .. t_{p+n}``) and extends it.
+
+Indices are 0-based; the papers number from 1 (Eck & Hadenfeld write ``N_{i,k}`` with the
+order ``k = p + 1``).
+"""
+
+from __future__ import annotations
+
+from functools import cached_property
+from typing import Any
+
+import numpy as np
+from scipy.interpolate import BSpline, make_interp_spline, make_lsq_spline
+from scipy.sparse import csr_matrix
+from scipy.sparse.linalg import spsolve
+
+from .._typing import ArrayLike, FloatArray
+from .._validate import _as_float, as_points, check_finite
+from ..errors import InputError
+from .parameterize import parameterize
+from .piecewise import PiecewiseCurve, PiecewisePolynomial, readonly
+
+__all__ = ["BSplineCurve", "interpolate_bspline", "fit_bspline", "basis_derivatives"]
+
+
+# ------------------------------------------------------------------------------------------
+# basis functions
+# ------------------------------------------------------------------------------------------
+def basis_derivatives(knots: FloatArray, degree: int, span: np.ndarray, x: FloatArray,
+                      nder: int) -> FloatArray:
+    """Non-zero B-spline basis functions and derivatives, vectorised over parameters.
+
+    Parameters
+    ----------
+    knots : ndarray, shape (K,)
+    degree : int
+    span : int ndarray, shape (m,)
+        Knot span ``s`` of each parameter, ``knots[s] <= x < knots[s+1]`` (``knots[s] <
+        knots[s+1]``); the non-zero functions there are ``N_{s-p} .. N_s``.
+    x : ndarray, shape (m,)
+    nder : int
+        Highest derivative.
+
+    Returns
+    -------
+    ndarray, shape (m, nder+1, degree+1)
+        ``out[q, k, a] = N_{span[q]-p+a}^{(k)}(x[q])``.
+
+    Notes
+    -----
+    Piegl & Tiller, *The NURBS Book*, algorithm A2.3, with every scalar replaced by an array over
+    the parameters.
+    """
+    p = int(degree)
+    x = np.asarray(x, dtype=float)
+    s = np.asarray(span)
+    m = x.shape[0]
+    ndu = np.empty((p + 1, p + 1, m))
+    ndu[0, 0] = 1.0
+    left = np.empty((p + 1, m))
+    right = np.empty((p + 1, m))
+    for j in range(1, p + 1):
+        left[j] = x - knots[s + 1 - j]
+        right[j] = knots[s + j] - x
+        saved = np.zeros(m)
+        for r in range(j):
+            ndu[j, r] = right[r + 1] + left[j - r]
+            temp = ndu[r, j - 1] / ndu[j, r]
+            ndu[r, j] = saved + right[r + 1] * temp
+            saved = left[j - r] * temp
+        ndu[j, j] = saved
+    out = np.zeros((m, nder + 1, p + 1))
+    out[:, 0, :] = ndu[:, p, :].T
+    if nder == 0:
+        return out
+    a = np.zeros((2, p + 1, m))
+    for r in range(p + 1):
+        s1, s2 = 0, 1
+        a[0, 0] = 1.0
+        for k in range(1, nder + 1):
+            d = np.zeros(m)
+            rk = r - k
+            pk = p - k
+            if r >= k:
+                a[s2, 0] = a[s1, 0] / ndu[pk + 1, rk]
+                d = a[s2, 0] * ndu[rk, pk]
+            j1 = 1 if rk >= -1 else -rk
+            j2 = k - 1 if r - 1 <= pk else p - r
+            for j in range(j1, j2 + 1):
+                a[s2, j] = (a[s1, j] - a[s1, j - 1]) / ndu[pk + 1, rk + j]
+                d = d + a[s2, j] * ndu[rk + j, pk]
+            if r <= pk:
+                a[s2, k] = -a[s1, k - 1] / ndu[pk + 1, r]
+                d = d + a[s2, k] * ndu[r, pk]
+            out[:, k, r] = d
+            s1, s2 = s2, s1
+    fac = float(p)
+    for k in range(1, nder + 1):
+        out[:, k, :] *= fac
+        fac *= p - k
+    return out
+
+
+def _gauss(nq: int) -> tuple[FloatArray, FloatArray]:
+    x, w = np.polynomial.legendre.leggauss(nq)
+    return 0.5 * (x + 1.0), 0.5 * w
+
+
+# ------------------------------------------------------------------------------------------
+# the curve
+# ------------------------------------------------------------------------------------------
+def _as_degree(degree: object) -> int:
+    if isinstance(degree, bool) or not isinstance(degree, (int, np.integer)):
+        raise InputError(f"degree must be an integer >= 2, got {degree!r}")
+    if degree < 2:
+        raise InputError(f"degree must be an integer >= 2, got {degree!r}")
+    return int(degree)
+
+
+class BSplineCurve(PiecewiseCurve):
+    """Polynomial B-spline curve of any degree >= 2, clamped open or periodic closed.
+
+    Parameters
+    ----------
+    control_points : array_like, shape (n, dim)
+        Control points ``d_i``, dim 2 or 3 (for a closed curve: the ``n`` distinct ones).
+    knots : array_like
+        Open: ``n + degree + 1`` non-decreasing knots, clamped (the first ``degree + 1`` equal,
+        the last ``degree + 1`` equal), interior multiplicity ``<= degree``.
+        Closed: the periodic knot vector of ``n + 2 degree + 1`` knots
+        (``t_{i+n} - t_i`` constant), or one period ``t_p .. t_{p+n}`` (``n + 1`` values,
+        strictly increasing up to multiplicity ``<= degree``).
+    degree : int
+        Polynomial degree ``p >= 2``.
+    closed : bool
+        Periodic curve (see the module docstring for the layout).
+
+    Attributes
+    ----------
+    control_points : ndarray, shape (n, dim), read-only
+    knots : ndarray, read-only
+        Full knot vector (periodic one for closed curves).
+    degree : int
+    closed : bool
+
+    Notes
+    -----
+    ``r(t) = sum_i d_i N_{i,p}(t)`` (Eck & Hadenfeld, eq. (9), with order ``k = p + 1`` and
+    0-based indices). The local power form (:attr:`piecewise`) is built per distinct knot span
+    from the basis derivatives at the span's left end (Piegl & Tiller algorithm A2.3).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from curvefair import BSplineCurve
+    >>> c = BSplineCurve([[0, 0], [1, 2], [3, 2], [4, 0]], [0, 0, 0, 0, 1, 1, 1, 1], 3)
+    >>> c(0.5).tolist()
+    [2.0, 1.5]
+    >>> c.to_scipy()(0.5).tolist()
+    [2.0, 1.5]
+    """
+
+    def __init__(self, control_points: ArrayLike, knots: ArrayLike, degree: int,
+                 closed: bool = False) -> None:
+        p = _as_degree(degree)
+        closed = bool(closed)
+        pts = as_points(control_points, "control_points", min_points=p + 1,
+                        allow_coincident=True)
+        n = pts.shape[0]
+        t = _as_float(knots, "knots")
+        if t.ndim != 1:
+            raise InputError(f"knots must be 1-D, got shape {t.shape}")
+        check_finite(t, "knots")
+        if t.shape[0] > 1:
+            dt = np.diff(t)
+            bad = np.flatnonzero(dt < 0)
+            if bad.size:
+                i = int(bad[0])
+                raise InputError(f"knots must be non-decreasing: knots[{i}] = {float(t[i])!r} > "
+                                 f"knots[{i + 1}] = {float(t[i + 1])!r}")
+        if closed:
+            t = self._periodic_knots(t, n, p)
+        else:
+            self._check_open_knots(t, n, p)
+        self._ctrl = readonly(pts)
+        self._knots = readonly(t)
+        self.degree = p
+        self._closed = closed
+
+    # -- validation -------------------------------------------------------------------------
+    @staticmethod
+    def _check_open_knots(t: FloatArray, n: int, p: int) -> None:
+        if t.shape[0] != n + p + 1:
+            raise InputError(f"knots must have n + degree + 1 = {n + p + 1} values for {n} control "
+                             f"points of degree {p} (open curve), got {t.shape[0]}")
+        for i in range(1, p + 1):
+            if t[i] != t[0]:
+                raise InputError(f"open curves must be clamped: knots[0..{p}] must be equal, but "
+                                 f"knots[{i}] = {float(t[i])!r} != knots[0] = {float(t[0])!r}")
+            k = n + p - i
+            if t[k] != t[-1]:
+                raise InputError(f"open curves must be clamped: knots[{n}..{n + p}] must be equal, "
+                                 f"but knots[{k}] = {float(t[k])!r} != "
+                                 f"knots[{n + p}] = {float(t[-1])!r}")
+        if not t[p] < t[n]:
+            raise InputError(f"the domain [knots[{p}], knots[{n}]] = "
+                             f"[{float(t[p])!r}, {float(t[n])!r}] is empty")
+        BSplineCurve._check_multiplicity(t[p + 1:n], p, offset=p + 1)
+
+    @staticmethod
+    def _check_multiplicity(inner: FloatArray, p: int, offset: int) -> None:
+        if inner.shape[0] <= p:
+            return
+        # p+1 equal consecutive knots <=> inner[i] == inner[i+p]
+        same = inner[p:] == inner[:-p]
+        bad = np.flatnonzero(same)
+        if bad.size:
+            i = int(bad[0])
+            raise InputError(f"interior knot {float(inner[i])!r} at knots[{i + offset}] has "
+                             f"multiplicity > degree = {p}")
+
+    @staticmethod
+    def _periodic_knots(t: FloatArray, n: int, p: int) -> FloatArray:
+        if t.shape[0] == n + 1:
+            period = t
+        elif t.shape[0] == n + 2 * p + 1:
+            period = t[p:p + n + 1]
+            T = period[-1] - period[0]
+            dt = np.diff(t)
+            scale = max(float(np.abs(t).max()), 1.0)
+            bad = np.flatnonzero(np.abs(dt[n:] - dt[:-n]) > 1e-10 * scale)
+            if bad.size:
+                i = int(bad[0])
+                raise InputError(
+                    f"closed curve: knots must be periodic (knots[i+{n}] - knots[i] = period "
+                    f"{float(T)!r}), but knots[{i + n + 1}] - knots[{i + n}] = "
+                    f"{float(dt[i + n])!r} != "
+                    f"knots[{i + 1}] - knots[{i}] = {float(dt[i])!r}")
+        else:
+            raise InputError(
+                f"closed curve with {n} control points of degree {p}: knots must have "
+                f"n + 2 degree + 1 = {n + 2 * p + 1} values (periodic knot vector) or n + 1 = "
+                f"{n + 1} (one period), got {t.shape[0]}")
+        T = period[-1] - period[0]
+        if not T > 0:
+            raise InputError(f"closed curve: the period knots[{p}..{p + n}] is empty")
+        # multiplicity over the cyclic sequence of one period (the seam counts once)
+        cyc = np.concatenate([period[:-1], period[:p] + T])
+        same = cyc[p:] == cyc[:-p]
+        bad = np.flatnonzero(same)
+        if bad.size:
+            i = int(bad[0])
+            raise InputError(f"knot {float(cyc[i])!r} at knots[{i + p}] has multiplicity > "
+                             f"degree = {p}")
+        full = np.empty(n + 2 * p + 1)
+        full[p:p + n + 1] = period
+        full[:p] = period[n - p:n] - T
+        full[p + n + 1:] = period[1:p + 1] + T
+        return full
+
+    # -- data -------------------------------------------------------------------------------
+    @property
+    def control_points(self) -> FloatArray:
+        """Control points, shape ``(n, dim)`` (the distinct ones for a closed curve; read-only)."""
+        return self._ctrl
+
+    @property
+    def knots(self) -> FloatArray:
+        """Knot vector (read-only): ``n + p + 1`` values (open) or ``n + 2p + 1`` (closed)."""
+        return self._knots
+
+    @property
+    def closed(self) -> bool:
+        return self._closed
+
+    @property
+    def dim(self) -> int:
+        return int(self._ctrl.shape[1])
+
+    @property
+    def n_ctrl(self) -> int:
+        """Number of (distinct) control points ``n``."""
+        return int(self._ctrl.shape[0])
+
+    def __len__(self) -> int:
+        return self.n_ctrl
+
+    @property
+    def extended_control_points(self) -> FloatArray:
+        """Control points multiplying ``N_0 .. N_{K-p-2}`` of :attr:`knots`: for a closed curve
+        the first ``degree`` points are repeated at the end, shape ``(n + p, dim)``."""
+        if not self._closed:
+            return self._ctrl
+        return readonly(self._ctrl[np.arange(self.n_ctrl + self.degree) % self.n_ctrl])
+
+    @property
+    def domain(self) -> tuple[float, float]:
+        p = self.degree
+        return float(self._knots[p]), float(self._knots[-p - 1])
+
+    @cached_property
+    def spans(self) -> np.ndarray:
+        """Indices ``s`` of the non-empty knot spans ``[knots[s], knots[s+1])`` of the domain."""
+        p = self.degree
+        t = self._knots
+        s = np.arange(p, t.shape[0] - p - 1)
+        s = s[t[s + 1] > t[s]]
+        readonly(s)
+        return s
+
+    def __repr__(self) -> str:
+        return (f"BSplineCurve(n_ctrl={self.n_ctrl}, degree={self.degree}, dim={self.dim}, "
+                f"closed={self.closed}, domain={self.domain})")
+
+    def replace(self, **changes: Any) -> "BSplineCurve":
+        """A new curve with some of control_points, knots, degree, closed changed."""
+        kw: dict[str, Any] = {"control_points": self._ctrl, "knots": self._knots,
+                              "degree": self.degree, "closed": self._closed}
+        unknown = set(changes) - set(kw)
+        if unknown:
+            raise InputError(f"replace() got unknown fields {sorted(unknown)}; valid: {sorted(kw)}")
+        kw.update(changes)
+        return type(self)(**kw)
+
+    def control_index(self, i: ArrayLike) -> np.ndarray:
+        """Map indices of basis functions ``N_i`` of :attr:`knots` to control-point indices
+        (``i mod n`` for closed curves)."""
+        i = np.asarray(i)
+        return i % self.n_ctrl if self._closed else i
+
+    # -- piecewise form ---------------------------------------------------------------------
+    def _make_piecewise(self) -> PiecewisePolynomial:
+        p = self.degree
+        t = self._knots
+        s = self.spans
+        ders = basis_derivatives(t, p, s, t[s], p)  # (m, p+1, p+1)
+        idx = self.control_index(s[:, None] - p + np.arange(p + 1)[None, :])  # (m, p+1)
+        local = self._ctrl[idx]  # (m, p+1, dim)
+        fact = np.cumprod(np.r_[1.0, np.arange(1, p + 1, dtype=float)])
+        coeffs = np.einsum("mka,mad->mkd", ders, local) / fact[None, :, None]
+        breaks = np.append(t[s], t[s[-1] + 1])
+        return PiecewisePolynomial(breaks, coeffs)
+
+    # -- Gram matrices ----------------------------------------------------------------------
+    def gram_band(self, l: int) -> FloatArray:  # noqa: E741
+        """Exact Gram matrix ``G_ij = int N_i^(l) N_j^(l) dt`` over the domain, banded.
+
+        Parameters
+        ----------
+        l : int
+            Derivative order, ``1 <= l <= degree``.
+
+        Returns
+        -------
+        ndarray, shape (n, 2 degree + 1)
+            ``W[i, p + o] = G[i, (i + o)]`` for ``-p <= o <= p`` (open curves: zero where
+            ``i + o`` is out of range; closed curves: the column index is ``(i + o) mod n``, and
+            when ``n < 2p + 1`` several offsets may name the same column -- their entries add).
+
+        Notes
+        -----
+        Gauss-Legendre quadrature with ``p - l + 1`` nodes per knot span is exact for the
+        degree ``2 (p - l)`` integrand (Eck & Hadenfeld, eq. (15) and the remark after (16)).
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from curvefair import BSplineCurve
+        >>> c = BSplineCurve(np.zeros((10, 2)), np.arange(11.0), 3, closed=True)
+        >>> (c.gram_band(2)[0] * 6).round(12).tolist()   # uniform cubic, l = 2
+        [1.0, 0.0, -9.0, 16.0, -9.0, 0.0, 1.0]
+        """
+        p = self.degree
+        if isinstance(l, bool) or not isinstance(l, (int, np.integer)) or not 1 <= l <= p:
+            raise InputError(f"l must be an integer in [1, degree = {p}], got {l!r}")
+        t = self._knots
+        s = self.spans
+        nq = p - int(l) + 1
+        xq, wq = _gauss(nq)
+        h = t[s + 1] - t[s]
+        x = (t[s][:, None] + h[:, None] * xq[None, :]).reshape(-1)
+        ss = np.repeat(s, nq)
+        d = basis_derivatives(t, p, ss, x, int(l))[:, int(l), :].reshape(s.shape[0], nq, p + 1)
+        # M[m, a, b] = sum_q w_q h_m d[m,q,a] d[m,q,b]
+        M = np.einsum("q,mqa,mqb->mab", wq, d, d) * h[:, None, None]
+        n = self.n_ctrl
+        W = np.zeros((n, 2 * p + 1))
+        for a in range(p + 1):
+            rows = self.control_index(s - p + a)
+            for b in range(p + 1):
+                np.add.at(W[:, p + b - a], rows, M[:, a, b])
+        return W
+
+    def gram_matrix(self, l: int) -> Any:  # noqa: E741
+        """The Gram matrix of :meth:`gram_band` as a ``scipy.sparse`` CSR matrix ``(n, n)``."""
+        W = self.gram_band(l)
+        n, w = W.shape
+        p = self.degree
+        rows = np.repeat(np.arange(n), w)
+        cols = (np.arange(n)[:, None] + np.arange(-p, p + 1)[None, :]).reshape(-1)
+        vals = W.reshape(-1)
+        if self._closed:
+            cols = cols % n
+        keep = (cols >= 0) & (cols < n) & (vals != 0)
+        return csr_matrix((vals[keep], (rows[keep], cols[keep])), shape=(n, n))
+
+    def energy_l(self, l: int) -> float:  # noqa: E741
+        """``E_l = int |r^(l)(t)|^2 dt`` over the domain, from the exact Gram matrix."""
+        G = self.gram_matrix(l)
+        d = self._ctrl
+        return float(np.sum(d * (G @ d)))
+
+    # -- scipy interop ----------------------------------------------------------------------
+    def to_scipy(self) -> BSpline:
+        """The same curve as a :class:`scipy.interpolate.BSpline` (periodic extrapolation for
+        closed curves; coefficients shape ``(n + p, dim)`` there)."""
+        c = np.array(self.extended_control_points)
+        return BSpline(np.array(self._knots), c, self.degree,
+                       extrapolate="periodic" if self._closed else True)
+
+    @classmethod
+    def from_scipy(cls, spl: BSpline, closed: bool | None = None) -> "BSplineCurve":
+        """Build from a :class:`scipy.interpolate.BSpline` with coefficients ``(n, dim)``.
+
+        ``closed=None`` detects a periodic spline (``extrapolate == "periodic"``, periodic knots,
+        last ``k`` coefficients repeating the first ``k``). Open splines must be clamped.
+        """
+        t = np.asarray(spl.t, dtype=float)
+        k = int(spl.k)
+        c = np.asarray(spl.c, dtype=float)
+        if c.ndim != 2:
+            raise InputError(f"spl.c must have shape (n, dim) with dim 2 or 3, got {c.shape}")
+        c = c[: t.shape[0] - k - 1]
+        if closed is None:
+            closed = spl.extrapolate == "periodic"
+        if closed:
+            n = c.shape[0] - k
+            if n < k + 1:
+                raise InputError(f"periodic spline has too few coefficients ({c.shape[0]})")
+            scale = max(float(np.abs(c).max()), 1.0)
+            if not np.allclose(c[n:], c[:k], rtol=0.0, atol=1e-10 * scale):
+                raise InputError("closed=True needs the last k coefficients of spl.c to repeat "
+                                 "the first k (scipy's periodic layout)")
+            return cls(c[:n], t, k, closed=True)
+        return cls(c, t, k, closed=False)
+
+
+# ------------------------------------------------------------------------------------------
+# builders
+# ------------------------------------------------------------------------------------------
+def _closed_data(points: ArrayLike, param: Any) -> tuple[FloatArray, FloatArray]:
+    """Distinct points (first not repeated) and their parameters plus the closing one."""
+    pts = as_points(points, "points", min_points=3)
+    scale = max(float(np.abs(pts).max()), 1.0)
+    if np.allclose(pts[0], pts[-1], rtol=0.0, atol=1e-12 * scale):
+        pts = pts[:-1]
+    loop = np.vstack([pts, pts[:1]])
+    if isinstance(param, str):
+        t = parameterize(loop, param)
+    else:
+        t = np.asarray(param, dtype=float)
+        if t.shape != (loop.shape[0],):
+            raise InputError(f"param for a closed curve needs {loop.shape[0]} values (one per "
+                             f"distinct point plus the closing one), got shape {t.shape}")
+        t = parameterize(loop, t)
+    return pts, t
+
+
+def interpolate_bspline(points: ArrayLike, degree: int = 3, param: str | ArrayLike = "chord",
+                        closed: bool = False) -> BSplineCurve:
+    """B-spline curve of the given degree through ``points``.
+
+    Parameters
+    ----------
+    points : array_like, shape (m, dim)
+        Data points (no two consecutive equal). For ``closed=True`` the first point may be
+        repeated last or not.
+    degree : int
+        ``>= 2``.
+    param : {"uniform", "chord", "centripetal"} or array_like
+        Parameterisation (:func:`curvefair.parameterize`); for closed curves one value per
+        distinct point plus one for the closing point.
+    closed : bool
+        Periodic interpolation.
+
+    Returns
+    -------
+    BSplineCurve
+        Open cubic: natural end conditions (``r'' = 0``, as :func:`interpolate_cubic`), so it is
+        the same curve; other open degrees: scipy's not-a-knot knot placement
+        (``make_interp_spline(..., bc_type=None)``). Closed: knots at the data parameters.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from curvefair import interpolate_bspline
+    >>> pts = np.c_[np.arange(6.0), np.sin(np.arange(6.0))]
+    >>> c = interpolate_bspline(pts)
+    >>> bool(np.allclose(c(c.knots[3]), pts[0]))
+    True
+    """
+    p = _as_degree(degree)
+    if closed:
+        pts, t = _closed_data(points, param)
+        if pts.shape[0] < p + 1:
+            raise InputError(f"a closed degree-{p} interpolant needs at least {p + 1} distinct "
+                             f"points, got {pts.shape[0]}")
+        loop = np.vstack([pts, pts[:1]])
+        spl = make_interp_spline(t, loop, k=p, bc_type="periodic", axis=0)
+        return BSplineCurve.from_scipy(spl, closed=True)
+    pts = as_points(points, "points", min_points=p + 1)
+    t = parameterize(pts, param)
+    bc = "natural" if p == 3 else None
+    spl = make_interp_spline(t, pts, k=p, bc_type=bc, axis=0)
+    return BSplineCurve.from_scipy(spl, closed=False)
+
+
+def fit_bspline(points: ArrayLike, n_ctrl: int, degree: int = 3,
+                param: str | ArrayLike = "chord", closed: bool = False) -> BSplineCurve:
+    """Least-squares B-spline curve with ``n_ctrl`` control points approximating ``points``.
+
+    Parameters
+    ----------
+    points : array_like, shape (m, dim)
+    n_ctrl : int
+        Number of (distinct) control points; ``degree + 1 <= n_ctrl <= m``.
+    degree : int
+    param : as for :func:`interpolate_bspline`.
+    closed : bool
+
+    Returns
+    -------
+    BSplineCurve
+        Minimises ``sum_q |r(u_q) - points_q|^2`` over all control points (plain least
+        squares: the ends are not forced through the first and last data points). Open curves:
+        knots by Piegl & Tiller's averaging rule (The NURBS Book, eq. (9.69)), so every span
+        holds data; closed curves: period knots at equally spaced data indices.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from curvefair import fit_bspline
+    >>> u = np.linspace(0, 3, 50)
+    >>> c = fit_bspline(np.c_[u, u**2], 8, param=u)   # a parabola is reproduced exactly
+    >>> c.n_ctrl, c(1.5).round(12).tolist()
+    (8, [1.5, 2.25])
+    """
+    p = _as_degree(degree)
+    if isinstance(n_ctrl, bool) or not isinstance(n_ctrl, (int, np.integer)):
+        raise InputError(f"n_ctrl must be an integer, got {n_ctrl!r}")
+    n = int(n_ctrl)
+    if closed:
+        pts, t = _closed_data(points, param)
+        m = pts.shape[0]
+        if not p + 1 <= n <= m:
+            raise InputError(f"n_ctrl must be in [degree + 1, number of distinct points] = "
+                             f"[{p + 1}, {m}], got {n}")
+        period = np.interp(np.arange(n + 1) * (m / n), np.arange(m + 1), t)
+        curve0 = BSplineCurve(np.zeros((n, pts.shape[1])), period, p, closed=True)
+        full = np.array(curve0.knots)
+        A = BSpline.design_matrix(t[:-1], full, p).tocoo()
+        A = csr_matrix((A.data, (A.row, A.col % n)), shape=(m, n))
+        AtA = (A.T @ A).tocsc()
+        ctrl = spsolve(AtA, A.T @ pts)
+        ctrl = np.asarray(ctrl).reshape(n, pts.shape[1])
+        return BSplineCurve(ctrl, full, p, closed=True)
+    pts = as_points(points, "points", min_points=p + 1)
+    m = pts.shape[0]
+    if not p + 1 <= n <= m:
+        raise InputError(f"n_ctrl must be in [degree + 1, number of points] = [{p + 1}, {m}], "
+                         f"got {n}")
+    u = parameterize(pts, param)
+    d = m / (n - p)
+    j = np.arange(1, n - p)
+    i = np.floor(j * d).astype(int)
+    alpha = j * d - i
+    inner = (1.0 - alpha) * u[i - 1] + alpha * u[i]
+    knots = np.r_[[u[0]] * (p + 1), inner, [u[-1]] * (p + 1)]
+    spl = make_lsq_spline(u, pts, knots, k=p, axis=0)
+    return BSplineCurve.from_scipy(spl, closed=False)

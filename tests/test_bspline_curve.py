@@ -1,0 +1,267 @@
+"""BSplineCurve: evaluation, power form, scipy round trip, builders, Gram matrices, validation.
+
+References: scipy.interpolate.BSpline (independent de Boor evaluation), a naive recursive
+Cox-de Boor basis (slow, obviously correct), dense Gauss quadrature of scipy-evaluated basis
+derivatives for the Gram matrices, interpolate_cubic for the natural cubic interpolant.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.interpolate import BSpline
+
+import curvefair
+from curvefair import BSplineCurve, InputError, fit_bspline, interpolate_bspline
+from curvefair.curves.bspline import basis_derivatives
+
+
+def _random_open(rng, n, p, dim=2, repeat=True):
+    inner = np.sort(rng.uniform(0.0, 3.0, n - p - 1))
+    if repeat and inner.size >= 3 and p >= 2:
+        inner[2] = inner[1]  # a double interior knot
+    t = np.r_[[0.0] * (p + 1), inner, [3.0] * (p + 1)]
+    return BSplineCurve(rng.normal(size=(n, dim)), t, p)
+
+
+def _random_closed(rng, n, p, dim=2):
+    gaps = rng.uniform(0.3, 1.7, n)
+    period = np.r_[0.0, np.cumsum(gaps)]
+    return BSplineCurve(rng.normal(size=(n, dim)), period, p, closed=True)
+
+
+def _naive_basis(t, p, i, x):
+    """Cox-de Boor recursion, right-continuous, scalar x (reference only)."""
+    if p == 0:
+        return 1.0 if t[i] <= x < t[i + 1] else 0.0
+    a = 0.0 if t[i + p] == t[i] else (x - t[i]) / (t[i + p] - t[i]) * _naive_basis(t, p - 1, i, x)
+    b = (0.0 if t[i + p + 1] == t[i + 1] else
+         (t[i + p + 1] - x) / (t[i + p + 1] - t[i + 1]) * _naive_basis(t, p - 1, i + 1, x))
+    return a + b
+
+
+@pytest.mark.parametrize("p", [2, 3, 4, 5])
+@pytest.mark.parametrize("closed", [False, True])
+def test_evaluation_matches_scipy(p, closed):
+    rng = np.random.default_rng(10 * p + closed)
+    c = _random_closed(rng, 11, p, 3) if closed else _random_open(rng, 11, p, 3)
+    spl = c.to_scipy()
+    t0, t1 = c.domain
+    u = np.linspace(t0, t1, 301)
+    for nu in range(p + 1):
+        ref = spl(u, nu)
+        scale = np.abs(ref).max()
+        np.testing.assert_allclose(c(u, nu), ref, rtol=0, atol=1e-10 * scale)
+
+
+def test_basis_matches_naive_recursion():
+    rng = np.random.default_rng(3)
+    p = 3
+    c = _random_open(rng, 9, p)
+    t = np.array(c.knots)
+    x = rng.uniform(*c.domain, 40)
+    span = np.searchsorted(t, x, side="right") - 1
+    got = basis_derivatives(t, p, span, x, 0)[:, 0, :]
+    for q in range(x.size):
+        ref = [_naive_basis(t, p, span[q] - p + a, x[q]) for a in range(p + 1)]
+        np.testing.assert_allclose(got[q], ref, atol=1e-14)
+
+
+def test_basis_derivatives_finite_differences():
+    rng = np.random.default_rng(4)
+    p = 4
+    c = _random_open(rng, 10, p, repeat=False)
+    t = np.array(c.knots)
+    x = rng.uniform(*c.domain, 30)
+    span = np.searchsorted(t, x, side="right") - 1
+    h = 1e-6
+    d = basis_derivatives(t, p, span, x, 2)
+    dp = basis_derivatives(t, p, span, x + h, 1)
+    dm = basis_derivatives(t, p, span, x - h, 1)
+    ok = (x - h > t[span]) & (x + h < t[span + 1])
+    np.testing.assert_allclose(d[ok, 1], (dp[ok, 0] - dm[ok, 0]) / (2 * h), atol=1e-6)
+    np.testing.assert_allclose(d[ok, 2], (dp[ok, 1] - dm[ok, 1]) / (2 * h), rtol=1e-5, atol=1e-4)
+
+
+@pytest.mark.parametrize("p", [2, 3, 5])
+def test_closed_is_periodic_and_smooth_at_seam(p):
+    c = _random_closed(np.random.default_rng(p), 9, p)
+    t0, t1 = c.domain
+    for nu in range(p):
+        a = c.piecewise.evaluate(np.array([t1]), nu, segment=np.array([c.piecewise.n_segments - 1]))
+        b = c(np.array([t0]), nu)
+        np.testing.assert_allclose(a, b, atol=1e-9 * max(1.0, np.abs(b).max()))
+    np.testing.assert_allclose(c(t0 + 0.3 + 2 * (t1 - t0)), c(t0 + 0.3), atol=1e-12)
+
+
+@pytest.mark.parametrize("closed", [False, True])
+def test_scipy_round_trip(closed):
+    rng = np.random.default_rng(7)
+    c = _random_closed(rng, 8, 3) if closed else _random_open(rng, 8, 3)
+    spl = c.to_scipy()
+    assert isinstance(spl, BSpline)
+    back = BSplineCurve.from_scipy(spl)
+    assert back.closed == closed
+    np.testing.assert_array_equal(back.knots, c.knots)
+    np.testing.assert_array_equal(back.control_points, c.control_points)
+    assert back.degree == c.degree
+
+
+def test_period_only_knots_equal_full_knots():
+    rng = np.random.default_rng(8)
+    c = _random_closed(rng, 7, 3)
+    full = BSplineCurve(c.control_points, c.knots, 3, closed=True)
+    np.testing.assert_array_equal(full.knots, c.knots)
+    assert c.knots.shape == (7 + 2 * 3 + 1,)
+    assert c.extended_control_points.shape == (10, 2)
+
+
+def test_immutable():
+    c = _random_open(np.random.default_rng(1), 6, 3)
+    with pytest.raises(ValueError):
+        c.control_points[0, 0] = 5.0
+    with pytest.raises(ValueError):
+        c.knots[0] = -1.0
+    with pytest.raises(ValueError):
+        c.piecewise.coeffs[0, 0, 0] = 1.0
+    d = c.replace(control_points=np.zeros((6, 2)))
+    assert np.all(d.control_points == 0) and not np.all(c.control_points == 0)
+
+
+def test_exported():
+    assert curvefair.BSplineCurve is BSplineCurve
+    assert issubclass(BSplineCurve, curvefair.PiecewiseCurve)
+
+
+# -- builders ------------------------------------------------------------------------------
+@pytest.mark.parametrize("p", [2, 3, 4, 5])
+@pytest.mark.parametrize("closed", [False, True])
+def test_interpolate_passes_through_points(p, closed):
+    rng = np.random.default_rng(p)
+    pts = np.cumsum(rng.uniform(0.5, 1.0, (12, 2)), axis=0) * [1, 0.3] + rng.normal(size=(12, 2))
+    if closed:
+        ang = np.sort(rng.uniform(0, 2 * np.pi, 12))
+        pts = np.c_[np.cos(ang), np.sin(ang)] * rng.uniform(0.8, 1.2, (12, 1))
+    c = interpolate_bspline(pts, degree=p, closed=closed)
+    assert c.degree == p and c.closed == closed
+    from curvefair import parameterize
+    loop = np.vstack([pts, pts[:1]]) if closed else pts
+    t = parameterize(loop, "chord")
+    np.testing.assert_allclose(c(t), loop, atol=1e-9)
+
+
+def test_open_cubic_interpolant_is_natural_spline():
+    rng = np.random.default_rng(5)
+    pts = rng.normal(size=(9, 3))
+    c = interpolate_bspline(pts, degree=3)
+    h = curvefair.interpolate_cubic(pts)
+    u = np.linspace(*c.domain, 200)
+    np.testing.assert_allclose(c(u), h(u), atol=1e-10)
+
+
+@pytest.mark.parametrize("closed", [False, True])
+def test_fit_reproduces_a_spline_in_its_space(closed):
+    # the knots depend only on the parameters and n_ctrl: take them from a first fit, put random
+    # control points on them, sample at the same parameters -> least squares must return them
+    rng = np.random.default_rng(11)
+    m = 60
+    u = np.sort(rng.uniform(0, 5, m))
+    u[0] = 0.0
+    param = np.r_[u, 5.5] if closed else u
+    first = fit_bspline(rng.normal(size=(m, 2)), 9, param=param, closed=closed)
+    ref = first.replace(control_points=rng.normal(size=(9, 2)))
+    fit = fit_bspline(ref(u), 9, param=param, closed=closed)
+    np.testing.assert_array_equal(fit.knots, ref.knots)
+    np.testing.assert_allclose(fit.control_points, ref.control_points, atol=1e-9)
+
+
+def test_fit_polynomial_exact():
+    u = np.linspace(0.0, 2.0, 60)
+    pts = np.c_[u**3 - u, 2 * u**2 + 1]
+    c = fit_bspline(pts, 7, degree=3, param=u)
+    np.testing.assert_allclose(c(u), pts, atol=1e-11)
+
+
+def test_fit_least_squares_optimal():
+    rng = np.random.default_rng(2)
+    pts = rng.normal(size=(30, 2)).cumsum(axis=0)
+    c = fit_bspline(pts, 8)
+    t = curvefair.parameterize(pts, "chord")
+    r0 = np.sum((c(t) - pts) ** 2)
+    for _ in range(5):  # any perturbation of the control points increases the residual
+        d = c.replace(control_points=c.control_points + 1e-3 * rng.normal(size=(8, 2)))
+        assert np.sum((d(t) - pts) ** 2) > r0
+
+
+# -- Gram matrices -------------------------------------------------------------------------
+@pytest.mark.parametrize("closed", [False, True])
+@pytest.mark.parametrize("p,l", [(3, 2), (3, 3), (4, 2), (5, 3), (2, 2)])
+def test_gram_matches_dense_quadrature(closed, p, l):
+    rng = np.random.default_rng(100 + p + l)
+    c = _random_closed(rng, 9, p) if closed else _random_open(rng, 9, p, repeat=False)
+    G = c.gram_matrix(l).toarray()
+    n = c.n_ctrl
+    # basis functions via scipy, integrated with 12-point Gauss per span (far more than needed)
+    t = np.array(c.knots)
+    xg, wg = np.polynomial.legendre.leggauss(12)
+    br = c.piecewise.breaks
+    x = ((br[:-1, None] + br[1:, None]) / 2 + (np.diff(br)[:, None] / 2) * xg).ravel()
+    w = (np.diff(br)[:, None] / 2 * wg).ravel()
+    K = t.shape[0] - p - 1
+    B = np.empty((K, x.size))
+    for i in range(K):
+        coef = np.zeros(K)
+        coef[i] = 1.0
+        B[i] = BSpline(t, coef, p)(x, l)
+    if closed:
+        B2 = np.zeros((n, x.size))
+        for i in range(K):
+            B2[i % n] += B[i]
+        B = B2
+    ref = (B * w) @ B.T
+    np.testing.assert_allclose(G, ref, atol=1e-9 * np.abs(ref).max())
+    # energy from the Gram matrix equals dense quadrature of |r^(l)|^2
+    e = np.sum(w * np.sum(c(x, l) ** 2, axis=1))
+    assert abs(c.energy_l(l) - e) <= 1e-9 * e
+
+
+# -- validation ----------------------------------------------------------------------------
+@pytest.mark.parametrize("kwargs,match", [
+    (dict(control_points=np.zeros((5, 2)), knots=np.r_[0, 0, 0, 0, 1, 2, 2, 2], degree=3),
+     "n \\+ degree \\+ 1 = 9"),
+    (dict(control_points=np.zeros((5, 2)), knots=np.r_[0, 0, 0, 0, 2, 1, 2, 2, 2], degree=3),
+     "non-decreasing: knots\\[4\\]"),
+    (dict(control_points=np.zeros((5, 2)), knots=np.r_[0, 0, 0, 0.5, 1, 2, 2, 2, 2], degree=3),
+     "clamped"),
+    (dict(control_points=np.zeros((8, 2)),
+          knots=np.r_[0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2], degree=3),
+     "knots\\[4\\] has multiplicity"),
+    (dict(control_points=np.zeros((5, 2)), knots=np.r_[0, 0, 0, 0, np.nan, 2, 2, 2, 2], degree=3),
+     "knots contains a non-finite value .*nan.* at index 4"),
+    (dict(control_points=[[0, 0], [1, np.inf], [2, 0], [3, 0], [4, 0]],
+          knots=np.r_[0, 0, 0, 0, 1, 2, 2, 2, 2], degree=3), "row 1"),
+    (dict(control_points=np.zeros((5, 4)), knots=np.r_[0, 0, 0, 0, 1, 2, 2, 2, 2], degree=3),
+     "columns"),
+    (dict(control_points=np.zeros((5, 2)), knots=np.r_[0, 0, 0, 0, 1, 2, 2, 2, 2], degree=1),
+     "degree"),
+    (dict(control_points=np.zeros((3, 2)), knots=np.r_[0, 0, 0, 0, 1, 1, 1], degree=3),
+     "at least 4"),
+    (dict(control_points=np.zeros((5, 2)), knots=np.arange(7.0), degree=3, closed=True),
+     "n \\+ 2 degree \\+ 1 = 12"),
+    (dict(control_points=np.zeros((5, 2)), knots=np.r_[0, 1, 1, 1, 1, 2], degree=3, closed=True),
+     "multiplicity"),
+    (dict(control_points=np.zeros((5, 2)), knots=np.r_[np.arange(11.0), 12.0], degree=3,
+          closed=True), "periodic"),
+])
+def test_invalid_input(kwargs, match):
+    with pytest.raises(InputError, match=match):
+        BSplineCurve(**kwargs)
+
+
+def test_builder_errors():
+    with pytest.raises(InputError, match="n_ctrl"):
+        fit_bspline(np.random.default_rng(0).normal(size=(10, 2)), 20)
+    with pytest.raises(InputError, match="degree"):
+        interpolate_bspline(np.random.default_rng(0).normal(size=(10, 2)), degree=1)
+    with pytest.raises(InputError, match="coincident"):
+        interpolate_bspline([[0, 0], [1, 1], [1, 1], [2, 0], [3, 1]])
