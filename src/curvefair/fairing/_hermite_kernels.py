@@ -1,0 +1,669 @@
+"""Compiled kernels of the local Hermite fairing steps and of their automatic loop.
+
+Everything here works on the DISTINCT data of a Hermite spline (a closed curve drops its repeated
+last point) in a uniform layout:
+
+* ``P``  -- points, ``(nd, dim)``;
+* ``D``  -- derivative data, ``(nd, nb, dim)`` with ``nb = 1`` (cubic: ``r'``) or ``nb = 2``
+  (quintic: ``r'``, ``r''``);
+* ``h``  -- segment widths, ``(nseg,)``; segment ``j`` joins point ``j`` and ``(j + 1) % nd``
+  (``nseg = nd - 1`` open, ``nd`` closed).
+
+Paper notation (Wang & Cao 2006; Wang 2005) for a step at point ``k`` (0-based here, 1-based in the
+papers): ``D0 = Delta_{k-1} = t_k - t_{k-1}`` (left segment), ``D1 = Delta_k = t_{k+1} - t_k``
+(right segment), ``a_{k-1,j}`` and ``a_{k,j}`` the power coefficients of those two segments.
+
+The spline-mode re-interpolation is written with the Gram matrix of the spline's own energy
+(``int |r''|^2`` for the C2 cubic, ``int |r'''|^2`` for the C4 quintic) in the Hermite unknowns:
+its stationarity conditions are exactly the C2 (C4) continuity conditions, the system is symmetric
+positive definite and block tridiagonal, and the change caused by moving one point decays
+geometrically away from it, so it is solved on a window that grows until the change at its edges is
+below machine precision relative to the change itself.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from ..curves.hermite import cubic_hermite_coefficients, quintic_hermite_coefficients
+from .ranking import tt_build, tt_top, tt_update
+
+# method codes (internal only; the public API uses names)
+KJELLANDER = 0
+POLIAKOFF = 1
+WANG_CAO = 2
+WANG_QUINTIC = 3
+
+# stop codes
+STOP_EPS = 0
+STOP_MAX_STEPS = 1
+STOP_ALL_BLOCKED = 2
+
+
+# ----------------------------------------------------------------------------------------------
+# Gram matrices of Hermite segments (exact, by Gauss-Legendre quadrature of polynomials)
+# ----------------------------------------------------------------------------------------------
+def hermite_gram(degree: int, q: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gram matrix ``K0`` of ``int_0^1 |d^q r / du^q|^2 du`` in the local Hermite data.
+
+    Local data order ``z = [r0, d0_1..d0_nb, r1, d1_1..d1_nb]`` (``nb = (degree - 1) // 2``).
+    For a segment of width ``h`` the matrix is ``K0[a, b] * h**(1 - 2 q + p[a] + p[b])`` where
+    ``p`` (returned) is the derivative order of each datum.
+    """
+    nb = (degree - 1) // 2
+    nz = 2 * (nb + 1)
+    p = np.array([j for _ in range(2) for j in range(nb + 1)], dtype=np.int64)
+    t = np.array([0.0, 1.0])
+    basis = np.zeros((nz, degree + 1))
+    for a in range(nz):
+        data = np.zeros((2, nb + 1, 1))
+        data[a // (nb + 1), a % (nb + 1), 0] = 1.0
+        if degree == 3:
+            c = cubic_hermite_coefficients(data[:, 0], data[:, 1], t)
+        else:
+            c = quintic_hermite_coefficients(data[:, 0], data[:, 1], data[:, 2], t)
+        basis[a] = c[0, :, 0]
+    # q-th derivative, then exact quadrature (Gauss-Legendre with 8 nodes: degree <= 15)
+    x, w = np.polynomial.legendre.leggauss(8)
+    u = 0.5 * (x + 1.0)
+    w = 0.5 * w
+    vals = np.zeros((nz, u.size))
+    for a in range(nz):
+        dc = np.polynomial.polynomial.polyder(basis[a], q)
+        vals[a] = np.polynomial.polynomial.polyval(u, dc)
+    K0 = (vals * w) @ vals.T
+    return K0, p
+
+
+# ----------------------------------------------------------------------------------------------
+# segment coefficients
+# ----------------------------------------------------------------------------------------------
+@njit(cache=True, inline="always")
+def _cubic_a23(P, D, h, j, c):  # type: ignore[no-untyped-def]
+    """``(a_{j,2}, a_{j,3})`` of cubic segment ``j``, coordinate ``c`` (Wang & Cao, eq. (6))."""
+    nd = P.shape[0]
+    i0 = j
+    i1 = (j + 1) % nd
+    H = h[j]
+    dp = P[i1, c] - P[i0, c]
+    a2 = 3.0 * dp / (H * H) - (2.0 * D[i0, 0, c] + D[i1, 0, c]) / H
+    a3 = -2.0 * dp / (H * H * H) + (D[i0, 0, c] + D[i1, 0, c]) / (H * H)
+    return a2, a3
+
+
+@njit(cache=True, inline="always")
+def _quintic_a2345(P, D, h, j, c):  # type: ignore[no-untyped-def]
+    """``a_{j,2..5}`` of quintic segment ``j``, coordinate ``c`` (Wang 2005, eq. (2))."""
+    nd = P.shape[0]
+    i0 = j
+    i1 = (j + 1) % nd
+    H = h[j]
+    m0 = D[i0, 0, c]
+    s0 = D[i0, 1, c]
+    b1 = P[i1, c] - P[i0, c] - m0 * H - 0.5 * s0 * H * H
+    b2 = D[i1, 0, c] - m0 - s0 * H
+    b3 = D[i1, 1, c] - s0
+    H2 = H * H
+    a2 = 0.5 * s0
+    a3 = (10.0 * b1 - 4.0 * b2 * H + 0.5 * b3 * H2) / (H2 * H)
+    a4 = (-15.0 * b1 + 7.0 * b2 * H - b3 * H2) / (H2 * H2)
+    a5 = (6.0 * b1 - 3.0 * b2 * H + 0.5 * b3 * H2) / (H2 * H2 * H)
+    return a2, a3, a4, a5
+
+
+# ----------------------------------------------------------------------------------------------
+# the local steps
+# ----------------------------------------------------------------------------------------------
+@njit(cache=True)
+def cubic_step(P, D, h, k, method, hstep, delta, eta):  # type: ignore[no-untyped-def]
+    """Unconstrained step of a cubic method at point ``k``; fills ``delta`` (and ``eta``).
+
+    * Kjellander (Wang & Cao 2006, eq. (4), spacing ``hstep``):
+      ``r_new = (r_{k-1} + r_{k+1}) / 2 + hstep (r'_{k-1} - r'_{k+1}) / 4``.
+    * Poliakoff (eq. (8) as corrected in ERRATA):
+      ``delta = -(a_{k,3} - a_{k-1,3}) / (2 / D1^3 + 2 / D0^3)``.
+    * Wang-Cao (eqs. (11)-(12)): ``delta*``, ``eta*``.
+    ``eta`` is zero for the position-only methods.
+    """
+    nd = P.shape[0]
+    km = (k - 1) % nd
+    kp = (k + 1) % nd
+    D0 = h[km]
+    D1 = h[k]
+    for c in range(P.shape[1]):
+        eta[c] = 0.0
+        if method == KJELLANDER:
+            delta[c] = (0.5 * (P[km, c] + P[kp, c]) + 0.25 * hstep * (D[km, 0, c] - D[kp, 0, c])
+                        - P[k, c])
+            continue
+        al2, al3 = _cubic_a23(P, D, h, km, c)
+        ar2, ar3 = _cubic_a23(P, D, h, k, c)
+        if method == POLIAKOFF:
+            delta[c] = -(ar3 - al3) / (2.0 / D1**3 + 2.0 / D0**3)
+        else:
+            J = al3 - ar3
+            G = ar2 - al2 - 3.0 * al3 * D0
+            f = D1 * D0 / (D1 + D0) ** 3
+            delta[c] = f * D1 * D0 * (2.0 * D1 * D0 * J + (D1 - D0) * G)
+            eta[c] = f * (3.0 * D1 * D0 * (D1 - D0) * J + 2.0 * (D1 * D1 - D1 * D0 + D0 * D0) * G)
+
+
+@njit(cache=True)
+def wang_cao_eta_given_delta(P, D, h, k, delta, eta):  # type: ignore[no-untyped-def]
+    """Energy-optimal ``eta`` for a GIVEN position change ``delta`` (Wang & Cao, Lemma 1, eq. (14)).
+
+    ``dF/deta = 0``: ``eta = (G - (3/D1^2 - 3/D0^2) delta) / (2 (1/D1 + 1/D0))`` with
+    ``G = a_{k,2} - a_{k-1,2} - 3 a_{k-1,3} D0``. With ``delta = delta*`` this is ``eta*``.
+    """
+    nd = P.shape[0]
+    km = (k - 1) % nd
+    D0 = h[km]
+    D1 = h[k]
+    for c in range(P.shape[1]):
+        al2, al3 = _cubic_a23(P, D, h, km, c)
+        ar2, ar3 = _cubic_a23(P, D, h, k, c)
+        G = ar2 - al2 - 3.0 * al3 * D0
+        eta[c] = (G - (3.0 / D1**2 - 3.0 / D0**2) * delta[c]) / (2.0 * (1.0 / D1 + 1.0 / D0))
+
+
+@njit(cache=True)
+def quintic_system(P, D, h, k, C):  # type: ignore[no-untyped-def]
+    """Wang 2005, Lemma: gradient ``C[c] = (C1, C2, C3)`` per coordinate and the Hessian entries
+    ``(H00, H01, H02, H11, H22)`` (``H12 = 0``), with ``W* - W = C.x + x^T H x / 2``."""
+    nd = P.shape[0]
+    km = (k - 1) % nd
+    D0 = h[km]
+    D1 = h[k]
+    for c in range(P.shape[1]):
+        l2, l3, l4, l5 = _quintic_a2345(P, D, h, km, c)
+        r2, r3, r4, r5 = _quintic_a2345(P, D, h, k, c)
+        C[c, 0] = (12.0 * (r3 - l3) + 24.0 * (r4 * D1 - l4 * D0)
+                   + 240.0 / 7.0 * (r5 * D1**2 - l5 * D0**2))
+        C[c, 1] = (-4.0 * (r2 - l2) + 12.0 * l3 * D0 + 24.0 / 5.0 * r4 * D1**2
+                   + 96.0 / 5.0 * l4 * D0**2 + 64.0 / 7.0 * r5 * D1**3 + 176.0 / 7.0 * l5 * D0**3)
+        C[c, 2] = (2.0 / 5.0 * (r4 * D1**3 + l4 * D0**3) + 6.0 / 7.0 * r5 * D1**4
+                   + 8.0 / 7.0 * l5 * D0**4)
+    H00 = 240.0 / 7.0 * (1.0 / D1**3 + 1.0 / D0**3)
+    H01 = 120.0 / 7.0 * (1.0 / D1**2 - 1.0 / D0**2)
+    H02 = 6.0 / 7.0 * (1.0 / D1 + 1.0 / D0)
+    H11 = 384.0 / 35.0 * (1.0 / D1 + 1.0 / D0)
+    H22 = 6.0 / 35.0 * (D0 + D1)
+    return H00, H01, H02, H11, H22
+
+
+@njit(cache=True)
+def quintic_step(P, D, h, k, delta, eta, xi, clamped_delta):  # type: ignore[no-untyped-def]
+    """Wang 2005 step: solve ``H [delta, eta, xi] = -[C1, C2, C3]`` per coordinate.
+
+    Because ``H12 = 0`` the system is solved by eliminating ``eta`` and ``xi``:
+    ``delta = -(C1 - H01 C2 / H11 - H02 C3 / H22) / S``, ``S = H00 - H01^2/H11 - H02^2/H22``,
+    ``eta = -(C2 + H01 delta) / H11``, ``xi = -(C3 + H02 delta) / H22``.
+    If ``clamped_delta`` is True, ``delta`` is taken as given and only ``eta``, ``xi`` are
+    computed (the optimal derivatives for that position). Returns the energy drops
+    ``(drop_total, drop_position)`` of the unconstrained step (``int |r''|^2`` units).
+    """
+    dim = P.shape[1]
+    C = np.empty((dim, 3))
+    H00, H01, H02, H11, H22 = quintic_system(P, D, h, k, C)
+    S = H00 - H01 * H01 / H11 - H02 * H02 / H22
+    drop_pos = 0.0
+    drop_der = 0.0
+    for c in range(dim):
+        c1 = C[c, 0] - H01 * C[c, 1] / H11 - H02 * C[c, 2] / H22
+        d_opt = -c1 / S
+        drop_pos += 0.5 * S * d_opt * d_opt
+        drop_der += 0.5 * (C[c, 1] ** 2 / H11 + C[c, 2] ** 2 / H22)
+        if not clamped_delta:
+            delta[c] = d_opt
+        eta[c] = -(C[c, 1] + H01 * delta[c]) / H11
+        xi[c] = -(C[c, 2] + H02 * delta[c]) / H22
+    return drop_pos + drop_der, drop_pos
+
+
+@njit(cache=True)
+def cubic_jump(P, D, h, k):  # type: ignore[no-untyped-def]
+    """``|r'''(t_k+) - r'''(t_k-)| = 6 |a_{k,3} - a_{k-1,3}|`` (Wang & Cao 2006, eq. (7))."""
+    nd = P.shape[0]
+    km = (k - 1) % nd
+    s = 0.0
+    for c in range(P.shape[1]):
+        al2, al3 = _cubic_a23(P, D, h, km, c)
+        ar2, ar3 = _cubic_a23(P, D, h, k, c)
+        s += (ar3 - al3) ** 2
+    return 6.0 * np.sqrt(s)
+
+
+@njit(cache=True)
+def measure_at(P, D, h, k, degree, spline):  # type: ignore[no-untyped-def]
+    """Ranking measure of point ``k``: cubic -> third-derivative jump; quintic -> energy drop
+    of the Wang step (hermite mode: whole step; spline mode: the part due to the position)."""
+    if degree == 3:
+        return cubic_jump(P, D, h, k)
+    dim = P.shape[1]
+    dl = np.empty(dim)
+    et = np.empty(dim)
+    xs = np.empty(dim)
+    tot, pos = quintic_step(P, D, h, k, dl, et, xs, False)
+    return pos if spline else tot
+
+
+# ----------------------------------------------------------------------------------------------
+# tournament tree: update a contiguous range of leaves in O(len + log N)
+# ----------------------------------------------------------------------------------------------
+@njit(cache=True, inline="always")
+def _wins(v1, i1, v2, i2):  # type: ignore[no-untyped-def]
+    # same rule as ranking.tt_update: larger value, ties to the smaller valid index
+    if v1 > v2:
+        return True
+    if v1 < v2:
+        return False
+    if i2 < 0:
+        return True
+    if i1 < 0:
+        return False
+    return i1 <= i2
+
+
+@njit(cache=True)
+def tt_update_range(tv, ti, lo, hi, values):  # type: ignore[no-untyped-def]
+    """Set leaves ``lo..hi`` (inclusive) to ``values[lo..hi]`` and repair their ancestors."""
+    p = tv.shape[0] // 2
+    for i in range(lo, hi + 1):
+        tv[p + i] = values[i]
+    a = (p + lo) // 2
+    b = (p + hi) // 2
+    while a >= 1:
+        for j in range(a, b + 1):
+            x = 2 * j
+            y = x + 1
+            if _wins(tv[x], ti[x], tv[y], ti[y]):
+                tv[j] = tv[x]
+                ti[j] = ti[x]
+            else:
+                tv[j] = tv[y]
+                ti[j] = ti[y]
+        a //= 2
+        b //= 2
+
+
+# ----------------------------------------------------------------------------------------------
+# window solve of the spline system (block tridiagonal, SPD, block size nb = 1 or 2)
+# ----------------------------------------------------------------------------------------------
+@njit(cache=True, inline="always")
+def _kseg(K0, pe, q, hj, a, b):  # type: ignore[no-untyped-def]
+    return K0[a, b] * hj ** (1 - 2 * q + pe[a] + pe[b])
+
+
+@njit(cache=True)
+def _inv_small(M, nb, out):  # type: ignore[no-untyped-def]
+    if nb == 1:
+        out[0, 0] = 1.0 / M[0, 0]
+    else:
+        det = M[0, 0] * M[1, 1] - M[0, 1] * M[1, 0]
+        out[0, 0] = M[1, 1] / det
+        out[1, 1] = M[0, 0] / det
+        out[0, 1] = -M[0, 1] / det
+        out[1, 0] = -M[1, 0] / det
+
+
+@njit(cache=True)
+def _assemble_window(nd, closed, h, K0, pe, q, nb, fixed, idx, L, Bd, Cu):  # type: ignore[no-untyped-def]
+    """Diagonal blocks ``Bd[v]`` and super-diagonal blocks ``Cu[v]`` (v -> v+1) of the window
+    whose actual point indices are ``idx[0..L-1]``; fixed unknowns become identity rows/cols."""
+    r1 = nb + 1  # offset of the end point's data in the local vector
+    for v in range(L):
+        i = idx[v]
+        for a in range(nb):
+            for b in range(nb):
+                s = 0.0
+                if closed or i >= 1:  # segment i-1 ends at i
+                    j = (i - 1) % nd
+                    s += _kseg(K0, pe, q, h[j], r1 + 1 + a, r1 + 1 + b)
+                if closed or i <= nd - 2:  # segment i starts at i
+                    s += _kseg(K0, pe, q, h[i], 1 + a, 1 + b)
+                Bd[v, a, b] = s
+                if v < L - 1:
+                    Cu[v, a, b] = _kseg(K0, pe, q, h[i], 1 + a, r1 + 1 + b)
+                else:
+                    Cu[v, a, b] = 0.0
+    for v in range(L):
+        i = idx[v]
+        for a in range(nb):
+            if fixed[i, a]:
+                for b in range(nb):
+                    Bd[v, a, b] = 0.0
+                    Bd[v, b, a] = 0.0
+                    Cu[v, a, b] = 0.0
+                    if v > 0:
+                        Cu[v - 1, b, a] = 0.0
+                Bd[v, a, a] = 1.0
+
+
+@njit(cache=True)
+def _block_thomas(L, nb, dim, Bd, Cu, R, X, Bp, Y):  # type: ignore[no-untyped-def]
+    """Solve the symmetric block tridiagonal system (sub-diagonal = Cu^T) for X (L, nb, dim)."""
+    inv = np.empty((2, 2))
+    W = np.empty((2, 2))
+    for v in range(L):
+        for a in range(nb):
+            for b in range(nb):
+                Bp[v, a, b] = Bd[v, a, b]
+            for c in range(dim):
+                Y[v, a, c] = R[v, a, c]
+        if v > 0:
+            # W = A_v Bp_{v-1}^{-1}, A_v = Cu_{v-1}^T
+            _inv_small(Bp[v - 1], nb, inv)
+            for a in range(nb):
+                for b in range(nb):
+                    s = 0.0
+                    for e in range(nb):
+                        s += Cu[v - 1, e, a] * inv[e, b]
+                    W[a, b] = s
+            for a in range(nb):
+                for b in range(nb):
+                    s = 0.0
+                    for e in range(nb):
+                        s += W[a, e] * Cu[v - 1, e, b]
+                    Bp[v, a, b] -= s
+                for c in range(dim):
+                    s = 0.0
+                    for e in range(nb):
+                        s += W[a, e] * Y[v - 1, e, c]
+                    Y[v, a, c] -= s
+    for v in range(L - 1, -1, -1):
+        _inv_small(Bp[v], nb, inv)
+        for c in range(dim):
+            for a in range(nb):
+                t = Y[v, a, c]
+                if v < L - 1:
+                    for e in range(nb):
+                        t -= Cu[v, a, e] * X[v + 1, e, c]
+                W[a, 0] = t
+            for a in range(nb):
+                s = 0.0
+                for e in range(nb):
+                    s += inv[a, e] * W[e, 0]
+                X[v, a, c] = s
+
+
+@njit(cache=True)
+def _rhs_for_move(nd, closed, h, K0, pe, q, nb, k, dr, idx, L, fixed, R):  # type: ignore[no-untyped-def]
+    """Right-hand side (minus the gradient change) caused by moving point ``k`` by ``dr``."""
+    dim = dr.shape[0]
+    r1 = nb + 1
+    for v in range(L):
+        for a in range(nb):
+            for c in range(dim):
+                R[v, a, c] = 0.0
+    for v in range(L):
+        i = idx[v]
+        for a in range(nb):
+            if fixed[i, a]:
+                continue
+            coef = 0.0
+            # segment i-1 (i is its end), segment i (i is its start)
+            if closed or i >= 1:
+                j = (i - 1) % nd
+                if (j + 1) % nd == i and i == k:
+                    coef += _kseg(K0, pe, q, h[j], r1 + 1 + a, r1)
+                if j == k:  # start point of segment j is k
+                    coef += _kseg(K0, pe, q, h[j], r1 + 1 + a, 0)
+            if closed or i <= nd - 2:
+                if i == k:
+                    coef += _kseg(K0, pe, q, h[i], 1 + a, 0)
+                if (i + 1) % nd == k:
+                    coef += _kseg(K0, pe, q, h[i], 1 + a, r1)
+            if coef != 0.0:
+                for c in range(dim):
+                    R[v, a, c] = -coef * dr[c]
+
+
+# ----------------------------------------------------------------------------------------------
+# the automatic loop
+# ----------------------------------------------------------------------------------------------
+@njit(cache=True)
+def _clamped_move(P, D, h, orig, k, method, degree, spline, hstep, tol, delta, eta, xi):  # type: ignore[no-untyped-def]
+    """Step at ``k`` clamped onto the ball of radius ``tol`` around ``orig[k]``.
+
+    Fills ``delta`` with the (clamped) position change and ``eta``/``xi`` with the derivative
+    changes that are optimal for that position (hermite mode). Returns
+    ``(norm of move, clamped?)``.
+    """
+    dim = P.shape[1]
+    if degree == 3:
+        cubic_step(P, D, h, k, method, hstep, delta, eta)
+    else:
+        quintic_step(P, D, h, k, delta, eta, xi, False)
+    clamped = False
+    if tol > 0.0:
+        off = 0.0
+        for c in range(dim):
+            off += (P[k, c] + delta[c] - orig[k, c]) ** 2
+        off = np.sqrt(off)
+        if off > tol:
+            f = tol / off * (1.0 - 4e-16)
+            for c in range(dim):
+                delta[c] = orig[k, c] + (P[k, c] + delta[c] - orig[k, c]) * f - P[k, c]
+            clamped = True
+            if not spline:
+                if degree == 5:
+                    quintic_step(P, D, h, k, delta, eta, xi, True)
+                elif method == WANG_CAO:
+                    wang_cao_eta_given_delta(P, D, h, k, delta, eta)
+    mv = 0.0
+    for c in range(dim):
+        mv += delta[c] ** 2
+    return np.sqrt(mv), clamped
+
+
+@njit(cache=True)
+def drive(P, D, h, orig, closed, degree, method, spline, hstep, eligible, tol, eps,
+          max_steps, move_floor, K0, pe, q, fixed, Hinv, w0, wmax, thr):  # type: ignore[no-untyped-def]
+    """Seed 001's steps 2-6 on the distinct data (modified in place).
+
+    Returns ``(steps, stop_code, hist_index, hist_measure, hist_disp, measure, blocked,
+    n_truncated, n_skipped, max_window)``; ``blocked`` is 0 (free), 1 (blocked by the tolerance),
+    2 (move ~0 without clamping).
+    """
+    nd = P.shape[0]
+    dim = P.shape[1]
+    nb = D.shape[1]
+    measure = np.empty(nd)
+    values = np.full(nd, -np.inf)
+    for i in range(nd):
+        if closed or (i >= 1 and i <= nd - 2):
+            measure[i] = measure_at(P, D, h, i, degree, spline)
+        else:
+            measure[i] = 0.0
+        if eligible[i]:
+            values[i] = measure[i]
+    tv, ti = tt_build(values)
+    blocked = np.zeros(nd, dtype=np.int8)
+    cap = 1024 if max_steps > 1024 else max(max_steps, 1)
+    h_idx = np.empty(cap, dtype=np.int64)
+    h_meas = np.empty(cap)
+    h_disp = np.empty(cap)
+    delta = np.empty(dim)
+    eta = np.empty(dim)
+    xi = np.empty(dim)
+    dense = Hinv.shape[0] > 0
+    # window work arrays
+    Lmax = 2 * wmax + 3
+    if Lmax > nd:
+        Lmax = nd
+    if Lmax < 3:
+        Lmax = 3
+    idx = np.empty(Lmax, dtype=np.int64)
+    Bd = np.empty((Lmax, nb, nb))
+    Cu = np.empty((Lmax, nb, nb))
+    R = np.empty((Lmax, nb, dim))
+    X = np.empty((Lmax, nb, dim))
+    Bp = np.empty((Lmax, nb, nb))
+    Y = np.empty((Lmax, nb, dim))
+    w_cur = w0
+    steps = 0
+    n_trunc = 0
+    n_skip = 0
+    max_window = 0
+    stop = STOP_MAX_STEPS
+    while True:
+        if steps >= max_steps:
+            stop = STOP_MAX_STEPS
+            break
+        k, v = tt_top(tv, ti)
+        if v == -np.inf or k < 0:
+            stop = STOP_ALL_BLOCKED
+            break
+        if v < eps:
+            stop = STOP_EPS
+            break
+        mv, clamped = _clamped_move(P, D, h, orig, k, method, degree, spline, hstep, tol,
+                                    delta, eta, xi)
+        if mv <= move_floor:
+            blocked[k] = 1 if clamped else 2
+            tt_update(tv, ti, k, -np.inf)
+            n_skip += 1
+            continue
+        # -- apply the move
+        for c in range(dim):
+            P[k, c] += delta[c]
+        if not spline:
+            if degree == 5:
+                for c in range(dim):
+                    D[k, 0, c] += eta[c]
+                    D[k, 1, c] += xi[c]
+            elif method == WANG_CAO:
+                for c in range(dim):
+                    D[k, 0, c] += eta[c]
+        if steps == cap:
+            cap2 = 2 * cap
+            if cap2 > max_steps:
+                cap2 = max_steps
+            n1 = np.empty(cap2, dtype=np.int64)
+            n2 = np.empty(cap2)
+            n3 = np.empty(cap2)
+            n1[:cap] = h_idx
+            n2[:cap] = h_meas
+            n3[:cap] = h_disp
+            h_idx = n1
+            h_meas = n2
+            h_disp = n3
+            cap = cap2
+        h_idx[steps] = k
+        h_meas[steps] = v
+        h_disp[steps] = mv
+        steps += 1
+        # -- re-interpolate (spline mode) and find the affected range [a, b] (virtual indices)
+        a = k - 1
+        b = k + 1
+        if spline:
+            if dense:
+                # closed and small: exact update with the precomputed inverse of the full system
+                for jj in range(3):
+                    idx[jj] = (k - 1 + jj) % nd
+                _rhs_for_move(nd, closed, h, K0, pe, q, nb, k, delta, idx, 3, fixed, R)
+                for r in range(nd * nb):
+                    for c in range(dim):
+                        s = 0.0
+                        for jj in range(3):
+                            for e in range(nb):
+                                s += Hinv[r, idx[jj] * nb + e] * R[jj, e, c]
+                        D[r // nb, r % nb, c] += s
+                a = 0
+                b = nd - 1
+            else:
+                w = w_cur
+                while True:
+                    if closed:
+                        if 2 * w + 1 > nd - 1:
+                            w = (nd - 2) // 2
+                        lo = k - w
+                        L = 2 * w + 1
+                        for vv in range(L):
+                            idx[vv] = (lo + vv) % nd
+                        left_open = True
+                        right_open = True
+                    else:
+                        lo = k - w
+                        if lo < 0:
+                            lo = 0
+                        hi = k + w
+                        if hi > nd - 1:
+                            hi = nd - 1
+                        L = hi - lo + 1
+                        for vv in range(L):
+                            idx[vv] = lo + vv
+                        left_open = lo > 0
+                        right_open = hi < nd - 1
+                    _assemble_window(nd, closed, h, K0, pe, q, nb, fixed, idx, L, Bd, Cu)
+                    _rhs_for_move(nd, closed, h, K0, pe, q, nb, k, delta, idx, L, fixed, R)
+                    _block_thomas(L, nb, dim, Bd, Cu, R, X, Bp, Y)
+                    ok = True
+                    for e in range(nb):
+                        big = 0.0
+                        for vv in range(L):
+                            for c in range(dim):
+                                t = abs(X[vv, e, c])
+                                if t > big:
+                                    big = t
+                        for c in range(dim):
+                            if left_open and abs(X[0, e, c]) > thr * big:
+                                ok = False
+                            if right_open and abs(X[L - 1, e, c]) > thr * big:
+                                ok = False
+                    can_grow = (closed and 2 * w + 1 < nd - 2 and w < wmax) or \
+                        ((not closed) and (left_open or right_open) and w < wmax)
+                    if ok or not can_grow:
+                        if not ok:
+                            n_trunc += 1
+                        break
+                    w = 2 * w
+                    if w > wmax:
+                        w = wmax
+                    if w > w_cur:
+                        w_cur = w
+                if L > max_window:
+                    max_window = L
+                for vv in range(L):
+                    i = idx[vv]
+                    for e in range(nb):
+                        for c in range(dim):
+                            D[i, e, c] += X[vv, e, c]
+                a = lo - 1
+                b = lo + L
+        # -- recompute measures / eligibility on [a, b] and update the tree
+        if closed:
+            if b - a + 1 >= nd:
+                a = 0
+                b = nd - 1
+        else:
+            if a < 1:
+                a = 1
+            if b > nd - 2:
+                b = nd - 2
+        for vv in range(a, b + 1):
+            i = vv % nd if closed else vv
+            m_new = measure_at(P, D, h, i, degree, spline)
+            measure[i] = m_new
+            if not eligible[i]:
+                values[i] = -np.inf
+                continue
+            if blocked[i] != 0:
+                mv2, cl2 = _clamped_move(P, D, h, orig, i, method, degree, spline, hstep, tol,
+                                         delta, eta, xi)
+                if mv2 <= move_floor:
+                    blocked[i] = 1 if cl2 else 2
+                    values[i] = -np.inf
+                    continue
+                blocked[i] = 0
+            values[i] = m_new
+        if closed and (a < 0 or b > nd - 1) and b - a + 1 < nd:
+            a2 = a % nd
+            b2 = b % nd
+            tt_update_range(tv, ti, a2, nd - 1, values)
+            tt_update_range(tv, ti, 0, b2, values)
+        elif b >= a:
+            tt_update_range(tv, ti, a, b, values)
+    return (steps, stop, h_idx[:steps].copy(), h_meas[:steps].copy(), h_disp[:steps].copy(),
+            measure, blocked, n_trunc, n_skip, max_window)
