@@ -307,7 +307,8 @@ def second_discrete_curvature(curve: Any) -> SecondDiscreteCurvature:
     Theorem 2: at the joint ``u_{i+2}`` the curve's curvature ``k_i`` satisfies
     ``K_i = 3 (u_{i+3} - u_i)(u_{i+4} - u_{i+1}) / (4 (u_{i+3} - u_{i+1})**2) k_i``, i.e.
     ``K_i = 27 k_i / 16`` for uniform knots. The theorem holds for any knot vector at a simple
-    knot; at a double knot the curve is only C1 and ``K_i`` matches the curvature of one side.
+    knot (the curve is C2 there). At a double knot ``u_j = u_{j+1}`` the curve is only C1; there
+    ``K_{j-2}`` matches the curvature from the left and ``K_{j-1}`` the one from the right.
     In 3-D ``D`` is the unsigned area ``|e_i x e_{i+1}| / 2`` and ``K_i >= 0`` matches the unsigned
     curvature. Definition 2: ``Delta K_i = K_i - K_{i-1}``,
     ``D_i = t_i K_{i-1} + (1 - t_i) K_{i+1} - K_i`` with ``t_i = L_{i+1} / (L_i + L_{i+1})``,
