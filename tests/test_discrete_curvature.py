@@ -66,7 +66,7 @@ def test_circle_converges_second_order_and_is_signed():
         np.testing.assert_allclose(discrete_curvature(P[::-1], closed=True), -C[::-1], rtol=1e-12)
     ratios = np.array(errs[:-1]) / np.array(errs[1:])
     assert np.all(ratios > 3.8) and np.all(ratios < 4.2)
-    assert errs[-1] < 2e-4
+    assert errs[-1] < 1.01 / R * (np.pi / 128) ** 2  # relative error ~ (pi / n)^2
 
 
 def test_ellipse_converges_second_order():
