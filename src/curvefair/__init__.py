@@ -22,6 +22,8 @@ from .curves import (
     parameterize,
 )
 from .errors import CurvefairError, FileFormatError, InputError, MissingDependencyError
+from .analysis.discrete import (BadPoint, SecondDiscreteCurvature, bad_points,  # noqa: I001
+                                 discrete_curvature, second_discrete_curvature)
 
 __all__ = [
     "__version__",
@@ -39,4 +41,9 @@ __all__ = [
     "InputError",
     "FileFormatError",
     "MissingDependencyError",
+    "discrete_curvature",
+    "second_discrete_curvature",
+    "bad_points",
+    "BadPoint",
+    "SecondDiscreteCurvature",
 ]
