@@ -28,6 +28,7 @@ from ._typing import FloatArray
 from .curves.hermite import CubicHermite, HermiteSpline, QuinticHermite
 from .errors import InputError
 from .fairing import _hermite_kernels as _k
+from .fairing.cheng_yu import cheng_yu  # noqa: F401  (Cheng & Yu, cubic B-splines)
 
 __all__ = ["kjellander", "poliakoff", "wang_cao", "wang_quintic", "uniform_spacing"]
 
