@@ -22,10 +22,14 @@ from .curves import (
     parameterize,
 )
 from .errors import CurvefairError, FileFormatError, InputError, MissingDependencyError
+from .io import CurveRecord, read_curves, write_curves  # noqa: I001
 from .analysis.discrete import (BadPoint, SecondDiscreteCurvature, bad_points,  # noqa: I001
                                  discrete_curvature, second_discrete_curvature)
 
 __all__ = [
+    "read_curves",
+    "write_curves",
+    "CurveRecord",
     "__version__",
     "CubicHermite",
     "QuinticHermite",

@@ -1,0 +1,280 @@
+"""Reading and writing curves: point lists, airfoils, JSON, DXF, Rhino 3dm, SVG, IGES, STEP.
+
+:func:`read_curves` returns a list of :class:`CurveRecord` -- the curve to fair plus what is
+needed to write it back faithfully; :func:`write_curves` writes faired records back, into a
+copy of the source file when ``template=`` names it (every other entity untouched).
+
+Formats (chosen by extension, or ``format=``):
+
+============  ===========================  ==========================================
+format        extensions                   needs
+============  ===========================  ==========================================
+``points``    .csv .txt .xyz .pts          --
+``airfoil``   .dat (Selig or Lednicer)     --
+``json``      .json (curvefair schema 1)   --
+``dxf``       .dxf                         ``pip install 'curvefair[dxf]'`` (ezdxf)
+``3dm``       .3dm                         ``pip install 'curvefair[rhino]'`` (rhino3dm)
+``svg``       .svg                         ``pip install 'curvefair[svg]'`` (svgpathtools)
+``iges``      .igs .iges                   ``pip install 'curvefair[occ]'`` (cadquery-ocp)
+``step``      .stp .step                   ``pip install 'curvefair[occ]'`` (cadquery-ocp)
+============  ===========================  ==========================================
+
+The record
+----------
+``CurveRecord(curve, name, kind, source, points, corners)``:
+
+- ``curve``: the curve to fair. Point data (points files, airfoils, polylines, DXF fit
+  points) become ``interpolate_cubic(points, "chord", "natural")`` (``"periodic"`` for a
+  closed loop); spline entities become :class:`~curvefair.BSplineCurve` with the file's
+  degree, knots and control points.
+- ``kind``: what the file held: ``"points"``, ``"airfoil"``, ``"polyline"``,
+  ``"fit_points"``, ``"bspline"``, ``"cubic_hermite"``, ``"quintic_hermite"``.
+- ``source``: format-specific facts for the write-back (file path, entity handle, layer,
+  object id, original text layout, name line, ...); always ``format``, ``path``, ``index``.
+- ``points``: the raw data points of point kinds.
+- ``corners``: indices of points to keep fixed (sharp corners, an airfoil's trailing edge):
+  give them to the fairing as ``protect``.
+
+Corners: a point list turning by ``corner_angle`` degrees (default 60) or more at a point is
+split into several records there, so that each record is smooth between its ends and the
+corner stays a corner; writing the records back joins the pieces again. Open airfoils also
+mark their first and last points (the trailing edge).
+
+Writing is always atomic (a temporary file in the destination folder, then ``os.replace``) and
+never replaces a file the curves were read from unless ``overwrite=True``.
+
+Examples
+--------
+>>> import os, tempfile
+>>> import numpy as np
+>>> from curvefair import read_curves, write_curves
+>>> d = tempfile.mkdtemp()
+>>> src = os.path.join(d, "wave.csv")
+>>> x = np.linspace(0, 3, 12)
+>>> np.savetxt(src, np.c_[x, np.sin(x)], delimiter=",", header="x,y", comments="")
+>>> recs = read_curves(src)
+>>> recs[0].kind, recs[0].curve.points.shape
+('points', (12, 2))
+>>> write_curves(os.path.join(d, "wave_faired.csv"), recs)
+>>> np.allclose(read_curves(os.path.join(d, "wave_faired.csv"))[0].points, recs[0].points)
+True
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any, Literal
+
+from .._validate import choice
+from ..curves.piecewise import PiecewiseCurve
+from ..errors import FileFormatError, InputError
+from ._common import KINDS, CurveRecord, atomic_path, atomic_write, curve_kind, same_path
+
+__all__ = ["read_curves", "write_curves", "CurveRecord", "KINDS", "FORMATS", "detect_format",
+           "atomic_write", "atomic_path"]
+
+FormatName = Literal["points", "airfoil", "json", "dxf", "3dm", "svg", "iges", "step"]
+
+#: format name -> file extensions
+FORMATS: dict[str, tuple[str, ...]] = {
+    "points": (".csv", ".txt", ".xyz", ".pts"),
+    "airfoil": (".dat",),
+    "json": (".json",),
+    "dxf": (".dxf",),
+    "3dm": (".3dm",),
+    "svg": (".svg",),
+    "iges": (".igs", ".iges"),
+    "step": (".stp", ".step"),
+}
+
+
+def detect_format(path: str | os.PathLike[str], format: str | None = None) -> str:
+    """The format name for ``path`` (by extension) or the validated ``format``."""
+    if format is not None:
+        return choice(format, FORMATS, "format")
+    ext = Path(path).suffix.lower()
+    for name, exts in FORMATS.items():
+        if ext in exts:
+            return name
+    known = ", ".join(e for exts in FORMATS.values() for e in exts)
+    raise InputError(f"cannot tell the format of {os.fspath(path)!r} from its extension "
+                     f"{ext!r}; known: {known}; or pass format=")
+
+
+def _module(fmt: str) -> Any:
+    # the modules themselves import their optional libraries lazily
+    if fmt == "points":
+        from . import points as m
+    elif fmt == "airfoil":
+        from . import airfoil as m
+    elif fmt == "json":
+        from . import jsonfmt as m
+    elif fmt == "dxf":
+        from . import dxf as m
+    elif fmt == "3dm":
+        from . import rhino as m
+    elif fmt == "svg":
+        from . import svg as m
+    else:
+        from . import occ as m
+    return m
+
+
+def read_curves(path: str | os.PathLike[str], *, format: FormatName | None = None,
+                corner_angle: float | None = 60.0,
+                on_unsupported: Literal["raise", "skip"] = "raise") -> list[CurveRecord]:
+    """Read every curve of a file.
+
+    Parameters
+    ----------
+    path : path-like
+    format : str, optional
+        One of :data:`FORMATS`; default: from the extension.
+    corner_angle : float or None
+        Point lists are split at points turning by this many degrees or more (None: never).
+    on_unsupported : {"raise", "skip"}
+        What to do with a curve entity curvefair cannot represent exactly (a rational or
+        unclamped DXF spline, a polyline with arcs, an SVG arc...): raise
+        :class:`~curvefair.FileFormatError` naming it, or skip it with a warning.
+
+    Returns
+    -------
+    list of CurveRecord
+        In file order (see the module docstring for the record).
+
+    Raises
+    ------
+    FileFormatError
+        Missing, empty, truncated or garbled file, NaN coordinates, duplicate consecutive
+        points, no curves; the message names the file and, for text formats, the line.
+    MissingDependencyError
+        The format's optional library is not installed (the message names the extra).
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> from curvefair import read_curves
+    >>> p = os.path.join(tempfile.mkdtemp(), "foil.dat")
+    >>> _ = open(p, "w").write("TOY\\n1 0\\n0.5 0.1\\n0 0\\n0.5 -0.05\\n1 0\\n")
+    >>> r = read_curves(p)
+    >>> r[0].kind, r[0].name, r[0].corners
+    ('airfoil', 'TOY', (0, 4))
+    """
+    fmt = detect_format(path, format)
+    choice(on_unsupported, ("raise", "skip"), "on_unsupported")
+    if corner_angle is not None:
+        corner_angle = float(corner_angle)
+        if not 0.0 < corner_angle <= 180.0:
+            raise InputError(f"corner_angle must be in (0, 180] degrees or None, got "
+                             f"{corner_angle!r}")
+    p = Path(path)
+    if not p.exists():
+        raise FileFormatError("no such file", path)
+    if p.is_dir():
+        raise FileFormatError("is a folder, not a file", path)
+    records = _module(fmt).read(path, corner_angle=corner_angle, on_unsupported=on_unsupported)
+    if not records:
+        raise FileFormatError(f"no curves in the {fmt} file", path)
+    return records
+
+
+def _as_records(curves: object) -> list[CurveRecord]:
+    if isinstance(curves, (CurveRecord, PiecewiseCurve)):
+        curves = [curves]
+    if not isinstance(curves, Sequence) or isinstance(curves, (str, bytes)):
+        raise InputError(f"curves must be a CurveRecord, a curve, or a sequence of them, got "
+                         f"{type(curves).__name__}")
+    out = []
+    for i, c in enumerate(curves):
+        if isinstance(c, CurveRecord):
+            out.append(c)
+        elif isinstance(c, PiecewiseCurve):
+            out.append(CurveRecord(c, None, curve_kind(c), {"format": None, "path": None,
+                                                            "index": i}))
+        else:
+            raise InputError(f"curves[{i}] must be a CurveRecord or a curve, got "
+                             f"{type(c).__name__}")
+    if not out:
+        raise InputError("curves is empty: nothing to write")
+    return out
+
+
+def _template_path(template: object) -> str | None:
+    if template is None:
+        return None
+    if isinstance(template, CurveRecord):
+        template = [template]
+    if isinstance(template, (str, os.PathLike)):
+        t = os.path.abspath(os.fspath(template))
+        if not os.path.isfile(t):
+            raise InputError(f"template: no such file {t!r}")
+        return t
+    if isinstance(template, Sequence) and template and \
+            all(isinstance(r, CurveRecord) for r in template):
+        paths = {r.path for r in template}
+        if len(paths) != 1 or None in paths:
+            raise InputError("template: the records must all come from one file")
+        return _template_path(paths.pop())
+    raise InputError(f"template must be a path, a CurveRecord or a list of records from one "
+                     f"file, got {type(template).__name__}")
+
+
+def write_curves(path: str | os.PathLike[str], curves: CurveRecord | PiecewiseCurve |
+                 Sequence[CurveRecord | PiecewiseCurve], *, template: object = None,
+                 format: FormatName | None = None, overwrite: bool = False,
+                 decimals: int | None = None) -> None:
+    """Write curves (usually faired records from :func:`read_curves`) to a file, atomically.
+
+    Parameters
+    ----------
+    path : path-like
+        Destination; the format comes from its extension unless ``format`` is given.
+    curves : CurveRecord, curve, or sequence of them
+        Records keep what the source file needs (layout, handles, ids). Bare curves are written
+        as new curves (new entities in DXF/3dm/SVG, a new file for point formats).
+    template : path, CurveRecord or list of records, optional
+        The source file. DXF, 3dm and SVG: the output is a copy of it in which the entities the
+        records came from are replaced (same handle / id / element, same degree, knot vector
+        and closedness) and everything else is untouched. Point formats: bare curves are
+        written into the template's layout, in order. Without a template DXF/3dm/SVG/IGES/STEP
+        files hold just the given curves; point formats use the layout stored in the records.
+    format : str, optional
+    overwrite : bool
+        Allow ``path`` to be a file the curves were read from (or the template).
+    decimals : int, optional
+        Text point formats: number of decimals for every number (default: as in the source).
+
+    Raises
+    ------
+    InputError
+        Nothing to write, a point count that differs from the source's, ``path`` is an input
+        file and ``overwrite`` is False, a curve the format cannot hold.
+    MissingDependencyError
+        The format's optional library is not installed.
+    """
+    fmt = detect_format(path, format)
+    records = _as_records(curves)
+    tpath = _template_path(template)
+    inputs = [tpath] + [r.path for r in records]
+    if not overwrite and any(p is not None and same_path(path, p) for p in inputs):
+        raise InputError(f"path {os.fspath(path)!r} is one of the input files; pass "
+                         "overwrite=True to replace it")
+    if decimals is not None and (isinstance(decimals, bool) or not isinstance(decimals, int)
+                                 or decimals < 0):
+        raise InputError(f"decimals must be an integer >= 0, got {decimals!r}")
+    mod = _module(fmt)
+    if fmt in ("points", "airfoil") and tpath is not None and \
+            all(r.format != fmt for r in records):
+        records = _fill_template(records, mod.read(tpath, corner_angle=None), tpath)
+    writer: Callable[..., None] = mod.write
+    writer(path, records, template=tpath, decimals=decimals)
+
+
+def _fill_template(records: list[CurveRecord], tmpl: list[CurveRecord],
+                   tpath: str) -> list[CurveRecord]:
+    if len(tmpl) != len(records):
+        raise InputError(f"template {tpath!r} holds {len(tmpl)} point list(s), got "
+                         f"{len(records)} curves")
+    return [t.with_curve(r.curve) for t, r in zip(tmpl, records, strict=False)]

@@ -1,0 +1,469 @@
+"""Shared pieces of the file formats: the record, atomic writes, lazy imports, corners.
+
+Nothing here is format specific; the format modules (``points``, ``airfoil``, ``jsonfmt``,
+``dxf``, ``rhino``, ``svg``, ``occ``) build on it.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import importlib
+import os
+import stat
+import tempfile
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any
+
+import numpy as np
+
+from .._typing import ArrayLike, FloatArray
+from ..curves.bspline import BSplineCurve
+from ..curves.hermite import CubicHermite, QuinticHermite
+from ..curves.interpolate import interpolate_cubic
+from ..curves.piecewise import PiecewiseCurve, readonly
+from ..errors import FileFormatError, InputError, MissingDependencyError
+
+__all__ = [
+    "CurveRecord",
+    "KINDS",
+    "atomic_write",
+    "atomic_path",
+    "lazy_import",
+    "turning_angles",
+    "split_at_corners",
+    "points_curve",
+    "check_points",
+]
+
+#: What a record's ``kind`` can say the file held.
+KINDS = ("points", "airfoil", "polyline", "fit_points", "bspline", "cubic_hermite",
+         "quintic_hermite")
+
+
+@dataclass(frozen=True, eq=False)
+class CurveRecord:
+    """One curve read from a file, with what is needed to write it back faithfully.
+
+    Attributes
+    ----------
+    curve : PiecewiseCurve
+        The curve to fair: a :class:`~curvefair.BSplineCurve` for spline entities, a
+        :class:`~curvefair.CubicHermite` (``interpolate_cubic(points, "chord", "natural")``, or
+        ``"periodic"`` for closed point loops) for point data, or whatever a JSON file held.
+    name : str or None
+        Name line of an airfoil, DXF layer + handle, 3dm object name, SVG path id, JSON name.
+    kind : str
+        What the file held (one of :data:`KINDS`): ``"points"`` (a text point list),
+        ``"airfoil"`` (a Selig/Lednicer ``.dat``), ``"polyline"`` (DXF/3dm/SVG polyline
+        vertices), ``"fit_points"`` (a DXF spline defined by fit points only), ``"bspline"``
+        (control points + knots), ``"cubic_hermite"``/``"quintic_hermite"`` (JSON).
+    source : mapping
+        Read-only, format specific; always ``"format"``, ``"path"`` (absolute, or None for
+        curves not read from a file) and ``"index"`` (0-based position of the record in the
+        file). See :doc:`docs/formats.md <formats>` for the keys of each format.
+    points : ndarray, shape (m, dim), or None
+        The raw data points of point kinds (``points``, ``airfoil``, ``polyline``,
+        ``fit_points``), in file order; ``curve.points`` starts as exactly these (plus the first
+        point repeated last for a closed loop).
+    corners : tuple of int
+        0-based indices into ``points`` (and ``curve.points``) that are sharp corners or fixed
+        ends (an airfoil's trailing edge): pass them to the fairing as ``protect``. A point list
+        with interior corners is split there into several records, so a corner is always the
+        first or last point of a record.
+
+    Notes
+    -----
+    Records are immutable; :meth:`with_curve` gives a copy holding the faired curve, which is
+    what :func:`curvefair.write_curves` takes.
+    """
+
+    curve: PiecewiseCurve
+    name: str | None = None
+    kind: str = "bspline"
+    source: Mapping[str, Any] = field(default_factory=dict)
+    points: FloatArray | None = None
+    corners: tuple[int, ...] = ()
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.curve, PiecewiseCurve):
+            raise InputError(f"curve must be a curvefair curve, got {type(self.curve).__name__}")
+        if self.kind not in KINDS:
+            raise InputError(f"kind must be one of {KINDS}, got {self.kind!r}")
+        if not isinstance(self.source, MappingProxyType):
+            object.__setattr__(self, "source", MappingProxyType(dict(self.source)))
+        if self.points is not None:
+            pts = np.array(self.points, dtype=np.float64)
+            object.__setattr__(self, "points", readonly(pts))
+        object.__setattr__(self, "corners", tuple(int(i) for i in self.corners))
+
+    @property
+    def format(self) -> str | None:
+        """The format the record was read from (``source["format"]``)."""
+        return self.source.get("format")
+
+    @property
+    def path(self) -> str | None:
+        """The file the record was read from (``source["path"]``)."""
+        return self.source.get("path")
+
+    def with_curve(self, curve: PiecewiseCurve) -> CurveRecord:
+        """A copy holding ``curve`` (e.g. the faired one); everything else unchanged."""
+        return dataclasses.replace(self, curve=curve)
+
+    def __repr__(self) -> str:
+        return (f"CurveRecord(name={self.name!r}, kind={self.kind!r}, format={self.format!r}, "
+                f"curve={self.curve!r}, corners={self.corners})")
+
+
+# ------------------------------------------------------------------------------------------
+# atomic writes
+# ------------------------------------------------------------------------------------------
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+@contextlib.contextmanager
+def atomic_path(path: str | os.PathLike[str], suffix: str | None = None) -> Iterator[Path]:
+    """Yield a temporary path in the destination folder; on success ``os.replace`` it onto
+    ``path``, on error delete it. The destination keeps its permissions if it existed.
+
+    For libraries that save to a file name (ezdxf, rhino3dm, OCC). ``suffix`` defaults to the
+    destination's (some libraries choose the format by the extension).
+    """
+    dest = Path(path)
+    folder = dest.parent if str(dest.parent) else Path(".")
+    if not folder.is_dir():
+        raise InputError(f"path: the folder {str(folder)!r} does not exist")
+    fd, tmp = tempfile.mkstemp(prefix="." + dest.name + ".", suffix=dest.suffix if suffix is None
+                               else suffix, dir=folder)
+    os.close(fd)
+    tmp_path = Path(tmp)
+    try:
+        yield tmp_path
+        if dest.exists():
+            mode = stat.S_IMODE(dest.stat().st_mode)
+        else:
+            mode = 0o666 & ~_umask()
+        os.chmod(tmp_path, mode)
+        os.replace(tmp_path, dest)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            tmp_path.unlink()
+        raise
+
+
+def atomic_write(path: str | os.PathLike[str], data: str | bytes | Callable[[Any], None],
+                 *, encoding: str = "utf-8", newline: str | None = "") -> None:
+    """Write ``data`` to ``path`` atomically: temp file in the same folder, fsync, os.replace.
+
+    Parameters
+    ----------
+    path : path-like
+    data : str, bytes, or callable
+        Text, bytes, or a function called with the open (text) file object.
+    encoding : str
+        For text.
+    newline : str or None
+        As for :func:`open`; the default ``""`` writes line endings exactly as given.
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> d = tempfile.mkdtemp()
+    >>> atomic_write(os.path.join(d, "a.txt"), "hello\\n")
+    >>> open(os.path.join(d, "a.txt")).read()
+    'hello\\n'
+    """
+    with atomic_path(path) as tmp:
+        if isinstance(data, bytes):
+            with open(tmp, "wb") as fb:
+                fb.write(data)
+                fb.flush()
+                os.fsync(fb.fileno())
+        else:
+            with open(tmp, "w", encoding=encoding, newline=newline) as ft:
+                if callable(data):
+                    data(ft)
+                else:
+                    ft.write(data)
+                ft.flush()
+                os.fsync(ft.fileno())
+
+
+# ------------------------------------------------------------------------------------------
+# optional dependencies
+# ------------------------------------------------------------------------------------------
+def lazy_import(module: str, package: str, extra: str, what: str) -> Any:
+    """Import ``module`` or raise :class:`MissingDependencyError` naming the extra."""
+    try:
+        return importlib.import_module(module)
+    except ImportError:
+        raise MissingDependencyError(package, extra, what) from None
+
+
+# ------------------------------------------------------------------------------------------
+# points, corners
+# ------------------------------------------------------------------------------------------
+def check_points(pts: FloatArray, path: object, lines: Sequence[int | None] | None = None,
+                 what: str = "point") -> None:
+    """FileFormatError for NaN/inf coordinates and duplicate consecutive points.
+
+    ``lines`` (1-based line numbers per point) makes the message name the line.
+    """
+    bad = ~np.isfinite(pts).all(axis=1)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        ln = None if lines is None else lines[i]
+        raise FileFormatError(f"{what} {i} has a non-finite coordinate {pts[i].tolist()}",
+                              path, ln)
+    if pts.shape[0] > 1:
+        d = np.abs(np.diff(pts, axis=0)).max(axis=1)
+        scale = max(float(np.abs(pts).max()), np.finfo(float).tiny)
+        dup = np.flatnonzero(d <= 4 * np.finfo(float).eps * scale)
+        if dup.size:
+            i = int(dup[0])
+            ln = None if lines is None else lines[i + 1]
+            where = "" if lines is None or lines[i] is None else f" (lines {lines[i]} and {ln})"
+            raise FileFormatError(
+                f"duplicate consecutive {what}s {i} and {i + 1}{where}: {pts[i].tolist()}",
+                path, ln)
+
+
+def turning_angles(points: FloatArray, closed: bool) -> FloatArray:
+    """Turning angle in degrees at every point, shape ``(n,)``.
+
+    The angle between the incoming chord ``p_i - p_{i-1}`` and the outgoing chord
+    ``p_{i+1} - p_i`` (0 = straight on, 180 = reversal). Open curves get 0 at both ends; a
+    closed loop (first point NOT repeated) wraps around.
+    """
+    p = np.asarray(points, dtype=float)
+    n = p.shape[0]
+    out = np.zeros(n)
+    if n < 3:
+        return out
+    if closed:
+        a = p - np.roll(p, 1, axis=0)
+        b = np.roll(p, -1, axis=0) - p
+    else:
+        a = p[1:-1] - p[:-2]
+        b = p[2:] - p[1:-1]
+    na = np.linalg.norm(a, axis=1)
+    nb = np.linalg.norm(b, axis=1)
+    cos = np.einsum("ij,ij->i", a, b) / np.maximum(na * nb, np.finfo(float).tiny)
+    ang = np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
+    if closed:
+        out[:] = ang
+    else:
+        out[1:-1] = ang
+    return out
+
+
+def split_at_corners(points: FloatArray, closed: bool, corner_angle: float | None,
+                     extra_corners: Sequence[int] = ()) -> tuple[list[np.ndarray], FloatArray]:
+    """Cut a point list at its corners.
+
+    Parameters
+    ----------
+    points : ndarray, shape (m, dim)
+        Distinct points (a closed loop does NOT repeat its first point).
+    closed : bool
+    corner_angle : float or None
+        A point whose turning angle (:func:`turning_angles`) is ``>= corner_angle`` degrees is a
+        corner; None: no detection.
+    extra_corners : sequence of int
+        Points that are corners whatever their angle.
+
+    Returns
+    -------
+    pieces : list of int ndarray
+        Indices into ``points`` of each piece, in order. A closed loop without corners is one
+        piece ``[0, 1, ..., m-1, 0]`` (its first point repeated last, as a closed curve stores
+        it); otherwise every piece runs from a corner (or end) to the next, sharing corners.
+    angles : ndarray, shape (m,)
+    """
+    m = points.shape[0]
+    angles = turning_angles(points, closed)
+    is_c = np.zeros(m, dtype=bool)
+    if corner_angle is not None:
+        is_c |= angles >= float(corner_angle)
+    if len(extra_corners):
+        is_c[np.asarray(extra_corners, dtype=int) % m] = True
+    if not closed:
+        is_c[0] = is_c[-1] = False
+        cuts = np.r_[0, np.flatnonzero(is_c), m - 1]
+        return [np.arange(a, b + 1) for a, b in zip(cuts[:-1], cuts[1:], strict=False)], angles
+    c = np.flatnonzero(is_c)
+    if c.size == 0:
+        return [np.r_[np.arange(m), 0]], angles
+    ext = np.r_[c, c[0] + m]
+    return [np.arange(a, b + 1) % m for a, b in zip(ext[:-1], ext[1:], strict=False)], angles
+
+
+def points_curve(pts: FloatArray, closed_loop: bool) -> CubicHermite:
+    """The curve through data points: C2 cubic, chord parameters, natural (open) or periodic.
+
+    ``closed_loop``: ``pts`` repeats its first point last and the curve is periodic.
+    """
+    if closed_loop:
+        return interpolate_cubic(pts, "chord", "periodic")
+    return interpolate_cubic(pts, "chord", "natural")
+
+
+def data_points(curve: PiecewiseCurve, what: str) -> FloatArray:
+    """The data points of a Hermite curve (what a points format writes back)."""
+    pts = getattr(curve, "points", None)
+    if pts is None:
+        raise InputError(
+            f"{what}: a {type(curve).__name__} has no data points to write to a points format; "
+            "write it to JSON, DXF, 3dm or SVG, or evaluate it at the parameters you want")
+    return np.asarray(pts, dtype=float)
+
+
+def piece_values(n_points: int, dim: int, records: Sequence[CurveRecord], what: str,
+                 closed_loop_dup: bool = False) -> FloatArray:
+    """Assemble the written points of a split point list from its records.
+
+    Every record has ``source["indices"]`` (indices into the assembled list of ``n_points``
+    points) and a curve with matching data points. Points shared by two pieces (corners) take
+    the value of the first piece that has them.
+    """
+    out = np.full((n_points, dim), np.nan)
+    for rec in records:
+        idx = np.asarray(rec.source["indices"], dtype=int)
+        pts = data_points(rec.curve, what)
+        if pts.shape != (idx.shape[0], dim):
+            raise InputError(
+                f"{what}: record {rec.source.get('index')} ({rec.name!r}) must have "
+                f"{idx.shape[0]} data points of dimension {dim} (the number read), got "
+                f"{pts.shape[0]} of dimension {pts.shape[1]}")
+        fresh = np.isnan(out[idx, 0])
+        out[idx[fresh]] = pts[fresh]
+    missing = np.flatnonzero(np.isnan(out[:, 0]))
+    if missing.size:
+        raise InputError(f"{what}: no record gives point {int(missing[0])} of the source; pass "
+                         "every record read from the file")
+    return out
+
+
+def bspline_from_data(control_points: ArrayLike, knots: ArrayLike, degree: int,
+                      closed: bool) -> BSplineCurve:
+    return BSplineCurve(control_points, knots, degree, closed=closed)
+
+
+def curve_kind(curve: PiecewiseCurve) -> str:
+    """The record kind of a bare curve."""
+    if isinstance(curve, BSplineCurve):
+        return "bspline"
+    if isinstance(curve, QuinticHermite):
+        return "quintic_hermite"
+    if isinstance(curve, CubicHermite):
+        return "cubic_hermite"
+    raise InputError(f"unsupported curve type {type(curve).__name__}")
+
+
+def bezier_pieces(curve: PiecewiseCurve, what: str) -> FloatArray:
+    """Cubic Bezier control points of every polynomial piece, shape ``(m, 4, dim)``.
+
+    Exact for curves of degree <= 3 (lower degrees are elevated); raises for higher degrees.
+
+    Notes
+    -----
+    From the local power form ``r = a0 + a1 s + a2 s^2 + a3 s^3`` on ``s in [0, h]``:
+    ``b0 = a0``, ``b1 = a0 + a1 h/3``, ``b2 = a0 + 2 a1 h/3 + a2 h^2/3``, ``b3 = r(h)``.
+    """
+    pp = curve.piecewise
+    if pp.degree > 3:
+        raise InputError(f"{what}: a degree-{pp.degree} curve has no exact cubic Bezier form; "
+                         "fair a cubic curve, or write it to JSON/DXF/3dm")
+    c = np.zeros((pp.n_segments, 4, pp.dim))
+    c[:, : pp.degree + 1] = pp.coeffs
+    h = pp.widths[:, None]
+    a0, a1, a2, a3 = c[:, 0], c[:, 1] * h, c[:, 2] * h**2, c[:, 3] * h**3
+    b = np.empty_like(c)
+    b[:, 0] = a0
+    b[:, 1] = a0 + a1 / 3.0
+    b[:, 2] = a0 + 2.0 * a1 / 3.0 + a2 / 3.0
+    b[:, 3] = a0 + a1 + a2 + a3
+    return b
+
+
+def is_clamped(knots: FloatArray, degree: int) -> bool:
+    p = degree
+    return bool(np.all(knots[: p + 1] == knots[0]) and np.all(knots[-p - 1:] == knots[-1]))
+
+
+def same_path(a: object, b: object) -> bool:
+    """True when two paths name the same existing file."""
+    try:
+        return os.path.samefile(os.fspath(a), os.fspath(b))  # type: ignore[arg-type]
+    except (OSError, TypeError):
+        return False
+
+
+def point_records(points: FloatArray, *, closed: bool, corner_angle: float | None,
+                  kind: str, name: str | None, source: Mapping[str, Any],
+                  end_corners: bool = False, first_index: int = 0) -> list[CurveRecord]:
+    """Records of one point list: split at corners, each piece a curve through its points.
+
+    Parameters
+    ----------
+    points : ndarray, shape (m, dim)
+        Distinct points in order (a closed loop does not repeat its first point).
+    closed : bool
+        The list is a closed loop.
+    end_corners : bool
+        The first and last points are corners too (an airfoil's trailing edge).
+    source : mapping
+        Common source keys; each record adds ``"indices"`` (into ``points``), ``"n_points"``
+        (``m``), ``"closed"``, ``"piece"``, ``"n_pieces"``, ``"index"``.
+    first_index : int
+        ``source["index"]`` of the first record.
+    """
+    m = points.shape[0]
+    pieces, _ = split_at_corners(points, closed, corner_angle)
+    loop = closed and len(pieces) == 1
+    is_corner = np.zeros(m, dtype=bool)
+    if len(pieces) > 1:
+        for idx in pieces:
+            is_corner[idx[0]] = is_corner[idx[-1]] = True
+        if not closed:
+            is_corner[0] = is_corner[-1] = False
+    if end_corners and not closed:
+        is_corner[0] = is_corner[-1] = True
+    records = []
+    for k, idx in enumerate(pieces):
+        pts = points[idx]
+        curve = points_curve(pts, loop)
+        corners = tuple(int(j) for j in np.flatnonzero(is_corner[idx]) if not loop)
+        src = dict(source)
+        src.update(index=first_index + k, indices=tuple(int(i) for i in idx), n_points=m,
+                   closed=bool(closed), piece=k, n_pieces=len(pieces))
+        pname = name if len(pieces) == 1 or name is None else f"{name} [{k}]"
+        records.append(CurveRecord(curve, pname, kind, src, pts, corners))
+    return records
+
+
+def joined_points(records: Sequence[CurveRecord], what: str) -> FloatArray:
+    """The points of one point list, from its records (pieces joined again) or one curve.
+
+    Records that were split from one list (``source["indices"]``) are joined; a closed loop
+    comes back with its first point repeated last.
+    """
+    paths = {(r.path, r.format) for r in records}
+    if len(paths) == 1 and all("indices" in r.source for r in records):
+        n = int(records[0].source["n_points"])
+        dim = data_points(records[0].curve, what).shape[1]
+        pts = piece_values(n, dim, records, what)
+        if records[0].source.get("closed"):
+            pts = np.vstack([pts, pts[:1]])
+        return pts
+    if len(records) != 1:
+        raise InputError(f"{what}: a point file holds one point list, got {len(records)} "
+                         "curves (write each to its own file, or use JSON)")
+    return data_points(records[0].curve, what)

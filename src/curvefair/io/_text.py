@@ -1,0 +1,308 @@
+"""Line layout of numeric text files (CSV, whitespace columns, airfoil ``.dat``).
+
+A :class:`TextLayout` remembers every line of the file: comments, blank lines, the header or
+name line and, for each data row, the exact separators, padding and number style of its
+tokens, so that new values can be written back in the same layout (same columns, same
+number of decimals where that keeps the value, right-aligned columns stay aligned).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .._typing import FloatArray
+from ..errors import FileFormatError
+
+__all__ = ["TextLayout", "Token", "parse_text", "format_number"]
+
+_NUM = r"[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|nan|inf(?:inity)?)"
+_NUM_RE = re.compile(_NUM, re.IGNORECASE)
+_SEP_RE = re.compile(r"(\s*[,;]\s*|\s+)")
+
+
+@dataclass(frozen=True)
+class Token:
+    """Style of one number as it stood in the file."""
+
+    text: str
+    decimals: int      # digits after the point (of the mantissa for exponent style)
+    has_point: bool
+    exponent: str      # "" (fixed), "e" or "E"
+    exp_digits: int
+    exp_plus: bool     # an explicit '+' in the exponent
+    plus: bool         # an explicit leading '+'
+    bare_point: bool   # ".5" rather than "0.5"
+
+    @classmethod
+    def parse(cls, text: str) -> Token:
+        t = text
+        m = re.match(r"([+-]?)([^eE]*)(?:([eE])([+-]?)(\d+))?$", t)
+        assert m is not None
+        mant = m.group(2)
+        has_point = "." in mant
+        dec = len(mant.split(".", 1)[1]) if has_point else 0
+        exp = m.group(3) or ""
+        return cls(t, dec, has_point, exp, len(m.group(5) or ""), m.group(4) == "+",
+                   m.group(1) == "+", mant.startswith("."))
+
+
+def _render(v: float, tok: Token, decimals: int) -> str:
+    if tok.exponent:
+        mant, ex = f"{v:.{decimals}e}".split("e")
+        digits = (ex[1:].lstrip("0") or "0").rjust(tok.exp_digits, "0")
+        sign = "-" if ex[0] == "-" else ("+" if tok.exp_plus else "")
+        s = f"{mant}{tok.exponent}{sign}{digits}"
+    else:
+        s = f"{v:.{decimals}f}"
+        if decimals == 0 and tok.has_point:
+            s += "."
+    if tok.bare_point and not tok.exponent:
+        if s.startswith("0."):
+            s = s[1:]
+        elif s.startswith("-0."):
+            s = "-" + s[2:]
+    if tok.plus and not s.startswith("-"):
+        s = "+" + s
+    if float(s) == 0.0 and s.startswith("-") and not tok.text.startswith("-"):
+        s = s[1:]
+    return s
+
+
+def _shortest(v: float) -> str:
+    s = repr(float(v))
+    if s.endswith(".0"):
+        s = s[:-2]
+    return "0" if s == "-0" else s
+
+
+def format_number(v: float, tok: Token, column_decimals: int,
+                  decimals: int | None = None) -> str:
+    """Text for ``v`` in the style of the token it replaces.
+
+    1. ``decimals`` given: that many decimals, the token's style (fixed or exponent).
+    2. The token's own number of decimals if that writes ``v`` exactly (untouched values come
+       back character for character).
+    3. Otherwise the column's largest number of decimals in the file (the file's precision:
+       the value is rounded to it), or the shortest exact representation for integer columns.
+    """
+    if decimals is not None:
+        return _render(v, tok, int(decimals))
+    s = _render(v, tok, tok.decimals)
+    if float(s) == v:
+        return s
+    if column_decimals > 0 or tok.exponent:
+        return _render(v, tok, max(column_decimals, 1))
+    return _shortest(v)
+
+
+@dataclass(frozen=True)
+class Row:
+    """One data line split into pieces: ``prefix tok0 sep0 tok1 ... suffix``."""
+
+    prefix: str
+    tokens: tuple[Token, ...]
+    seps: tuple[str, ...]
+    suffix: str
+
+    def render(self, values: Sequence[float], column_decimals: Sequence[int],
+               decimals: int | None) -> str:
+        out = []
+        lead = self.prefix
+        for j, (tok, v) in enumerate(zip(self.tokens, values, strict=False)):
+            s = format_number(float(v), tok, column_decimals[j], decimals)
+            # keep right-aligned columns aligned: the blanks before the token absorb the
+            # change of length (at least one blank stays between whitespace-separated tokens)
+            delta = len(s) - len(tok.text)
+            core = lead.rstrip(" \t")
+            pad = lead[len(core):]
+            if delta and pad:
+                keep = 0 if j == 0 else 1
+                lead = core + pad[0] * max(len(pad) - delta, keep)
+            out.append(lead)
+            out.append(s)
+            lead = self.seps[j] if j < len(self.seps) else ""
+        out.append(self.suffix)
+        return "".join(out)
+
+
+@dataclass(frozen=True, eq=False)
+class TextLayout:
+    """Every line of a numeric text file, to write new values in the same layout.
+
+    Attributes
+    ----------
+    lines : tuple of str
+        The lines without their line ending.
+    newline : str
+        ``"\\n"`` or ``"\\r\\n"``.
+    final_newline : bool
+    header : int or None
+        0-based line index of the header / name line.
+    data_lines : tuple of int
+        0-based line index of each data row, in file order.
+    rows : tuple of Row
+    ncols : int
+    column_decimals : tuple of int
+        Largest number of decimals per column in the file.
+    encoding : str
+    """
+
+    lines: tuple[str, ...]
+    newline: str
+    final_newline: bool
+    header: int | None
+    data_lines: tuple[int, ...]
+    rows: tuple[Row, ...]
+    ncols: int
+    column_decimals: tuple[int, ...]
+    encoding: str
+    values: FloatArray
+
+    @property
+    def header_text(self) -> str | None:
+        return None if self.header is None else self.lines[self.header]
+
+    def line_numbers(self) -> list[int]:
+        """1-based line number of each data row."""
+        return [i + 1 for i in self.data_lines]
+
+    def render(self, values: FloatArray, decimals: int | None = None,
+               keep_rows: Sequence[int] = ()) -> str:
+        """The file text with the data rows replaced by ``values`` (shape ``(rows, ncols)``).
+
+        Rows listed in ``keep_rows`` are written exactly as they were (e.g. a Lednicer count
+        line).
+        """
+        if values.shape != (len(self.rows), self.ncols):
+            raise ValueError(f"values must have shape {(len(self.rows), self.ncols)}, "
+                             f"got {values.shape}")
+        lines = list(self.lines)
+        keep = set(int(k) for k in keep_rows)
+        for r, (li, row) in enumerate(zip(self.data_lines, self.rows, strict=False)):
+            if r in keep:
+                continue
+            lines[li] = row.render(values[r], self.column_decimals, decimals)
+        text = self.newline.join(lines)
+        if self.final_newline:
+            text += self.newline
+        return text
+
+
+def _split_row(line: str) -> Row | None:
+    """Parse a data line, or None when it is not all numbers."""
+    hash_at = line.find("#")
+    body, comment = (line, "") if hash_at < 0 else (line[:hash_at], line[hash_at:])
+    stripped = body.strip()
+    if not stripped:
+        return None
+    prefix = body[: len(body) - len(body.lstrip())]
+    trail = body[len(body.rstrip()):]
+    parts = _SEP_RE.split(stripped)
+    toks = parts[0::2]
+    seps = parts[1::2]
+    if not toks or not all(_NUM_RE.fullmatch(t) for t in toks):
+        return None
+    return Row(prefix, tuple(Token.parse(t) for t in toks), tuple(seps), trail + comment)
+
+
+def read_lines(path: str | os.PathLike[str]) -> tuple[list[str], str, bool, str]:
+    """Lines, newline, final-newline flag and encoding of a text file."""
+    try:
+        with open(path, "rb") as f:
+            raw = f.read()
+    except OSError as exc:
+        raise FileFormatError(f"cannot read the file: {exc.strerror or exc}", path) from None
+    if b"\x00" in raw:
+        line = raw[: raw.index(b"\x00")].count(b"\n") + 1
+        raise FileFormatError("binary data (NUL byte) in a text file", path, line)
+    encoding = "utf-8"
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        encoding = "latin-1"
+        text = raw.decode("latin-1")
+    newline = "\r\n" if "\r\n" in text else "\n"
+    final = text.endswith("\n")
+    body = text.replace("\r\n", "\n")
+    lines = body.split("\n")
+    if final:
+        lines = lines[:-1]
+    return lines, newline, final, encoding
+
+
+def parse_text(path: str | os.PathLike[str], *, header: bool = True,
+               ncols: Sequence[int] = (2, 3), what: str = "points file") -> TextLayout:
+    """Parse a numeric text file into a :class:`TextLayout`.
+
+    Comments start with ``#`` (whole lines or after the numbers), blank lines are kept, one
+    non-numeric line before the first data row is the header (or the name line of an airfoil)
+    when ``header`` is True. Separators: blanks, commas or semicolons.
+
+    Raises
+    ------
+    FileFormatError
+        Empty file, no data, a non-numeric line among the data, a different number of columns
+        than the first data row, a column count not in ``ncols``.
+    """
+    lines, newline, final, encoding = read_lines(path)
+    head: int | None = None
+    data_lines: list[int] = []
+    rows: list[Row] = []
+    width: int | None = None
+    for i, line in enumerate(lines):
+        s = line.strip()
+        if not s or s.startswith("#"):
+            continue
+        row = _split_row(line)
+        if row is None:
+            if not data_lines and head is None and header:
+                head = i
+                continue
+            short = s if len(s) <= 60 else s[:57] + "..."
+            if data_lines:
+                raise FileFormatError(f"not a row of numbers: {short!r}", path, i + 1)
+            raise FileFormatError(f"not a row of numbers (and not a header): {short!r}",
+                                  path, i + 1)
+        k = len(row.tokens)
+        if width is None:
+            if k not in ncols:
+                raise FileFormatError(
+                    f"{what} rows need {' or '.join(map(str, ncols))} columns, got {k}",
+                    path, i + 1)
+            width = k
+        elif k != width:
+            raise FileFormatError(
+                f"row has {k} columns but the first data row (line {data_lines[0] + 1}) has "
+                f"{width}", path, i + 1)
+        data_lines.append(i)
+        rows.append(row)
+    if not rows:
+        if not any(line.strip() for line in lines):
+            raise FileFormatError(f"empty {what}", path)
+        raise FileFormatError(f"no data rows in the {what}", path)
+    assert width is not None
+    values = np.array([[float(t.text) for t in r.tokens] for r in rows], dtype=np.float64)
+    col_dec = tuple(max(r.tokens[j].decimals for r in rows) for j in range(width))
+    return TextLayout(tuple(lines), newline, final, head, tuple(data_lines), tuple(rows), width,
+                      col_dec, encoding, values)
+
+
+def fresh_text(values: FloatArray, *, sep: str, header: str | None = None,
+               comments: Sequence[str] = ()) -> str:
+    """Text of a new points file: shortest exact numbers, ``sep`` between columns."""
+    out = [f"# {c}" for c in comments]
+    if header is not None:
+        out.append(header)
+    out.extend(sep.join(_shortest(float(v)) for v in row) for row in values)
+    return "\n".join(out) + "\n"
+
+
+def all_integral(vals: Sequence[Any]) -> bool:
+    return all(math.isfinite(v) and float(v).is_integer() for v in vals)

@@ -1,0 +1,130 @@
+"""Airfoil coordinate files (``.dat``) in the two layouts of the UIUC airfoil database.
+
+Selig
+    A name line, then ``x y`` rows from the trailing edge over the upper surface to the
+    leading edge and back along the lower surface to the trailing edge.
+Lednicer
+    A name line, a count line ``NU. NL.`` (number of upper and lower points), then the upper
+    surface from leading to trailing edge, then the lower surface from leading to trailing edge
+    (usually separated by blank lines; both usually start with the same leading-edge point).
+
+Records
+-------
+The contour in Selig order (Lednicer: upper reversed, then lower, the shared leading-edge
+point once) as ``kind="airfoil"`` records; the first and last points (the trailing edge) are
+corners, and so is any interior point turning by ``corner_angle`` or more (the contour is then
+split there). ``name`` is the name line. ``source`` keys: ``layout`` (TextLayout), ``airfoil_layout``
+(``"selig"`` or ``"lednicer"``), ``counts`` (Lednicer ``(NU, NL)``), ``row_map`` (file data row ->
+contour point; the count line is row 0 of a Lednicer file and maps to -1), ``indices``,
+``n_points``, ``closed`` (always False), ``piece``, ``n_pieces``.
+
+Writing
+-------
+The same layout: name line, count line and blank lines kept, each surface in its own order, the
+leading-edge point written to both surfaces of a Lednicer file, numbers formatted as
+:mod:`curvefair.io.points` does.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from ..errors import FileFormatError, InputError
+from ._common import (
+    CurveRecord,
+    atomic_write,
+    check_points,
+    joined_points,
+    piece_values,
+    point_records,
+)
+from ._text import TextLayout, fresh_text, parse_text
+
+__all__ = ["read", "write"]
+
+FORMAT = "airfoil"
+
+
+def _is_count_row(v: np.ndarray) -> bool:
+    return bool(np.all(v >= 2) and np.all(v == np.round(v)))
+
+
+def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
+         **_: Any) -> list[CurveRecord]:
+    """Read a Selig or Lednicer airfoil file; see the module docstring."""
+    lay = parse_text(path, header=True, ncols=(2,), what="airfoil file")
+    vals = lay.values
+    lines = lay.line_numbers()
+    name = lay.header_text.strip() if lay.header is not None else None
+    if _is_count_row(vals[0]):
+        nu, nl = (int(v) for v in vals[0])
+        pts = vals[1:]
+        got = pts.shape[0]
+        if got != nu + nl:
+            raise FileFormatError(
+                f"Lednicer count line (line {lines[0]}) announces {nu} + {nl} = {nu + nl} "
+                f"points, the file has {got}" + (" (truncated?)" if got < nu + nl else ""),
+                path, lines[-1])
+        upper, lower = pts[:nu], pts[nu:]
+        check_points(upper, path, lines[1:nu + 1])
+        check_points(lower, path, lines[nu + 1:])
+        shared = bool(np.array_equal(upper[0], lower[0]))
+        contour = np.vstack([upper[::-1], lower[1:] if shared else lower])
+        lo_map = np.arange(nl) + (nu - 1 if shared else nu)
+        # upper row i (LE -> TE) is contour point nu-1-i; the count line maps to -1
+        row_map = np.r_[-1, nu - 1 - np.arange(nu), lo_map]
+        kind_layout = "lednicer"
+        counts: tuple[int, int] | None = (nu, nl)
+        contour_lines = [lines[1 + nu - 1 - i] for i in range(nu)] + \
+            [lines[1 + nu + j] for j in range(1 if shared else 0, nl)]
+    else:
+        contour = vals
+        row_map = np.arange(vals.shape[0])
+        kind_layout = "selig"
+        counts = None
+        contour_lines = lines
+    check_points(contour, path, contour_lines)
+    if contour.shape[0] < 3:
+        raise FileFormatError(f"an airfoil needs at least 3 points, got {contour.shape[0]}",
+                              path)
+    src = {"format": FORMAT, "path": os.path.abspath(path), "layout": lay,
+           "airfoil_layout": kind_layout, "counts": counts,
+           "row_map": tuple(int(i) for i in row_map)}
+    return point_records(contour, closed=False, corner_angle=corner_angle, kind="airfoil",
+                         name=name, source=src, end_corners=True)
+
+
+def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
+          decimals: int | None = None, **_: Any) -> None:
+    """Write an airfoil file; see the module docstring.
+
+    Records read from an airfoil file are written back into its layout; one other curve is
+    written as a new Selig file (name line = the record's name, or ``"curvefair airfoil"``).
+    """
+    lays = {id(r.source.get("layout")): r.source.get("layout") for r in records}
+    lay = next(iter(lays.values()))
+    if len(lays) == 1 and isinstance(lay, TextLayout) and \
+            all(r.format == FORMAT for r in records):
+        n_points = int(records[0].source["n_points"])
+        contour = piece_values(n_points, 2, records, "write_curves")
+        row_map = np.asarray(records[0].source["row_map"], dtype=int)
+        rows = np.array(lay.values)
+        keep = np.flatnonzero(row_map < 0)
+        use = row_map >= 0
+        rows[use] = contour[row_map[use]]
+        atomic_write(path, lay.render(rows, decimals, keep_rows=keep))
+        return
+    pts = joined_points(records, "write_curves")
+    if pts.shape[1] != 2:
+        raise InputError(f"an airfoil file holds 2-D points, got dimension {pts.shape[1]}")
+    name = records[0].name or "curvefair airfoil"
+    if decimals is not None:
+        text = name + "\n" + "".join(f" {x:.{int(decimals)}f} {y:.{int(decimals)}f}\n"
+                                     for x, y in pts)
+    else:
+        text = fresh_text(pts, sep=" ", header=name)
+    atomic_write(path, text)
