@@ -428,33 +428,56 @@ def _clamped_move(P, D, h, orig, k, method, degree, spline, hstep, tol, delta, e
 
     Fills ``delta`` with the (clamped) position change and ``eta``/``xi`` with the derivative
     changes that are optimal for that position (hermite mode). Returns
-    ``(norm of move, clamped?)``.
+    ``(norm of move, clamped?, norm of the unclamped move)``.
     """
     dim = P.shape[1]
     if degree == 3:
         cubic_step(P, D, h, k, method, hstep, delta, eta)
     else:
         quintic_step(P, D, h, k, delta, eta, xi, False)
+    # work with the rounded new position so that the move applied is exactly delta and the
+    # tolerance holds for the stored numbers, not only in exact arithmetic
+    new = np.empty(dim)
+    want = 0.0
+    for c in range(dim):
+        new[c] = P[k, c] + delta[c]
+        want += delta[c] ** 2
+    want = np.sqrt(want)
     clamped = False
     if tol > 0.0:
-        off = 0.0
-        for c in range(dim):
-            off += (P[k, c] + delta[c] - orig[k, c]) ** 2
-        off = np.sqrt(off)
-        if off > tol:
-            f = tol / off * (1.0 - 4e-16)
+        tol_eff = tol * (1.0 - 1e-12)
+        for _ in range(8):
+            off = 0.0
             for c in range(dim):
-                delta[c] = orig[k, c] + (P[k, c] + delta[c] - orig[k, c]) * f - P[k, c]
+                off += (new[c] - orig[k, c]) ** 2
+            off = np.sqrt(off)
+            if off <= tol_eff:
+                break
+            f = tol_eff / off * (1.0 - 1e-15)
+            for c in range(dim):
+                new[c] = orig[k, c] + (new[c] - orig[k, c]) * f
             clamped = True
-            if not spline:
-                if degree == 5:
-                    quintic_step(P, D, h, k, delta, eta, xi, True)
-                elif method == WANG_CAO:
-                    wang_cao_eta_given_delta(P, D, h, k, delta, eta)
+    for c in range(dim):
+        delta[c] = new[c] - P[k, c]
+    if clamped and not spline:
+        if degree == 5:
+            quintic_step(P, D, h, k, delta, eta, xi, True)
+        elif method == WANG_CAO:
+            wang_cao_eta_given_delta(P, D, h, k, delta, eta)
     mv = 0.0
     for c in range(dim):
         mv += delta[c] ** 2
-    return np.sqrt(mv), clamped
+    return np.sqrt(mv), clamped, want
+
+
+# a clamped move smaller than this fraction of the move the step wants counts as blocked: the
+# point sits on its tolerance sphere and could only creep along it
+BLOCK_FRACTION = 1e-3
+
+
+@njit(cache=True, inline="always")
+def _is_blocked(mv, clamped, want, move_floor):  # type: ignore[no-untyped-def]
+    return mv <= move_floor or (clamped and mv <= BLOCK_FRACTION * want)
 
 
 @njit(cache=True)
@@ -518,9 +541,9 @@ def drive(P, D, h, orig, closed, degree, method, spline, hstep, eligible, tol, e
         if v < eps:
             stop = STOP_EPS
             break
-        mv, clamped = _clamped_move(P, D, h, orig, k, method, degree, spline, hstep, tol,
-                                    delta, eta, xi)
-        if mv <= move_floor:
+        mv, clamped, want = _clamped_move(P, D, h, orig, k, method, degree, spline, hstep, tol,
+                                          delta, eta, xi)
+        if _is_blocked(mv, clamped, want, move_floor):
             blocked[k] = 1 if clamped else 2
             tt_update(tv, ti, k, -np.inf)
             n_skip += 1
@@ -650,9 +673,9 @@ def drive(P, D, h, orig, closed, degree, method, spline, hstep, eligible, tol, e
                 values[i] = -np.inf
                 continue
             if blocked[i] != 0:
-                mv2, cl2 = _clamped_move(P, D, h, orig, i, method, degree, spline, hstep, tol,
-                                         delta, eta, xi)
-                if mv2 <= move_floor:
+                mv2, cl2, want2 = _clamped_move(P, D, h, orig, i, method, degree, spline, hstep,
+                                                tol, delta, eta, xi)
+                if _is_blocked(mv2, cl2, want2, move_floor):
                     blocked[i] = 1 if cl2 else 2
                     values[i] = -np.inf
                     continue
@@ -667,3 +690,14 @@ def drive(P, D, h, orig, closed, degree, method, spline, hstep, eligible, tol, e
             tt_update_range(tv, ti, a, b, values)
     return (steps, stop, h_idx[:steps].copy(), h_meas[:steps].copy(), h_disp[:steps].copy(),
             measure, blocked, n_trunc, n_skip, max_window)
+
+
+@njit(cache=True)
+def all_measures(P, D, h, closed, degree, spline):  # type: ignore[no-untyped-def]
+    """Ranking measure of every point (0 at the ends of an open curve)."""
+    nd = P.shape[0]
+    out = np.zeros(nd)
+    for i in range(nd):
+        if closed or (i >= 1 and i <= nd - 2):
+            out[i] = measure_at(P, D, h, i, degree, spline)
+    return out

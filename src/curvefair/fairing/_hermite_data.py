@@ -1,0 +1,47 @@
+"""Distinct-data layout of Hermite splines used by the steps and the fairing drivers."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._typing import FloatArray
+from ..curves.hermite import CubicHermite, HermiteSpline, QuinticHermite
+
+__all__ = ["distinct_data", "rebuild", "uniform_spacing"]
+
+
+def distinct_data(curve: HermiteSpline) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """``(P, D, h)``: distinct points ``(nd, dim)``, derivatives ``(nd, nb, dim)``, widths.
+
+    A closed curve drops its repeated last point; its segment widths include the closing one.
+    Arrays are fresh writable copies.
+    """
+    pts = np.array(curve.points, dtype=np.float64)
+    ders = [np.asarray(d) for d in curve._derivs]
+    h = np.diff(np.asarray(curve.params, dtype=np.float64))
+    if curve.closed:
+        pts = pts[:-1]
+        ders = [d[:-1] for d in ders]
+    D = np.ascontiguousarray(np.stack(ders, axis=1), dtype=np.float64)
+    return np.ascontiguousarray(pts), D, np.ascontiguousarray(h)
+
+
+def rebuild(curve: HermiteSpline, P: FloatArray, D: FloatArray) -> HermiteSpline:
+    """A curve like ``curve`` with distinct data ``P``, ``D`` (the seam is repeated if closed)."""
+    if curve.closed:
+        P = np.vstack([P, P[:1]])
+        D = np.concatenate([D, D[:1]], axis=0)
+    if isinstance(curve, QuinticHermite):
+        return QuinticHermite(P, D[:, 0], D[:, 1], curve.params, closed=curve.closed)
+    return CubicHermite(P, D[:, 0], curve.params, closed=curve.closed)
+
+
+def uniform_spacing(params: FloatArray, rtol: float = 1e-9) -> float | None:
+    """The common spacing of ``params`` if they are uniform (to ``rtol``), else None."""
+    h = np.diff(np.asarray(params, dtype=np.float64))
+    if h.size == 0:
+        return None
+    hm = float(h.mean())
+    if np.all(np.abs(h - hm) <= rtol * abs(hm)):
+        return hm
+    return None

@@ -1,0 +1,478 @@
+"""The automatic fairing loop :func:`fair` and its method registry.
+
+Every fairing method (local Hermite steps, Eck-Hadenfeld, knot removal, ...) registers a
+:class:`MethodSpec` whose *driver* runs the method's loop. :func:`fair` validates the arguments
+common to all methods, calls the driver, and writes the report (before/after analysis, which
+points moved and how far, the largest deviation of the curve).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .._typing import FloatArray
+from ..curves.piecewise import PiecewiseCurve
+from ..errors import InputError
+
+__all__ = [
+    "MethodSpec",
+    "DriverOutput",
+    "FairingHistory",
+    "FairingResult",
+    "METHODS",
+    "register_method",
+    "available_methods",
+    "fair",
+    "CLAMPS",
+    "MODES",
+]
+
+CLAMPS = ("g0", "g1", "g2")
+MODES = ("spline", "hermite")
+
+
+# ----------------------------------------------------------------------------------------------
+# data classes
+# ----------------------------------------------------------------------------------------------
+@dataclass(frozen=True, eq=False)
+class FairingHistory:
+    """What each step of a fairing loop did, as compact arrays (one entry per step).
+
+    Attributes
+    ----------
+    step : ndarray of int64, shape (s,)
+        Step number, 1-based.
+    index : ndarray of int64, shape (s,)
+        The data point (control point) moved, 0-based.
+    measure : ndarray of float64, shape (s,)
+        Its ranking measure just before the move (e.g. the third-derivative jump).
+    displacement : ndarray of float64, shape (s,)
+        Length of that move.
+    """
+
+    step: np.ndarray
+    index: np.ndarray
+    measure: np.ndarray
+    displacement: np.ndarray
+
+    @classmethod
+    def from_arrays(cls, index: Iterable[int], measure: Iterable[float],
+                    displacement: Iterable[float]) -> "FairingHistory":
+        """Build from per-step arrays; step numbers are ``1 .. len(index)``."""
+        idx = np.asarray(index, dtype=np.int64).reshape(-1)
+        meas = np.asarray(measure, dtype=np.float64).reshape(-1)
+        disp = np.asarray(displacement, dtype=np.float64).reshape(-1)
+        if not idx.shape == meas.shape == disp.shape:
+            raise InputError("history arrays must have the same length, got "
+                             f"{idx.shape[0]}, {meas.shape[0]}, {disp.shape[0]}")
+        arrs = [np.arange(1, idx.shape[0] + 1, dtype=np.int64), idx, meas, disp]
+        for a in arrs:
+            a.setflags(write=False)
+        return cls(*arrs)
+
+    @classmethod
+    def empty(cls) -> "FairingHistory":
+        return cls.from_arrays([], [], [])
+
+    def __len__(self) -> int:
+        return int(self.index.shape[0])
+
+    def to_dict(self) -> dict[str, list[Any]]:
+        """Plain lists (JSON-serialisable; non-finite measures become None)."""
+        return {
+            "step": self.step.tolist(),
+            "index": self.index.tolist(),
+            "measure": [_finite_or_none(v) for v in self.measure.tolist()],
+            "displacement": [_finite_or_none(v) for v in self.displacement.tolist()],
+        }
+
+
+@dataclass
+class DriverOutput:
+    """What a method's driver returns to :func:`fair`.
+
+    Attributes
+    ----------
+    curve : PiecewiseCurve
+        The faired curve (same type as the input).
+    steps : int
+        Steps taken (moves actually made).
+    stop_reason : str
+        ``"eps"`` (largest measure below eps), ``"max_steps"``, ``"tolerance"`` (every remaining
+        move above eps is blocked by the tolerance or protection), ``"converged"`` (every
+        remaining move is ~0), or a method-specific reason.
+    history : FairingHistory or None
+    eps, max_steps : optional
+        The effective values when the driver chose defaults (reported).
+    extra : dict
+        Method-specific report entries (JSON-serialisable).
+    """
+
+    curve: PiecewiseCurve
+    steps: int
+    stop_reason: str
+    history: FairingHistory | None = None
+    eps: float | None = None
+    max_steps: int | None = None
+    extra: dict[str, Any] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class MethodSpec:
+    """A fairing method as :func:`fair` knows it.
+
+    Attributes
+    ----------
+    name : str
+        The ``method=`` name.
+    curve_types : tuple of type
+        Curve classes the method accepts.
+    driver : callable
+        ``driver(curve, *, tol, eps, max_steps, clamp, protect, **options) -> DriverOutput``;
+        ``clamp`` is a ``(left, right)`` pair of ``"g0" | "g1" | "g2"``, ``protect`` a frozenset
+        of 0-based data-point indices (control points for B-splines; a closed Hermite curve's seam
+        is index 0).
+    summary : str
+        One line for listings.
+    source : str
+        Paper and equations.
+    default : bool
+        The default method for its curve types.
+    modes : tuple of str
+        Values of ``fair(mode=...)`` the method accepts. A method declaring more than the plain
+        ``("spline",)`` receives ``mode=`` as a keyword.
+    """
+
+    name: str
+    curve_types: tuple[type, ...]
+    driver: Callable[..., DriverOutput]
+    summary: str
+    source: str
+    default: bool = False
+    modes: tuple[str, ...] = ("spline",)
+
+
+@dataclass(frozen=True, eq=False)
+class FairingResult:
+    """Result of :func:`fair`.
+
+    Attributes
+    ----------
+    curve : PiecewiseCurve
+        The faired curve.
+    report : dict
+        JSON-serialisable summary (see :func:`fair`).
+    history : FairingHistory
+        One entry per step.
+    """
+
+    curve: PiecewiseCurve
+    report: dict[str, Any]
+    history: FairingHistory
+
+    def __repr__(self) -> str:
+        r = self.report
+        return (f"FairingResult(method={r.get('method')!r}, steps={r.get('steps')}, "
+                f"stop_reason={r.get('stop_reason')!r}, curve={self.curve!r})")
+
+
+METHODS: dict[str, MethodSpec] = {}
+
+
+def register_method(spec: MethodSpec) -> MethodSpec:
+    """Add (or replace) a method in :data:`METHODS`; returns ``spec``."""
+    if not isinstance(spec, MethodSpec):
+        raise InputError(f"register_method needs a MethodSpec, got {type(spec).__name__}")
+    METHODS[spec.name] = spec
+    return spec
+
+
+def available_methods(curve: object = None) -> list[str]:
+    """Names of the registered methods (those accepting ``curve``'s type, if given)."""
+    if curve is None:
+        return list(METHODS)
+    return [n for n, s in METHODS.items() if isinstance(curve, s.curve_types)]
+
+
+# ----------------------------------------------------------------------------------------------
+# helpers
+# ----------------------------------------------------------------------------------------------
+def _finite_or_none(v: Any) -> Any:
+    if isinstance(v, float) and not math.isfinite(v):
+        return None
+    return v
+
+
+def _jsonable(obj: Any) -> Any:
+    """Convert numpy scalars/arrays to plain Python; non-finite floats to None."""
+    if isinstance(obj, dict):
+        return {str(k): _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return _jsonable(obj.tolist())
+    if isinstance(obj, (np.bool_, bool)):
+        return bool(obj)
+    if isinstance(obj, (np.integer,)):
+        return int(obj)
+    if isinstance(obj, (np.floating, float)):
+        return _finite_or_none(float(obj))
+    if obj is None or isinstance(obj, (int, str)):
+        return obj
+    if isinstance(obj, (set, frozenset)):
+        return sorted(_jsonable(v) for v in obj)
+    return str(obj)
+
+
+def data_points(curve: PiecewiseCurve) -> FloatArray:
+    """The data a fairing method moves: ``control_points`` of a B-spline, else ``points``.
+
+    A closed Hermite curve's repeated last point is dropped (distinct points only).
+    """
+    if hasattr(curve, "control_points"):
+        return np.asarray(curve.control_points)  # type: ignore[attr-defined]
+    pts = np.asarray(curve.points)  # type: ignore[attr-defined]
+    if curve.closed and not hasattr(curve, "control_points"):
+        return pts[:-1]
+    return pts
+
+
+def normalize_clamp(clamp: object) -> tuple[str, str]:
+    """``"g1"`` -> ``("g1", "g1")``; a pair is checked element-wise."""
+    if isinstance(clamp, str):
+        pair: tuple[object, object] = (clamp, clamp)
+    else:
+        try:
+            left, right = clamp  # type: ignore[misc]
+        except (TypeError, ValueError):
+            raise InputError(f"clamp must be one of {CLAMPS} or a (left, right) pair of them, "
+                             f"got {clamp!r}") from None
+        pair = (left, right)
+    for side, v in zip(("left", "right"), pair):
+        if not isinstance(v, str) or v not in CLAMPS:
+            raise InputError(f"unknown clamp {v!r} ({side} end); valid values are: "
+                             + ", ".join(repr(c) for c in CLAMPS))
+    return pair  # type: ignore[return-value]
+
+
+def normalize_protect(protect: object, curve: PiecewiseCurve) -> frozenset[int]:
+    """Validate protected data-point indices; a closed Hermite curve maps ``n-1`` to the seam 0."""
+    n_stored = (int(curve.control_points.shape[0]) if hasattr(curve, "control_points")  # type: ignore[attr-defined]
+                else int(np.asarray(curve.points).shape[0]))  # type: ignore[attr-defined]
+    seam_alias = curve.closed and not hasattr(curve, "control_points")
+    if protect is None:
+        return frozenset()
+    if isinstance(protect, (int, np.integer)) and not isinstance(protect, bool):
+        items: list[object] = [protect]
+    else:
+        try:
+            items = list(protect)  # type: ignore[call-overload]
+        except TypeError:
+            raise InputError(f"protect must be a sequence of point indices, got {protect!r}"
+                             ) from None
+    out = set()
+    for v in items:
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)):
+            raise InputError(f"protect must contain integer point indices, got {v!r}")
+        i = int(v)
+        if not 0 <= i < n_stored:
+            raise InputError(f"protect index {i} is out of range: the curve has {n_stored} "
+                             f"data points (valid: 0 .. {n_stored - 1})")
+        out.add(0 if (seam_alias and i == n_stored - 1) else i)
+    return frozenset(out)
+
+
+def _default_method(curve: PiecewiseCurve) -> MethodSpec:
+    for spec in METHODS.values():
+        if spec.default and isinstance(curve, spec.curve_types):
+            return spec
+    for spec in METHODS.values():
+        if isinstance(curve, spec.curve_types):
+            return spec
+    raise InputError(f"no fairing method is registered for {type(curve).__name__}")
+
+
+def _analysis_block(curve: PiecewiseCurve) -> dict[str, Any]:
+    from ..analysis import analyze
+
+    a = analyze(curve)
+    inf = a.inflections
+    ext = a.extrema
+    return {
+        "energy": float(a.energy2),
+        "max_jump": float(a.max_jump),
+        "inflections": int(len(inf)) if not isinstance(inf, (int, np.integer)) else int(inf),
+        "extrema": int(len(ext)) if not isinstance(ext, (int, np.integer)) else int(ext),
+    }
+
+
+# ----------------------------------------------------------------------------------------------
+# fair
+# ----------------------------------------------------------------------------------------------
+def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None = None,
+         eps: float | None = None, max_steps: int | None = None, clamp: Any = "g0",
+         protect: Iterable[int] = (), mode: str = "spline", **options: Any) -> FairingResult:
+    """Fair a curve automatically: repeatedly apply a local step at the worst point.
+
+    Parameters
+    ----------
+    curve : PiecewiseCurve
+        :class:`~curvefair.CubicHermite`, :class:`~curvefair.QuinticHermite`, or a B-spline
+        (with a B-spline method registered).
+    method : str, optional
+        A name from :func:`available_methods`; default: the curve type's default
+        (``"poliakoff"`` for cubic, ``"wang-quintic"`` for quintic Hermite splines).
+    tol : float > 0, optional
+        No data point ever ends farther than ``tol`` from its ORIGINAL position: each step is
+        clamped onto the ball of radius ``tol`` around the original point (ERRATA, Eck &
+        Hadenfeld); a point whose clamped move is ~0 is skipped.
+    eps : float >= 0, optional
+        Stop when the largest ranking measure is below ``eps``; ``0`` runs until ``max_steps``
+        or until the tolerance blocks every move. Default: method-specific (relative to the
+        initial largest measure; see the method's notes).
+    max_steps : int >= 0, optional
+        Step cap (default method-specific).
+    clamp : {"g0", "g1", "g2"} or (left, right)
+        End conditions kept exactly: ``"g0"`` end points fixed, ``"g1"`` also the end tangent,
+        ``"g2"`` also the end second derivative (curvature). Ignored for closed curves.
+    protect : iterable of int
+        Data-point indices that never move (0-based; B-splines: control points).
+    mode : {"spline", "hermite"}
+        For the Hermite methods: ``"spline"`` re-interpolates after every step (the papers'
+        examples), ``"hermite"`` keeps the step's own derivatives.
+    **options
+        Passed to the method's driver.
+
+    Returns
+    -------
+    FairingResult
+        ``.curve``, ``.report`` (JSON-serialisable dict, no NaN) and ``.history``.
+
+    Raises
+    ------
+    InputError
+        Unknown method/mode/clamp, ``tol <= 0``, ``eps < 0``, negative ``max_steps``, protect
+        index out of range, a curve the method does not handle, too few points.
+
+    Notes
+    -----
+    The loop is Wang & Cao 2006's steps 1-6: rank the points, fair the worst, re-interpolate,
+    repeat. The report holds ``method``, ``steps``, ``stop_reason``, ``moved`` (indices and
+    their final displacement from the original), ``energy_before/after`` (``int |r''|^2``),
+    ``max_jump_before/after``, ``inflections_before/after``, ``extrema_before/after``,
+    ``max_point_displacement`` (+ ``max_point_index``), ``max_deviation`` (+ where:
+    ``max_deviation_param``, ``max_deviation_point``), ``tol``, ``eps``, ``max_steps``,
+    ``clamp``, ``protect``, ``mode``, ``time_s`` and method-specific entries.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from curvefair import interpolate_cubic, fair
+    >>> pts = np.column_stack([np.arange(1.0, 8.0), np.ones(7)])
+    >>> pts[3] = (4.3, 1.6)
+    >>> res = fair(interpolate_cubic(pts), "poliakoff", tol=0.5)
+    >>> res.report["energy_after"] < res.report["energy_before"]
+    True
+    """
+    t_start = time.perf_counter()
+    if not isinstance(curve, PiecewiseCurve):
+        raise InputError(f"curve must be a curvefair curve, got {type(curve).__name__}")
+    if method is None:
+        spec = _default_method(curve)
+    else:
+        if not isinstance(method, str) or method not in METHODS:
+            raise InputError(f"unknown method {method!r}; valid methods are: "
+                             + ", ".join(repr(m) for m in METHODS))
+        spec = METHODS[method]
+    if not isinstance(curve, spec.curve_types):
+        raise InputError(
+            f"method {spec.name!r} needs a {' or '.join(t.__name__ for t in spec.curve_types)}, "
+            f"got {type(curve).__name__}; methods for this curve: "
+            + ", ".join(repr(m) for m in available_methods(curve)))
+    from .._validate import as_positive
+
+    tol_v = as_positive(tol, "tol", allow_none=True)
+    if eps is not None:
+        try:
+            eps_v: float | None = float(eps)
+        except (TypeError, ValueError):
+            raise InputError(f"eps must be a number >= 0, got {eps!r}") from None
+        if not math.isfinite(eps_v) or eps_v < 0:
+            raise InputError(f"eps must be a finite number >= 0, got {eps!r}")
+    else:
+        eps_v = None
+    if max_steps is not None:
+        if isinstance(max_steps, bool) or not isinstance(max_steps, (int, np.integer)) \
+                or max_steps < 0:
+            raise InputError(f"max_steps must be an integer >= 0, got {max_steps!r}")
+        max_steps = int(max_steps)
+    clamp_pair = normalize_clamp(clamp)
+    prot = normalize_protect(protect, curve)
+    if not isinstance(mode, str) or mode not in MODES:
+        raise InputError(f"unknown mode {mode!r}; valid values are: "
+                         + ", ".join(repr(m) for m in MODES))
+    if mode not in spec.modes:
+        raise InputError(f"method {spec.name!r} supports mode "
+                         + " or ".join(repr(m) for m in spec.modes) + f", got {mode!r}")
+    kwargs = dict(options)
+    if spec.modes != ("spline",):
+        kwargs["mode"] = mode
+
+    before = _analysis_block(curve)
+    out = spec.driver(curve, tol=tol_v, eps=eps_v, max_steps=max_steps, clamp=clamp_pair,
+                      protect=prot, **kwargs)
+    if not isinstance(out, DriverOutput):
+        raise TypeError(f"driver of {spec.name!r} returned {type(out).__name__}, "
+                        "expected DriverOutput")
+    new = out.curve
+    after = _analysis_block(new)
+
+    from ..analysis import deviation
+
+    p0 = data_points(curve)
+    p1 = data_points(new)
+    moved_mask = np.any(p0 != p1, axis=1) if p0.shape == p1.shape else np.ones(len(p1), bool)
+    moved_idx = np.flatnonzero(moved_mask)
+    disp = (np.sqrt(np.sum((p1[moved_idx] - p0[moved_idx]) ** 2, axis=1))
+            if p0.shape == p1.shape else np.zeros(0))
+    dev = deviation(curve, new)
+    history = out.history if out.history is not None else FairingHistory.empty()
+    report: dict[str, Any] = {
+        "method": spec.name,
+        "curve_type": type(curve).__name__,
+        "closed": bool(curve.closed),
+        "n_points": int(p0.shape[0]),
+        "mode": mode if spec.modes != ("spline",) else None,
+        "steps": int(out.steps),
+        "stop_reason": out.stop_reason,
+        "moved": {"indices": moved_idx, "displacement": disp},
+        "n_moved": int(moved_idx.size),
+        "energy_before": before["energy"],
+        "energy_after": after["energy"],
+        "max_jump_before": before["max_jump"],
+        "max_jump_after": after["max_jump"],
+        "inflections_before": before["inflections"],
+        "inflections_after": after["inflections"],
+        "extrema_before": before["extrema"],
+        "extrema_after": after["extrema"],
+        "max_point_displacement": float(dev.max_point_displacement),
+        "max_point_index": None if dev.point_index is None else int(dev.point_index),
+        "max_deviation": float(dev.max_distance),
+        "max_deviation_param": None if dev.param is None else float(dev.param),
+        "max_deviation_point": None if dev.point_a is None else np.asarray(dev.point_a),
+        "tol": tol_v,
+        "eps": out.eps if out.eps is not None else eps_v,
+        "max_steps": out.max_steps if out.max_steps is not None else max_steps,
+        "clamp": list(clamp_pair),
+        "protect": sorted(prot),
+    }
+    for k, v in out.extra.items():
+        report.setdefault(k, v)
+    report["time_s"] = time.perf_counter() - t_start
+    return FairingResult(new, _jsonable(report), history)
