@@ -25,8 +25,13 @@ from .errors import CurvefairError, FileFormatError, InputError, MissingDependen
 from .io import CurveRecord, read_curves, write_curves  # noqa: I001
 from .analysis.discrete import (BadPoint, SecondDiscreteCurvature, bad_points,  # noqa: I001
                                  discrete_curvature, second_discrete_curvature)
+from . import steps  # noqa: I001
+from .fairing import FairingResult, fair  # noqa: I001
 
 __all__ = [
+    "fair",
+    "FairingResult",
+    "steps",
     "read_curves",
     "write_curves",
     "CurveRecord",
