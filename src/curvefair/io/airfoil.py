@@ -13,7 +13,8 @@ Records
 The contour in Selig order (Lednicer: upper reversed, then lower, the shared leading-edge
 point once) as ``kind="airfoil"`` records; the first and last points (the trailing edge) are
 corners, and so is any interior point turning by ``corner_angle`` or more (the contour is then
-split there). ``name`` is the name line. ``source`` keys: ``layout`` (TextLayout), ``airfoil_layout``
+split there). ``name`` is the name line. ``source`` keys: ``layout`` (TextLayout),
+``airfoil_layout``
 (``"selig"`` or ``"lednicer"``), ``counts`` (Lednicer ``(NU, NL)``), ``row_map`` (file data row ->
 contour point; the count line is row 0 of a Lednicer file and maps to -1), ``indices``,
 ``n_points``, ``closed`` (always False), ``piece``, ``n_pieces``.
