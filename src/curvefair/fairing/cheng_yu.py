@@ -113,6 +113,7 @@ def _step_factor(Q, Q0, m0, m1, r0, r1, a, b, pair, e, tmp0, tmp1):  # type: ign
     (sampled, then bisected; the returned ``s`` satisfies the bound as computed)."""
     if e < 0.0:  # no bound
         return 1.0
+    e = e * (1.0 - 1e-12)  # margin: the bound then survives any re-rounding of the distance
     if _excess(Q, Q0, m0, m1, 1.0, r0, r1, a, b, pair, e, tmp0, tmp1) <= 0.0:
         # still check the path for a rational curve leaving and re-entering the ball
         ok = True
@@ -267,9 +268,11 @@ def cheng_yu(curve: Any, m: int, e: float | None = None, pair: bool = False, *,
     >>> pts = np.c_[np.arange(8.0), np.zeros(8)]
     >>> pts[4, 1] = 1.0
     >>> c = BSplineCurve(pts, np.r_[0, 0, 0, np.arange(6.0), 5, 5, 5], 3)
-    >>> c2 = cheng_yu(c, 4, e=0.25)
-    >>> round(float(c2.control_points[4, 1]), 12)
-    0.75
+    >>> c2, d = cheng_yu(c, 4, e=0.25, return_factor=True)
+    >>> round(float(np.linalg.norm(c2.control_points[4] - pts[4])), 12), 0 < d < 1
+    (0.25, True)
+    >>> bool(cheng_yu(c, 4).control_points[4, 1] == 0.0)   # d = 0: the E_2 minimiser
+    True
     """
     curve = _cubic_bspline(curve, "cheng_yu")
     n = curve.n_ctrl
