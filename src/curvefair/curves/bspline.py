@@ -23,6 +23,7 @@ from functools import cached_property
 from typing import Any
 
 import numpy as np
+from numba import njit
 from scipy.interpolate import BSpline, make_interp_spline, make_lsq_spline
 from scipy.sparse import csr_matrix
 from scipy.sparse.linalg import spsolve
@@ -40,7 +41,7 @@ __all__ = ["BSplineCurve", "interpolate_bspline", "fit_bspline", "basis_derivati
 # basis functions
 # ------------------------------------------------------------------------------------------
 def basis_derivatives(knots: FloatArray, degree: int, span: np.ndarray, x: FloatArray,
-                      nder: int) -> FloatArray:
+                      nder: int, local: bool = False) -> FloatArray:
     """Non-zero B-spline basis functions and derivatives, vectorised over parameters.
 
     Parameters
@@ -53,6 +54,9 @@ def basis_derivatives(knots: FloatArray, degree: int, span: np.ndarray, x: Float
     x : ndarray, shape (m,)
     nder : int
         Highest derivative.
+    local : bool
+        ``x`` holds offsets ``x - knots[span]`` (then equal knot patterns give bitwise equal
+        results wherever they sit on the line).
 
     Returns
     -------
@@ -61,57 +65,66 @@ def basis_derivatives(knots: FloatArray, degree: int, span: np.ndarray, x: Float
 
     Notes
     -----
-    Piegl & Tiller, *The NURBS Book*, algorithm A2.3, with every scalar replaced by an array over
-    the parameters.
+    Piegl & Tiller, *The NURBS Book*, algorithm A2.3 (compiled loop over the parameters).
     """
     p = int(degree)
-    x = np.asarray(x, dtype=float)
-    s = np.asarray(span)
-    m = x.shape[0]
-    ndu = np.empty((p + 1, p + 1, m))
-    ndu[0, 0] = 1.0
-    left = np.empty((p + 1, m))
-    right = np.empty((p + 1, m))
-    for j in range(1, p + 1):
-        left[j] = x - knots[s + 1 - j]
-        right[j] = knots[s + j] - x
-        saved = np.zeros(m)
-        for r in range(j):
-            ndu[j, r] = right[r + 1] + left[j - r]
-            temp = ndu[r, j - 1] / ndu[j, r]
-            ndu[r, j] = saved + right[r + 1] * temp
-            saved = left[j - r] * temp
-        ndu[j, j] = saved
-    out = np.zeros((m, nder + 1, p + 1))
-    out[:, 0, :] = ndu[:, p, :].T
-    if nder == 0:
-        return out
-    a = np.zeros((2, p + 1, m))
-    for r in range(p + 1):
-        s1, s2 = 0, 1
-        a[0, 0] = 1.0
-        for k in range(1, nder + 1):
-            d = np.zeros(m)
-            rk = r - k
-            pk = p - k
-            if r >= k:
-                a[s2, 0] = a[s1, 0] / ndu[pk + 1, rk]
-                d = a[s2, 0] * ndu[rk, pk]
-            j1 = 1 if rk >= -1 else -rk
-            j2 = k - 1 if r - 1 <= pk else p - r
-            for j in range(j1, j2 + 1):
-                a[s2, j] = (a[s1, j] - a[s1, j - 1]) / ndu[pk + 1, rk + j]
-                d = d + a[s2, j] * ndu[rk + j, pk]
-            if r <= pk:
-                a[s2, k] = -a[s1, k - 1] / ndu[pk + 1, r]
-                d = d + a[s2, k] * ndu[r, pk]
-            out[:, k, r] = d
-            s1, s2 = s2, s1
-    fac = float(p)
-    for k in range(1, nder + 1):
-        out[:, k, :] *= fac
-        fac *= p - k
+    x = np.ascontiguousarray(x, dtype=np.float64)
+    s = np.ascontiguousarray(span, dtype=np.int64)
+    out = np.zeros((x.shape[0], int(nder) + 1, p + 1))
+    _ders_kernel(np.ascontiguousarray(knots, dtype=np.float64), p, s, x, int(nder), bool(local),
+                 out)
     return out
+
+
+@njit(cache=True)
+def _ders_kernel(knots, p, span, x, nder, local, out):  # type: ignore[no-untyped-def]
+    ndu = np.empty((p + 1, p + 1))
+    left = np.empty(p + 1)
+    right = np.empty(p + 1)
+    a = np.empty((2, p + 1))
+    for q in range(x.shape[0]):
+        s = span[q]
+        u = x[q]
+        base = knots[s] if local else 0.0
+        ndu[0, 0] = 1.0
+        for j in range(1, p + 1):
+            left[j] = u - (knots[s + 1 - j] - base)
+            right[j] = (knots[s + j] - base) - u
+            saved = 0.0
+            for r in range(j):
+                ndu[j, r] = right[r + 1] + left[j - r]
+                temp = ndu[r, j - 1] / ndu[j, r]
+                ndu[r, j] = saved + right[r + 1] * temp
+                saved = left[j - r] * temp
+            ndu[j, j] = saved
+        for j in range(p + 1):
+            out[q, 0, j] = ndu[j, p]
+        for r in range(p + 1):
+            s1 = 0
+            s2 = 1
+            a[0, 0] = 1.0
+            for k in range(1, nder + 1):
+                d = 0.0
+                rk = r - k
+                pk = p - k
+                if r >= k:
+                    a[s2, 0] = a[s1, 0] / ndu[pk + 1, rk]
+                    d = a[s2, 0] * ndu[rk, pk]
+                j1 = 1 if rk >= -1 else -rk
+                j2 = k - 1 if r - 1 <= pk else p - r
+                for j in range(j1, j2 + 1):
+                    a[s2, j] = (a[s1, j] - a[s1, j - 1]) / ndu[pk + 1, rk + j]
+                    d += a[s2, j] * ndu[rk + j, pk]
+                if r <= pk:
+                    a[s2, k] = -a[s1, k - 1] / ndu[pk + 1, r]
+                    d += a[s2, k] * ndu[r, pk]
+                out[q, k, r] = d
+                s1, s2 = s2, s1
+        fac = float(p)
+        for k in range(1, nder + 1):
+            for j in range(p + 1):
+                out[q, k, j] *= fac
+            fac *= p - k
 
 
 def _gauss(nq: int) -> tuple[FloatArray, FloatArray]:
@@ -199,6 +212,7 @@ class BSplineCurve(PiecewiseCurve):
         self._knots = readonly(t)
         self.degree = p
         self._closed = closed
+        self._gram_cache: dict[int, FloatArray] = {}
 
     # -- validation -------------------------------------------------------------------------
     @staticmethod
@@ -333,7 +347,10 @@ class BSplineCurve(PiecewiseCurve):
         if unknown:
             raise InputError(f"replace() got unknown fields {sorted(unknown)}; valid: {sorted(kw)}")
         kw.update(changes)
-        return type(self)(**kw)
+        out = type(self)(**kw)
+        if set(changes) <= {"control_points"} and out.n_ctrl == self.n_ctrl:
+            out._gram_cache = self._gram_cache  # same knots: the Gram matrices are shared
+        return out
 
     def control_index(self, i: ArrayLike) -> np.ndarray:
         """Map indices of basis functions ``N_i`` of :attr:`knots` to control-point indices
@@ -365,7 +382,7 @@ class BSplineCurve(PiecewiseCurve):
 
         Returns
         -------
-        ndarray, shape (n, 2 degree + 1)
+        ndarray, shape (n, 2 degree + 1), read-only (cached: it depends on the knots only)
             ``W[i, p + o] = G[i, (i + o)]`` for ``-p <= o <= p`` (open curves: zero where
             ``i + o`` is out of range; closed curves: the column index is ``(i + o) mod n``, and
             when ``n < 2p + 1`` several offsets may name the same column -- their entries add).
@@ -380,28 +397,37 @@ class BSplineCurve(PiecewiseCurve):
         >>> import numpy as np
         >>> from curvefair import BSplineCurve
         >>> c = BSplineCurve(np.zeros((10, 2)), np.arange(11.0), 3, closed=True)
-        >>> (c.gram_band(2)[0] * 6).round(12).tolist()   # uniform cubic, l = 2
-        [1.0, 0.0, -9.0, 16.0, -9.0, 0.0, 1.0]
+        >>> (c.gram_band(2)[0] * 6).round(12).tolist() == [1, 0, -9, 16, -9, 0, 1]  # l = 2
+        True
         """
         p = self.degree
         if isinstance(l, bool) or not isinstance(l, (int, np.integer)) or not 1 <= l <= p:
             raise InputError(f"l must be an integer in [1, degree = {p}], got {l!r}")
+        W = self._gram_cache.get(int(l))
+        if W is None:
+            W = readonly(self._gram_band(int(l)))
+            self._gram_cache[int(l)] = W
+        return W
+
+    def _gram_band(self, l: int) -> FloatArray:  # noqa: E741
+        p = self.degree
         t = self._knots
         s = self.spans
         nq = p - int(l) + 1
         xq, wq = _gauss(nq)
         h = t[s + 1] - t[s]
-        x = (t[s][:, None] + h[:, None] * xq[None, :]).reshape(-1)
+        x = (h[:, None] * xq[None, :]).reshape(-1)
         ss = np.repeat(s, nq)
-        d = basis_derivatives(t, p, ss, x, int(l))[:, int(l), :].reshape(s.shape[0], nq, p + 1)
+        d = basis_derivatives(t, p, ss, x, int(l), local=True)[:, int(l), :]
+        d = d.reshape(s.shape[0], nq, p + 1)
         # M[m, a, b] = sum_q w_q h_m d[m,q,a] d[m,q,b]
         M = np.einsum("q,mqa,mqb->mab", wq, d, d) * h[:, None, None]
         n = self.n_ctrl
         W = np.zeros((n, 2 * p + 1))
         for a in range(p + 1):
-            rows = self.control_index(s - p + a)
+            rows = self.control_index(s - p + a)  # distinct for fixed a
             for b in range(p + 1):
-                np.add.at(W[:, p + b - a], rows, M[:, a, b])
+                W[rows, p + b - a] += M[:, a, b]
         return W
 
     def gram_matrix(self, l: int) -> Any:  # noqa: E741
