@@ -9,6 +9,8 @@ differences of a quadratic are exact).
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy.optimize import minimize
 
 from curvefair import BSplineCurve, InputError, steps
@@ -246,3 +248,20 @@ def test_bad_input():
         cheng_yu(c, 2, e=0.1, original=far)
     with pytest.raises(InputError, match="cubic"):
         cheng_yu(BSplineCurve(rng.normal(size=(6, 2)), np.r_[0, 0, 0, 1, 2, 3, 4, 4, 4.0], 2), 2)
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**31), closed=st.booleans(), pair=st.booleans(),
+       e=st.one_of(st.none(), st.floats(1e-3, 1.0)), dim=st.sampled_from([2, 3]))
+def test_property_energy_never_rises_and_bound_holds(seed, closed, pair, e, dim):
+    # eq. (8)/(9) minimise (1 - d) E_2 + d sum_j G_jj |x_j - Q_j|^2, so E_2 cannot rise
+    rng = np.random.default_rng(seed)
+    c = random_closed(rng, 8, dim) if closed else random_open(rng, 9, dim)
+    m = int(rng.integers(0, c.n_ctrl if closed else c.n_ctrl - 1))
+    new = cheng_yu(c, m, e=e, pair=pair)
+    assert energy2(new) <= energy2(c) * (1 + 1e-12) + 1e-12
+    if e is not None:
+        disp = np.linalg.norm(np.asarray(new.control_points) - c.control_points, axis=1)
+        assert disp.max() <= e
+        u = np.linspace(*c.domain, 2001)
+        assert np.linalg.norm(new(u) - c(u), axis=1).max() <= e
