@@ -3,7 +3,8 @@
 Seeded noisy samples of a smooth planar curve, interpolated by a cubic B-spline (chord params),
 then the compiled ranking loop of ``cheng_yu_driver`` (``eps=0``, ``tol`` = half the sample
 spacing) capped at S1 and S2 accepted steps; the per-step cost is
-``(T(S2) - T(S1)) / (steps2 - steps1)``, which removes the loop's O(n) start (K, D, ranking tree). Peer measured in the same run: one vectorised
+``(T(S2) - T(S1)) / (steps2 - steps1)``, which removes the loop's O(n) start (K, D, ranking
+tree). Peer measured in the same run: one vectorised
 ``second_discrete_curvature`` of the whole curve (what a loop without local updates would redo
 after every step to re-rank the bad points).
 

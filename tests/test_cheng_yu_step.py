@@ -24,7 +24,7 @@ def energy2(curve):
     a0, a1 = curve.domain
     br = br[(br >= a0) & (br <= a1)]
     tot = 0.0
-    for a, b in zip(br[:-1], br[1:]):
+    for a, b in zip(br[:-1], br[1:], strict=True):
         u = 0.5 * (a + b) + 0.5 * (b - a) * XG
         v = curve(u, 2)
         tot += 0.5 * (b - a) * np.sum(WG * np.sum(v * v, axis=1))

@@ -85,8 +85,8 @@ def discrete_curvature(points: ArrayLike, closed: bool = False) -> FloatArray:
     garbled in the seed text).
 
     On a circle of radius ``R`` the value is ``(L_i + L_{i+1})**2 / (M_i**2 R)``, i.e. ``1/R`` only
-    in the limit of fine spacing (relative error about ``(L_i**2 + L_{i+1}**2) / (8 R**2)`` for small
-    chords, second order); it always overestimates a circle slightly.
+    in the limit of fine spacing (relative error about ``L_i L_{i+1} / (4 R**2)`` for small chords,
+    second order); it always overestimates a circle slightly.
 
     Open ends follow Remark 1: the reflected vertices ``Q_{-1} = 2 Q_0 - Q_1`` and
     ``Q_n = 2 Q_{n-1} - Q_{n-2}`` make the end triangles degenerate, so ``C_0 = C_{n-1} = 0``.
@@ -136,8 +136,8 @@ def _discrete_curvature_core(prev: FloatArray, cur: FloatArray, nxt: FloatArray,
     if bad.size:
         i = int(bad[0]) + offset
         raise InputError(
-            f"points: the polygon turns back on itself at index {i} (points[{i}-1] == points[{i}+1]);"
-            " the discrete curvature does not exist there"
+            f"points: the polygon turns back on itself at index {i} "
+            f"(points[{i}-1] == points[{i}+1]); the discrete curvature does not exist there"
         )
     twice_area = _cross2(e0, e1)
     s = l0 + l1
@@ -163,7 +163,8 @@ def _cubic_bspline(curve: Any, what: str) -> Any:
 def corner_cut_ratios(knots: FloatArray, n: int, closed: bool) -> tuple[FloatArray, FloatArray]:
     """The corner-cutting proportions ``l_i`` and ``m_i`` of Definition 1, shape ``(n,)`` each.
 
-    ``l_i = (u_{i+3} - u_{i+2}) / (u_{i+3} - u_i)``, ``m_i = (u_{i+2} - u_{i+1}) / (u_{i+4} - u_{i+1})``
+    ``l_i = (u_{i+3} - u_{i+2}) / (u_{i+3} - u_i)``,
+    ``m_i = (u_{i+2} - u_{i+1}) / (u_{i+4} - u_{i+1})``
     (Cheng & Yu, Definition 1). Open curves: defined for ``i = 1 .. n-2`` (the end entries are 0);
     closed curves: for every control point, with the periodic knot vector.
     """
@@ -250,8 +251,8 @@ class SecondDiscreteCurvature:
         ``Delta K_i = K_i - K_{i-1}`` (Definition 2; ``Delta K_0 = 0`` for open curves, cyclic for
         closed ones).
     second_difference : ndarray, shape (n,)
-        ``D_i = t_i K_{i-1} + (1 - t_i) K_{i+1} - K_i`` (Definition 2; ``D_0 = D_{n-1} = 0`` for open
-        curves).
+        ``D_i = t_i K_{i-1} + (1 - t_i) K_{i+1} - K_i`` (Definition 2; ``D_0 = D_{n-1} = 0`` for
+        open curves).
     weights : ndarray, shape (n,)
         ``t_i = L_{i+1} / (L_i + L_{i+1})`` (0.5 at open ends and where both legs vanish).
     params : ndarray, shape (n,)

@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from .._typing import ArrayLike, FloatArray
+from .._typing import FloatArray
 from ..analysis.discrete import (
     _cubic_bspline,
     corner_cut_ratios,
@@ -394,7 +394,8 @@ def _d_at(K, t, i, n, closed):  # type: ignore[no-untyped-def]
 
 @njit(cache=True)
 def _flags_at(K, t, i, n, closed):  # type: ignore[no-untyped-def]
-    """Bit mask of the bad-point kinds at ``i`` (1, 2, 4 for kinds 1, 2, 3); as ``bad_point_kinds``."""
+    """Bit mask of the bad-point kinds at ``i`` (1, 2, 4 for kinds 1, 2, 3), as in
+    ``bad_point_kinds``."""
     if not _valid(i, n, closed):
         return 0
     kp = K[(i - 1) % n]
