@@ -110,10 +110,38 @@ def _excess(Q, Q0, m0, m1, s, r0, r1, a, b, pair, e, tmp0, tmp1):  # type: ignor
 @njit(cache=True)
 def _step_factor(Q, Q0, m0, m1, r0, r1, a, b, pair, e, tmp0, tmp1):  # type: ignore[no-untyped-def]
     """Largest ``s = 1 - d`` in ``[0, 1]`` with the error bound kept on all of ``[0, s]``
-    (sampled, then bisected; the returned ``s`` satisfies the bound as computed)."""
+    (one point: closed form; two points: sampled, then bisected). The returned ``s`` satisfies
+    the bound as computed."""
     if e < 0.0:  # no bound
         return 1.0
     e = e * (1.0 - 1e-12)  # margin: the bound then survives any re-rounding of the distance
+    if not pair:
+        # the segment Q + s r meets the ball |x - Q0| <= e in an interval containing s = 0:
+        # its upper end in closed form, |p + s r|^2 = e^2 with p = Q - Q0
+        rr = 0.0
+        pr = 0.0
+        pp = 0.0
+        for c in range(Q.shape[1]):
+            p = Q[m0, c] - Q0[m0, c]
+            rr += r0[c] * r0[c]
+            pr += p * r0[c]
+            pp += p * p
+        if rr == 0.0:
+            return 1.0
+        es = e * (1.0 - 1e-12)  # aim a hair inside, so the check below passes at once
+        disc = pr * pr - rr * (pp - es * es)
+        if disc < 0.0:
+            disc = 0.0
+        if pr <= 0.0:
+            s = (np.sqrt(disc) - pr) / rr
+        else:
+            s = (es * es - pp) / (pr + np.sqrt(disc))
+        s = min(max(s, 0.0), 1.0)
+        for _ in range(60):  # guard against rounding: shrink until the computed point is inside
+            if _excess(Q, Q0, m0, m1, s, r0, r1, a, b, pair, e, tmp0, tmp1) <= 0.0:
+                return s
+            s *= 1.0 - 1e-12
+        return 0.0
     if _excess(Q, Q0, m0, m1, 1.0, r0, r1, a, b, pair, e, tmp0, tmp1) <= 0.0:
         # still check the path for a rational curve leaving and re-entering the ball
         ok = True
