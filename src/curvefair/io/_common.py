@@ -367,30 +367,47 @@ def curve_kind(curve: PiecewiseCurve) -> str:
     raise InputError(f"unsupported curve type {type(curve).__name__}")
 
 
-def bezier_pieces(curve: PiecewiseCurve, what: str) -> FloatArray:
-    """Cubic Bezier control points of every polynomial piece, shape ``(m, 4, dim)``.
+def bezier_pieces(curve: PiecewiseCurve, what: str, max_degree: int | None = None
+                  ) -> FloatArray:
+    """Bezier control points of every polynomial piece, shape ``(m, p+1, dim)``.
 
-    Exact for curves of degree <= 3 (lower degrees are elevated); raises for higher degrees.
+    ``p`` is the curve's degree, or ``max_degree`` when given (lower degrees are elevated;
+    a higher degree raises :class:`InputError`).
 
     Notes
     -----
-    From the local power form ``r = a0 + a1 s + a2 s^2 + a3 s^3`` on ``s in [0, h]``:
-    ``b0 = a0``, ``b1 = a0 + a1 h/3``, ``b2 = a0 + 2 a1 h/3 + a2 h^2/3``, ``b3 = r(h)``.
+    From the local power form ``r = sum_j a_j s^j`` on ``s in [0, h]``, with ``c_j = a_j h^j``:
+    ``b_k = sum_{j<=k} C(k, j) / C(p, j) c_j`` (the power-to-Bernstein change of basis).
     """
+    from math import comb
+
     pp = curve.piecewise
-    if pp.degree > 3:
-        raise InputError(f"{what}: a degree-{pp.degree} curve has no exact cubic Bezier form; "
-                         "fair a cubic curve, or write it to JSON/DXF/3dm")
-    c = np.zeros((pp.n_segments, 4, pp.dim))
+    p = pp.degree if max_degree is None else int(max_degree)
+    if pp.degree > p:
+        raise InputError(f"{what}: a degree-{pp.degree} curve has no exact degree-{p} Bezier "
+                         "form; fair a cubic curve, or write it to JSON/DXF/3dm")
+    c = np.zeros((pp.n_segments, p + 1, pp.dim))
     c[:, : pp.degree + 1] = pp.coeffs
-    h = pp.widths[:, None]
-    a0, a1, a2, a3 = c[:, 0], c[:, 1] * h, c[:, 2] * h**2, c[:, 3] * h**3
-    b = np.empty_like(c)
-    b[:, 0] = a0
-    b[:, 1] = a0 + a1 / 3.0
-    b[:, 2] = a0 + 2.0 * a1 / 3.0 + a2 / 3.0
-    b[:, 3] = a0 + a1 + a2 + a3
-    return b
+    c *= (pp.widths[:, None] ** np.arange(p + 1)[None, :])[:, :, None]
+    M = np.array([[comb(k, j) / comb(p, j) if j <= k else 0.0 for j in range(p + 1)]
+                  for k in range(p + 1)])
+    return np.einsum("kj,mjd->mkd", M, c)
+
+
+def bspline_of(curve: PiecewiseCurve, what: str) -> BSplineCurve:
+    """``curve`` as a B-spline: itself, or (Hermite curves) its pieces as Bezier segments with
+    knots of multiplicity ``degree`` at the breaks -- the same curve, exactly."""
+    if isinstance(curve, BSplineCurve):
+        return curve
+    b = bezier_pieces(curve, what)
+    m, p1, _ = b.shape
+    p = p1 - 1
+    if p < 2:
+        raise InputError(f"{what}: a degree-{p} curve is not a B-spline of degree >= 2")
+    ctrl = np.vstack([b[0, :1]] + [b[i, 1:] for i in range(m)])
+    br = curve.piecewise.breaks
+    knots = np.r_[[br[0]] * (p + 1), np.repeat(br[1:-1], p), [br[-1]] * (p + 1)]
+    return BSplineCurve(ctrl, knots, p, closed=False)
 
 
 def is_clamped(knots: FloatArray, degree: int) -> bool:

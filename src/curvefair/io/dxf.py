@@ -1,0 +1,359 @@
+"""DXF drawings through ezdxf (``pip install 'curvefair[dxf]'``).
+
+Read
+----
+Every ``SPLINE``, ``LWPOLYLINE`` and 2-D / 3-D ``POLYLINE`` of the model space and the paper
+space layouts (block definitions are not read: editing them would change every insert).
+
+``SPLINE`` with control points -> ``kind="bspline"``, a :class:`~curvefair.BSplineCurve` with
+the entity's degree, knots and control points:
+
+- clamped knot vector: an open curve (the DXF *closed* flag, set on splines whose first and
+  last control points coincide, is kept as it is);
+- periodic layout (closed flag, the first ``degree`` control points repeated at the end,
+  ``n + 2 degree + 1`` knots -- what ezdxf's ``set_closed`` and most CAD programs write, or
+  ``n + 1`` knots as in AutoCAD's documentation): a closed curve;
+- weights other than 1 (rational), degree < 2 or any other knot layout: unsupported.
+
+``SPLINE`` with fit points only -> ``kind="fit_points"``: the curve through the fit points
+(periodic if the spline is closed). Polylines -> ``kind="polyline"``, split at corners like
+every point list; polylines with arc segments (bulges) or spline/curve-fit vertices are
+unsupported. Coordinates are the entity's own (OCS for 2-D polylines); a curve whose points
+all have the same z is 2-D and keeps that z (``source["z"]``).
+
+``source`` keys: ``handle``, ``dxftype``, ``layer``, ``layout``, ``z`` (None for 3-D), and
+``spline_layout`` (``"clamped"``, ``"periodic"``, ``"periodic_short"``) or the point-list keys.
+
+Write
+-----
+With ``template=`` the source drawing is loaded, each record's entity is found by handle and
+only its geometry is replaced (control points and knots, with the same layout; fit points;
+vertex positions -- widths, bulges, flags, layer, colour, linetype, handle and every other
+entity untouched), then saved to a temporary file next to the destination and moved into
+place. A control-point spline that also had fit points loses them (they no longer describe
+the faired curve). Records that do not come from the template, and every record when there is
+no template, are added to the model space of the drawing (a new R2010 drawing without a
+template): B-splines and Hermite curves as ``SPLINE`` (Hermite pieces as Bezier segments, the
+same curve exactly), point kinds as ``LWPOLYLINE`` (2-D) or 3-D ``POLYLINE``, fit-point records
+as fit-point ``SPLINE``.
+"""
+
+from __future__ import annotations
+
+import os
+import warnings
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from .._typing import FloatArray
+from ..curves.bspline import BSplineCurve
+from ..errors import CurvefairError, FileFormatError, InputError
+from ._common import (
+    CurveRecord,
+    atomic_path,
+    bspline_of,
+    check_points,
+    data_points,
+    is_clamped,
+    joined_points,
+    piece_values,
+    point_records,
+    points_curve,
+)
+
+__all__ = ["read", "write"]
+
+FORMAT = "dxf"
+
+
+def _ezdxf(what: str) -> Any:
+    from ._common import lazy_import
+
+    return lazy_import("ezdxf", "ezdxf", "dxf", what)
+
+
+class _Unsupported(Exception):
+    pass
+
+
+def _planar(xyz: FloatArray) -> tuple[FloatArray, float | None]:
+    """2-D points and their common z, or the 3-D points and None."""
+    if xyz.shape[0] and np.all(xyz[:, 2] == xyz[0, 2]):
+        return np.ascontiguousarray(xyz[:, :2]), float(xyz[0, 2])
+    return xyz, None
+
+
+def _ring(pts: FloatArray, closed_flag: bool) -> tuple[FloatArray, np.ndarray, bool]:
+    """Distinct points, vertex -> distinct index map, closed.
+
+    A closed polyline that repeats its first vertex last, or an open one that ends where it
+    starts (4 vertices or more), is a closed loop.
+    """
+    n = pts.shape[0]
+    if n >= 3 and np.array_equal(pts[0], pts[-1]) and (closed_flag or n >= 4):
+        return pts[:-1], np.r_[np.arange(n - 1), 0], True
+    return pts, np.arange(n), bool(closed_flag)
+
+
+def _spline_record(e: Any, base: dict[str, Any], path: object, corner_angle: float | None,
+                   index: int) -> list[CurveRecord]:
+    p = int(e.dxf.degree)
+    weights = np.asarray(e.weights, dtype=float)
+    if weights.size and not np.all(weights == 1.0):
+        raise _Unsupported("rational spline (weights other than 1)")
+    cps = np.asarray([tuple(v) for v in e.control_points], dtype=float).reshape(-1, 3)
+    fits = np.asarray([tuple(v) for v in e.fit_points], dtype=float).reshape(-1, 3)
+    closed_flag = bool(e.closed)
+    if cps.shape[0] == 0:
+        if fits.shape[0] < 2:
+            raise FileFormatError(f"SPLINE {base['handle']} has neither control points nor 2 "
+                                  "fit points", path)
+        check_points(fits, path, None, what=f"SPLINE {base['handle']} fit point")
+        pts, z = _planar(fits)
+        distinct, row_map, closed = _ring(pts, closed_flag)
+        src = dict(base, z=z, row_map=tuple(int(i) for i in row_map),
+                   has_end_tangents=bool(e.dxf.hasattr("start_tangent")))
+        return point_records(distinct, closed=closed, corner_angle=None, kind="fit_points",
+                             name=base["name"], source=src, first_index=index)
+    if not np.isfinite(cps).all():
+        raise FileFormatError(f"SPLINE {base['handle']} has a non-finite control point", path)
+    if p < 2:
+        raise _Unsupported(f"degree-{p} spline")
+    knots = np.asarray(e.knots, dtype=float)
+    N = cps.shape[0]
+    pts, z = _planar(cps)
+    try:
+        if knots.shape[0] == N + p + 1 and is_clamped(knots, p):
+            curve = BSplineCurve(pts, knots, p, closed=False)
+            layout = "clamped"
+        elif closed_flag and knots.shape[0] == N + p + 1 and N > 2 * p and \
+                np.array_equal(cps[N - p:], cps[:p]):
+            curve = BSplineCurve(pts[: N - p], knots, p, closed=True)
+            layout = "periodic"
+        elif closed_flag and knots.shape[0] == N + 1:
+            curve = BSplineCurve(pts, knots, p, closed=True)
+            layout = "periodic_short"
+        else:
+            raise _Unsupported(f"knot layout ({knots.shape[0]} knots for {N} control points "
+                               f"of degree {p}, neither clamped nor periodic)")
+    except CurvefairError as exc:
+        if isinstance(exc, FileFormatError):
+            raise
+        raise FileFormatError(f"SPLINE {base['handle']}: {exc}", path) from None
+    src = dict(base, z=z, spline_layout=layout, had_fit_points=bool(fits.shape[0]))
+    return [CurveRecord(curve, base["name"], "bspline", src)]
+
+
+def _polyline_record(e: Any, base: dict[str, Any], path: object,
+                     corner_angle: float | None, index: int) -> list[CurveRecord]:
+    kind = e.dxftype()
+    if kind == "LWPOLYLINE":
+        raw = np.asarray(e.get_points("xyb"), dtype=float).reshape(-1, 3)
+        if np.any(raw[:, 2] != 0):
+            raise _Unsupported("polyline with arc segments (bulges)")
+        pts = raw[:, :2]
+        z: float | None = float(e.dxf.get("elevation", 0.0))
+    else:
+        if not (e.is_2d_polyline or e.is_3d_polyline):
+            return []                     # polyface / mesh: not a curve
+        if e.dxf.flags & 6:
+            raise _Unsupported("spline-fit or curve-fit POLYLINE")
+        verts = list(e.vertices)
+        if any(v.dxf.get("bulge", 0.0) for v in verts):
+            raise _Unsupported("polyline with arc segments (bulges)")
+        xyz = np.asarray([tuple(v.dxf.location) for v in verts], dtype=float).reshape(-1, 3)
+        pts, z = _planar(xyz)
+    if pts.shape[0] < 2:
+        raise FileFormatError(f"{kind} {base['handle']} has fewer than 2 vertices", path)
+    check_points(pts, path, None, what=f"{kind} {base['handle']} vertex")
+    closed_flag = bool(e.closed) if kind == "LWPOLYLINE" else bool(e.is_closed)
+    distinct, row_map, closed = _ring(pts, closed_flag)
+    src = dict(base, z=z, row_map=tuple(int(i) for i in row_map))
+    return point_records(distinct, closed=closed, corner_angle=corner_angle, kind="polyline",
+                         name=base["name"], source=src, first_index=index)
+
+
+def _load(path: object, what: str) -> Any:
+    ezdxf = _ezdxf(what)
+    try:
+        return ezdxf.readfile(os.fspath(path))  # type: ignore[arg-type]
+    except OSError as exc:
+        raise FileFormatError(f"not a readable DXF file ({exc})", path) from None
+    except Exception as exc:  # ezdxf raises its own DXFStructureError, ValueError, ...
+        raise FileFormatError(f"not a readable DXF file ({type(exc).__name__}: {exc})",
+                              path) from None
+
+
+def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
+         on_unsupported: str = "raise", **_: Any) -> list[CurveRecord]:
+    """Read the curves of a DXF drawing; see the module docstring."""
+    doc = _load(path, "reading DXF files")
+    records: list[CurveRecord] = []
+    for layout in doc.layouts:
+        for e in layout:
+            t = e.dxftype()
+            if t not in ("SPLINE", "LWPOLYLINE", "POLYLINE"):
+                continue
+            handle = e.dxf.handle
+            layer = e.dxf.get("layer", "0")
+            base = {"format": FORMAT, "path": os.path.abspath(path), "handle": handle,
+                    "dxftype": t, "layer": layer, "layout": layout.name,
+                    "name": f"{layer}:{t}:{handle}"}
+            try:
+                if t == "SPLINE":
+                    new = _spline_record(e, base, path, corner_angle, len(records))
+                else:
+                    new = _polyline_record(e, base, path, corner_angle, len(records))
+            except _Unsupported as exc:
+                msg = f"{t} {handle} on layer {layer!r}: unsupported {exc}"
+                if on_unsupported == "raise":
+                    raise FileFormatError(msg + " (read_curves(..., on_unsupported='skip') "
+                                          "skips it)", path) from None
+                warnings.warn(f"{os.fspath(path)}: skipped {msg}", UserWarning, stacklevel=3)
+                continue
+            for r in new:
+                src = dict(r.source)
+                src.pop("name", None)
+                src["index"] = len(records)
+                records.append(CurveRecord(r.curve, r.name, r.kind, src, r.points, r.corners))
+    return records
+
+
+# ------------------------------------------------------------------------------------------
+# write
+# ------------------------------------------------------------------------------------------
+def _xyz(pts: FloatArray, z: float | None) -> list[tuple[float, float, float]]:
+    pts = np.asarray(pts, dtype=float)
+    if pts.shape[1] == 2:
+        zz = 0.0 if z is None else z
+        return [(float(x), float(y), zz) for x, y in pts]
+    return [tuple(float(v) for v in row) for row in pts]  # type: ignore[misc]
+
+
+def _set_spline(e: Any, rec: CurveRecord) -> None:
+    curve = bspline_of(rec.curve, "write_curves (DXF)")
+    layout = rec.source.get("spline_layout", "clamped")
+    z = rec.source.get("z")
+    if curve.closed != (layout != "clamped"):
+        raise InputError(f"write_curves: SPLINE {rec.source['handle']} was "
+                         f"{'closed' if layout != 'clamped' else 'open'}; the curve is not")
+    p = curve.degree
+    if layout == "periodic_short":
+        cps = curve.control_points
+        knots = curve.knots[p: p + curve.n_ctrl + 1]
+    else:
+        cps = curve.extended_control_points
+        knots = curve.knots
+    e.dxf.degree = p
+    e.control_points = _xyz(cps, z)
+    e.knots = [float(k) for k in knots]
+    e.weights = []
+    if len(e.fit_points):
+        e.fit_points = []
+
+
+def _group(records: Sequence[CurveRecord]) -> dict[str, list[CurveRecord]]:
+    out: dict[str, list[CurveRecord]] = {}
+    for r in records:
+        out.setdefault(r.source["handle"], []).append(r)
+    return out
+
+
+def _set_points(e: Any, recs: list[CurveRecord]) -> None:
+    src = recs[0].source
+    n = int(src["n_points"])
+    dim = data_points(recs[0].curve, "write_curves (DXF)").shape[1]
+    distinct = piece_values(n, dim, recs, "write_curves (DXF)")
+    pts = distinct[np.asarray(src["row_map"], dtype=int)]
+    t = e.dxftype()
+    if t == "SPLINE":
+        e.fit_points = _xyz(pts, src.get("z"))
+        return
+    if t == "LWPOLYLINE":
+        old = list(e.get_points("xyseb"))
+        if len(old) != pts.shape[0]:
+            raise InputError(f"write_curves: LWPOLYLINE {src['handle']} has {len(old)} "
+                             f"vertices in the template, the records {pts.shape[0]}")
+        e.set_points([(float(x), float(y), s, w, b) for (x, y), (_, _, s, w, b)
+                      in zip(pts[:, :2], old, strict=True)], format="xyseb")
+        return
+    verts = list(e.vertices)
+    if len(verts) != pts.shape[0]:
+        raise InputError(f"write_curves: POLYLINE {src['handle']} has {len(verts)} vertices "
+                         f"in the template, the records {pts.shape[0]}")
+    for v, xyz in zip(verts, _xyz(pts, src.get("z")), strict=True):
+        v.dxf.location = xyz
+
+
+def _add_new(msp: Any, rec: CurveRecord, z: float | None) -> None:
+    if rec.kind in ("points", "airfoil", "polyline"):
+        pts = data_points(rec.curve, "write_curves (DXF)")
+        closed = bool(rec.curve.closed)
+        if closed:
+            pts = pts[:-1]
+        if pts.shape[1] == 2:
+            msp.add_lwpolyline([tuple(map(float, q)) for q in pts], format="xy",
+                               close=closed, dxfattribs={"elevation": z or 0.0})
+        else:
+            msp.add_polyline3d(_xyz(pts, None), close=closed)
+        return
+    if rec.kind == "fit_points":
+        pts = data_points(rec.curve, "write_curves (DXF)")
+        s = msp.add_spline(fit_points=_xyz(pts[:-1] if rec.curve.closed else pts, z))
+        s.closed = bool(rec.curve.closed)
+        return
+    curve = bspline_of(rec.curve, "write_curves (DXF)")
+    p = curve.degree
+    s = msp.add_spline(degree=p)
+    s.control_points = _xyz(curve.extended_control_points, z)
+    s.knots = [float(k) for k in curve.knots]
+    if curve.closed:
+        s.dxf.flags = s.dxf.flags | s.CLOSED | s.PERIODIC
+
+
+def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
+          template: str | None = None, **_: Any) -> None:
+    """Write a DXF drawing; see the module docstring."""
+    ezdxf = _ezdxf("writing DXF files")
+    if template is not None:
+        doc = _load(template, "writing DXF files")
+    else:
+        doc = ezdxf.new("R2010")
+    msp = doc.modelspace()
+    ours = [r for r in records if template is not None and r.format == FORMAT
+            and r.path is not None and os.path.abspath(r.path) == os.path.abspath(template)]
+    others = [r for r in records if not any(r is o for o in ours)]
+    for handle, recs in _group(ours).items():
+        e = doc.entitydb.get(handle)
+        if e is None or e.dxftype() != recs[0].source["dxftype"]:
+            raise InputError(f"write_curves: the template has no {recs[0].source['dxftype']} "
+                             f"with handle {handle}")
+        if recs[0].kind == "bspline":
+            _set_spline(e, recs[0])
+        else:
+            _set_points(e, recs)
+    # records from another DXF file that were split into pieces: join them again
+    for _key, recs in _group_foreign(others).items():
+        if len(recs) > 1 or "indices" in recs[0].source:
+            pts = joined_points(recs, "write_curves (DXF)")
+            closed = bool(recs[0].source.get("closed"))
+            whole = recs[0].with_curve(points_curve(pts, closed) if pts.shape[0] > 1 else
+                                       recs[0].curve)
+            _add_new(msp, whole, recs[0].source.get("z"))
+        else:
+            _add_new(msp, recs[0], recs[0].source.get("z"))
+    with atomic_path(path, suffix=".dxf") as tmp:
+        doc.saveas(os.fspath(tmp))
+
+
+def _group_foreign(records: Sequence[CurveRecord]) -> dict[Any, list[CurveRecord]]:
+    out: dict[Any, list[CurveRecord]] = {}
+    for i, r in enumerate(records):
+        if "indices" in r.source and r.path is not None:
+            key: Any = (r.path, r.source.get("handle"), r.format)
+        else:
+            key = ("single", i)
+        out.setdefault(key, []).append(r)
+    return out
