@@ -30,6 +30,7 @@ from .fairing import _hermite_kernels as _k
 from .fairing._hermite_data import distinct_data, rebuild, uniform_spacing
 from .fairing.cheng_yu import cheng_yu  # noqa: F401  (Cheng & Yu, cubic B-splines)
 from .fairing.eck_hadenfeld import eck_hadenfeld  # noqa: F401  (Eck & Hadenfeld, B-splines)
+from .fairing.knot_removal import knot_removal  # noqa: F401  (Farin, B-splines)
 
 __all__ = ["kjellander", "poliakoff", "wang_cao", "wang_quintic", "uniform_spacing"]
 

@@ -167,29 +167,43 @@ def wang_cao_eta_given_delta(P, D, h, k, delta, eta):  # type: ignore[no-untyped
         eta[c] = (G - (3.0 / D1**2 - 3.0 / D0**2) * delta[c]) / (2.0 * (1.0 / D1 + 1.0 / D0))
 
 
-@njit(cache=True)
-def quintic_system(P, D, h, k, C):  # type: ignore[no-untyped-def]
-    """Wang 2005, Lemma: gradient ``C[c] = (C1, C2, C3)`` per coordinate and the Hessian entries
-    ``(H00, H01, H02, H11, H22)`` (``H12 = 0``), with ``W* - W = C.x + x^T H x / 2``."""
+@njit(cache=True, inline="always")
+def _quintic_C(P, D, h, k, c):  # type: ignore[no-untyped-def]
+    """Wang 2005, Lemma: ``(C1, C2, C3)`` of coordinate ``c`` at point ``k``."""
     nd = P.shape[0]
     km = (k - 1) % nd
     D0 = h[km]
     D1 = h[k]
-    for c in range(P.shape[1]):
-        l2, l3, l4, l5 = _quintic_a2345(P, D, h, km, c)
-        r2, r3, r4, r5 = _quintic_a2345(P, D, h, k, c)
-        C[c, 0] = (12.0 * (r3 - l3) + 24.0 * (r4 * D1 - l4 * D0)
-                   + 240.0 / 7.0 * (r5 * D1**2 - l5 * D0**2))
-        C[c, 1] = (-4.0 * (r2 - l2) + 12.0 * l3 * D0 + 24.0 / 5.0 * r4 * D1**2
-                   + 96.0 / 5.0 * l4 * D0**2 + 64.0 / 7.0 * r5 * D1**3 + 176.0 / 7.0 * l5 * D0**3)
-        C[c, 2] = (2.0 / 5.0 * (r4 * D1**3 + l4 * D0**3) + 6.0 / 7.0 * r5 * D1**4
-                   + 8.0 / 7.0 * l5 * D0**4)
+    l2, l3, l4, l5 = _quintic_a2345(P, D, h, km, c)
+    r2, r3, r4, r5 = _quintic_a2345(P, D, h, k, c)
+    C1 = (12.0 * (r3 - l3) + 24.0 * (r4 * D1 - l4 * D0)
+          + 240.0 / 7.0 * (r5 * D1**2 - l5 * D0**2))
+    C2 = (-4.0 * (r2 - l2) + 12.0 * l3 * D0 + 24.0 / 5.0 * r4 * D1**2
+          + 96.0 / 5.0 * l4 * D0**2 + 64.0 / 7.0 * r5 * D1**3 + 176.0 / 7.0 * l5 * D0**3)
+    C3 = (2.0 / 5.0 * (r4 * D1**3 + l4 * D0**3) + 6.0 / 7.0 * r5 * D1**4
+          + 8.0 / 7.0 * l5 * D0**4)
+    return C1, C2, C3
+
+
+@njit(cache=True, inline="always")
+def _quintic_H(D0, D1):  # type: ignore[no-untyped-def]
+    """Wang 2005, Theorem: Hessian entries ``(H00, H01, H02, H11, H22)``; ``H12 = 0``."""
     H00 = 240.0 / 7.0 * (1.0 / D1**3 + 1.0 / D0**3)
     H01 = 120.0 / 7.0 * (1.0 / D1**2 - 1.0 / D0**2)
     H02 = 6.0 / 7.0 * (1.0 / D1 + 1.0 / D0)
     H11 = 384.0 / 35.0 * (1.0 / D1 + 1.0 / D0)
     H22 = 6.0 / 35.0 * (D0 + D1)
     return H00, H01, H02, H11, H22
+
+
+@njit(cache=True)
+def quintic_system(P, D, h, k, C):  # type: ignore[no-untyped-def]
+    """Wang 2005, Lemma: gradient ``C[c] = (C1, C2, C3)`` per coordinate and the Hessian entries
+    ``(H00, H01, H02, H11, H22)`` (``H12 = 0``), with ``W* - W = C.x + x^T H x / 2``."""
+    nd = P.shape[0]
+    for c in range(P.shape[1]):
+        C[c, 0], C[c, 1], C[c, 2] = _quintic_C(P, D, h, k, c)
+    return _quintic_H(h[(k - 1) % nd], h[k])
 
 
 @njit(cache=True)
@@ -203,22 +217,38 @@ def quintic_step(P, D, h, k, delta, eta, xi, clamped_delta):  # type: ignore[no-
     computed (the optimal derivatives for that position). Returns the energy drops
     ``(drop_total, drop_position)`` of the unconstrained step (``int |r''|^2`` units).
     """
-    dim = P.shape[1]
-    C = np.empty((dim, 3))
-    H00, H01, H02, H11, H22 = quintic_system(P, D, h, k, C)
+    nd = P.shape[0]
+    H00, H01, H02, H11, H22 = _quintic_H(h[(k - 1) % nd], h[k])
     S = H00 - H01 * H01 / H11 - H02 * H02 / H22
     drop_pos = 0.0
     drop_der = 0.0
-    for c in range(dim):
-        c1 = C[c, 0] - H01 * C[c, 1] / H11 - H02 * C[c, 2] / H22
+    for c in range(P.shape[1]):
+        C1, C2, C3 = _quintic_C(P, D, h, k, c)
+        c1 = C1 - H01 * C2 / H11 - H02 * C3 / H22
         d_opt = -c1 / S
         drop_pos += 0.5 * S * d_opt * d_opt
-        drop_der += 0.5 * (C[c, 1] ** 2 / H11 + C[c, 2] ** 2 / H22)
+        drop_der += 0.5 * (C2 * C2 / H11 + C3 * C3 / H22)
         if not clamped_delta:
             delta[c] = d_opt
-        eta[c] = -(C[c, 1] + H01 * delta[c]) / H11
-        xi[c] = -(C[c, 2] + H02 * delta[c]) / H22
+        eta[c] = -(C2 + H01 * delta[c]) / H11
+        xi[c] = -(C3 + H02 * delta[c]) / H22
     return drop_pos + drop_der, drop_pos
+
+
+@njit(cache=True)
+def quintic_measure(P, D, h, k, spline):  # type: ignore[no-untyped-def]
+    """Energy drop of the Wang step at ``k`` (whole step, or only its position part)."""
+    nd = P.shape[0]
+    H00, H01, H02, H11, H22 = _quintic_H(h[(k - 1) % nd], h[k])
+    S = H00 - H01 * H01 / H11 - H02 * H02 / H22
+    out = 0.0
+    for c in range(P.shape[1]):
+        C1, C2, C3 = _quintic_C(P, D, h, k, c)
+        c1 = C1 - H01 * C2 / H11 - H02 * C3 / H22
+        out += 0.5 * c1 * c1 / S
+        if not spline:
+            out += 0.5 * (C2 * C2 / H11 + C3 * C3 / H22)
+    return out
 
 
 @njit(cache=True)
@@ -240,12 +270,7 @@ def measure_at(P, D, h, k, degree, spline):  # type: ignore[no-untyped-def]
     of the Wang step (hermite mode: whole step; spline mode: the part due to the position)."""
     if degree == 3:
         return cubic_jump(P, D, h, k)
-    dim = P.shape[1]
-    dl = np.empty(dim)
-    et = np.empty(dim)
-    xs = np.empty(dim)
-    tot, pos = quintic_step(P, D, h, k, dl, et, xs, False)
-    return pos if spline else tot
+    return quintic_measure(P, D, h, k, spline)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -291,8 +316,19 @@ def tt_update_range(tv, ti, lo, hi, values):  # type: ignore[no-untyped-def]
 # window solve of the spline system (block tridiagonal, SPD, block size nb = 1 or 2)
 # ----------------------------------------------------------------------------------------------
 @njit(cache=True, inline="always")
-def _kseg(K0, pe, q, hj, a, b):  # type: ignore[no-untyped-def]
-    return K0[a, b] * hj ** (1 - 2 * q + pe[a] + pe[b])
+def _powers(hj, q, pw):  # type: ignore[no-untyped-def]
+    """``pw[e] = hj ** (1 - 2 q + e)`` for ``e = 0 .. 2 q - 2`` (exponents up to -1)."""
+    ih = 1.0 / hj
+    x = ih
+    for e in range(2 * q - 2, -1, -1):
+        pw[e] = x
+        x *= ih
+
+
+@njit(cache=True, inline="always")
+def _kseg(K0, pe, pw, a, b):  # type: ignore[no-untyped-def]
+    """Entry (a, b) of the Gram matrix of a segment whose powers ``pw`` are set."""
+    return K0[a, b] * pw[pe[a] + pe[b]]
 
 
 @njit(cache=True)
@@ -308,7 +344,7 @@ def _inv_small(M, nb, out):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def _assemble_window(nd, closed, h, K0, pe, q, nb, fixed, idx, L, Bd, Cu):  # type: ignore[no-untyped-def]
+def _assemble_window(nd, closed, h, K0, pe, q, nb, fixed, idx, L, Bd, Cu, pw):  # type: ignore[no-untyped-def]
     """Diagonal blocks ``Bd[v]`` and super-diagonal blocks ``Cu[v]`` (v -> v+1) of the window
     whose actual point indices are ``idx[0..L-1]``; fixed unknowns become identity rows/cols."""
     r1 = nb + 1  # offset of the end point's data in the local vector
@@ -316,17 +352,20 @@ def _assemble_window(nd, closed, h, K0, pe, q, nb, fixed, idx, L, Bd, Cu):  # ty
         i = idx[v]
         for a in range(nb):
             for b in range(nb):
-                s = 0.0
-                if closed or i >= 1:  # segment i-1 ends at i
-                    j = (i - 1) % nd
-                    s += _kseg(K0, pe, q, h[j], r1 + 1 + a, r1 + 1 + b)
-                if closed or i <= nd - 2:  # segment i starts at i
-                    s += _kseg(K0, pe, q, h[i], 1 + a, 1 + b)
-                Bd[v, a, b] = s
-                if v < L - 1:
-                    Cu[v, a, b] = _kseg(K0, pe, q, h[i], 1 + a, r1 + 1 + b)
-                else:
-                    Cu[v, a, b] = 0.0
+                Bd[v, a, b] = 0.0
+                Cu[v, a, b] = 0.0
+        if closed or i >= 1:  # segment i-1 ends at i
+            _powers(h[(i - 1) % nd], q, pw)
+            for a in range(nb):
+                for b in range(nb):
+                    Bd[v, a, b] += _kseg(K0, pe, pw, r1 + 1 + a, r1 + 1 + b)
+        if closed or i <= nd - 2:  # segment i starts at i
+            _powers(h[i], q, pw)
+            for a in range(nb):
+                for b in range(nb):
+                    Bd[v, a, b] += _kseg(K0, pe, pw, 1 + a, 1 + b)
+                    if v < L - 1:
+                        Cu[v, a, b] = _kseg(K0, pe, pw, 1 + a, r1 + 1 + b)
     for v in range(L):
         i = idx[v]
         for a in range(nb):
@@ -388,35 +427,36 @@ def _block_thomas(L, nb, dim, Bd, Cu, R, X, Bp, Y):  # type: ignore[no-untyped-d
 
 
 @njit(cache=True)
-def _rhs_for_move(nd, closed, h, K0, pe, q, nb, k, dr, idx, L, fixed, R):  # type: ignore[no-untyped-def]
-    """Right-hand side (minus the gradient change) caused by moving point ``k`` by ``dr``."""
+def _rhs_for_move(nd, closed, h, K0, pe, q, nb, k, dr, idx, L, fixed, R, pw):  # type: ignore[no-untyped-def]
+    """Right-hand side (minus the gradient change) caused by moving point ``k`` by ``dr``.
+
+    Only the points ``k - 1, k, k + 1`` share a segment with ``k``; for point ``i`` the entry is
+    ``-K[d_i, r_k] dr`` summed over the segments holding both.
+    """
     dim = dr.shape[0]
     r1 = nb + 1
     for v in range(L):
-        for a in range(nb):
-            for c in range(dim):
-                R[v, a, c] = 0.0
-    for v in range(L):
         i = idx[v]
         for a in range(nb):
-            if fixed[i, a]:
-                continue
             coef = 0.0
-            # segment i-1 (i is its end), segment i (i is its start)
-            if closed or i >= 1:
-                j = (i - 1) % nd
-                if (j + 1) % nd == i and i == k:
-                    coef += _kseg(K0, pe, q, h[j], r1 + 1 + a, r1)
-                if j == k:  # start point of segment j is k
-                    coef += _kseg(K0, pe, q, h[j], r1 + 1 + a, 0)
-            if closed or i <= nd - 2:
-                if i == k:
-                    coef += _kseg(K0, pe, q, h[i], 1 + a, 0)
-                if (i + 1) % nd == k:
-                    coef += _kseg(K0, pe, q, h[i], 1 + a, r1)
-            if coef != 0.0:
-                for c in range(dim):
-                    R[v, a, c] = -coef * dr[c]
+            if not fixed[i, a]:
+                if closed or i >= 1:  # segment j = i-1: i is its end point
+                    j = (i - 1) % nd
+                    if i == k or j == k:
+                        _powers(h[j], q, pw)
+                        if i == k:
+                            coef += _kseg(K0, pe, pw, r1 + 1 + a, r1)
+                        if j == k:
+                            coef += _kseg(K0, pe, pw, r1 + 1 + a, 0)
+                if closed or i <= nd - 2:  # segment i: i is its start point
+                    if i == k or (i + 1) % nd == k:
+                        _powers(h[i], q, pw)
+                        if i == k:
+                            coef += _kseg(K0, pe, pw, 1 + a, 0)
+                        if (i + 1) % nd == k:
+                            coef += _kseg(K0, pe, pw, 1 + a, r1)
+            for c in range(dim):
+                R[v, a, c] = -coef * dr[c]
 
 
 # ----------------------------------------------------------------------------------------------
@@ -435,13 +475,12 @@ def _clamped_move(P, D, h, orig, k, method, degree, spline, hstep, tol, delta, e
         cubic_step(P, D, h, k, method, hstep, delta, eta)
     else:
         quintic_step(P, D, h, k, delta, eta, xi, False)
-    # work with the rounded new position so that the move applied is exactly delta and the
-    # tolerance holds for the stored numbers, not only in exact arithmetic
-    new = np.empty(dim)
+    # work with the rounded new position (held in delta for now) so that the move applied is
+    # exactly delta and the tolerance holds for the stored numbers, not only in exact arithmetic
     want = 0.0
     for c in range(dim):
-        new[c] = P[k, c] + delta[c]
         want += delta[c] ** 2
+        delta[c] = P[k, c] + delta[c]
     want = np.sqrt(want)
     clamped = False
     if tol > 0.0:
@@ -449,16 +488,16 @@ def _clamped_move(P, D, h, orig, k, method, degree, spline, hstep, tol, delta, e
         for _ in range(8):
             off = 0.0
             for c in range(dim):
-                off += (new[c] - orig[k, c]) ** 2
+                off += (delta[c] - orig[k, c]) ** 2
             off = np.sqrt(off)
             if off <= tol_eff:
                 break
             f = tol_eff / off * (1.0 - 1e-15)
             for c in range(dim):
-                new[c] = orig[k, c] + (new[c] - orig[k, c]) * f
+                delta[c] = orig[k, c] + (delta[c] - orig[k, c]) * f
             clamped = True
     for c in range(dim):
-        delta[c] = new[c] - P[k, c]
+        delta[c] = delta[c] - P[k, c]
     if clamped and not spline:
         if degree == 5:
             quintic_step(P, D, h, k, delta, eta, xi, True)
@@ -481,27 +520,32 @@ def _is_blocked(mv, clamped, want, move_floor):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def drive(P, D, h, orig, closed, degree, method, spline, hstep, eligible, tol, eps,
-          max_steps, move_floor, K0, pe, q, fixed, Hinv, w0, wmax, thr):  # type: ignore[no-untyped-def]
-    """Seed 001's steps 2-6 on the distinct data (modified in place).
+def drive_setup(P, D, h, closed, degree, spline, eligible):  # type: ignore[no-untyped-def]
+    """Initial measures and the ranking tree: ``(measure, values, tv, ti)`` (``O(n)``)."""
+    nd = P.shape[0]
+    measure = all_measures(P, D, h, closed, degree, spline)
+    values = np.full(nd, -np.inf)
+    for i in range(nd):
+        if eligible[i]:
+            values[i] = measure[i]
+    tv, ti = tt_build(values)
+    return measure, values, tv, ti
 
-    Returns ``(steps, stop_code, hist_index, hist_measure, hist_disp, measure, blocked,
+
+@njit(cache=True)
+def drive(P, D, h, orig, closed, degree, method, spline, hstep, eligible, tol, eps,
+          max_steps, move_floor, K0, pe, q, fixed, Hinv, w0, wmax, thr,
+          measure, values, tv, ti):  # type: ignore[no-untyped-def]
+    """Seed 001's steps 2-6 on the distinct data (``P``, ``D``, ``measure``, ``values`` and the
+    tree ``tv``/``ti`` from :func:`drive_setup` are modified in place).
+
+    Returns ``(steps, stop_code, hist_index, hist_measure, hist_disp, blocked,
     n_truncated, n_skipped, max_window)``; ``blocked`` is 0 (free), 1 (blocked by the tolerance),
     2 (move ~0 without clamping).
     """
     nd = P.shape[0]
     dim = P.shape[1]
     nb = D.shape[1]
-    measure = np.empty(nd)
-    values = np.full(nd, -np.inf)
-    for i in range(nd):
-        if closed or (i >= 1 and i <= nd - 2):
-            measure[i] = measure_at(P, D, h, i, degree, spline)
-        else:
-            measure[i] = 0.0
-        if eligible[i]:
-            values[i] = measure[i]
-    tv, ti = tt_build(values)
     blocked = np.zeros(nd, dtype=np.int8)
     cap = 1024 if max_steps > 1024 else max(max_steps, 1)
     h_idx = np.empty(cap, dtype=np.int64)
@@ -524,6 +568,7 @@ def drive(P, D, h, orig, closed, degree, method, spline, hstep, eligible, tol, e
     X = np.empty((Lmax, nb, dim))
     Bp = np.empty((Lmax, nb, nb))
     Y = np.empty((Lmax, nb, dim))
+    pw = np.empty(8)
     w_cur = w0
     steps = 0
     n_trunc = 0
@@ -585,7 +630,7 @@ def drive(P, D, h, orig, closed, degree, method, spline, hstep, eligible, tol, e
                 # closed and small: exact update with the precomputed inverse of the full system
                 for jj in range(3):
                     idx[jj] = (k - 1 + jj) % nd
-                _rhs_for_move(nd, closed, h, K0, pe, q, nb, k, delta, idx, 3, fixed, R)
+                _rhs_for_move(nd, closed, h, K0, pe, q, nb, k, delta, idx, 3, fixed, R, pw)
                 for r in range(nd * nb):
                     for c in range(dim):
                         s = 0.0
@@ -619,8 +664,8 @@ def drive(P, D, h, orig, closed, degree, method, spline, hstep, eligible, tol, e
                             idx[vv] = lo + vv
                         left_open = lo > 0
                         right_open = hi < nd - 1
-                    _assemble_window(nd, closed, h, K0, pe, q, nb, fixed, idx, L, Bd, Cu)
-                    _rhs_for_move(nd, closed, h, K0, pe, q, nb, k, delta, idx, L, fixed, R)
+                    _assemble_window(nd, closed, h, K0, pe, q, nb, fixed, idx, L, Bd, Cu, pw)
+                    _rhs_for_move(nd, closed, h, K0, pe, q, nb, k, delta, idx, L, fixed, R, pw)
                     _block_thomas(L, nb, dim, Bd, Cu, R, X, Bp, Y)
                     ok = True
                     for e in range(nb):
@@ -689,7 +734,7 @@ def drive(P, D, h, orig, closed, degree, method, spline, hstep, eligible, tol, e
         elif b >= a:
             tt_update_range(tv, ti, a, b, values)
     return (steps, stop, h_idx[:steps].copy(), h_meas[:steps].copy(), h_disp[:steps].copy(),
-            measure, blocked, n_trunc, n_skip, max_window)
+            blocked, n_trunc, n_skip, max_window)
 
 
 @njit(cache=True)

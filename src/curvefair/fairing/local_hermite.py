@@ -85,10 +85,10 @@ from . import _hermite_kernels as _k
 from ._hermite_data import distinct_data, rebuild, uniform_spacing
 from .fair import DriverOutput, FairingHistory, MethodSpec, register_method
 
-__all__ = ["hermite_driver", "hold_zone_cubic"]
+__all__ = ["hermite_driver", "prepare", "hold_zone_cubic", "spline_derivatives"]
 
 _THR = 2.0**-56
-_W0 = {3: 24, 5: 40}
+_W0 = {3: 32, 5: 48}  # 0.27**32, 0.43**48 < 2**-56 on uniform parameters
 _WMAX = 4096
 _DENSE_MAX = 300  # closed curves with nd * nb <= this use a precomputed dense inverse
 _GRAM = {3: _k.hermite_gram(3, 2), 5: _k.hermite_gram(5, 3)}
@@ -190,12 +190,12 @@ def _dense_inverse(nd: int, nb: int, h: FloatArray, degree: int) -> FloatArray:
 # ----------------------------------------------------------------------------------------------
 # the driver
 # ----------------------------------------------------------------------------------------------
-def hermite_driver(curve: HermiteSpline, *, method: str, tol: float | None, eps: float | None,
-                   max_steps: int | None, clamp: tuple[str, str], protect: frozenset[int],
-                   mode: str = "spline", **options: Any) -> DriverOutput:
-    """Driver of the four Hermite methods (see the module docstring); called by :func:`fair`."""
-    if options:
-        raise InputError(f"method {method!r} got unknown options {sorted(options)}")
+def prepare(curve: HermiteSpline, *, method: str, tol: float | None, eps: float | None,
+            max_steps: int | None, clamp: tuple[str, str], protect: frozenset[int],
+            mode: str = "spline") -> dict[str, Any]:
+    """Validate and set up everything the compiled loop needs (``O(n)``); see
+    :func:`hermite_driver`. Returns a dict with the kernel arguments under ``"args"`` (in the
+    order of :func:`_hermite_kernels.drive`) and bookkeeping entries."""
     degree = curve.degree
     code = _METHOD_CODE[method]
     spline = mode == "spline"
@@ -217,26 +217,6 @@ def hermite_driver(curve: HermiteSpline, *, method: str, tol: float | None, eps:
                              "(use 'poliakoff' for non-uniform params)")
         hstep = hs
     extra: dict[str, Any] = {}
-    t0 = time.perf_counter()
-
-    fixed = np.zeros((nd, nb), dtype=np.bool_)
-    if spline and not closed:
-        for side, cl in enumerate(clamp):
-            i = 0 if side == 0 else nd - 1
-            if degree == 3:
-                fixed[i, 0] = cl in ("g1", "g2")
-            else:
-                fixed[i, 0] = cl in ("g1", "g2")
-                fixed[i, 1] = cl == "g2"
-
-    # -- step 1: (re-)interpolate (derivatives given by the end conditions stay bit-identical)
-    if spline:
-        D_new = spline_derivatives(curve, P, clamp)
-        D_new[fixed] = D[fixed]
-        scale = np.abs(D).max(axis=(0, 2)) + 1e-300
-        extra["input_reinterpolation_change"] = float(
-            (np.abs(D_new - D).max(axis=(0, 2)) / scale).max())
-        D = D_new
 
     # -- who may move
     eligible = np.ones(nd, dtype=np.bool_)
@@ -254,13 +234,31 @@ def hermite_driver(curve: HermiteSpline, *, method: str, tol: float | None, eps:
                 held.append(1)
             if clamp[1] == "g2":
                 held.append(nd - 2)
+    held = sorted(set(held))
     for i in held:
         eligible[i] = False
     for i in protect:
         eligible[i] = False
-    # -- defaults
-    meas0 = _k.all_measures(P, D, h, closed, degree, spline)
-    m0 = float(meas0[eligible].max()) if eligible.any() else 0.0
+    fixed = np.zeros((nd, nb), dtype=np.bool_)
+    if spline and not closed:
+        for side, cl in enumerate(clamp):
+            i = 0 if side == 0 else nd - 1
+            fixed[i, 0] = cl in ("g1", "g2")
+            if degree == 5:
+                fixed[i, 1] = cl == "g2"
+
+    # -- step 1: (re-)interpolate (derivatives given by the end conditions stay bit-identical)
+    if spline:
+        D_new = spline_derivatives(curve, P, clamp)
+        D_new[fixed] = D[fixed]
+        scale = np.abs(D).max(axis=(0, 2)) + 1e-300
+        extra["input_reinterpolation_change"] = float(
+            (np.abs(D_new - D).max(axis=(0, 2)) / scale).max())
+        D = D_new
+
+    # -- ranking and defaults
+    measure, values, tv, ti = _k.drive_setup(P, D, h, closed, degree, spline, eligible)
+    m0 = float(measure[eligible].max()) if eligible.any() else 0.0
     rel = 1e-2 if degree == 3 else 1e-4
     eps_eff = rel * m0 if eps is None else float(eps)
     n_elig = int(eligible.sum())
@@ -269,18 +267,33 @@ def hermite_driver(curve: HermiteSpline, *, method: str, tol: float | None, eps:
     floor = 8.0 * np.finfo(float).eps * scale
     if tol is not None:
         floor = max(floor, 1e-9 * tol)
-
     K0, pe = _GRAM[degree]
     q = _Q[degree]
     Hinv = np.zeros((0, 0))
     if spline and closed and nd * nb <= _DENSE_MAX:
         Hinv = _dense_inverse(nd, nb, h, degree)
-    orig = P.copy()
-    (steps, stop, h_idx, h_meas, h_disp, measure, blocked, n_trunc, n_skip,
-     max_window) = _k.drive(P, D, h, orig, closed, degree, code, spline, hstep, eligible,
-                            -1.0 if tol is None else float(tol), eps_eff, max_eff, floor,
-                            K0, pe, q, fixed, Hinv, _W0[degree], _WMAX, _THR)
+    args = (P, D, h, P.copy(), closed, degree, code, spline, hstep, eligible,
+            -1.0 if tol is None else float(tol), eps_eff, max_eff, floor,
+            K0, pe, q, fixed, Hinv, _W0[degree], _WMAX, _THR, measure, values, tv, ti)
+    return {"args": args, "extra": extra, "held": held, "eligible": eligible, "m0": m0,
+            "eps": eps_eff, "max_steps": max_eff, "n_elig": n_elig, "measure": measure,
+            "P": P, "D": D, "spline": spline, "degree": degree, "nd": nd, "Hinv": Hinv}
 
+
+def hermite_driver(curve: HermiteSpline, *, method: str, tol: float | None, eps: float | None,
+                   max_steps: int | None, clamp: tuple[str, str], protect: frozenset[int],
+                   mode: str = "spline", **options: Any) -> DriverOutput:
+    """Driver of the four Hermite methods (see the module docstring); called by :func:`fair`."""
+    if options:
+        raise InputError(f"method {method!r} got unknown options {sorted(options)}")
+    t0 = time.perf_counter()
+    st = prepare(curve, method=method, tol=tol, eps=eps, max_steps=max_steps, clamp=clamp,
+                 protect=protect, mode=mode)
+    (steps, stop, h_idx, h_meas, h_disp, blocked, n_trunc, n_skip,
+     max_window) = _k.drive(*st["args"])
+    P, D, measure, eligible = st["P"], st["D"], st["measure"], st["eligible"]
+    eps_eff, n_elig, spline, degree = st["eps"], st["n_elig"], st["spline"], st["degree"]
+    extra, held, m0, Hinv, nd = st["extra"], st["held"], st["m0"], st["Hinv"], st["nd"]
     if stop == _k.STOP_MAX_STEPS:
         reason = "max_steps"
     elif stop == _k.STOP_EPS:
@@ -309,7 +322,7 @@ def hermite_driver(curve: HermiteSpline, *, method: str, tol: float | None, eps:
         extra["window_truncations"] = int(n_trunc)
     return DriverOutput(new, int(steps), reason,
                         FairingHistory.from_arrays(h_idx, h_meas, h_disp),
-                        eps=eps_eff, max_steps=max_eff, extra=extra)
+                        eps=eps_eff, max_steps=st["max_steps"], extra=extra)
 
 
 _SPECS = [
