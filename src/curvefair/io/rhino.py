@@ -1,0 +1,317 @@
+"""Rhino ``.3dm`` models through rhino3dm / openNURBS (``pip install 'curvefair[rhino]'``).
+
+Read
+----
+Every object whose geometry is a ``NurbsCurve`` or a ``PolylineCurve`` (instance definitions
+are not read; lines, arcs and other geometry are left alone):
+
+- non-rational ``NurbsCurve`` of degree >= 2 -> ``kind="bspline"``: clamped knots give an open
+  curve, periodic ones (``IsPeriodic``: the first ``degree`` control points repeated at the
+  end) a closed curve. openNURBS stores ``n + p - 1`` knots; the two "superfluous" end knots
+  are added back (``Knots.SuperfluousKnot``), so the knot vector is the usual full one;
+- degree-1 ``NurbsCurve`` and ``PolylineCurve`` -> ``kind="polyline"`` (vertices, split at
+  corners like every point list);
+- rational curves, unclamped non-periodic knots, ``PolyCurve``: unsupported
+  (``on_unsupported``).
+
+A curve whose control points all have the same z is 2-D (``source["z"]`` keeps that z).
+``source`` keys: ``id`` (the object's GUID as a string), ``object`` (index in the object
+table), ``layer`` (layer name), ``geometry`` (class name), ``z``, ``nurbs_layout``
+(``"clamped"``/``"periodic"``), plus the point-list keys for polylines.
+
+Write
+-----
+With ``template=`` the model is read again, each record's object is found by id and its
+geometry is edited in place (control points and knots, or vertices: same number, same
+degree) -- attributes, layers, materials, every other object untouched -- and the model is
+written (same archive version) to a temporary file next to the destination and moved into
+place. A curve whose control-point count or degree changed replaces the object's geometry
+(same attributes and id). Without a template: a new model (version 7) with the curves.
+"""
+
+from __future__ import annotations
+
+import os
+import warnings
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from .._typing import FloatArray
+from ..curves.bspline import BSplineCurve
+from ..errors import CurvefairError, FileFormatError, InputError
+from ._common import (
+    CurveRecord,
+    atomic_path,
+    bspline_of,
+    check_points,
+    data_points,
+    is_clamped,
+    joined_points,
+    lazy_import,
+    piece_values,
+    point_records,
+    points_curve,
+)
+
+__all__ = ["read", "write"]
+
+FORMAT = "3dm"
+
+
+def _rhino(what: str) -> Any:
+    return lazy_import("rhino3dm", "rhino3dm", "rhino", what)
+
+
+class _Unsupported(Exception):
+    pass
+
+
+def _planar(xyz: FloatArray) -> tuple[FloatArray, float | None]:
+    if xyz.shape[0] and np.all(xyz[:, 2] == xyz[0, 2]):
+        return np.ascontiguousarray(xyz[:, :2]), float(xyz[0, 2])
+    return xyz, None
+
+
+def _load(path: object, what: str) -> Any:
+    rh = _rhino(what)
+    p = os.fspath(path)  # type: ignore[arg-type]
+    try:
+        size = os.path.getsize(p)
+    except OSError as exc:
+        raise FileFormatError(f"cannot read the file: {exc.strerror or exc}", path) from None
+    if size == 0:
+        raise FileFormatError("empty 3dm file", path)
+    model = rh.File3dm.Read(p)
+    if model is None:
+        raise FileFormatError("not a readable 3dm file (openNURBS could not read it)", path)
+    return model
+
+
+def _nurbs(g: Any) -> tuple[FloatArray, FloatArray, FloatArray, int]:
+    pts = g.Points
+    n = len(pts)
+    xyzw = np.array([(pts[i].X, pts[i].Y, pts[i].Z, pts[i].W) for i in range(n)], dtype=float)
+    knots = np.array(list(g.Knots), dtype=float)
+    full = np.r_[g.Knots.SuperfluousKnot(True), knots, g.Knots.SuperfluousKnot(False)]
+    return xyzw[:, :3], xyzw[:, 3], full, int(g.Degree)
+
+
+def _records_of(obj: Any, i: int, base: dict[str, Any], path: object, rh: Any,
+                corner_angle: float | None, index: int) -> list[CurveRecord]:
+    g = obj.Geometry
+    if isinstance(g, rh.PolylineCurve):
+        xyz = np.array([tuple(_p3(g.Point(k))) for k in range(g.PointCount)], dtype=float)
+        return _polyline(xyz, base, path, corner_angle, index)
+    if not isinstance(g, rh.NurbsCurve):
+        if isinstance(g, rh.PolyCurve):
+            raise _Unsupported("PolyCurve")
+        return []
+    if g.IsRational:
+        xyz, w, _, _ = _nurbs(g)
+        if not np.all(w == 1.0):
+            raise _Unsupported("rational NurbsCurve (weights other than 1)")
+    xyz, _, full, p = _nurbs(g)
+    if not np.isfinite(xyz).all() or not np.isfinite(full).all():
+        raise FileFormatError(f"object {base['id']}: non-finite control point or knot", path)
+    if p == 1:
+        return _polyline(xyz, dict(base, nurbs_layout="degree1"), path, corner_angle, index)
+    if p < 1:
+        raise _Unsupported(f"degree-{p} NurbsCurve")
+    pts, z = _planar(xyz)
+    N = pts.shape[0]
+    try:
+        if is_clamped(full, p):
+            curve = BSplineCurve(pts, full, p, closed=False)
+            layout = "clamped"
+        elif g.IsPeriodic and N > 2 * p - 1 and np.array_equal(xyz[N - p:], xyz[:p]):
+            curve = BSplineCurve(pts[: N - p], full, p, closed=True)
+            layout = "periodic"
+        else:
+            raise _Unsupported("knot vector neither clamped nor periodic")
+    except CurvefairError as exc:
+        if isinstance(exc, FileFormatError):
+            raise
+        raise FileFormatError(f"object {base['id']}: {exc}", path) from None
+    src = dict(base, z=z, nurbs_layout=layout, index=index)
+    return [CurveRecord(curve, base["name"], "bspline", src)]
+
+
+def _p3(p: Any) -> tuple[float, float, float]:
+    return (float(p.X), float(p.Y), float(p.Z))
+
+
+def _polyline(xyz: FloatArray, base: dict[str, Any], path: object,
+              corner_angle: float | None, index: int) -> list[CurveRecord]:
+    if xyz.shape[0] < 2:
+        raise FileFormatError(f"object {base['id']}: fewer than 2 vertices", path)
+    check_points(xyz, path, None, what=f"object {base['id']} vertex")
+    pts, z = _planar(xyz)
+    n = pts.shape[0]
+    closed = n >= 4 and bool(np.array_equal(pts[0], pts[-1]))
+    distinct = pts[:-1] if closed else pts
+    row_map = np.r_[np.arange(n - 1), 0] if closed else np.arange(n)
+    src = dict(base, z=z, row_map=tuple(int(k) for k in row_map))
+    return point_records(distinct, closed=closed, corner_angle=corner_angle, kind="polyline",
+                         name=base["name"], source=src, first_index=index)
+
+
+def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
+         on_unsupported: str = "raise", **_: Any) -> list[CurveRecord]:
+    """Read the curves of a Rhino model; see the module docstring."""
+    rh = _rhino("reading 3dm files")
+    model = _load(path, "reading 3dm files")
+    layers = [model.Layers[k].Name for k in range(len(model.Layers))]
+    records: list[CurveRecord] = []
+    for i in range(len(model.Objects)):
+        obj = model.Objects[i]
+        attr = obj.Attributes
+        ident = str(attr.Id)
+        li = int(attr.LayerIndex)
+        layer = layers[li] if 0 <= li < len(layers) else None
+        name = attr.Name or f"{type(obj.Geometry).__name__}:{ident}"
+        base = {"format": FORMAT, "path": os.path.abspath(path), "id": ident, "object": i,
+                "layer": layer, "geometry": type(obj.Geometry).__name__, "name": name}
+        try:
+            new = _records_of(obj, i, base, path, rh, corner_angle, len(records))
+        except _Unsupported as exc:
+            msg = f"object {ident} ({base['geometry']}, {name!r}): unsupported {exc}"
+            if on_unsupported == "raise":
+                raise FileFormatError(msg + " (read_curves(..., on_unsupported='skip') skips "
+                                      "it)", path) from None
+            warnings.warn(f"{os.fspath(path)}: skipped {msg}", UserWarning, stacklevel=3)
+            continue
+        for r in new:
+            src = dict(r.source)
+            src.pop("name", None)
+            src["index"] = len(records)
+            records.append(CurveRecord(r.curve, r.name, r.kind, src, r.points, r.corners))
+    return records
+
+
+# ------------------------------------------------------------------------------------------
+# write
+# ------------------------------------------------------------------------------------------
+def _xyz(pts: FloatArray, z: float | None) -> FloatArray:
+    pts = np.asarray(pts, dtype=float)
+    if pts.shape[1] == 2:
+        return np.c_[pts, np.full(pts.shape[0], 0.0 if z is None else z)]
+    return pts
+
+
+def _nurbs_of(rh: Any, curve: BSplineCurve, z: float | None) -> Any:
+    p = curve.degree
+    cps = _xyz(curve.extended_control_points, z)
+    g = rh.NurbsCurve(3, False, p + 1, cps.shape[0])
+    for k, (x, y, zz) in enumerate(cps):
+        g.Points[k] = rh.Point4d(float(x), float(y), float(zz), 1.0)
+    for k, v in enumerate(curve.knots[1:-1]):
+        g.Knots[k] = float(v)
+    return g
+
+
+def _edit_nurbs(rh: Any, model: Any, obj: Any, rec: CurveRecord) -> None:
+    curve = bspline_of(rec.curve, "write_curves (3dm)")
+    g = obj.Geometry
+    layout = rec.source.get("nurbs_layout", "clamped")
+    if curve.closed != (layout == "periodic"):
+        raise InputError(f"write_curves: object {rec.source['id']} was "
+                         f"{'closed' if layout == 'periodic' else 'open'}; the curve is not")
+    cps = _xyz(curve.extended_control_points, rec.source.get("z"))
+    knots = curve.knots[1:-1]
+    if int(g.Degree) == curve.degree and len(g.Points) == cps.shape[0]:
+        for k, (x, y, zz) in enumerate(cps):
+            g.Points[k] = rh.Point4d(float(x), float(y), float(zz), 1.0)
+        for k, v in enumerate(knots):
+            g.Knots[k] = float(v)
+        return
+    _replace_geometry(model, obj, _nurbs_of(rh, curve, rec.source.get("z")))
+
+
+def _replace_geometry(model: Any, obj: Any, geometry: Any) -> None:
+    attr = obj.Attributes
+    ident = attr.Id
+    model.Objects.Delete(ident)
+    model.Objects.Add(geometry, attr)
+
+
+def _edit_points(rh: Any, obj: Any, recs: list[CurveRecord]) -> None:
+    src = recs[0].source
+    n = int(src["n_points"])
+    dim = data_points(recs[0].curve, "write_curves (3dm)").shape[1]
+    distinct = piece_values(n, dim, recs, "write_curves (3dm)")
+    pts = _xyz(distinct[np.asarray(src["row_map"], dtype=int)], src.get("z"))
+    g = obj.Geometry
+    if isinstance(g, rh.PolylineCurve):
+        if g.PointCount != pts.shape[0]:
+            raise InputError(f"write_curves: object {src['id']} has {g.PointCount} vertices, "
+                             f"the records {pts.shape[0]}")
+        for k, (x, y, z) in enumerate(pts):
+            g.SetPoint(k, rh.Point3d(float(x), float(y), float(z)))
+        return
+    if len(g.Points) != pts.shape[0]:
+        raise InputError(f"write_curves: object {src['id']} has {len(g.Points)} control points, "
+                         f"the records {pts.shape[0]}")
+    for k, (x, y, z) in enumerate(pts):
+        g.Points[k] = rh.Point4d(float(x), float(y), float(z), 1.0)
+
+
+def _add_new(rh: Any, model: Any, rec: CurveRecord) -> None:
+    z = rec.source.get("z")
+    attr = rh.ObjectAttributes()
+    if rec.name:
+        attr.Name = rec.name
+    if rec.kind in ("points", "airfoil", "polyline"):
+        pts = _xyz(data_points(rec.curve, "write_curves (3dm)"), z)
+        geom = rh.PolylineCurve([rh.Point3d(*map(float, q)) for q in pts])
+    else:
+        geom = _nurbs_of(rh, bspline_of(rec.curve, "write_curves (3dm)"), z)
+    model.Objects.Add(geom, attr)
+
+
+def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
+          template: str | None = None, **_: Any) -> None:
+    """Write a Rhino model; see the module docstring."""
+    rh = _rhino("writing 3dm files")
+    if template is not None:
+        model = _load(template, "writing 3dm files")
+        version = int(rh.File3dm.ReadArchiveVersion(os.fspath(template)) or 0)
+        version = version // 10 if version >= 50 else version
+    else:
+        model = rh.File3dm()
+        version = 7
+    ours = [r for r in records if template is not None and r.format == FORMAT
+            and r.path is not None and os.path.abspath(r.path) == os.path.abspath(template)]
+    others = [r for r in records if not any(r is o for o in ours)]
+    groups: dict[str, list[CurveRecord]] = {}
+    for r in ours:
+        groups.setdefault(r.source["id"], []).append(r)
+    for ident, recs in groups.items():
+        obj = None
+        for k in range(len(model.Objects)):
+            if str(model.Objects[k].Attributes.Id) == ident:
+                obj = model.Objects[k]
+                break
+        if obj is None:
+            raise InputError(f"write_curves: the template has no object with id {ident}")
+        if recs[0].kind == "bspline":
+            _edit_nurbs(rh, model, obj, recs[0])
+        else:
+            _edit_points(rh, obj, recs)
+    joined: dict[Any, list[CurveRecord]] = {}
+    for i, r in enumerate(others):
+        key = (r.path, r.format, r.source.get("id"), r.source.get("handle"),
+               r.source.get("element"), r.source.get("subpath")) \
+            if "indices" in r.source else ("single", i)
+        joined.setdefault(key, []).append(r)
+    for recs in joined.values():
+        if "indices" in recs[0].source:
+            pts = joined_points(recs, "write_curves (3dm)")
+            closed = bool(recs[0].source.get("closed"))
+            _add_new(rh, model, recs[0].with_curve(points_curve(pts, closed)))
+        else:
+            _add_new(rh, model, recs[0])
+    with atomic_path(path, suffix=".3dm") as tmp:
+        if not model.Write(os.fspath(tmp), max(min(version, 8), 2)):
+            raise InputError(f"write_curves: openNURBS could not write {os.fspath(path)!r}")

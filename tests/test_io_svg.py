@@ -1,0 +1,233 @@
+"""SVG paths through svgpathtools: Bezier chains as B-splines, polylines, element write-back.
+
+References: Bezier chains are made from known scipy B-splines by knot insertion
+(``scipy.interpolate.insert``, independent of curvefair) and evaluated with svgpathtools'
+own ``point``; tests/data/matplotlib_logo.svg was written by matplotlib (see
+tests/data/README.md).
+"""
+
+from __future__ import annotations
+
+import re
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.interpolate import BSpline, insert
+
+from curvefair import (
+    BSplineCurve,
+    FileFormatError,
+    MissingDependencyError,
+    interpolate_cubic,
+    read_curves,
+    write_curves,
+)
+from curvefair.io.svg import bezier_chain_to_bspline
+
+spt = pytest.importorskip("svgpathtools")
+
+DATA = Path(__file__).parent / "data"
+
+
+def _beziers_of(t, c):
+    """Bezier segments of a scipy cubic B-spline by inserting every interior knot to
+    multiplicity 3 (scipy.interpolate.insert); returns (m, 4, 2) and the breaks."""
+    tck = (np.asarray(t, float), [np.asarray(c)[:, 0], np.asarray(c)[:, 1]], 3)
+    breaks = np.unique(t[3:-3])
+    for b in breaks[1:-1]:
+        mult = int(np.sum(tck[0] == b))
+        if mult < 3:
+            tck = insert(b, tck, m=3 - mult)
+    cx, cy = tck[1]
+    cp = np.c_[cx, cy][: len(tck[0]) - 4]
+    m = len(breaks) - 1
+    return np.array([cp[3 * i: 3 * i + 4] for i in range(m)]), breaks
+
+
+def test_c2_chain_recovers_the_b_spline():
+    t = np.r_[[0] * 4, 0.7, 1.1, 2.0, 2.2, 3.5, [4.5] * 4]
+    rng = np.random.default_rng(5)
+    c = rng.random((9, 2)) * 10
+    P, breaks = _beziers_of(t, c)
+    got = bezier_chain_to_bspline(P, closed=False)
+    # all interior knots simple, the same knot spacing up to an affine map
+    inner = got.knots[4:-4]
+    assert len(np.unique(inner)) == len(inner) == len(breaks) - 2
+    span_old = np.diff(breaks)
+    span_new = np.diff(np.r_[got.knots[3], inner, got.knots[-4]])
+    np.testing.assert_allclose(span_new / span_new[0], span_old / span_old[0], rtol=1e-10)
+    ref = BSpline(t, c, 3)
+    s = np.linspace(0, 1, 11)
+    for i in range(len(breaks) - 1):
+        u_old = breaks[i] + s * span_old[i]
+        u_new = got.piecewise.breaks[i] + s * span_new[i]
+        np.testing.assert_allclose(got(u_new), ref(u_old), atol=1e-9)
+    np.testing.assert_allclose(got.control_points, c, atol=1e-9)
+
+
+def test_c1_and_c0_joins_get_multiplicity_2_and_3():
+    # C1 chain: a C1 spline with a double knot at 2.0
+    t = np.r_[[0] * 4, 1.0, 2.0, 2.0, 3.0, [4.0] * 4]
+    c = np.array([[0, 0], [1, 2], [2, 3], [3, 1], [4, 2], [5, 0], [6, 1], [7, 0]], float)
+    P, _ = _beziers_of(t, c)
+    got = bezier_chain_to_bspline(P, closed=False)
+    _, counts = np.unique(got.knots[4:-4], return_counts=True)
+    assert sorted(counts.tolist()) == [1, 1, 2]
+    # a kink: segments meet at an angle
+    K = np.array([[[0, 0], [1, 1], [2, 1], [3, 0]], [[3, 0], [4, 1], [5, 1], [6, 0]]], float)
+    got = bezier_chain_to_bspline(K, closed=False)
+    np.testing.assert_array_equal(got.knots[4:-4], [got.knots[4]] * 3)
+    np.testing.assert_array_equal(got.control_points, K.reshape(-1, 2)[[0, 1, 2, 3, 5, 6, 7]])
+
+
+def test_closed_c2_chain_is_periodic():
+    ref = BSplineCurve(np.c_[np.cos(np.arange(7) * 0.9), np.sin(np.arange(7) * 1.1)],
+                       np.cumsum(np.r_[0, 1, 1.5, 1, 2, 1, 1, 1.2]), 3, closed=True)
+    pp = ref.piecewise
+    from curvefair.io._common import bezier_pieces
+    P = bezier_pieces(ref, "t")
+    got = bezier_chain_to_bspline(P, closed=True)
+    assert got.closed and got.n_ctrl == 7
+    s = np.linspace(0, 1, 7)
+    for i in range(pp.n_segments):
+        a = got.piecewise.breaks[i] + s * got.piecewise.widths[i]
+        b = pp.breaks[i] + s * pp.widths[i]
+        np.testing.assert_allclose(got(a), ref(b), atol=1e-9)
+
+
+def _svg(body):
+    return ('<?xml version="1.0"?>\n<svg xmlns="http://www.w3.org/2000/svg" '
+            'viewBox="0 0 100 100">\n' + body + "</svg>\n")
+
+
+def test_read_kinds_and_svgpathtools_evaluation(tmp_path):
+    p = tmp_path / "a.svg"
+    p.write_text(_svg(
+        '<path id="wave" d="M 10 50 C 20 20 30 20 40 50 S 60 80 70 50" stroke="red"/>\n'
+        '<g transform="scale(2)"><path id="poly" d="M0,0 L10,0 L20,5 L30,0 L30,30 L0,30 Z"/>'
+        '</g>\n<path id="quad" d="M 0 0 Q 5 10 10 0 T 20 0"/>\n'
+        '<rect x="1" y="1" width="5" height="5"/>\n'))
+    recs = read_curves(p)
+    by = {}
+    for r in recs:
+        by.setdefault(r.source["id"], []).append(r)
+    (w,) = by["wave"]
+    assert w.kind == "bspline" and w.source["n_subpaths"] == 1
+    # the S command reflects the handle: C1 join, uniform widths -> a double knot
+    assert np.unique(w.curve.knots[4:-4], return_counts=True)[1].tolist() == [2]
+    path = spt.parse_path("M 10 50 C 20 20 30 20 40 50 S 60 80 70 50")
+    for i, seg in enumerate(path):
+        a, b = w.curve.piecewise.breaks[i: i + 2]
+        for s in np.linspace(0, 1, 9):
+            z = seg.point(s)
+            np.testing.assert_allclose(w.curve(a + s * (b - a)), [z.real, z.imag], atol=1e-10)
+    poly = by["poly"]
+    assert all(r.kind == "polyline" for r in poly) and poly[0].source["transform"] is None
+    assert sum(len(r.points) - 1 for r in poly) == 6      # a closed hexagon cut at its corners
+    (q,) = by["quad"]
+    assert q.kind == "bspline"
+    qp = spt.parse_path("M 0 0 Q 5 10 10 0 T 20 0")
+    a, b = q.curve.piecewise.breaks[:2]
+    for s in np.linspace(0, 1, 5):
+        z = qp[0].point(s)
+        np.testing.assert_allclose(q.curve(a + s * (b - a)), [z.real, z.imag], atol=1e-12)
+
+
+def test_real_matplotlib_svg_round_trip_and_element_write_back(tmp_path):
+    src = DATA / "matplotlib_logo.svg"
+    recs = read_curves(src)
+    kinds = [r.kind for r in recs]
+    assert kinds.count("bspline") == 3 and kinds.count("polyline") >= 30
+    circle = next(r for r in recs if r.kind == "bspline")
+    # matplotlib's circle: 8 cubic arcs with C1 (not C2) joins
+    _, counts = np.unique(circle.curve.knots[4:-4], return_counts=True)
+    assert counts.tolist() == [2] * 7 and circle.source["svg_closed"]
+    u = np.linspace(*circle.curve.domain, 200)
+    r = np.hypot(*(circle.curve(u) - [36, 36]).T)
+    assert np.abs(r - 34.2).max() < 0.02
+    out = tmp_path / "same.svg"
+    write_curves(out, recs, template=src)
+    assert out.read_bytes() == src.read_bytes()
+    # fair (here: move) one control point of the circle: only its d attribute changes
+    cp = np.array(circle.curve.control_points)
+    cp[5] += [0.3, 0.1]
+    faired = circle.curve.replace(control_points=cp)
+    new = [x.with_curve(faired) if x is circle else x for x in recs]
+    write_curves(tmp_path / "f.svg", new, template=src)
+    a = src.read_text().splitlines()
+    b = (tmp_path / "f.svg").read_text().splitlines()
+    changed = [ln for ln in b if ln not in a]
+    assert len(changed) == 1 and 'style="fill:#ffffff;"' in changed[0]
+    assert len(re.findall(r"\bC\b", changed[0])) == 8
+    back = read_curves(tmp_path / "f.svg")
+    c2 = next(x for x in back if x.source["element"] == circle.source["element"])
+    np.testing.assert_allclose(c2.curve(c2.curve.piecewise.breaks),
+                               faired(faired.piecewise.breaks), atol=1e-6)  # 6 decimals
+    assert c2.curve.knots.shape == faired.knots.shape
+    # a polyline written back keeps its vertex count
+    pl = next(x for x in recs if x.kind == "polyline" and len(x.points) > 100)
+    moved = pl.curve.replace(points=np.array(pl.curve.points) + 0.5)
+    write_curves(tmp_path / "g.svg", [x.with_curve(moved) if x is pl else x for x in recs],
+                 template=src, decimals=4)
+    bp = next(x for x in read_curves(tmp_path / "g.svg") if x.source["element"] ==
+              pl.source["element"])
+    np.testing.assert_allclose(bp.curve.points, moved.points, atol=5e-5)
+
+
+def test_fresh_svg_from_curves(tmp_path):
+    ref = BSplineCurve([[0, 0], [1, 2], [3, 3], [4, 1], [6, 0]], [0, 0, 0, 0, .4, 1, 1, 1, 1], 3)
+    h = interpolate_cubic([[0, 5], [2, 6], [4, 5.5], [6, 7]])
+    write_curves(tmp_path / "n.svg", [ref, h])
+    back = read_curves(tmp_path / "n.svg")
+    assert [b.kind for b in back] == ["bspline", "bspline"]
+    for orig, b in zip([ref, h], back, strict=True):
+        for i in range(orig.piecewise.n_segments):
+            s = np.linspace(0, 1, 7)
+            x = orig.piecewise.breaks[i] + s * orig.piecewise.widths[i]
+            y = b.curve.piecewise.breaks[i] + s * b.curve.piecewise.widths[i]
+            np.testing.assert_allclose(b.curve(y), orig(x), atol=1e-9)
+    with pytest.raises(Exception, match="dimension|2-D"):
+        write_curves(tmp_path / "3d.svg", interpolate_cubic([[0, 0, 0], [1, 1, 1], [2, 0, 1]]))
+
+
+def test_arcs_are_unsupported(tmp_path):
+    p = tmp_path / "arc.svg"
+    p.write_text(_svg('<path id="a" d="M 0 0 A 5 5 0 0 1 10 0"/>\n'
+                      '<path id="b" d="M 0 0 L 5 5 L 10 0"/>\n'))
+    with pytest.raises(FileFormatError, match="Arc"):
+        read_curves(p)
+    with pytest.warns(UserWarning, match="Arc"):
+        recs = read_curves(p, on_unsupported="skip", corner_angle=None)
+    assert [r.source["id"] for r in recs] == ["b"]
+    # the arc element stays untouched on write-back
+    moved = recs[0].curve.replace(points=np.array(recs[0].curve.points) + [0, 1])
+    write_curves(tmp_path / "o.svg", [recs[0].with_curve(moved)], template=p)
+    text = (tmp_path / "o.svg").read_text()
+    assert 'd="M 0 0 A 5 5 0 0 1 10 0"' in text and 'd="M 0,1 L 5,6 L 10,1"' in text
+
+
+@pytest.mark.parametrize("text, match, line", [
+    ("", "empty", None),
+    ("<svg><path d='M 0 0 L 1 1'></svg>", "not well-formed", 1),
+    ("<html><path d='M 0 0 L 1 1'/></html>", "not <svg>", None),
+    ("<svg xmlns='http://www.w3.org/2000/svg'><path d='M 0 0 L 1 nan L 2 2'/></svg>",
+     "bad path data|non-finite", None),
+    ("<svg xmlns='http://www.w3.org/2000/svg'><rect width='1' height='1'/></svg>",
+     "no curves", None),
+])
+def test_malformed_svg(tmp_path, text, match, line):
+    p = tmp_path / "bad.svg"
+    p.write_text(text)
+    with pytest.raises(FileFormatError, match=match) as exc:
+        read_curves(p)
+    assert exc.value.path == str(p) and exc.value.line == line
+
+
+def test_missing_svgpathtools(tmp_path, monkeypatch):
+    p = tmp_path / "a.svg"
+    p.write_text(_svg('<path d="M 0 0 L 1 1 L 2 0"/>'))
+    monkeypatch.setitem(sys.modules, "svgpathtools", None)
+    with pytest.raises(MissingDependencyError, match=r"curvefair\[svg\]"):
+        read_curves(p)
