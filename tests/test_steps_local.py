@@ -11,8 +11,14 @@ import pytest
 from scipy.interpolate import BPoly, CubicHermiteSpline
 from scipy.optimize import minimize
 
-from curvefair import CubicHermite, InputError, QuinticHermite, interpolate_cubic
-from curvefair import interpolate_quintic, steps
+from curvefair import (
+    CubicHermite,
+    InputError,
+    QuinticHermite,
+    interpolate_cubic,
+    interpolate_quintic,
+    steps,
+)
 
 GX, GW = np.polynomial.legendre.leggauss(40)
 
@@ -228,7 +234,7 @@ def test_rho_relation_on_c2_spline():
 
 
 def _corrected_uniform_corollary(q, k):
-    # ERRATA: uniform corollary of Wang 2005 (all Delta = 1), delta corrected; eta and xi as printed.
+    # ERRATA: uniform corollary of Wang 2005 (all Delta = 1), delta corrected; eta, xi as printed.
     a = q.coefficients()
     L, R = a[k - 1], a[k]
     delta = (-(R[3] - L[3]) / 5 - 11 / 30 * R[4] + 13 / 30 * L[4] - 0.5 * R[5] + 2 / 3 * L[5])

@@ -254,7 +254,7 @@ def normalize_clamp(clamp: object) -> tuple[str, str]:
             raise InputError(f"clamp must be one of {CLAMPS} or a (left, right) pair of them, "
                              f"got {clamp!r}") from None
         pair = (left, right)
-    for side, v in zip(("left", "right"), pair):
+    for side, v in zip(("left", "right"), pair, strict=True):
         if not isinstance(v, str) or v not in CLAMPS:
             raise InputError(f"unknown clamp {v!r} ({side} end); valid values are: "
                              + ", ".join(repr(c) for c in CLAMPS))
@@ -442,6 +442,13 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
     disp = (np.sqrt(np.sum((p1[moved_idx] - p0[moved_idx]) ** 2, axis=1))
             if p0.shape == p1.shape else np.zeros(0))
     dev = deviation(curve, new)
+    if dev.max_point_displacement is not None:
+        max_disp = float(dev.max_point_displacement)
+        max_idx = None if dev.point_index is None else int(dev.point_index)
+    elif disp.size:
+        max_disp, max_idx = float(disp.max()), int(moved_idx[int(np.argmax(disp))])
+    else:
+        max_disp, max_idx = 0.0, None
     history = out.history if out.history is not None else FairingHistory.empty()
     report: dict[str, Any] = {
         "method": spec.name,
@@ -461,9 +468,10 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
         "inflections_after": after["inflections"],
         "extrema_before": before["extrema"],
         "extrema_after": after["extrema"],
-        "max_point_displacement": float(dev.max_point_displacement),
-        "max_point_index": None if dev.point_index is None else int(dev.point_index),
+        "max_point_displacement": max_disp,
+        "max_point_index": max_idx,
         "max_deviation": float(dev.max_distance),
+        "max_deviation_upper_bound": _finite_or_none(float(getattr(dev, "upper_bound", math.nan))),
         "max_deviation_param": None if dev.param is None else float(dev.param),
         "max_deviation_point": None if dev.point_a is None else np.asarray(dev.point_a),
         "tol": tol_v,
