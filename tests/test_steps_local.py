@@ -347,3 +347,46 @@ def test_steps_do_not_modify_input_and_no_nan():
         out = fn(c, 2)
         assert np.isfinite(out.points).all() and np.isfinite(out.tangents).all()
     np.testing.assert_array_equal(c.points, before)
+
+
+@pytest.mark.parametrize("method", ["poliakoff", "wang-cao", "wang-quintic"])
+def test_clamped_step_is_the_constrained_minimiser(method):
+    # fair(mode="hermite", tol) clamps the position radially onto the tolerance circle and
+    # re-optimises the derivatives for it; the claim is that this is the exact minimiser of the
+    # two segments' strain energy over {|r_k - r_k,orig| <= tol} x derivatives. Reference:
+    # position = orig + tol (cos th, sin th), minimise over th and the free derivatives.
+    from curvefair import fair
+
+    rng = np.random.default_rng(40)
+    if method == "wang-quintic":
+        c = _random_quintic(rng, 5, 2)
+    else:
+        c = _random_cubic(rng, 5, 2)
+    res = fair(c, method, mode="hermite", tol=0.05, eps=0.0, max_steps=1)
+    k = int(res.history.index[0])
+    assert np.isclose(np.linalg.norm(res.curve.points[k] - c.points[k]), 0.05, rtol=1e-9)
+    t3 = c.params[k - 1:k + 2]
+    hmean = np.diff(t3).mean()
+    nder = {"poliakoff": 0, "wang-cao": 1, "wang-quintic": 2}[method]
+
+    def energy(x):
+        r3 = c.points[k - 1:k + 2].copy()
+        r3[1] = c.points[k] + 0.05 * np.array([np.cos(x[0]), np.sin(x[0])])
+        ders = [np.array(d[k - 1:k + 2]) for d in c._derivs]
+        for j in range(nder):
+            ders[j][1] = x[1 + 2 * j:3 + 2 * j]
+        if method == "wang-quintic":
+            return _energy_quintic(t3, r3, ders[0], ders[1])
+        return _energy_cubic(t3, r3, ders[0])
+
+    # start from the best of a coarse angle scan
+    th = np.linspace(0, 2 * np.pi, 73)[:-1]
+    x0 = np.concatenate([[0.0]] + [np.array(d[k]) for d in c._derivs][:nder])
+    e = [energy(np.r_[t, x0[1:]]) for t in th]
+    x0[0] = th[int(np.argmin(e))]
+    scales = np.concatenate([[1.0]] + [np.ones(2) / hmean**j for j in range(1, nder + 1)])
+    ref = _minimise(energy, x0, scales)
+    ref_pos = c.points[k] + 0.05 * np.array([np.cos(ref[0]), np.sin(ref[0])])
+    assert np.abs(res.curve.points[k] - ref_pos).max() < 1e-8
+    for j in range(nder):
+        assert _rel(res.curve._derivs[j][k], ref[1 + 2 * j:3 + 2 * j]) < 1e-7
