@@ -395,8 +395,10 @@ def bezier_pieces(curve: PiecewiseCurve, what: str, max_degree: int | None = Non
 
 
 def bspline_of(curve: PiecewiseCurve, what: str) -> BSplineCurve:
-    """``curve`` as a B-spline: itself, or (Hermite curves) its pieces as Bezier segments with
-    knots of multiplicity ``degree`` at the breaks -- the same curve, exactly."""
+    """``curve`` as a B-spline: itself, or (Hermite curves) the same curve exactly with a knot
+    at every break of multiplicity ``degree - 1 - continuity`` + 1 (cubic Hermite: C1, double
+    knots; quintic Hermite: C2, triple knots), falling back to Bezier knots (multiplicity
+    ``degree``) if the curve is not that smooth."""
     if isinstance(curve, BSplineCurve):
         return curve
     b = bezier_pieces(curve, what)
@@ -404,10 +406,37 @@ def bspline_of(curve: PiecewiseCurve, what: str) -> BSplineCurve:
     p = p1 - 1
     if p < 2:
         raise InputError(f"{what}: a degree-{p} curve is not a B-spline of degree >= 2")
+    br = np.asarray(curve.piecewise.breaks, dtype=float)
+    cont = {3: 1, 5: 2}.get(p, 0)
+    if cont and m > 1:
+        smooth = _smooth_bspline(curve, br, p, p - cont)
+        if smooth is not None:
+            return smooth
     ctrl = np.vstack([b[0, :1]] + [b[i, 1:] for i in range(m)])
-    br = curve.piecewise.breaks
     knots = np.r_[[br[0]] * (p + 1), np.repeat(br[1:-1], p), [br[-1]] * (p + 1)]
     return BSplineCurve(ctrl, knots, p, closed=False)
+
+
+def _smooth_bspline(curve: PiecewiseCurve, br: FloatArray, p: int,
+                    mult: int) -> BSplineCurve | None:
+    """The clamped B-spline with interior knots ``br[1:-1]`` of multiplicity ``mult`` equal
+    to ``curve`` (least squares on p+1 points per span, checked), or None."""
+    from scipy.interpolate import BSpline
+
+    knots = np.r_[[br[0]] * (p + 1), np.repeat(br[1:-1], mult), [br[-1]] * (p + 1)]
+    s = (np.arange(p + 1) + 0.5) / (p + 1)
+    x = (br[:-1, None] + np.diff(br)[:, None] * s[None, :]).reshape(-1)
+    x = np.r_[br[0], x, br[-1]]
+    y = curve(x)
+    A = BSpline.design_matrix(x, knots, p).toarray()
+    c, *_ = np.linalg.lstsq(A, y, rcond=None)
+    c[0], c[-1] = y[0], y[-1]
+    out = BSplineCurve(c, knots, p)
+    u = np.linspace(br[0], br[-1], 8 * (br.shape[0] - 1) + 1)
+    scale = max(float(np.abs(y).max()), 1.0)
+    if float(np.abs(out(u) - curve(u)).max()) <= 1e-10 * scale:
+        return out
+    return None
 
 
 def is_clamped(knots: FloatArray, degree: int) -> bool:
