@@ -138,13 +138,14 @@ def _free_edges(shape: Any) -> list[Any]:
             in_faces.add(fe.Current())
             fe.Next()
         ex.Next()
+    to_edge = getattr(TopoDS, "Edge_s", None) or TopoDS.Edge  # 7.x / 8.x spelling
     seen = _ShapeSet()
     out = []
     ex = TopExp_Explorer(shape, TopAbs_ShapeEnum.TopAbs_EDGE)
     while ex.More():
         e = ex.Current()
         if e not in in_faces and seen.add(e):
-            out.append(TopoDS.Edge(e))
+            out.append(to_edge(e))
         ex.Next()
     return out
 
@@ -213,7 +214,15 @@ def read(path: str | os.PathLike[str], *, on_unsupported: str = "raise",
 def _geom(curve: BSplineCurve, z: float | None) -> Any:
     from OCP.Geom import Geom_BSplineCurve
     from OCP.gp import gp_Pnt
-    from OCP.OCP import collections as col
+
+    try:  # cadquery-ocp >= 8: NCollection arrays live in OCP.OCP.collections
+        from OCP.OCP import collections as _c
+
+        pnt_a, real_a, int_a = _c.Array1_gp_Pnt, _c.Array1_double, _c.Array1_int
+    except (ImportError, AttributeError):  # 7.x
+        from OCP.TColgp import TColgp_Array1OfPnt as pnt_a
+        from OCP.TColStd import TColStd_Array1OfInteger as int_a
+        from OCP.TColStd import TColStd_Array1OfReal as real_a
 
     def arr(cls: Any, vals: Sequence[Any]) -> Any:
         a = cls(1, len(vals))
@@ -233,9 +242,9 @@ def _geom(curve: BSplineCurve, z: float | None) -> Any:
     if curve.closed and mults[0] != mults[-1]:
         raise InputError("write_curves: a periodic curve needs the same knot multiplicity at "
                          "both ends of its period")
-    poles = arr(col.Array1_gp_Pnt, [gp_Pnt(*map(float, q)) for q in cps])
-    return Geom_BSplineCurve(poles, arr(col.Array1_double, [float(k) for k in knots]),
-                             arr(col.Array1_int, [int(m) for m in mults]), p, bool(curve.closed))
+    poles = arr(pnt_a, [gp_Pnt(*map(float, q)) for q in cps])
+    return Geom_BSplineCurve(poles, arr(real_a, [float(k) for k in knots]),
+                             arr(int_a, [int(m) for m in mults]), p, bool(curve.closed))
 
 
 def _edge(curve: BSplineCurve, z: float | None) -> Any:
@@ -254,6 +263,7 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
     _occ(f"writing {fmt.upper()} files")
     from OCP.BRep import BRep_Builder
     from OCP.BRepTools import BRepTools_ReShape
+    from OCP.IFSelect import IFSelect_ReturnStatus
     from OCP.IGESControl import IGESControl_Writer
     from OCP.STEPControl import STEPControl_StepModelType, STEPControl_Writer
     from OCP.TopoDS import TopoDS_Compound
@@ -297,6 +307,6 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
         else:
             sw = STEPControl_Writer()
             sw.Transfer(comp, STEPControl_StepModelType.STEPControl_AsIs)
-            ok = int(sw.Write(os.fspath(tmp)).value) == 1
+            ok = sw.Write(os.fspath(tmp)) == IFSelect_ReturnStatus.IFSelect_RetDone
         if not ok:
             raise InputError(f"write_curves: OCC could not write {os.fspath(path)!r}")
