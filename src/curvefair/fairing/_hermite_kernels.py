@@ -514,6 +514,10 @@ def _clamped_move(P, D, h, orig, k, method, degree, spline, hstep, tol, delta, e
 BLOCK_FRACTION = 1e-3
 
 
+# relative change of a blocked point's measure that makes the loop try its step again
+RECHECK = 1e-9
+
+
 @njit(cache=True, inline="always")
 def _is_blocked(mv, clamped, want, move_floor):  # type: ignore[no-untyped-def]
     return mv <= move_floor or (clamped and mv <= BLOCK_FRACTION * want)
@@ -547,6 +551,7 @@ def drive(P, D, h, orig, closed, degree, method, spline, hstep, eligible, tol, e
     dim = P.shape[1]
     nb = D.shape[1]
     blocked = np.zeros(nd, dtype=np.int8)
+    block_measure = np.zeros(nd)  # measure of a point when it was blocked
     cap = 1024 if max_steps > 1024 else max(max_steps, 1)
     h_idx = np.empty(cap, dtype=np.int64)
     h_meas = np.empty(cap)
@@ -590,6 +595,7 @@ def drive(P, D, h, orig, closed, degree, method, spline, hstep, eligible, tol, e
                                           delta, eta, xi)
         if _is_blocked(mv, clamped, want, move_floor):
             blocked[k] = 1 if clamped else 2
+            block_measure[k] = v
             tt_update(tv, ti, k, -np.inf)
             n_skip += 1
             continue
@@ -718,10 +724,17 @@ def drive(P, D, h, orig, closed, degree, method, spline, hstep, eligible, tol, e
                 values[i] = -np.inf
                 continue
             if blocked[i] != 0:
+                # a blocked point stays blocked while its measure has not changed by more than a
+                # relative RECHECK since it was blocked (far inside a spline window the change
+                # is at rounding level); otherwise try its step again
+                if abs(m_new - block_measure[i]) <= RECHECK * block_measure[i]:
+                    values[i] = -np.inf
+                    continue
                 mv2, cl2, want2 = _clamped_move(P, D, h, orig, i, method, degree, spline, hstep,
                                                 tol, delta, eta, xi)
                 if _is_blocked(mv2, cl2, want2, move_floor):
                     blocked[i] = 1 if cl2 else 2
+                    block_measure[i] = m_new
                     values[i] = -np.inf
                     continue
                 blocked[i] = 0
