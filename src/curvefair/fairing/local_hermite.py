@@ -31,7 +31,7 @@ The loop (Wang & Cao 2006, "Algorithm", steps 1-6)
    step's energy on that ball, because after optimising the derivatives out the energy is
    isotropic around the unconstrained optimum; in hermite mode the derivatives are then
    re-optimised for the clamped position). A point whose move is ~0 is skipped (ranked out)
-   until a neighbour's move changes its data: ~0 means at most 8 ulp of the data's scale (or
+   until a neighbour's move changes its measure by more than ``1e-9`` relative: ~0 means at most 8 ulp of the data's scale (or
    ``1e-9 tol``), or -- when the tolerance clamps it -- less than ``1e-3`` of the move the step
    wants (the point sits on its tolerance sphere and could only creep along it; letting it creep
    costs thousands of steps for no visible gain).
