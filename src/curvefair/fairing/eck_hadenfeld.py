@@ -291,7 +291,7 @@ def _eh_loop(X, z, Wu, pat, p, closed, tol, eps_abs, max_steps,
              hist):  # type: ignore[no-untyped-def]
     """Ranking-list loop, compiled; updates ``X`` and ``z`` in place.
 
-    ``X[i] = (d_i, g_i, orig_i)`` with 3 columns each (planar curves have zero third columns),
+    ``X[i] = (d_i, g_i, orig_i)``, ``dim`` columns each (``X`` has ``3 dim`` columns),
     ``g = G d``; ``z[i]`` the ranking number (-1: never moves); ``G``'s band row ``i`` is
     ``Wu[pat[i]]`` (rows shared by equal knot patterns, e.g. every interior row of a uniform
     curve). Everything is written out in this one function: calling numba functions with array
@@ -307,6 +307,7 @@ def _eh_loop(X, z, Wu, pat, p, closed, tol, eps_abs, max_steps,
     Returns (steps, total energy drop, stop code, number of history rows).
     """
     n = X.shape[0]
+    D = X.shape[1] // 3
     B = 1 << _BLOCK_SHIFT
     nb = (n + B - 1) >> _BLOCK_SHIFT
     P = 1
@@ -318,9 +319,14 @@ def _eh_loop(X, z, Wu, pat, p, closed, tol, eps_abs, max_steps,
     for i in range(n):
         if z[i] >= 0.0:
             any_movable = True
-            z[i] = _candidate(X[i, 3], X[i, 4], X[i, 5], X[i, 0], X[i, 1], X[i, 2],
-                              X[i, 6], X[i, 7], X[i, 8], Wu[pat[i], p], Wu[pat[i], 2 * p + 1],
-                              tol)[0]
+            if D == 3:
+                z[i] = _candidate(X[i, 3], X[i, 4], X[i, 5], X[i, 0], X[i, 1], X[i, 2],
+                                  X[i, 6], X[i, 7], X[i, 8], Wu[pat[i], p],
+                                  Wu[pat[i], 2 * p + 1], tol)[0]
+            else:
+                z[i] = _candidate(X[i, 2], X[i, 3], 0.0, X[i, 0], X[i, 1], 0.0,
+                                  X[i, 4], X[i, 5], 0.0, Wu[pat[i], p],
+                                  Wu[pat[i], 2 * p + 1], tol)[0]
     if not any_movable:
         return 0, 0.0, 2, 0
     for b in range(nb):
@@ -347,12 +353,17 @@ def _eh_loop(X, z, Wu, pat, p, closed, tol, eps_abs, max_steps,
         if zr <= 0.0 or zr < eps_abs:
             code = 0
             break
-        zz, e0, e1, e2 = _candidate(X[r, 3], X[r, 4], X[r, 5], X[r, 0], X[r, 1], X[r, 2],
-                                    X[r, 6], X[r, 7], X[r, 8], Wu[pat[r], p],
-                                    Wu[pat[r], 2 * p + 1], tol)
+        if D == 3:
+            zz, e0, e1, e2 = _candidate(X[r, 3], X[r, 4], X[r, 5], X[r, 0], X[r, 1], X[r, 2],
+                                        X[r, 6], X[r, 7], X[r, 8], Wu[pat[r], p],
+                                        Wu[pat[r], 2 * p + 1], tol)
+            X[r, 2] += e2
+        else:
+            zz, e0, e1, e2 = _candidate(X[r, 2], X[r, 3], 0.0, X[r, 0], X[r, 1], 0.0,
+                                        X[r, 4], X[r, 5], 0.0, Wu[pat[r], p],
+                                        Wu[pat[r], 2 * p + 1], tol)
         X[r, 0] += e0
         X[r, 1] += e1
-        X[r, 2] += e2
         pr = pat[r]
         for c in range(2 * p + 1):
             i = r + c - p
@@ -364,9 +375,10 @@ def _eh_loop(X, z, Wu, pat, p, closed, tol, eps_abs, max_steps,
             elif i < 0 or i >= n:
                 continue
             w = Wu[pr, c]
-            X[i, 3] += w * e0
-            X[i, 4] += w * e1
-            X[i, 5] += w * e2
+            X[i, D] += w * e0
+            X[i, D + 1] += w * e1
+            if D == 3:
+                X[i, 5] += w * e2
         # the changed ranking numbers: one or two contiguous ranges
         lo1 = r - p
         hi1 = r + p
@@ -391,9 +403,15 @@ def _eh_loop(X, z, Wu, pat, p, closed, tol, eps_abs, max_steps,
             if hi < lo:
                 continue
             for i in range(lo, hi + 1):
-                if z[i] >= 0.0:
+                if z[i] < 0.0:
+                    continue
+                if D == 3:
                     z[i] = _candidate(X[i, 3], X[i, 4], X[i, 5], X[i, 0], X[i, 1], X[i, 2],
                                       X[i, 6], X[i, 7], X[i, 8], Wu[pat[i], p],
+                                      Wu[pat[i], 2 * p + 1], tol)[0]
+                else:
+                    z[i] = _candidate(X[i, 2], X[i, 3], 0.0, X[i, 0], X[i, 1], 0.0,
+                                      X[i, 4], X[i, 5], 0.0, Wu[pat[i], p],
                                       Wu[pat[i], 2 * p + 1], tol)[0]
             blo = lo >> _BLOCK_SHIFT
             bhi = hi >> _BLOCK_SHIFT
@@ -555,11 +573,11 @@ def eck_hadenfeld_fair(curve: BSplineCurve, *, l: int = 2, tol: float | None = N
     mask = movable_mask(curve, clamp, protect)
     W = curve.gram_band(lv)
     dim = curve.dim
-    X = np.zeros((n, 9))
+    X = np.zeros((n, 3 * dim))
     X[:, :dim] = curve.control_points
-    X[:, 3:3 + dim] = _residual(curve, W)
-    X[:, 6:6 + dim] = curve.control_points
-    e0 = float(np.sum(X[:, :3] * X[:, 3:6]))
+    X[:, dim:2 * dim] = _residual(curve, W)
+    X[:, 2 * dim:] = curve.control_points
+    e0 = float(np.sum(X[:, :dim] * X[:, dim:2 * dim]))
     eps_abs = epsv * e0 if eps_relative else epsv
     hist = np.zeros((int(min(max(history_max, 0), max_steps)), 3))
     z = np.where(mask, 0.0, -1.0)
