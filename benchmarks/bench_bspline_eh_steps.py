@@ -94,7 +94,8 @@ def peer_loop(d, g, orig, W, p, movable, tol, max_steps):  # type: ignore[no-unt
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawTextHelpFormatter)
     ap.add_argument("--sizes", type=int, nargs="+", default=[1000, 10000, 100000, 1000000])
     ap.add_argument("--steps", type=int, default=3_000_000)
     ap.add_argument("--tol", type=float, default=0.5, help="inf: unconstrained")
@@ -106,8 +107,8 @@ def main() -> None:
     eh._eh_loop(X, z, Wu, pat, 3, False, args.tol, 0.0, 10, np.zeros((0, 3)))
     d = np.ascontiguousarray(X[:, :2])
     peer_loop(d.copy(), np.ascontiguousarray(X[:, 2:4]), d.copy(), W, 3, mask, args.tol, 10)
-    ap = argparse.ArgumentParser(description=__doc__,
-                                 formatter_class=argparse.RawTextHelpFormatter)
+    print(f"{'n':>9} {'setup s':>8} {'steps':>9} {'curvefair M/s':>14} {'peer M/s':>9} "
+          f"{'ratio':>6}")
     for n in args.sizes:
         c = make_curve(n, args.seed)
         t0 = time.perf_counter()
