@@ -25,10 +25,20 @@ from .errors import CurvefairError, FileFormatError, InputError, MissingDependen
 from .io import CurveRecord, read_curves, write_curves  # noqa: I001
 from .analysis.discrete import (BadPoint, SecondDiscreteCurvature, bad_points,  # noqa: I001
                                  discrete_curvature, second_discrete_curvature)
+from .analysis import (Analysis, Deviation, analyze, curvature,  # noqa: I001
+                       curvature_derivative, deviation, energy, torsion)
 from . import steps  # noqa: I001
 from .fairing import FairingResult, fair  # noqa: I001
 
 __all__ = [
+    "energy",
+    "curvature",
+    "curvature_derivative",
+    "torsion",
+    "analyze",
+    "Analysis",
+    "deviation",
+    "Deviation",
     "fair",
     "FairingResult",
     "steps",

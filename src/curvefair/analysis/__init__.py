@@ -1,0 +1,36 @@
+"""Fairness analysis: exact energies, curvature and torsion, bad-point measures, deviation.
+
+Public: :func:`energy`, :func:`curvature`, :func:`curvature_derivative`, :func:`torsion`,
+:func:`analyze` (-> :class:`Analysis`), :func:`deviation` (-> :class:`Deviation`); the discrete
+curvature of Cheng & Yu lives in :mod:`curvefair.analysis.discrete`.
+"""
+
+from ._analyze import Analysis, analyze, derivative_jumps
+from ._curvature import curvature, curvature_derivative, torsion
+from ._deviation import Deviation, deviation
+from ._energy import energy, segment_energies
+from .discrete import (
+                       BadPoint,
+                       SecondDiscreteCurvature,
+                       bad_points,
+                       discrete_curvature,
+                       second_discrete_curvature,
+)
+
+__all__ = [
+    "Analysis",
+    "analyze",
+    "derivative_jumps",
+    "curvature",
+    "curvature_derivative",
+    "torsion",
+    "Deviation",
+    "deviation",
+    "energy",
+    "segment_energies",
+    "discrete_curvature",
+    "second_discrete_curvature",
+    "bad_points",
+    "BadPoint",
+    "SecondDiscreteCurvature",
+]
