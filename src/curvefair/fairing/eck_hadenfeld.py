@@ -461,6 +461,12 @@ def band_patterns(W: FloatArray) -> tuple[FloatArray, np.ndarray]:
     return Wu, pat
 
 
+def default_eps(n: int) -> float:
+    """Default relative threshold of the ranking list: ``1e-4 / n`` (see
+    :func:`eck_hadenfeld_fair`)."""
+    return 1e-4 / max(int(n), 1)
+
+
 @dataclass(frozen=True)
 class EHResult:
     """Outcome of :func:`eck_hadenfeld_fair`.
@@ -506,7 +512,9 @@ def eck_hadenfeld_fair(curve: BSplineCurve, *, l: int = 2, tol: float | None = N
         convex hull property, of the curve from the input curve at equal parameter).
     eps : float, optional
         Stop when the largest ranking number is below ``eps * E_l(input)``
-        (``eps_relative=True``, default ``1e-9``) or below ``eps`` (``eps_relative=False``).
+        (``eps_relative=True``; default ``1e-4 / n``, i.e. ``1e-4`` of the mean energy per
+        control point, which gives the same local accuracy for every ``n``) or below ``eps``
+        (``eps_relative=False``; default 0).
     max_steps : int or None
         Step cap (default ``100 n``).
     clamp : (left, right)
@@ -558,7 +566,7 @@ def eck_hadenfeld_fair(curve: BSplineCurve, *, l: int = 2, tol: float | None = N
         if not np.isfinite(tolv) or tolv < 0:
             raise InputError(f"tol must be a finite number >= 0 or None, got {tol!r}")
     if eps is None:
-        epsv = 1e-9 if eps_relative else 0.0
+        epsv = default_eps(n) if eps_relative else 0.0
     else:
         try:
             epsv = float(eps)
@@ -614,7 +622,7 @@ def _driver(curve: BSplineCurve, *, tol: float | None, eps: float | None, max_st
     n = curve.n_ctrl
     return DriverOutput(
         curve=res.curve, steps=res.steps, stop_reason=res.stop_reason, history=hist,
-        eps=(1e-9 if eps_relative else 0.0) if eps is None else eps,
+        eps=(default_eps(n) if eps_relative else 0.0) if eps is None else eps,
         max_steps=100 * n if max_steps is None else max_steps,
         extra={"l": int(l), "energy_l_before": res.energy_before,
                "energy_l_after": res.energy_after, "eps_relative": bool(eps_relative),

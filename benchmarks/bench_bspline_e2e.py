@@ -1,0 +1,166 @@
+"""End to end: fair a noisy N-point planar curve to a tolerance; compare with csaps.
+
+Seeded data: ``N`` samples ``(t, A sin(t / 7) + B sin(t / 31))`` of a smooth curve at ``t = 0,
+1, 2, ...`` plus Gaussian noise ``sigma`` in both coordinates.
+
+curvefair: interpolate the points by a cubic B-spline at the parameters ``t``
+(:func:`interpolate_bspline`), then fair it with ``tol`` (control points stay within ``tol`` of
+the original ones, so the curve stays within ``tol`` of every data point at its parameter), by
+Eck & Hadenfeld (``l = 2``, ranking list) and by the global QP; free ends. Timed: interpolation +
+fairing.
+
+Peer, measured in the same run: csaps' cubic smoothing spline ``csaps(t, points.T, smooth=p)``,
+with ``p`` found by bisection so that ITS largest deviation from the data equals the largest
+deviation of the curvefair result ("equal maximum deviation"). Timed: one csaps fit at that
+``p`` (the bisection is reported separately).
+
+Reported per curve: time, largest deviation from the data at the data parameters, RMS
+deviation, ``E2 = int |r''|^2 dt``, ``E3 = int |r'''|^2 dt`` (exact, piecewise), curvature sign
+changes at the data parameters (inflections; the smooth curve has about ``N / (7 pi)``).
+
+Usage::
+
+    python benchmarks/bench_bspline_e2e.py --n 1000000 --sigma 0.05 --tol 0.3
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+
+from curvefair import interpolate_bspline
+from curvefair.fairing.eck_hadenfeld import eck_hadenfeld_fair
+from curvefair.fairing.global_fair import global_fair
+
+
+def data(n: int, sigma: float, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    rng = np.random.default_rng(seed)
+    t = np.arange(n, dtype=float)
+    pts = np.c_[t, 20.0 * np.sin(t / 7.0) + 50.0 * np.sin(t / 31.0)]
+    return t, pts + sigma * rng.normal(size=pts.shape)
+
+
+def metrics(coeffs_desc: np.ndarray, breaks: np.ndarray, values: np.ndarray,
+            d1: np.ndarray, d2: np.ndarray, pts: np.ndarray) -> dict[str, float]:
+    """``coeffs_desc`` (4, m, dim): cubic pieces, highest power first (scipy PPoly order)."""
+    H = np.diff(breaks)[:, None]
+    c0, c1 = coeffs_desc[0], coeffs_desc[1]
+    e2 = float(np.sum(12 * c0**2 * H**3 + 12 * c0 * c1 * H**2 + 4 * c1**2 * H))
+    e3 = float(np.sum(36 * c0**2 * H))
+    dev = np.sqrt(np.sum((values - pts) ** 2, axis=1))
+    cross = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]
+    sgn = np.sign(cross[np.abs(cross) > 1e-12 * np.abs(cross).max()])
+    return {"max_dev": float(dev.max()), "rms_dev": float(np.sqrt(np.mean(dev**2))),
+            "E2": e2, "E3": e3, "inflections": int(np.count_nonzero(np.diff(sgn)))}
+
+
+def bspline_metrics(curve, t: np.ndarray, pts: np.ndarray) -> dict[str, float]:
+    pp = curve.piecewise
+    return metrics(np.asarray(pp.coeffs)[:, ::-1].transpose(1, 0, 2), np.asarray(pp.breaks),
+                   curve(t), curve(t, 1), curve(t, 2), pts)
+
+
+def csaps_fit(t: np.ndarray, pts: np.ndarray, smooth: float):
+    from csaps import CubicSmoothingSpline
+
+    return CubicSmoothingSpline(t, pts.T, smooth=smooth).spline
+
+
+def csaps_metrics(spl, t: np.ndarray, pts: np.ndarray) -> dict[str, float]:
+    c = np.asarray(spl.c)  # (4, m, dim) or (4, m, dim) with axis handling
+    if c.shape[-1] != pts.shape[1]:
+        c = np.moveaxis(c, 1, -1)
+    vals = spl(t).T if spl(t[:2]).shape[0] == pts.shape[1] else spl(t)
+    d1 = spl.derivative(1)(t)
+    d2 = spl.derivative(2)(t)
+    if d1.shape[0] == pts.shape[1]:
+        d1, d2 = d1.T, d2.T
+    return metrics(c, np.asarray(spl.x), vals, d1, d2, pts)
+
+
+def csaps_matching(t: np.ndarray, pts: np.ndarray, target: float, iters: int):
+    """Bisection on logit(smooth) so that the largest deviation equals ``target``."""
+    lo, hi = -30.0, 30.0  # logit bounds: smooth ~ 1e-13 .. 1 - 1e-13
+    best = None
+    for _ in range(iters):
+        mid = 0.5 * (lo + hi)
+        p = 1.0 / (1.0 + np.exp(-mid))
+        spl = csaps_fit(t, pts, p)
+        v = spl(t)
+        v = v.T if v.shape[0] == pts.shape[1] else v
+        dev = float(np.sqrt(np.sum((v - pts) ** 2, axis=1)).max())
+        if dev > target:
+            lo = mid  # too smooth: move towards interpolation
+        else:
+            hi = mid
+            best = p
+    return best if best is not None else 1.0 / (1.0 + np.exp(-hi))
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawTextHelpFormatter)
+    ap.add_argument("--n", type=int, default=1_000_000)
+    ap.add_argument("--sigma", type=float, default=0.05)
+    ap.add_argument("--tol", type=float, default=0.3)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--bisect", type=int, default=40, help="csaps bisection steps")
+    ap.add_argument("--no-global", action="store_true")
+    args = ap.parse_args()
+    t, pts = data(args.n, args.sigma, args.seed)
+    # warm up the compiled code outside the timing
+    eck_hadenfeld_fair(interpolate_bspline(pts[:200], param=t[:200]), tol=args.tol)
+
+    rows = {}
+    t0 = time.perf_counter()
+    c = interpolate_bspline(pts, param=t)
+    t_interp = time.perf_counter() - t0
+    rows["input (interpolant)"] = (t_interp, bspline_metrics(c, t, pts), "")
+
+    t0 = time.perf_counter()
+    eh = eck_hadenfeld_fair(c, l=2, tol=args.tol, clamp=(None, None), max_steps=200 * args.n)
+    t_eh = time.perf_counter() - t0 + t_interp
+    rows["curvefair eck-hadenfeld"] = (t_eh, bspline_metrics(eh.curve, t, pts),
+                                       f"{eh.steps} steps, {eh.stop_reason}")
+    if not args.no_global:
+        t0 = time.perf_counter()
+        gl = global_fair(c, tol=args.tol, l=2)
+        t_gl = time.perf_counter() - t0 + t_interp
+        rows["curvefair global"] = (t_gl, bspline_metrics(gl.curve, t, pts),
+                                    f"{gl.iterations} IP iterations, {gl.stop_reason}")
+
+    peers = {}
+    for name in list(rows)[1:]:
+        target = rows[name][1]["max_dev"]
+        tb = time.perf_counter()
+        p = csaps_matching(t, pts, target, args.bisect)
+        t_bis = time.perf_counter() - tb
+        t0 = time.perf_counter()
+        spl = csaps_fit(t, pts, p)
+        t_cs = time.perf_counter() - t0
+        peers[name] = (t_cs, csaps_metrics(spl, t, pts), f"smooth={p:.6g}, bisection {t_bis:.1f}s")
+
+    print(f"n = {args.n}, sigma = {args.sigma}, tol = {args.tol}, seed = {args.seed}")
+    hdr = f"{'curve':<34} {'time s':>7} {'max dev':>9} {'rms dev':>9} {'E2':>11} {'E3':>11} " \
+          f"{'inflect':>8}  note"
+    print(hdr)
+
+    def line(name: str, row) -> None:
+        tm, m, note = row
+        print(f"{name:<34} {tm:>7.2f} {m['max_dev']:>9.4f} {m['rms_dev']:>9.4f} {m['E2']:>11.4g} "
+              f"{m['E3']:>11.4g} {m['inflections']:>8d}  {note}")
+
+    for name, row in rows.items():
+        line(name, row)
+        if name in peers:
+            line("  csaps at equal max deviation", peers[name])
+            r = row[0] / peers[name][0]
+            e = row[1]["E2"] / peers[name][1]["E2"]
+            print(f"  ratio curvefair/csaps: time {r:.2f}, E2 {e:.3f}, "
+                  f"E3 {row[1]['E3'] / peers[name][1]['E3']:.3f}")
+
+
+if __name__ == "__main__":
+    main()
