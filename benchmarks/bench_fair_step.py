@@ -27,7 +27,7 @@ from curvefair import interpolate_cubic, interpolate_quintic
 from curvefair.fairing import _hermite_kernels as _k
 from curvefair.fairing.local_hermite import prepare
 
-_MUTABLE = (0, 1, 22, 23, 24, 25)  # P, D, measure, values, tv, ti in the kernel arguments
+_MUTABLE = (0, 1, 22, 23, 24, 25, 26, 27)  # P, D and the loop state in the kernel arguments
 
 
 def data(n: int, seed: int = 0) -> tuple[np.ndarray, float]:

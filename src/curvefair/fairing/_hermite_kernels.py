@@ -380,10 +380,9 @@ def _assemble_window(nd, closed, h, K0, pe, q, nb, fixed, idx, L, Bd, Cu, pw):  
 
 
 @njit(cache=True)
-def _block_thomas(L, nb, dim, Bd, Cu, R, X, Bp, Y):  # type: ignore[no-untyped-def]
-    """Solve the symmetric block tridiagonal system (sub-diagonal = Cu^T) for X (L, nb, dim)."""
-    inv = np.empty((2, 2))
-    W = np.empty((2, 2))
+def _block_thomas(L, nb, dim, Bd, Cu, R, X, Bp, Y, inv, W):  # type: ignore[no-untyped-def]
+    """Solve the symmetric block tridiagonal system (sub-diagonal = Cu^T) for X (L, nb, dim);
+    ``inv`` and ``W`` are 2x2 scratch arrays."""
     for v in range(L):
         for a in range(nb):
             for b in range(nb):
@@ -525,7 +524,8 @@ def _is_blocked(mv, clamped, want, move_floor):  # type: ignore[no-untyped-def]
 
 @njit(cache=True)
 def drive_setup(P, D, h, closed, degree, spline, eligible):  # type: ignore[no-untyped-def]
-    """Initial measures and the ranking tree: ``(measure, values, tv, ti)`` (``O(n)``)."""
+    """Initial state of the loop (``O(n)``): ``(measure, values, tv, ti, blocked,
+    block_measure)`` -- measures, tree leaves, the tree, block flags and measures at blocking."""
     nd = P.shape[0]
     measure = all_measures(P, D, h, closed, degree, spline)
     values = np.full(nd, -np.inf)
@@ -533,15 +533,15 @@ def drive_setup(P, D, h, closed, degree, spline, eligible):  # type: ignore[no-u
         if eligible[i]:
             values[i] = measure[i]
     tv, ti = tt_build(values)
-    return measure, values, tv, ti
+    return measure, values, tv, ti, np.zeros(nd, dtype=np.int8), np.zeros(nd)
 
 
 @njit(cache=True)
 def drive(P, D, h, orig, closed, degree, method, spline, hstep, eligible, tol, eps,
           max_steps, move_floor, K0, pe, q, fixed, Hinv, w0, wmax, thr,
-          measure, values, tv, ti):  # type: ignore[no-untyped-def]
-    """Seed 001's steps 2-6 on the distinct data (``P``, ``D``, ``measure``, ``values`` and the
-    tree ``tv``/``ti`` from :func:`drive_setup` are modified in place).
+          measure, values, tv, ti, blocked, block_measure):  # type: ignore[no-untyped-def]
+    """Seed 001's steps 2-6 on the distinct data (``P``, ``D`` and the state from
+    :func:`drive_setup` are modified in place; no ``O(n)`` work or allocation here).
 
     Returns ``(steps, stop_code, hist_index, hist_measure, hist_disp, blocked,
     n_truncated, n_skipped, max_window)``; ``blocked`` is 0 (free), 1 (blocked by the tolerance),
@@ -550,8 +550,6 @@ def drive(P, D, h, orig, closed, degree, method, spline, hstep, eligible, tol, e
     nd = P.shape[0]
     dim = P.shape[1]
     nb = D.shape[1]
-    blocked = np.zeros(nd, dtype=np.int8)
-    block_measure = np.zeros(nd)  # measure of a point when it was blocked
     cap = 1024 if max_steps > 1024 else max(max_steps, 1)
     h_idx = np.empty(cap, dtype=np.int64)
     h_meas = np.empty(cap)
@@ -574,6 +572,8 @@ def drive(P, D, h, orig, closed, degree, method, spline, hstep, eligible, tol, e
     Bp = np.empty((Lmax, nb, nb))
     Y = np.empty((Lmax, nb, dim))
     pw = np.empty(8)
+    inv2 = np.empty((2, 2))
+    W2 = np.empty((2, 2))
     w_cur = w0
     steps = 0
     n_trunc = 0
@@ -672,7 +672,7 @@ def drive(P, D, h, orig, closed, degree, method, spline, hstep, eligible, tol, e
                         right_open = hi < nd - 1
                     _assemble_window(nd, closed, h, K0, pe, q, nb, fixed, idx, L, Bd, Cu, pw)
                     _rhs_for_move(nd, closed, h, K0, pe, q, nb, k, delta, idx, L, fixed, R, pw)
-                    _block_thomas(L, nb, dim, Bd, Cu, R, X, Bp, Y)
+                    _block_thomas(L, nb, dim, Bd, Cu, R, X, Bp, Y, inv2, W2)
                     ok = True
                     for e in range(nb):
                         big = 0.0

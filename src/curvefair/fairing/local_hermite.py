@@ -31,10 +31,10 @@ The loop (Wang & Cao 2006, "Algorithm", steps 1-6)
    step's energy on that ball, because after optimising the derivatives out the energy is
    isotropic around the unconstrained optimum; in hermite mode the derivatives are then
    re-optimised for the clamped position). A point whose move is ~0 is skipped (ranked out)
-   until a neighbour's move changes its measure by more than ``1e-9`` relative: ~0 means at most 8 ulp of the data's scale (or
-   ``1e-9 tol``), or -- when the tolerance clamps it -- less than ``1e-3`` of the move the step
-   wants (the point sits on its tolerance sphere and could only creep along it; letting it creep
-   costs thousands of steps for no visible gain).
+   until a neighbour's move changes its measure by more than ``1e-9`` relative: ~0 means at
+   most 8 ulp of the data's scale (or ``1e-9 tol``), or -- when the tolerance clamps it -- less
+   than ``1e-3`` of the move the step wants (the point sits on its tolerance sphere and could
+   only creep along it; letting it creep costs thousands of steps for no visible gain).
 4. Spline mode: re-interpolate. Moving one point changes every derivative of the spline, but the
    change decays geometrically away from it (by >= 2 per point for the cubic, ~0.27 on uniform
    parameters; ~0.43 for the quintic), so only a window is solved: the system with the current
@@ -260,7 +260,8 @@ def prepare(curve: HermiteSpline, *, method: str, tol: float | None, eps: float 
         D = D_new
 
     # -- ranking and defaults
-    measure, values, tv, ti = _k.drive_setup(P, D, h, closed, degree, spline, eligible)
+    measure, values, tv, ti, blocked, block_measure = _k.drive_setup(
+        P, D, h, closed, degree, spline, eligible)
     m0 = float(measure[eligible].max()) if eligible.any() else 0.0
     rel = 1e-2 if degree == 3 else 1e-4
     eps_eff = rel * m0 if eps is None else float(eps)
@@ -277,7 +278,8 @@ def prepare(curve: HermiteSpline, *, method: str, tol: float | None, eps: float 
         Hinv = _dense_inverse(nd, nb, h, degree)
     args = (P, D, h, P.copy(), closed, degree, code, spline, hstep, eligible,
             -1.0 if tol is None else float(tol), eps_eff, max_eff, floor,
-            K0, pe, q, fixed, Hinv, _W0[degree], _WMAX, _THR, measure, values, tv, ti)
+            K0, pe, q, fixed, Hinv, _W0[degree], _WMAX, _THR, measure, values, tv, ti,
+            blocked, block_measure)
     return {"args": args, "extra": extra, "held": held, "eligible": eligible, "m0": m0,
             "eps": eps_eff, "max_steps": max_eff, "n_elig": n_elig, "measure": measure,
             "P": P, "D": D, "spline": spline, "degree": degree, "nd": nd, "Hinv": Hinv}
