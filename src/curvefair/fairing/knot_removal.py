@@ -22,6 +22,7 @@ from .._typing import FloatArray
 from ..curves.bspline import BSplineCurve, basis_derivatives
 from ..errors import InputError
 from .eck_hadenfeld import check_bspline, movable_mask
+from .ranking import tt_build, tt_top, tt_update
 
 __all__ = ["knot_removal", "knot_jumps", "interior_knots", "knot_removal_fair", "KRResult"]
 
@@ -310,6 +311,9 @@ class KRResult:
         ``(knot index j, z_j, largest control point move of that step)``.
     blocked : list of int
         Knots skipped because their removal would break the tolerance or move a protected point.
+    sum_tracked : float
+        ``sum z_j`` as maintained by the loop's local updates (equals ``sum_after`` up to
+        rounding; kept for checking).
     """
 
     curve: BSplineCurve
@@ -319,6 +323,7 @@ class KRResult:
     sum_after: float
     history: np.ndarray
     blocked: list[int] = field(default_factory=list)
+    sum_tracked: float = 0.0
 
 
 def knot_removal_fair(curve: BSplineCurve, *, variant: Variant = "one-point",
@@ -402,20 +407,30 @@ def knot_removal_fair(curve: BSplineCurve, *, variant: Variant = "one-point",
         if not (np.isfinite(epsv) and epsv >= 0):
             raise InputError(f"eps must be a finite number >= 0, got {eps!r}")
     eps_abs = epsv * float(z.max()) if eps_relative else epsv
-    # the knots whose measure depends on each control point
-    ctrl_to_knots: dict[int, list[int]] = {}
-    for k in range(nk):
-        for i in kd.ctrl[k]:
-            ctrl_to_knots.setdefault(int(i), []).append(k)
+    # knot j's measure depends on the control points of basis functions j-p-1 .. j, so a moved
+    # control point i touches the knots j = b .. b+p+1 for every basis index b of i
+    p = curve.degree
+    n = curve.n_ctrl
+    pos = np.full(len(curve.knots), -1, dtype=np.int64)
+    pos[js] = np.arange(nk)
+
+    def touched_knots(idx: np.ndarray) -> np.ndarray:
+        jj = (idx[:, None] + np.arange(p + 2)[None, :]).ravel()
+        if curve.closed:
+            jj = p + (jj - p) % n  # the period's copy of each knot
+        jj = jj[(jj >= 0) & (jj < pos.size)]
+        kk = pos[jj]
+        return np.unique(kk[kk >= 0])
     rank = z.copy()
+    tv, ti = tt_build(rank)  # indexed tournament tree: O(log N) per update
     blocked: list[int] = []
     hist: list[tuple[int, float, float]] = []
     total = sum0
     steps = 0
     reason = "max_steps"
     while steps < max_steps:
-        k = int(np.argmax(rank))
-        zk = float(rank[k])
+        k, zk = tt_top(tv, ti)
+        k, zk = int(k), float(zk)
         if zk < 0:  # every knot blocked
             reason = "tolerance"
             break
@@ -432,12 +447,12 @@ def knot_removal_fair(curve: BSplineCurve, *, variant: Variant = "one-point",
                 reason = "tolerance"
                 break
             rank[k] = -1.0
+            tt_update(tv, ti, k, -1.0)
             blocked.append(j)
             continue
         old = d[idx].copy()
         d[idx] = new
-        touched = sorted({kk for i in idx.tolist() for kk in ctrl_to_knots.get(i, [])})
-        tk = np.array(touched, dtype=np.int64)
+        tk = touched_knots(np.asarray(idx, dtype=np.int64))
         znew = kd.jumps(d, tk)
         new_total = total - float(z[tk].sum()) + float(znew.sum())
         if new_total >= total:
@@ -446,15 +461,17 @@ def knot_removal_fair(curve: BSplineCurve, *, variant: Variant = "one-point",
             break
         total = new_total
         z[tk] = znew
-        keep = rank[tk] >= 0
-        rank[tk[keep]] = znew[keep]
+        for kk, zz in zip(tk.tolist(), znew.tolist()):
+            if rank[kk] >= 0:
+                rank[kk] = zz
+                tt_update(tv, ti, kk, zz)
         # a move can unblock nothing: blocked knots stay blocked (their z may change, the
         # tolerance they would break is measured from the original points)
         steps += 1
         hist.append((j, zk, float(np.sqrt(np.sum((new - old) ** 2, axis=1)).max())))
     out = curve.replace(control_points=d)
     h = np.array(hist, dtype=float).reshape(-1, 3)
-    return KRResult(out, steps, reason, sum0, float(kd.jumps(d).sum()), h, blocked)
+    return KRResult(out, steps, reason, sum0, float(kd.jumps(d).sum()), h, blocked, total)
 
 
 # ------------------------------------------------------------------------------------------
