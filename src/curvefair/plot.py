@@ -1,0 +1,935 @@
+"""Plots of curves and their fairness: curvature combs, curvature plots, before/after comparisons.
+
+Matplotlib is optional (``pip install 'curvefair[plot]'``) and imported only inside the plotting
+functions; without it they raise :class:`curvefair.MissingDependencyError`.
+:func:`curvature_comb` needs only numpy and gives the comb's hairs for any plotting library.
+
+Conventions
+-----------
+* **Comb** (porcupine plot, Farin & Sapidis 1989): at sampled points ``r(t)`` a hair
+  ``r(t) - scale * kappa(t) * N(t)`` is drawn, where ``kappa * N = r'' _|_ r' / |r'|^2`` is the
+  curvature vector (``N`` the principal normal, pointing towards the centre of curvature). Hairs
+  therefore point *away* from the centre of curvature, to the convex side, as in CAD systems, and
+  their length is proportional to the curvature. The hair tips are joined by the envelope.
+  Every segment is sampled at both of its ends, so a curvature jump at a breakpoint shows as two
+  hairs at the same point.
+* **Curvature** is signed for planar curves (positive where the curve turns left) and the
+  unsigned ``|r' x r''| / |r'|^3`` for space curves.
+* **3-D curves** are drawn as their orthogonal projection onto the best-fit plane of the curve
+  (least squares through dense samples; ``projection="plane"``, the default) or onto a coordinate
+  plane (``"xy"``, ``"xz"``, ``"yz"``); the axes labels say which. The comb uses the 3-D
+  principal normal and is projected with the curve.
+* **Markers**: inflections (sign changes of the curvature, planar curves only), curvature extrema,
+  and the worst bad points, ranked by the jump of the third derivative at the breakpoints
+  (Wang & Cao 2006, section "Bad points identification"), labelled 1, 2, 3, ...
+
+Indices are 0-based (the papers number points from 1).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any, Literal, NamedTuple
+
+import numpy as np
+
+from ._typing import FloatArray
+from ._validate import as_positive, choice
+from .curves.piecewise import PiecewiseCurve
+from .errors import InputError, MissingDependencyError
+
+__all__ = [
+    "plot_curve",
+    "plot_curvature",
+    "plot_compare",
+    "figure",
+    "curvature_comb",
+    "Comb",
+]
+
+ProjectionName = Literal["plane", "xy", "xz", "yz"]
+PROJECTIONS = ("plane", "xy", "xz", "yz")
+
+# Styles -------------------------------------------------------------------------------------
+_MAIN = {"curve": "#1f4e79", "hair": "#5b9bd5", "envelope": "#2e75b6", "points": "#1f4e79"}
+_REF = {"curve": "#8c8c8c", "hair": "#c9c9c9", "envelope": "#a6a6a6", "points": "#8c8c8c"}
+_INFLECTION = "#e07b00"
+_EXTREMUM = "#2f9e44"
+_BAD = "#c92a2a"
+_GID_HAIRS = "curvefair-comb-hairs"
+_GID_ENVELOPE = "curvefair-comb-envelope"
+_GID_CURVE = "curvefair-curve"
+_GID_CURVATURE = "curvefair-curvature"
+_GID_DEVIATION = "curvefair-deviation"
+
+#: Target number of hairs for the automatic comb density.
+_AUTO_HAIRS = 600
+#: Target number of samples for the drawn curve and curvature plot.
+_AUTO_SAMPLES = 6000
+
+
+def _mpl() -> Any:
+    """Import matplotlib lazily; raise MissingDependencyError naming the ``plot`` extra."""
+    try:
+        import matplotlib  # noqa: F401
+        import matplotlib.collections
+        import matplotlib.figure
+        import matplotlib.lines
+    except ImportError:
+        raise MissingDependencyError("matplotlib", "plot", "curvefair.plot") from None
+    return matplotlib
+
+
+def _pyplot_axes(n: int = 1, **kw: Any) -> Any:
+    _mpl()
+    import matplotlib.pyplot as plt
+
+    if n == 1:
+        return plt.gca()
+    fig, axes = plt.subplots(n, 1, **kw)
+    return axes
+
+
+# Sampling -----------------------------------------------------------------------------------
+def _check_curve(curve: object, name: str) -> PiecewiseCurve:
+    if not isinstance(curve, PiecewiseCurve):
+        raise InputError(f"{name} must be a curvefair curve (PiecewiseCurve), "
+                         f"got {type(curve).__name__}")
+    return curve
+
+
+def _density(value: object, n_segments: int, name: str, target: int, cap: int) -> int:
+    """Samples (intervals) per segment: given, or chosen so the total is about ``target``."""
+    if value is None:
+        return int(min(cap, max(1, math.ceil(target / n_segments))))
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+        raise InputError(f"{name} must be an integer >= 1 (intervals per curve segment), "
+                         f"got {value!r}")
+    return int(value)
+
+
+@dataclass
+class _Samples:
+    """A curve sampled at ``fracs`` of every segment (both segment ends included)."""
+
+    u: FloatArray  # (m, k) parameters
+    seg: np.ndarray  # (m, k) segment index
+    r: FloatArray  # (m, k, dim)
+    kvec: FloatArray  # (m, k, dim) curvature vector kappa * N
+    kappa: FloatArray  # (m, k) signed (2-D) or unsigned (3-D) curvature
+    s: FloatArray  # (m, k) arc length from the start of the curve
+
+    def flat(self, name: str) -> FloatArray:
+        a = getattr(self, name)
+        return a.reshape((-1,) + a.shape[2:])
+
+
+_GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(8)
+_GAUSS_X = 0.5 * (_GAUSS_X + 1.0)
+_GAUSS_W = 0.5 * _GAUSS_W
+
+
+def _arclength_table(curve: PiecewiseCurve, fracs: FloatArray) -> FloatArray:
+    """Arc length at ``breaks[i] + fracs * width_i`` for every segment ``i``: ``(m, k)``.
+
+    Composite 8-point Gauss-Legendre quadrature of the speed on every sub-interval between
+    consecutive ``fracs`` (``fracs`` must start at 0 and be increasing).
+    """
+    pp = curve.piecewise
+    df = np.diff(fracs)
+    nodes = (fracs[:-1, None] + df[:, None] * _GAUSS_X[None, :]).reshape(-1)
+    speed = np.linalg.norm(pp.segment_values(nodes, 1), axis=2)  # (m, (k-1)*8)
+    speed = speed.reshape(pp.n_segments, df.size, _GAUSS_X.size)
+    sub = (speed @ _GAUSS_W) * df[None, :] * pp.widths[:, None]  # (m, k-1)
+    local = np.concatenate([np.zeros((pp.n_segments, 1)), np.cumsum(sub, axis=1)], axis=1)
+    if fracs[-1] < 1.0:  # segment lengths need the whole segment
+        seg_len = _arclength_table(curve, np.array([0.0, 1.0]))[:, -1]
+    else:
+        seg_len = local[:, -1]
+    offset = np.concatenate([[0.0], np.cumsum(seg_len)[:-1]])
+    return local + offset[:, None]
+
+
+def _curvature_vectors(curve: PiecewiseCurve, u: FloatArray, d1: FloatArray, d2: FloatArray,
+                       side: str) -> tuple[FloatArray, FloatArray]:
+    """Curvature (:func:`curvefair.curvature`) and curvature vector ``kappa N`` at ``u``.
+
+    ``d1``, ``d2`` are ``r'``, ``r''`` at ``u`` (shape ``(k, dim)``). ``N`` is the unit normal
+    towards the centre of curvature: in 2-D the left normal (the curvature is signed), in 3-D the
+    principal normal (the unit part of ``r''`` orthogonal to ``r'``). Zero-speed points have
+    curvature 0 (as :func:`curvefair.curvature` defines it) and a zero vector.
+    """
+    from .analysis import curvature
+
+    kappa = np.asarray(curvature(curve, u, side=side), dtype=float).reshape(-1)
+    sp = np.sqrt(np.sum(d1 * d1, axis=-1))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        if curve.dim == 2:
+            n = np.column_stack([-d1[:, 1], d1[:, 0]]) / sp[:, None]
+        else:
+            t = d1 / sp[:, None]
+            perp = d2 - np.sum(d2 * t, axis=1)[:, None] * t
+            n = perp / np.linalg.norm(perp, axis=1)[:, None]
+    kvec = kappa[:, None] * n
+    kvec[~np.all(np.isfinite(kvec), axis=1) | (kappa == 0.0)] = 0.0
+    return kvec, kappa
+
+
+def _sample(curve: PiecewiseCurve, per_segment: int) -> _Samples:
+    pp = curve.piecewise
+    m = pp.n_segments
+    fracs = np.linspace(0.0, 1.0, per_segment + 1)
+    r = pp.segment_values(fracs, 0)
+    d1 = pp.segment_values(fracs, 1)
+    d2 = pp.segment_values(fracs, 2) if pp.degree >= 2 else np.zeros_like(d1)
+    u = pp.breaks[:-1, None] + pp.widths[:, None] * fracs[None, :]
+    u[:, -1] = pp.breaks[1:]
+    dim = r.shape[2]
+    kvec = np.empty_like(r)
+    kappa = np.empty(u.shape)
+    # the segment's own (one-sided) values: right limits at its start, left limits at its end
+    kv, ka = _curvature_vectors(curve, u[:, :-1].reshape(-1), d1[:, :-1].reshape(-1, dim),
+                                d2[:, :-1].reshape(-1, dim), "right")
+    kvec[:, :-1], kappa[:, :-1] = kv.reshape(m, -1, dim), ka.reshape(m, -1)
+    kv, ka = _curvature_vectors(curve, u[:, -1], d1[:, -1], d2[:, -1], "left")
+    kvec[:, -1], kappa[:, -1] = kv, ka
+    seg = np.broadcast_to(np.arange(m)[:, None], u.shape)
+    return _Samples(u=u, seg=seg, r=r, kvec=kvec, kappa=kappa, s=_arclength_table(curve, fracs))
+
+
+# Comb ---------------------------------------------------------------------------------------
+class Comb(NamedTuple):
+    """Hairs of a curvature comb (see :func:`curvature_comb`)."""
+
+    #: Hair roots on the curve, shape ``(N, dim)``.
+    base: FloatArray
+    #: Hair tips ``base - scale * kappa * N``, shape ``(N, dim)``; joined they give the envelope.
+    tip: FloatArray
+    #: Curvature at the roots, shape ``(N,)`` (signed for planar curves).
+    kappa: FloatArray
+    #: Parameters of the roots, shape ``(N,)``.
+    u: FloatArray
+    #: The scale used: hair length = ``scale * |kappa|``.
+    scale: float
+
+
+def _auto_scale(max_kappa: float, extent: float) -> float:
+    """Scale making the longest hair a fifth of the curve's extent."""
+    if not np.isfinite(max_kappa) or max_kappa <= 0.0 or extent <= 0.0:
+        return 1.0 if extent <= 0.0 else extent
+    return 0.2 * extent / max_kappa
+
+
+def _extent(points: FloatArray) -> float:
+    pts = points[np.all(np.isfinite(points), axis=1)]
+    if pts.size == 0:
+        return 0.0
+    return float(np.max(pts.max(axis=0) - pts.min(axis=0)))
+
+
+def curvature_comb(curve: PiecewiseCurve, scale: float | None = None,
+                   density: int | None = None) -> Comb:
+    """The hairs of the curvature comb of ``curve``, without plotting.
+
+    Parameters
+    ----------
+    curve : PiecewiseCurve
+        Any curvefair curve, dim 2 or 3.
+    scale : float, optional
+        Hair length per unit curvature (length units squared). Default: the longest hair is a
+        fifth of the largest side of the curve's bounding box.
+    density : int, optional
+        Hair intervals per curve segment; every segment gets ``density + 1`` hairs, including
+        both of its ends (so a curvature jump at a breakpoint shows as two different hairs at one
+        point). Default: about 600 hairs in all, at most 40 intervals per segment.
+
+    Returns
+    -------
+    Comb
+        ``base``, ``tip`` (``(N, dim)``), ``kappa``, ``u`` (``(N,)``) and the ``scale`` used.
+
+    Notes
+    -----
+    ``tip = base - scale * kappa * N`` with the curvature vector
+    ``kappa N = (r'' |r'|^2 - r' (r'.r'')) / |r'|^4`` (Farin & Sapidis 1989, porcupine plot):
+    hairs point away from the centre of curvature.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from curvefair import interpolate_cubic
+    >>> from curvefair.plot import curvature_comb
+    >>> t = np.linspace(0, np.pi, 9)
+    >>> c = curvature_comb(interpolate_cubic(np.c_[np.cos(t), np.sin(t)]), scale=0.5, density=4)
+    >>> c.base.shape, round(float(np.median(c.kappa)), 2)
+    ((40, 2), 1.0)
+    """
+    curve = _check_curve(curve, "curve")
+    per = _density(density, curve.piecewise.n_segments, "density", _AUTO_HAIRS, 40)
+    smp = _sample(curve, per)
+    if scale is None:
+        scale = _auto_scale(float(np.nanmax(np.abs(smp.kappa))), _extent(smp.flat("r")))
+    else:
+        scale = float(as_positive(scale, "scale"))  # type: ignore[arg-type]
+    base = smp.flat("r")
+    tip = base - scale * smp.flat("kvec")
+    return Comb(base=base, tip=tip, kappa=smp.flat("kappa"), u=smp.flat("u"), scale=scale)
+
+
+# Features: inflections, curvature extrema, bad points ----------------------------------------
+@dataclass
+class _Features:
+    inflections: FloatArray = field(default_factory=lambda: np.empty(0))  # parameters
+    extrema: FloatArray = field(default_factory=lambda: np.empty(0))  # parameters
+    bad: list[tuple[int, float, float]] = field(default_factory=list)  # (index, u, measure)
+    bad_order: int = 3  # derivative whose jump ranks the bad points
+
+
+def _features(curve: PiecewiseCurve, n_bad: int) -> _Features:
+    """Inflections, curvature extrema and the ``n_bad`` worst bad points, from :func:`analyze`.
+
+    Bad points are the breakpoints ranked by the jump of the third derivative (Wang & Cao 2006);
+    a curve without third-derivative jumps (a C4 quintic spline) is ranked by the jump of its
+    highest derivative, ``Analysis.top_jumps``.
+    """
+    from .analysis import analyze
+
+    a = analyze(curve)
+    feats = _Features(inflections=np.asarray(a.inflection_params, dtype=float),
+                      extrema=np.asarray(a.extremum_params, dtype=float))
+    if n_bad > 0 and a.jumps.size:
+        jumps, order_ = np.asarray(a.jumps), 3
+        if a.degree > 3 and not a.max_jump > 1e-9 * a.max_top_jump:
+            jumps, order_ = np.asarray(a.top_jumps), a.degree
+        top = float(jumps.max())
+        rank = np.argsort(-jumps, kind="stable")[:n_bad]
+        feats.bad = [(int(a.jump_indices[i]), float(a.jump_params[i]), float(jumps[i]))
+                     for i in rank if top > 0.0 and jumps[i] > 1e-9 * top]
+        feats.bad_order = order_
+    return feats
+
+
+def _s_at(curve: PiecewiseCurve, smp: _Samples, u: FloatArray) -> FloatArray:
+    """Arc length at parameters ``u`` (interpolated in the sample table)."""
+    return np.interp(u, smp.flat("u"), smp.flat("s"))
+
+
+# Projection ---------------------------------------------------------------------------------
+class _Projector:
+    """Maps 2-D or 3-D points to plot coordinates."""
+
+    def __init__(self, dense_points: list[FloatArray], projection: str) -> None:
+        choice(projection, PROJECTIONS, "projection")
+        dims = {p.shape[1] for p in dense_points}
+        if len(dims) > 1:
+            raise InputError("curves drawn together must all be 2-D or all 3-D")
+        self.dim = dims.pop()
+        self.labels = ("x", "y")
+        self.note = ""
+        if self.dim == 2:
+            self.basis = np.eye(2)
+            self.origin = np.zeros(2)
+            return
+        if projection != "plane":
+            ax = {"x": 0, "y": 1, "z": 2}
+            self.basis = np.eye(3)[:, [ax[projection[0]], ax[projection[1]]]]
+            self.origin = np.zeros(3)
+            self.labels = (projection[0], projection[1])
+            self.note = f"3-D curve, projected onto the {projection} plane"
+            return
+        pts = np.vstack(dense_points)
+        pts = pts[np.all(np.isfinite(pts), axis=1)]
+        self.origin = pts.mean(axis=0)
+        _, _, vt = np.linalg.svd(pts - self.origin, full_matrices=False)
+        e1, e2 = vt[0], vt[1]
+        # deterministic orientation: largest component of e1 positive, normal towards +z (or +x)
+        e1 = e1 * np.sign(e1[np.argmax(np.abs(e1))])
+        nrm = np.cross(e1, e2)
+        if nrm[np.argmax(np.abs(nrm))] < 0:
+            e2 = -e2
+        self.basis = np.column_stack([e1, e2])
+        self.labels = ("u (best-fit plane)", "v (best-fit plane)")
+        self.note = "3-D curve, projected onto its best-fit plane"
+
+    def __call__(self, pts: FloatArray) -> FloatArray:
+        if self.dim == 2:
+            return pts
+        return (pts - self.origin) @ self.basis
+
+    def vec(self, v: FloatArray) -> FloatArray:
+        return v if self.dim == 2 else v @ self.basis
+
+
+# Prepared curves ----------------------------------------------------------------------------
+@dataclass
+class _Prepared:
+    curve: PiecewiseCurve
+    fine: _Samples  # for the drawn curve and curvature plot
+    comb: _Samples  # hair roots
+    feats: _Features
+    label: str | None
+
+    @property
+    def length(self) -> float:
+        return float(self.fine.s[-1, -1])
+
+
+def _prepare(curves: Sequence[PiecewiseCurve], names: Sequence[str], comb_density: Any,
+             markers: bool, n_bad: int) -> list[_Prepared]:
+    out = []
+    for c, name in zip(curves, names, strict=True):
+        _check_curve(c, name)
+        m = c.piecewise.n_segments
+        fine = _sample(c, _density(None, m, "samples", _AUTO_SAMPLES, 64))
+        comb = _sample(c, _density(comb_density, m, "comb_density", _AUTO_HAIRS, 40))
+        feats = _features(c, n_bad) if markers else _Features()
+        out.append(_Prepared(c, fine, comb, feats, None))
+    return out
+
+
+def _joint_scale(prepared: list[_Prepared], comb_scale: object) -> float:
+    if comb_scale is not None:
+        return float(as_positive(comb_scale, "comb_scale"))  # type: ignore[arg-type]
+    kmax = max((float(np.nanmax(np.abs(p.comb.kappa))) for p in prepared
+                if np.any(np.isfinite(p.comb.kappa))), default=0.0)
+    extent = _extent(np.vstack([p.fine.flat("r") for p in prepared]))
+    return _auto_scale(kmax, extent)
+
+
+def _projector(prepared: list[_Prepared], projection: str) -> _Projector:
+    return _Projector([p.fine.flat("r") for p in prepared], projection)
+
+
+# Drawing ------------------------------------------------------------------------------------
+def _draw_curve(ax: Any, p: _Prepared, proj: _Projector, *, comb: bool, scale: float,
+                markers: bool, style: dict[str, str], label: str | None, points: bool,
+                ref: bool = False, bad_labels: bool = True) -> None:
+    mpl = _mpl()
+    LineCollection = mpl.collections.LineCollection
+    xy = proj(p.fine.flat("r"))
+    ax.plot(xy[:, 0], xy[:, 1], color=style["curve"], lw=1.3 if ref else 1.8,
+            ls="--" if ref else "-", label=label, zorder=3 if ref else 4, gid=_GID_CURVE)
+    if comb:
+        base = proj(p.comb.r)  # (m, k, 2)
+        tip = base - scale * proj.vec(p.comb.kvec)
+        fin = np.all(np.isfinite(tip), axis=-1)
+        segs = np.stack([base[fin], tip[fin]], axis=1)
+        ax.add_collection(LineCollection(segs, colors=style["hair"], linewidths=0.6,
+                                         alpha=0.9, zorder=2, gid=_GID_HAIRS))
+        env = tip.reshape(-1, 2).copy()
+        ax.plot(env[:, 0], env[:, 1], color=style["envelope"], lw=0.9, zorder=2,
+                gid=_GID_ENVELOPE)
+    if points:
+        data = getattr(p.curve, "points", None)
+        ctrl = getattr(p.curve, "control_points", None)
+        if data is not None:
+            d = proj(np.asarray(data))
+            ax.plot(d[:, 0], d[:, 1], ls="none", marker="o", ms=3.5 if ref else 4.0,
+                    mfc="white" if ref else style["points"], mec=style["points"], mew=0.9,
+                    zorder=5)
+        elif ctrl is not None:
+            d = proj(np.asarray(ctrl))
+            ax.plot(d[:, 0], d[:, 1], ls=":", lw=0.8, marker="s", ms=3.0, color=style["points"],
+                    mfc="white", zorder=3)
+    if markers and not ref:
+        _draw_curve_markers(ax, p, proj, ref=ref, bad_labels=bad_labels)
+
+
+def _draw_curve_markers(ax: Any, p: _Prepared, proj: _Projector, *, ref: bool,
+                        bad_labels: bool) -> None:
+    f = p.feats
+    alpha = 0.55 if ref else 1.0
+    if f.inflections.size:
+        q = proj(p.curve(f.inflections))
+        ax.plot(q[:, 0], q[:, 1], ls="none", marker="D", ms=6, mfc=_INFLECTION, mec="white",
+                mew=0.6, alpha=alpha, zorder=6, gid="curvefair-inflections")
+    if f.extrema.size:
+        q = proj(p.curve(f.extrema))
+        ax.plot(q[:, 0], q[:, 1], ls="none", marker="^", ms=6, mfc=_EXTREMUM, mec="white",
+                mew=0.6, alpha=alpha, zorder=6, gid="curvefair-extrema")
+    if f.bad:
+        ub = np.array([b[1] for b in f.bad])
+        q = proj(p.curve(ub))
+        ax.plot(q[:, 0], q[:, 1], ls="none", marker="o", ms=11, mfc="none", mec=_BAD,
+                mew=1.4, alpha=alpha, zorder=6, gid="curvefair-bad-points")
+        if bad_labels:
+            for rank, xy in enumerate(q, start=1):
+                ax.annotate(f"{rank}", xy, xytext=(6, 6), textcoords="offset points",
+                            color=_BAD, fontsize=8, fontweight="bold", alpha=alpha, zorder=7)
+
+
+def _legend_handles(has: dict[str, Any]) -> list[Any]:
+    mpl = _mpl()
+    Line2D = mpl.lines.Line2D
+    out = []
+    if has.get("inflection"):
+        out.append(Line2D([], [], ls="none", marker="D", ms=6, mfc=_INFLECTION, mec="white",
+                          label="inflection"))
+    if has.get("extremum"):
+        out.append(Line2D([], [], ls="none", marker="^", ms=6, mfc=_EXTREMUM, mec="white",
+                          label="curvature extremum"))
+    if has.get("bad"):
+        out.append(Line2D([], [], ls="none", marker="o", ms=9, mfc="none", mec=_BAD, mew=1.4,
+                          label=("worst bad points (largest derivative jumps)"
+                                 if has["bad_order"] is None else
+                                 f"worst bad points (max |Δr{_prime(has['bad_order'])}|)")))
+    return out
+
+
+def _common_order(prepared: list[_Prepared]) -> int | None:
+    orders = {p.feats.bad_order for p in prepared if p.feats.bad}
+    return orders.pop() if len(orders) == 1 else (3 if not orders else None)
+
+
+def _prime(order: int) -> str:
+    sup = str.maketrans("0123456789", "⁰¹²³⁴⁵⁶⁷⁸⁹")
+    return "'" * order if order <= 3 else "⁽" + str(order).translate(sup) + "⁾"
+
+
+def _finish_curve_axes(ax: Any, prepared: list[_Prepared], proj: _Projector, scale: float,
+                       comb: bool, markers: bool, extra_handles: list[Any] | None = None) -> None:
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.autoscale_view()
+    ax.set_xlabel(proj.labels[0])
+    ax.set_ylabel(proj.labels[1])
+    ax.grid(True, lw=0.4, alpha=0.4)
+    handles, _ = ax.get_legend_handles_labels()
+    handles = list(handles) + (extra_handles or [])
+    if markers:
+        handles += _legend_handles({
+            "inflection": any(p.feats.inflections.size for p in prepared),
+            "extremum": any(p.feats.extrema.size for p in prepared),
+            "bad": any(p.feats.bad for p in prepared),
+            "bad_order": _common_order(prepared),
+        })
+    if handles:
+        ax.legend(handles=handles, loc="best", fontsize=8, framealpha=0.85)
+    notes = []
+    if comb:
+        notes.append(f"comb: hair = {scale:.3g} × κ")
+    if proj.note:
+        notes.append(proj.note)
+    if notes:
+        ax.text(0.01, 0.01, "; ".join(notes), transform=ax.transAxes, fontsize=7.5,
+                color="0.35", ha="left", va="bottom")
+
+
+def _draw_curvature(ax: Any, p: _Prepared, *, style: dict[str, str], label: str | None,
+                    markers: bool, ref: bool = False, offset: float = 0.0) -> None:
+    s = p.fine.flat("s") + offset
+    k = p.fine.flat("kappa")
+    ax.plot(s, k, color=style["curve"], lw=1.2 if ref else 1.6, ls="--" if ref else "-",
+            label=label, gid=_GID_CURVATURE, zorder=3 if ref else 4)
+    if not markers or ref:
+        return
+    f = p.feats
+    alpha = 0.55 if ref else 1.0
+    if f.inflections.size:
+        ax.plot(_s_at(p.curve, p.fine, f.inflections) + offset, np.zeros(f.inflections.size),
+                ls="none", marker="D", ms=5.5, mfc=_INFLECTION, mec="white", mew=0.6,
+                alpha=alpha, zorder=6)
+    if f.extrema.size:
+        ke = _kappa_at(p.curve, f.extrema)
+        ax.plot(_s_at(p.curve, p.fine, f.extrema) + offset, ke, ls="none", marker="^", ms=5.5,
+                mfc=_EXTREMUM, mec="white", mew=0.6, alpha=alpha, zorder=6)
+    for rank, (_, ub, _) in enumerate(f.bad, start=1):
+        sb = float(_s_at(p.curve, p.fine, np.array([ub]))[0]) + offset
+        ax.axvline(sb, color=_BAD, lw=0.9, ls=":", alpha=alpha, zorder=1)
+        if not ref:
+            ax.annotate(f"{rank}", (sb, 1.0), xycoords=("data", "axes fraction"),
+                        xytext=(3, -10), textcoords="offset points", color=_BAD, fontsize=8,
+                        fontweight="bold")
+
+
+def _kappa_at(curve: PiecewiseCurve, u: FloatArray) -> FloatArray:
+    from .analysis import curvature
+
+    return np.asarray(curvature(curve, u), dtype=float).reshape(-1)
+
+
+def _finish_curvature_axes(ax: Any, dim: int) -> None:
+    ax.axhline(0.0, color="0.6", lw=0.7, zorder=1)
+    ax.set_xlabel("arc length s")
+    ax.set_ylabel("curvature κ (signed)" if dim == 2 else "curvature κ")
+    ax.grid(True, lw=0.4, alpha=0.4)
+    ax.margins(x=0.01)
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(loc="best", fontsize=8, framealpha=0.85)
+
+
+def _same_domain(a: PiecewiseCurve, b: PiecewiseCurve) -> bool:
+    (a0, a1), (b0, b1) = a.domain, b.domain
+    tol_t = 1e-12 * max(a1 - a0, b1 - b0, abs(a0), abs(a1))
+    return abs(a0 - b0) <= tol_t and abs(a1 - b1) <= tol_t
+
+
+def _nearest_distance(q: FloatArray, other: PiecewiseCurve) -> FloatArray:
+    """Distance from each point of ``q`` to ``other``, replaced by a fine polyline.
+
+    About 20 000 vertices; nearest vertex from a k-d tree, then the two adjacent chords.
+    """
+    from scipy.spatial import cKDTree
+
+    m = other.piecewise.n_segments
+    poly = _sample(other, _density(None, m, "samples", 20000, 256)).flat("r")
+    _, j = cKDTree(poly).query(q)
+    best = np.linalg.norm(q - poly[j], axis=1)
+    for a_off in (-1, 0):
+        a = np.clip(j + a_off, 0, poly.shape[0] - 2)
+        p0, p1 = poly[a], poly[a + 1]
+        d = p1 - p0
+        dd = np.sum(d * d, axis=1)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = np.clip(np.sum((q - p0) * d, axis=1) / dd, 0.0, 1.0)
+        t = np.where(dd > 0, t, 0.0)
+        best = np.minimum(best, np.linalg.norm(q - (p0 + t[:, None] * d), axis=1))
+    return best
+
+
+def _draw_deviation(ax: Any, before: _Prepared, after: _Prepared, *, offset: float = 0.0,
+                    annotate: bool = True) -> tuple[float, bool]:
+    """Plot the deviation of ``after`` from ``before`` against the arc length of ``after``.
+
+    Curves on the same parameter domain (a curve and its faired version): ``|after(t) -
+    before(t)|``, the quantity the fairing tolerance bounds, with its certified maximum from
+    :func:`curvefair.deviation`. Otherwise: the distance to the nearest point of ``before``.
+    Returns (largest value, parametric?).
+    """
+    from .analysis import deviation
+
+    s = after.fine.flat("s") + offset
+    parametric = _same_domain(before.curve, after.curve)
+    if parametric:
+        u = after.fine.flat("u")
+        dev = np.linalg.norm(after.fine.flat("r") - before.curve(u), axis=1)
+        d = deviation(before.curve, after.curve)
+        dmax = float(d.max_distance)
+        smax = float(_s_at(after.curve, after.fine, np.array([d.param]))[0]) + offset
+    else:
+        dev = _nearest_distance(after.fine.flat("r"), before.curve)
+        i = int(np.argmax(dev))
+        dmax, smax = float(dev[i]), float(s[i])
+    ax.fill_between(s, 0.0, dev, color=_MAIN["hair"], alpha=0.35, lw=0, zorder=2)
+    ax.plot(s, dev, color=_MAIN["curve"], lw=1.3, gid=_GID_DEVIATION, zorder=3)
+    if annotate:
+        ax.plot([smax], [dmax], marker="v", color=_BAD, ms=6, zorder=5, ls="none")
+        ax.annotate(f"max {dmax:.3g} at s = {smax:.3g}", (smax, dmax), xytext=(6, -2),
+                    textcoords="offset points", fontsize=8, color=_BAD, va="top")
+    return dmax, parametric
+
+
+def _finish_deviation_axes(ax: Any, tol: float | None, dmax: float, parametric: bool,
+                           labels: tuple[str, str]) -> None:
+    if tol is not None:
+        ax.axhline(tol, color=_BAD, lw=1.0, ls="--", label=f"tolerance {tol:.3g}", zorder=4)
+        ax.legend(loc="upper right", fontsize=8, framealpha=0.85)
+    top = max(dmax, tol or 0.0)
+    ax.set_ylim(0.0, 1.2 * top if top > 0 else 1.0)
+    ax.set_xlabel("arc length s")
+    ax.set_ylabel("deviation")
+    what = (f"deviation |{labels[1]}(t) - {labels[0]}(t)|" if parametric else
+            f"distance of {labels[1]} to the nearest point of {labels[0]}")
+    ax.set_title(what, fontsize=9, loc="left")
+    ax.grid(True, lw=0.4, alpha=0.4)
+    ax.margins(x=0.01)
+
+
+# Public plotting functions ------------------------------------------------------------------
+def plot_curve(curve: PiecewiseCurve, ax: Any = None, comb: bool = True,
+               comb_scale: float | None = None, comb_density: int | None = None,
+               markers: bool = True, *, points: bool = True, label: str | None = None,
+               projection: ProjectionName = "plane", n_bad: int = 3) -> Any:
+    """Draw ``curve`` with its curvature comb and markers.
+
+    Parameters
+    ----------
+    curve : PiecewiseCurve
+        Any curvefair curve (2-D, or 3-D drawn as a projection, see ``projection``).
+    ax : matplotlib Axes, optional
+        Where to draw; default the current pyplot axes.
+    comb : bool
+        Draw the curvature comb (hairs and their envelope).
+    comb_scale : float, optional
+        Hair length per unit curvature. Default: the longest hair is a fifth of the curve's extent.
+    comb_density : int, optional
+        Hair intervals per curve segment (``density + 1`` hairs per segment, both ends included).
+        Default: about 600 hairs in all.
+    markers : bool
+        Mark inflections (◆), curvature extrema (▲) and the ``n_bad`` worst bad points (○, ranked
+        by the jump of the third derivative at the breakpoints, Wang & Cao 2006).
+    points : bool
+        Draw the data points (Hermite curves) or the control polygon (B-splines).
+    label : str, optional
+        Legend label of the curve.
+    projection : {"plane", "xy", "xz", "yz"}
+        For 3-D curves: the best-fit plane (default) or a coordinate plane. Ignored in 2-D.
+    n_bad : int
+        How many bad points to mark.
+
+    Returns
+    -------
+    matplotlib Axes
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import numpy as np
+    >>> from curvefair import interpolate_cubic
+    >>> from curvefair.plot import plot_curve
+    >>> pts = np.column_stack([np.arange(1.0, 8.0), np.ones(7)]); pts[3] = (4.3, 1.6)
+    >>> ax = plot_curve(interpolate_cubic(pts))
+    """
+    _mpl()
+    if ax is None:
+        ax = _pyplot_axes()
+    prepared = _prepare([curve], ["curve"], comb_density, markers, n_bad)
+    proj = _projector(prepared, projection)
+    scale = _joint_scale(prepared, comb_scale)
+    _draw_curve(ax, prepared[0], proj, comb=comb, scale=scale, markers=markers, style=_MAIN,
+                label=label, points=points)
+    _finish_curve_axes(ax, prepared, proj, scale, comb, markers)
+    return ax
+
+
+def plot_curvature(curve: PiecewiseCurve, ax: Any = None, *, markers: bool = True,
+                   label: str | None = None, n_bad: int = 3) -> Any:
+    """Plot the curvature of ``curve`` against its arc length.
+
+    Parameters
+    ----------
+    curve : PiecewiseCurve
+    ax : matplotlib Axes, optional
+        Default: the current pyplot axes.
+    markers : bool
+        Mark inflections (zeros, planar curves), curvature extrema and bad points (dotted
+        vertical lines with their rank).
+    label : str, optional
+    n_bad : int
+
+    Returns
+    -------
+    matplotlib Axes
+
+    Notes
+    -----
+    Planar curves: signed ``kappa = (x'y'' - y'x'') / |r'|^3``; space curves
+    ``|r' x r''| / |r'|^3``. Arc length by composite Gauss-Legendre quadrature of ``|r'|``.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import numpy as np
+    >>> from curvefair import interpolate_cubic
+    >>> from curvefair.plot import plot_curvature
+    >>> ax = plot_curvature(interpolate_cubic(np.c_[np.arange(6.0), np.arange(6.0) ** 2]))
+    """
+    _mpl()
+    if ax is None:
+        ax = _pyplot_axes()
+    p = _prepare([curve], ["curve"], None, markers, n_bad)[0]
+    _draw_curvature(ax, p, style=_MAIN, label=label, markers=markers)
+    _finish_curvature_axes(ax, curve.dim)
+    return ax
+
+
+def plot_compare(before: PiecewiseCurve, after: PiecewiseCurve, axes: Any = None, *,
+                 tol: float | None = None, labels: tuple[str, str] = ("before", "after"),
+                 comb: bool = True, comb_scale: float | None = None,
+                 comb_density: int | None = None, markers: bool = True,
+                 projection: ProjectionName = "plane", n_bad: int = 3) -> Any:
+    """Overlay ``before`` and ``after`` with their combs, and plot the deviation of ``after``.
+
+    Parameters
+    ----------
+    before, after : PiecewiseCurve
+        E.g. a curve and its faired version.
+    axes : pair of matplotlib Axes, optional
+        ``(curve_axes, deviation_axes)``; default a new pyplot figure with two rows.
+    tol : float, optional
+        Tolerance drawn as a line on the deviation plot.
+    labels : (str, str)
+        Legend labels.
+    comb, comb_scale, comb_density, markers, projection, n_bad
+        As for :func:`plot_curve`. Both combs use the same scale, so they compare.
+
+    Returns
+    -------
+    (Axes, Axes)
+        The curve axes and the deviation axes.
+
+    Notes
+    -----
+    The deviation at a point of ``after`` is its distance to the nearest point of ``before``
+    (``before`` replaced by a polyline of about 20 000 vertices), plotted against the arc length
+    of ``after``.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import numpy as np
+    >>> from curvefair import interpolate_cubic
+    >>> from curvefair.plot import plot_compare
+    >>> pts = np.column_stack([np.arange(1.0, 8.0), np.ones(7)]); pts[3] = (4.3, 1.6)
+    >>> flat = pts.copy(); flat[3] = (4.2, 1.02)
+    >>> ax_curve, ax_dev = plot_compare(interpolate_cubic(pts), interpolate_cubic(flat), tol=0.7)
+    """
+    _mpl()
+    if axes is None:
+        axes = _pyplot_axes(2, figsize=(8, 6), height_ratios=(2, 1), layout="constrained")
+    ax_c, ax_d = axes
+    prepared = (_prepare([before], ["before"], comb_density, False, n_bad)
+                + _prepare([after], ["after"], comb_density, markers, n_bad))
+    proj = _projector(prepared, projection)
+    scale = _joint_scale(prepared, comb_scale)
+    tol = None if tol is None else as_positive(tol, "tol")
+    _draw_curve(ax_c, prepared[0], proj, comb=comb, scale=scale, markers=markers, style=_REF,
+                label=labels[0], points=True, ref=True, bad_labels=False)
+    _draw_curve(ax_c, prepared[1], proj, comb=comb, scale=scale, markers=markers, style=_MAIN,
+                label=labels[1], points=True)
+    _finish_curve_axes(ax_c, prepared, proj, scale, comb, markers)
+    dmax, parametric = _draw_deviation(ax_d, prepared[0], prepared[1])
+    _finish_deviation_axes(ax_d, tol, dmax, parametric, labels)
+    return ax_c, ax_d
+
+
+def _as_curve_list(x: Any, name: str) -> list[PiecewiseCurve]:
+    if isinstance(x, PiecewiseCurve):
+        return [x]
+    try:
+        items = list(x)
+    except TypeError:
+        raise InputError(f"{name} must be a curve or a sequence of curves, "
+                         f"got {type(x).__name__}") from None
+    if not items:
+        raise InputError(f"{name} is an empty sequence of curves")
+    return [_check_curve(c, f"{name}[{i}]") for i, c in enumerate(items)]
+
+
+def figure(curve: PiecewiseCurve | Sequence[PiecewiseCurve],
+           compare: PiecewiseCurve | Sequence[PiecewiseCurve] | None = None, *,
+           labels: tuple[str, str] | None = None, tol: float | None = None,
+           comb: bool = True, comb_scale: float | None = None, comb_density: int | None = None,
+           markers: bool = True, projection: ProjectionName = "plane", n_bad: int = 3,
+           title: str | None = None, figsize: tuple[float, float] | None = None) -> Any:
+    """The standard curvefair figure: curve and comb above, curvature against arc length below.
+
+    With ``compare`` the second curve (e.g. the faired one) is drawn over ``curve`` with its own
+    comb at the same scale, both curvature plots share the lower panel, and a third panel shows
+    the deviation of ``compare`` from ``curve``.
+
+    Parameters
+    ----------
+    curve : PiecewiseCurve or sequence of them
+        Several curves (e.g. every curve of a file) are drawn together; their curvature plots
+        follow one another along a common arc-length axis, separated by grey lines.
+    compare : PiecewiseCurve or sequence, optional
+        As many curves as ``curve``, paired in order.
+    labels : (str, str), optional
+        Legend labels of ``curve`` and ``compare``; default ``("curve", "compare")``, or
+        ``("before", "after")`` is a good choice for fairing.
+    tol : float, optional
+        Tolerance line on the deviation panel.
+    comb, comb_scale, comb_density, markers, projection, n_bad
+        As for :func:`plot_curve`.
+    title : str, optional
+    figsize : (float, float), optional
+        Inches; default 9 wide, the height following the curve's aspect ratio.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        A figure not managed by pyplot: save it with ``fig.savefig(path)`` (works headless).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from curvefair import interpolate_cubic
+    >>> from curvefair.plot import figure
+    >>> pts = np.column_stack([np.arange(1.0, 8.0), np.ones(7)]); pts[3] = (4.3, 1.6)
+    >>> fig = figure(interpolate_cubic(pts), title="Wang & Cao 2006, Example 1")
+    >>> len(fig.axes)
+    2
+    """
+    mpl = _mpl()
+    curves = _as_curve_list(curve, "curve")
+    others = None if compare is None else _as_curve_list(compare, "compare")
+    if others is not None and len(others) != len(curves):
+        raise InputError(f"compare has {len(others)} curves but curve has {len(curves)}; "
+                         "they are paired in order")
+    if labels is None:
+        labels = ("curve", "compare")
+    tol = None if tol is None else as_positive(tol, "tol")
+    prep = _prepare(curves, [f"curve[{i}]" for i in range(len(curves))], comb_density,
+                    markers and others is None, n_bad)
+    prep_o = ([] if others is None else
+              _prepare(others, [f"compare[{i}]" for i in range(len(others))], comb_density,
+                       markers, n_bad))
+    everything = prep + prep_o
+    proj = _projector(everything, projection)
+    scale = _joint_scale(everything, comb_scale)
+
+    # layout: curve panel height from the data's aspect ratio
+    xy = [proj(p.fine.flat("r")) for p in everything]
+    if comb:
+        xy += [proj(p.comb.flat("r")) - scale * proj.vec(p.comb.flat("kvec")) for p in everything]
+    xy = np.vstack(xy)
+    xy = xy[np.all(np.isfinite(xy), axis=1)]
+    span = np.ptp(xy, axis=0) if xy.size else np.ones(2)
+    aspect = float(span[1] / span[0]) if span[0] > 0 else 1.0
+    width = 9.0
+    # axes about 8 inches wide; 10 % margins; 0.8 inch for labels
+    top_h = float(np.clip(8.0 * aspect * 1.1 + 0.8, 2.4, 8.0))
+    heights = [top_h, 2.4] + ([1.8] if others else [])
+    if figsize is None:
+        figsize = (width, sum(heights) + (0.4 if title else 0.0))
+    fig = mpl.figure.Figure(figsize=figsize, layout="constrained")
+    axs = fig.subplots(len(heights), 1, height_ratios=heights)
+    ax_c, ax_k = axs[0], axs[1]
+
+    multi = len(curves) > 1
+    for i, p in enumerate(prep):
+        lab = labels[0] if i == 0 else None
+        if others is None:
+            _draw_curve(ax_c, p, proj, comb=comb, scale=scale, markers=markers, style=_MAIN,
+                        label=lab if multi else None, points=True)
+        else:
+            _draw_curve(ax_c, p, proj, comb=comb, scale=scale, markers=markers, style=_REF,
+                        label=lab, points=True, ref=True, bad_labels=False)
+            _draw_curve(ax_c, prep_o[i], proj, comb=comb, scale=scale, markers=markers,
+                        style=_MAIN, label=labels[1] if i == 0 else None, points=True)
+    _finish_curve_axes(ax_c, everything, proj, scale, comb, markers)
+
+    offset = 0.0
+    dmax = 0.0
+    parametric = True
+    for i, p in enumerate(prep):
+        if others is None:
+            _draw_curvature(ax_k, p, style=_MAIN, label=(labels[0] if multi and i == 0 else None),
+                            markers=markers, offset=offset)
+            length = p.length
+        else:
+            q = prep_o[i]
+            _draw_curvature(ax_k, p, style=_REF, label=labels[0] if i == 0 else None,
+                            markers=markers, ref=True, offset=offset)
+            _draw_curvature(ax_k, q, style=_MAIN, label=labels[1] if i == 0 else None,
+                            markers=markers, offset=offset)
+            dm, parametric = _draw_deviation(axs[2], p, q, offset=offset, annotate=not multi)
+            dmax = max(dmax, dm)
+            length = max(p.length, q.length)
+        offset += length
+        if multi and i < len(prep) - 1:
+            for ax in axs[1:]:
+                ax.axvline(offset, color="0.5", lw=1.0, ls="-", alpha=0.6)
+    _finish_curvature_axes(ax_k, proj.dim)
+    if others is not None:
+        _finish_deviation_axes(axs[2], tol, dmax, parametric, labels)
+    if multi:
+        ax_k.set_xlabel("arc length s (curves one after another)")
+    if title:
+        fig.suptitle(title, fontsize=11)
+    return fig
