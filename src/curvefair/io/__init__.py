@@ -155,12 +155,15 @@ def read_curves(path: str | os.PathLike[str], *, format: FormatName | None = Non
     Examples
     --------
     >>> import os, tempfile
+    >>> import numpy as np
     >>> from curvefair import read_curves
     >>> p = os.path.join(tempfile.mkdtemp(), "foil.dat")
-    >>> _ = open(p, "w").write("TOY\\n1 0\\n0.5 0.1\\n0 0\\n0.5 -0.05\\n1 0\\n")
+    >>> th = np.linspace(0, 2 * np.pi, 81)          # a thin ellipse as a Selig airfoil
+    >>> rows = "".join(f"{(1 + np.cos(t)) / 2:.6f} {0.06 * np.sin(t):.6f}\\n" for t in th)
+    >>> _ = open(p, "w").write("TOY\\n" + rows)
     >>> r = read_curves(p)
-    >>> r[0].kind, r[0].name, r[0].corners
-    ('airfoil', 'TOY', (0, 4))
+    >>> len(r), r[0].kind, r[0].name, r[0].corners        # the trailing edge is kept sharp
+    (1, 'airfoil', 'TOY', (0, 80))
     """
     fmt = detect_format(path, format)
     choice(on_unsupported, ("raise", "skip"), "on_unsupported")

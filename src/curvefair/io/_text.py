@@ -13,7 +13,7 @@ import os
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -25,10 +25,10 @@ __all__ = ["TextLayout", "Token", "parse_text", "format_number"]
 _NUM = r"[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|nan|inf(?:inity)?)"
 _NUM_RE = re.compile(_NUM, re.IGNORECASE)
 _SEP_RE = re.compile(r"(\s*[,;]\s*|\s+)")
+_TOKEN_RE = re.compile(r"([+-]?)([^eE]*)(?:([eE])([+-]?)(\d+))?$")
 
 
-@dataclass(frozen=True)
-class Token:
+class Token(NamedTuple):
     """Style of one number as it stood in the file."""
 
     text: str
@@ -42,15 +42,13 @@ class Token:
 
     @classmethod
     def parse(cls, text: str) -> Token:
-        t = text
-        m = re.match(r"([+-]?)([^eE]*)(?:([eE])([+-]?)(\d+))?$", t)
+        m = _TOKEN_RE.match(text)
         assert m is not None
-        mant = m.group(2)
-        has_point = "." in mant
-        dec = len(mant.split(".", 1)[1]) if has_point else 0
-        exp = m.group(3) or ""
-        return cls(t, dec, has_point, exp, len(m.group(5) or ""), m.group(4) == "+",
-                   m.group(1) == "+", mant.startswith("."))
+        sign, mant, exp, exp_sign, exp_digits = m.groups()
+        point = mant.find(".")
+        dec = len(mant) - point - 1 if point >= 0 else 0
+        return cls(text, dec, point >= 0, exp or "", len(exp_digits or ""), exp_sign == "+",
+                   sign == "+", point == 0)
 
 
 def _render(v: float, tok: Token, decimals: int) -> str:

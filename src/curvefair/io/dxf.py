@@ -276,8 +276,13 @@ def _set_points(e: Any, recs: list[CurveRecord]) -> None:
         if len(old) != pts.shape[0]:
             raise InputError(f"write_curves: LWPOLYLINE {src['handle']} has {len(old)} "
                              f"vertices in the template, the records {pts.shape[0]}")
-        e.set_points([(float(x), float(y), s, w, b) for (x, y), (_, _, s, w, b)
-                      in zip(pts[:, :2], old, strict=True)], format="xyseb")
+        rows = np.array(old, dtype=float).reshape(-1, 5)
+        rows[:, :2] = pts[:, :2]
+        lw = getattr(e, "lwpoints", None)
+        if lw is not None and hasattr(lw, "set"):
+            lw.set(rows)           # one array assignment (set_points appends one by one)
+        else:  # pragma: no cover - older ezdxf
+            e.set_points([tuple(map(float, r)) for r in rows], format="xyseb")
         return
     verts = list(e.vertices)
     if len(verts) != pts.shape[0]:
