@@ -9,6 +9,7 @@ import numpy as np
 
 from .._typing import FloatArray
 from ..curves.piecewise import PiecewiseCurve
+from ..errors import InputError
 from ._core import bounding_diagonal, check_curve, falling
 from ._energy import segment_energies
 from ._sampling import sample_curve, scan_sign_changes
@@ -183,7 +184,7 @@ def _argmax_or_none(values: FloatArray, idx: np.ndarray) -> tuple[float, int | N
     return float(values[k]), int(idx[k])
 
 
-def analyze(curve: object) -> Analysis:
+def analyze(curve: object, *, nodes: int | None = None) -> Analysis:
     """Analyse the fairness of a curve: energies, jumps, Sapidis measure, inflections, extrema.
 
     Parameters
@@ -260,6 +261,13 @@ def analyze(curve: object) -> Analysis:
     True
     """
     c = check_curve(curve)
+    if nodes is None:
+        k_nodes = 0
+    elif isinstance(nodes, bool) or not isinstance(nodes, (int, np.integer)) or not (
+            2 <= nodes <= 64):
+        raise InputError(f"nodes must be None or an integer in [2, 64], got {nodes!r}")
+    else:
+        k_nodes = int(nodes)
     pp = c.piecewise
     coeffs = np.asarray(pp.coeffs)
     breaks = np.asarray(pp.breaks)
@@ -276,7 +284,7 @@ def analyze(curve: object) -> Analysis:
             planar = True
             cw = np.ascontiguousarray(coeffs @ E)  # (m, p1, 2): coordinates in the plane
 
-    smp = sample_curve(cw, h, planar, closed)
+    smp = sample_curve(cw, h, planar, closed, k_nodes)
     if dim == 2:
         L = smp.diagonal
     jidx, _ = _knots(m, closed)
@@ -304,10 +312,12 @@ def analyze(curve: object) -> Analysis:
     ktol = ZERO_RTOL * max(max_k, invL)
     kstol = ZERO_RTOL * max(max_ks, invL * invL)
     if planar:
-        n_infl, infl_at = scan_sign_changes(kap, smp.x, breaks, smp.extra[0], ktol, closed)
+        n_infl, infl_at = scan_sign_changes(kap, smp.x, breaks, smp.extra[0], ktol, closed,
+                                            smp.ell, smp.pos, 1)
     else:
         n_infl, infl_at = 0, np.zeros(0)
-    n_ext, ext_at = scan_sign_changes(dks, smp.x, breaks, smp.extra[1], kstol, closed)
+    n_ext, ext_at = scan_sign_changes(dks, smp.x, breaks, smp.extra[1], kstol, closed,
+                                      smp.ell, smp.pos, 2)
 
     # -- Sapidis-Farin measure from the one-sided samples at the knots ----------------------
     z = smp.knots[jidx, 2]

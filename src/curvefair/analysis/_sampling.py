@@ -23,7 +23,13 @@ from ._core import CROSS_RTOL, SPEED_RTOL, derivs_at, falling, frenet, lobatto
 
 __all__ = ["Samples", "sample_curve", "scan_sign_changes"]
 
-_CHUNK = 1 << 14
+#: Rounding level of curvature-type quantities computed from floating-point spline data: on a
+#: segment of length scale ``ell`` starting at distance ``pos`` from the origin, the
+#: curvature is zero within ``ROUNDING_FLOOR (ell + pos) / ell**2`` and ``dkappa/ds`` within
+#: ``ROUNDING_FLOOR (ell + pos) / ell**3``: coordinates rounded to ``eps * pos`` and
+#: derivatives to ``eps * ell`` bend a straight segment that much (about 1e3 machine
+#: epsilons, a margin of about 100 over the rounding estimates).
+ROUNDING_FLOOR = 1e3 * float(np.finfo(float).eps)
 _MAX_SPLITS = 48
 
 
@@ -45,15 +51,23 @@ class _Plan:
     degs: tuple[int, int]
 
 
+def min_nodes(degree: int, planar: bool) -> int:
+    """Smallest number of Lobatto nodes per segment the sign certificate needs."""
+    p = degree
+    d_n = max(2 * p - 4, 0)
+    d_e = max(4 * p - 7 if planar else 6 * p - 11, 0)
+    return max(d_e + 1, d_n + 2, p + 3)
+
+
 @lru_cache(maxsize=32)
-def _plan(degree: int, planar: bool) -> _Plan:
+def _plan(degree: int, planar: bool, nodes: int = 0) -> _Plan:
     p = degree
     # degrees: the leading coefficients of r' and r'' are parallel, so N = x'y'' - y'x'' has
     # degree 2p - 4 (not 2p - 3), N' = x'y''' - y'x''' degree 2p - 5, and the numerator E of
     # dkappa/ds degree 4p - 7 (planar) or 6p - 11 (3-D: |C|^2 (r'.r''), C = r' x r'')
     d_n = max(2 * p - 4, 0)
     d_e = max(4 * p - 7 if planar else 6 * p - 11, 0)
-    K = max(d_e + 1, d_n + 2, p + 3)
+    K = max(min_nodes(p, planar), nodes)
     x, w = lobatto(K)
     tab = np.zeros((3, K, p + 1))
     for nu in range(1, 4):
@@ -125,6 +139,8 @@ class Samples:
     max_dkds: float
     knots: FloatArray  # (m, 3): jumps of r''', r^(degree), dkappa/ds at each breakpoint
     diagonal: float  # bounding-box diagonal of the breakpoint positions
+    ell: FloatArray  # (m,) length scale of each segment (derivative size times width)
+    pos: FloatArray  # (m,) norm of each segment's start point
     energies: FloatArray  # (m, 2): exact int |r''|^2 and int |r'''|^2 per segment
     extra: tuple[tuple[np.ndarray, FloatArray, FloatArray], ...]  # per quantity: seg, u, value
 
@@ -151,7 +167,7 @@ def _variations_1d(b, n):  # type: ignore[no-untyped-def]
 
 @njit(cache=True, fastmath={"contract", "arcp", "reassoc"})
 def _pass_kernel(cw, h, tab, w, fall, fits, nfit, subs, speed_rtol, cross_rtol, closed,
-                 kap, dks, knots, energies, box, gaps):  # type: ignore[no-untyped-def]
+                 kap, dks, knots, energies, box, ell, pos, gaps):  # type: ignore[no-untyped-def]
     """One fused pass over the segments (see :func:`sample_curve`).
 
     ``tab[nu-1, q, j] = j!/(j-nu)! x_q^(j-nu)`` (derivative ``nu`` of ``u^j`` at node ``q``),
@@ -160,7 +176,9 @@ def _pass_kernel(cw, h, tab, w, fall, fits, nfit, subs, speed_rtol, cross_rtol, 
     the same per gap. Writes ``kap``/``dks`` (m, K); ``knots[i]`` = jumps at breakpoint ``i``
     of the third derivative, of the ``degree``-th derivative and of ``dkappa/ds`` (row 0:
     the seam of a closed curve, else 0); ``energies[i, 0/1]`` (exact ``int |r''|^2`` and
-    ``int |r'''|^2``); ``box`` (2, dim) the bounding box of the breakpoint positions; and
+    ``int |r'''|^2``); ``box`` (2, dim) the bounding box of the breakpoint positions; ``ell``
+    (m,) each segment's length scale (size of its derivative polynomial times its width),
+    ``pos`` (m,) the norm of its start point; and
     ``gaps`` (rows ``(which, segment, gap)`` whose gap Bernstein coefficients still vary at
     least twice). Returns ``(arc, dke, n_singular, max|kappa|, max|dkds|, n_gaps)``.
     """
@@ -210,6 +228,11 @@ def _pass_kernel(cw, h, tab, w, fall, fits, nfit, subs, speed_rtol, cross_rtol, 
                 if j >= 2:
                     sc2 += fall[j, 2] * nrm
             hp *= hi
+        ell[i] = sc1
+        c0n = 0.0
+        for d in range(dim):
+            c0n += cw[i, 0, d] * cw[i, 0, d]
+        pos[i] = np.sqrt(c0n)
         sc1 *= ih
         sc2 *= ih2
         # exact energies: int_0^1 |sum_j g_j u^j|^2 du * h with g_j = fall[j+o, o] e_{j+o} / h^o
@@ -416,7 +439,8 @@ def _refine_gaps(cw: FloatArray, h: FloatArray, plan: _Plan, gaps: np.ndarray
     return out
 
 
-def sample_curve(cw: FloatArray, h: FloatArray, planar: bool, closed: bool) -> Samples:
+def sample_curve(cw: FloatArray, h: FloatArray, planar: bool, closed: bool,
+                 nodes: int = 0) -> Samples:
     """Sample ``kappa`` and ``dkappa/ds`` on every segment; integrate; certify signs.
 
     ``cw`` are power coefficients ``(m, p+1, dim)`` (``dim`` 2 for planar curves, 3 for
@@ -425,7 +449,7 @@ def sample_curve(cw: FloatArray, h: FloatArray, planar: bool, closed: bool) -> S
     """
     m, p1, dim = cw.shape
     p = p1 - 1
-    plan = _plan(p, planar)
+    plan = _plan(p, planar, nodes)
     K = plan.K
     dmax = max(plan.degs) + 1
     fits = np.zeros((2, K, dmax))
@@ -446,13 +470,15 @@ def sample_curve(cw: FloatArray, h: FloatArray, planar: bool, closed: bool) -> S
     knots = np.empty((m, 3))
     energies = np.empty((m, 2))
     box = np.empty((2, dim))
+    ell = np.empty(m)
+    pos = np.empty(m)
     cwc = np.ascontiguousarray(cw, dtype=np.float64)
     hc = np.ascontiguousarray(h, dtype=np.float64)
     gaps = np.empty((max(1 << 12, m // 4), 3), dtype=np.int64)
     while True:
         arc, dke, nsing, maxk, maxks, ngap = _pass_kernel(
             cwc, hc, plan.tab, plan.w, fall, fits, nfit, subs, SPEED_RTOL, CROSS_RTOL,
-            bool(closed), kap, dks, knots, energies, box, gaps)
+            bool(closed), kap, dks, knots, energies, box, ell, pos, gaps)
         if ngap <= gaps.shape[0]:
             break
         gaps = np.empty((ngap, 3), dtype=np.int64)  # rare: the buffer was too small; redo
@@ -469,12 +495,14 @@ def sample_curve(cw: FloatArray, h: FloatArray, planar: bool, closed: bool) -> S
     return Samples(x=plan.x, kappa=kap, dkds=dks, arc_length=float(arc),
                    dkds_energy=float(dke), n_singular=int(nsing), max_kappa=float(maxk),
                    max_dkds=float(maxks), knots=knots, energies=energies,
-                   diagonal=float(np.sqrt(np.sum((box[1] - box[0]) ** 2))),
+                   diagonal=float(np.sqrt(np.sum((box[1] - box[0]) ** 2))), ell=ell,
+                   pos=pos,
                    extra=(extra[0], extra[1]))
 
 
 @njit(cache=True)
-def _scan_kernel(vals, x, breaks, ex_seg, ex_u, ex_val, tol, out):  # type: ignore[no-untyped-def]
+def _scan_kernel(vals, x, breaks, ex_seg, ex_u, ex_val, tol, ell, pos, floor, power,
+                 out):  # type: ignore[no-untyped-def]
     m, K = vals.shape
     ne = ex_seg.shape[0]
     n = 0
@@ -489,6 +517,11 @@ def _scan_kernel(vals, x, breaks, ex_seg, ex_u, ex_val, tol, out):  # type: igno
         t0 = breaks[i]
         hw = breaks[i + 1] - t0
         q = 0
+        tl = tol
+        if ell[i] > 0.0:
+            fl = floor * (ell[i] + pos[i]) / ell[i] ** (power + 1.0)
+            if fl > tl:
+                tl = fl
         while e < ne and ex_seg[e] < i:
             e += 1
         while q < K or (e < ne and ex_seg[e] == i):
@@ -500,9 +533,9 @@ def _scan_kernel(vals, x, breaks, ex_seg, ex_u, ex_val, tol, out):  # type: igno
                 u = x[q]
                 v = vals[i, q]
                 q += 1
-            if v > tol:
+            if v > tl:
                 s = 1
-            elif v < -tol:
+            elif v < -tl:
                 s = -1
             else:
                 continue
@@ -522,8 +555,12 @@ def _scan_kernel(vals, x, breaks, ex_seg, ex_u, ex_val, tol, out):  # type: igno
 
 def scan_sign_changes(vals: FloatArray, x: FloatArray, breaks: FloatArray,
                       extra: tuple[np.ndarray, FloatArray, FloatArray], tol: float,
-                      closed: bool) -> tuple[int, FloatArray]:
-    """Sign changes of the sampled sequence (``|v| <= tol`` is zero), cyclic when closed.
+                      closed: bool, ell: FloatArray, pos: FloatArray, power: int
+                      ) -> tuple[int, FloatArray]:
+    """Sign changes of the sampled sequence, cyclic when closed.
+
+    On segment ``i`` a value counts as zero where ``|v| <= max(tol, ROUNDING_FLOOR (ell_i +
+    pos_i) / ell_i**(power + 1))``.
 
     Returns the count and the linearly interpolated parameters of the changes (sorted).
     """
@@ -532,7 +569,10 @@ def scan_sign_changes(vals: FloatArray, x: FloatArray, breaks: FloatArray,
     n, fs, ft, fv, ls, lt, lv = _scan_kernel(
         np.ascontiguousarray(vals), x, np.ascontiguousarray(breaks, dtype=np.float64),
         np.ascontiguousarray(ex_seg, dtype=np.int64), np.ascontiguousarray(ex_u),
-        np.ascontiguousarray(ex_val), float(tol), out)
+        np.ascontiguousarray(ex_val), float(tol), np.ascontiguousarray(ell),
+        np.ascontiguousarray(pos),
+        ROUNDING_FLOOR,
+        float(power), out)
     loc = out[:n].copy()
     if closed and fs != 0 and ls != fs:
         period = float(breaks[-1] - breaks[0])
