@@ -1,0 +1,574 @@
+"""The ``curvefair`` command: a thin layer over the public API.
+
+Every command calls the same functions a Python user would: :func:`curvefair.read_curves`,
+:func:`curvefair.fair`, :func:`curvefair.write_curves`, :func:`curvefair.analyze`,
+:func:`curvefair.plot.figure` and the method registry :data:`curvefair.fairing.METHODS`.
+
+Exit codes: 0 success; 1 bad input (the message names the file and, for text formats, the line)
+or a curve that could not be faired; 2 usage error (unknown option, missing argument, output
+equal to input without ``--in-place``, nonexistent input file).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import sys
+import time
+from collections.abc import Iterator, Sequence
+from pathlib import Path
+from typing import Any
+
+try:
+    import click
+except ImportError:  # pragma: no cover - exercised only without the extra
+    sys.stderr.write("the curvefair command needs click and rich: pip install 'curvefair[cli]'\n")
+    raise SystemExit(1) from None
+
+from . import __version__
+from .errors import CurvefairError
+
+__all__ = ["main"]
+
+EXIT_OK = 0
+EXIT_INPUT = 1
+EXIT_USAGE = 2
+
+_EXAMPLES = """\b
+Examples:
+  curvefair fair profile.csv -o profile_faired.csv --tol 0.05 --plot before_after.png
+  curvefair fair part.dxf -o part_faired.dxf --method knot-removal --tol 0.01 --report r.json
+  curvefair fair foil.dat --in-place --tol 1e-4 --clamp g2
+  curvefair analyze profile.csv
+  curvefair analyze part.dxf --json > analysis.json
+  curvefair plot profile.csv --compare profile_faired.csv -o compare.svg
+  curvefair methods
+"""
+
+
+# ------------------------------------------------------------------------------------------
+# errors and output helpers
+# ------------------------------------------------------------------------------------------
+class InputFailure(click.ClickException):
+    """Bad input: exit code 1, ``Error: <message>`` on stderr, no traceback."""
+
+    exit_code = EXIT_INPUT
+
+
+@contextlib.contextmanager
+def _user_errors() -> Iterator[None]:
+    """Turn curvefair's errors and OS errors into exit code 1 with a one-line message."""
+    try:
+        yield
+    except CurvefairError as exc:
+        raise InputFailure(str(exc)) from None
+    except OSError as exc:
+        where = f"{exc.filename}: " if getattr(exc, "filename", None) else ""
+        raise InputFailure(f"{where}{exc.strerror or exc}") from None
+
+
+def _console(stderr: bool = False, quiet: bool = False) -> Any:
+    from rich.console import Console
+
+    stream = sys.stderr if stderr else sys.stdout
+    width = None if stream.isatty() else 200  # no wrapping when piped
+    return Console(file=stream, width=width, quiet=quiet, highlight=False,
+                   soft_wrap=not stream.isatty())
+
+
+def _fmt(v: Any, digits: int = 4) -> str:
+    if v is None:
+        return "-"
+    if isinstance(v, bool):
+        return "yes" if v else "no"
+    if isinstance(v, int):
+        return str(v)
+    try:
+        x = float(v)
+    except (TypeError, ValueError):
+        return str(v)
+    return f"{x:.{digits}g}"
+
+
+def _arrow(a: Any, b: Any, digits: int = 4) -> str:
+    return f"{_fmt(a, digits)} → {_fmt(b, digits)}"
+
+
+def _write_json(path: str, obj: Any) -> None:
+    from .io import atomic_write
+
+    atomic_write(path, json.dumps(obj, indent=2, allow_nan=False) + "\n")
+
+
+def _save_figure(fig: Any, path: str) -> None:
+    from .io import atomic_path
+
+    fmt = Path(path).suffix.lower().lstrip(".")
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format=fmt, dpi=150)
+
+
+_FIG_FORMATS = ("png", "svg", "pdf")
+
+
+def _check_figure_path(path: str, option: str) -> None:
+    ext = Path(path).suffix.lower().lstrip(".")
+    if ext not in _FIG_FORMATS:
+        raise click.BadParameter(
+            f"{path!r}: the figure format comes from the extension, one of "
+            + ", ".join("." + e for e in _FIG_FORMATS), param_hint=option)
+
+
+def _parse_protect(value: str | None) -> list[int]:
+    if not value:
+        return []
+    out = []
+    for tok in value.replace(" ", "").split(","):
+        if not tok:
+            continue
+        try:
+            i = int(tok)
+        except ValueError:
+            raise click.BadParameter(f"{tok!r} is not an integer point index",
+                                     param_hint="--protect") from None
+        if i < 0:
+            raise click.BadParameter(f"{i} is negative; point indices start at 0",
+                                     param_hint="--protect")
+        out.append(i)
+    return out
+
+
+def _read(path: str, corner_angle: float | None) -> list[Any]:
+    from . import read_curves
+
+    return read_curves(path, corner_angle=corner_angle)
+
+
+def _record_label(rec: Any, i: int) -> str:
+    return rec.name if rec.name else f"curve {i}"
+
+
+# shared options ---------------------------------------------------------------------------
+def _reading_options(f: Any) -> Any:
+    f = click.option("--corner-angle", type=click.FloatRange(0, 180, min_open=True),
+                     default=60.0, show_default=True, metavar="DEG",
+                     help="Point lists turning by DEG degrees or more at a point are split "
+                          "there into separate curves (the corner is kept fixed).")(f)
+    f = click.option("--no-corners", is_flag=True,
+                     help="Never split point lists at corners.")(f)
+    return f
+
+
+def _quiet_option(f: Any) -> Any:
+    return click.option("-q", "--quiet", is_flag=True,
+                        help="Print nothing but errors.")(f)
+
+
+def _corner(corner_angle: float, no_corners: bool) -> float | None:
+    return None if no_corners else corner_angle
+
+
+# ------------------------------------------------------------------------------------------
+# the group
+# ------------------------------------------------------------------------------------------
+@click.group(context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 100},
+             epilog=_EXAMPLES)
+@click.version_option(__version__, "-V", "--version", prog_name="curvefair",
+                      message="%(prog)s %(version)s")
+def main() -> None:
+    """Fair spline curves (remove curvature wiggles) by the published local methods, never
+    moving anything farther than a tolerance you set.
+
+    Files: point lists (.csv .txt .xyz .pts), airfoils (.dat), curvefair JSON (.json), and with
+    the optional extras DXF, Rhino .3dm, SVG, IGES and STEP. Point indices are 0-based.
+    """
+
+
+# ------------------------------------------------------------------------------------------
+# methods
+# ------------------------------------------------------------------------------------------
+def _method_rows() -> list[dict[str, Any]]:
+    from .fairing import METHODS
+
+    return [{"name": s.name, "curve_types": [t.__name__ for t in s.curve_types],
+             "default": bool(s.default), "modes": list(s.modes), "summary": s.summary,
+             "source": s.source} for s in METHODS.values()]
+
+
+def _default_methods_text() -> str:
+    try:
+        rows = _method_rows()
+    except Exception:  # pragma: no cover - help must always render
+        return "the registry's default for the curve type"
+    pairs = [f"{t}: {r['name']}" for r in rows if r["default"] for t in r["curve_types"]]
+    return "; ".join(pairs) if pairs else "the first method accepting the curve type"
+
+
+@main.command("methods")
+@click.option("--json", "as_json", is_flag=True, help="Machine-readable output.")
+def methods_cmd(as_json: bool) -> None:
+    """List the fairing methods: curve types, one line each and the source paper."""
+    rows = _method_rows()
+    if as_json:
+        click.echo(json.dumps(rows, indent=2))
+        return
+    from rich.table import Table
+
+    table = Table(show_lines=True, title="curvefair fairing methods (* = default for its type)")
+    table.add_column("method", no_wrap=True, style="bold")
+    table.add_column("curves")
+    table.add_column("what it does")
+    table.add_column("source")
+    for r in rows:
+        table.add_row(r["name"] + (" *" if r["default"] else ""), ", ".join(r["curve_types"]),
+                      r["summary"], r["source"])
+    _console().print(table)
+
+
+# ------------------------------------------------------------------------------------------
+# analyze
+# ------------------------------------------------------------------------------------------
+_CHENG_YU_KINDS = {1: "inflection (Cheng-Yu kind 1)", 2: "curvature extremum (Cheng-Yu kind 2)",
+                   3: "convexity (Cheng-Yu kind 3)"}
+
+
+def _bad_point_list(curve: Any, a: Any) -> list[dict[str, Any]]:
+    """The ranked bad points of a curve, from the library's measures.
+
+    Hermite curves (and B-splines of degree other than 3): breakpoints ranked by the jump of the
+    third derivative (Wang & Cao 2006), or of the highest derivative when a C4 quintic has
+    none; for a Hermite curve the breakpoint index is the data-point index. Cubic B-splines:
+    the bad control points of Cheng & Yu (:func:`curvefair.bad_points`), ranked by ``z_i``.
+    """
+    from . import BSplineCurve, bad_points
+
+    if isinstance(curve, BSplineCurve) and curve.degree == 3:
+        return [{"index": int(b.index), "index_of": "control point", "param": None,
+                 "measure": float(b.value), "measure_name": "z = D^2 (Cheng-Yu)",
+                 "kind": _CHENG_YU_KINDS.get(int(b.kind), str(b.kind)),
+                 "kinds": [int(k) for k in b.kinds]} for b in bad_points(curve)]
+    import numpy as np
+
+    jumps, name = np.asarray(a.jumps), "|Δr'''|"
+    if a.degree > 3 and not a.max_jump > 1e-9 * a.max_top_jump:
+        jumps, name = np.asarray(a.top_jumps), f"|Δr^({a.degree})|"
+    if jumps.size == 0 or float(jumps.max()) <= 0.0:
+        return []
+    top = float(jumps.max())
+    order = np.argsort(-jumps, kind="stable")
+    of = "data point" if hasattr(curve, "points") else "breakpoint"
+    return [{"index": int(a.jump_indices[i]), "index_of": of, "param": float(a.jump_params[i]),
+             "measure": float(jumps[i]), "measure_name": name,
+             "kind": "derivative jump", "sapidis": float(a.sapidis[i])}
+            for i in order if jumps[i] > 1e-9 * top]
+
+
+@main.command("analyze")
+@click.argument("infile", metavar="IN", type=click.Path(exists=True, dir_okay=False))
+@click.option("--json", "as_json", is_flag=True, help="Machine-readable output (JSON on stdout).")
+@click.option("--top", type=click.IntRange(min=0), default=10, show_default=True,
+              help="Bad points listed per curve in the table (--json lists all).")
+@_reading_options
+@_quiet_option
+def analyze_cmd(infile: str, as_json: bool, top: int, corner_angle: float, no_corners: bool,
+                quiet: bool) -> None:
+    """Analyse every curve of IN: energies, inflections, curvature extrema, the worst jumps,
+    and the ranked list of bad points (index, measure, kind)."""
+    from . import analyze
+
+    with _user_errors():
+        records = _read(infile, _corner(corner_angle, no_corners))
+        out = []
+        for i, rec in enumerate(records):
+            a = analyze(rec.curve)
+            out.append({"index": i, "name": rec.name, "kind": rec.kind,
+                        "curve_type": type(rec.curve).__name__, "corners": list(rec.corners),
+                        "analysis": a.to_dict(), "bad_points": _bad_point_list(rec.curve, a)})
+    if as_json:
+        click.echo(json.dumps({"file": infile, "curves": out}, indent=2, allow_nan=False))
+        return
+    if quiet:
+        return
+    from rich.table import Table
+
+    con = _console()
+    for i, (rec, item) in enumerate(zip(records, out, strict=True)):
+        a = item["analysis"]
+        con.print(f"[bold]{_record_label(rec, i)}[/bold]: {item['curve_type']}, "
+                  f"{a['dim']}-D, degree {a['degree']}, {a['n_segments']} segments"
+                  + (", closed" if a["closed"] else "")
+                  + (f"; corners kept fixed: {item['corners']}" if item["corners"] else ""))
+        t = Table(show_header=False, box=None, padding=(0, 2))
+        t.add_column(style="dim")
+        t.add_column(justify="right")
+        for label, key in (("strain energy ∫|r''|² dt", "energy2"),
+                           ("jerk energy ∫|r'''|² dt", "energy3"),
+                           ("arc length", "arc_length"), ("∫(dκ/ds)² ds", "dkds_energy"),
+                           ("inflections", "inflections"), ("curvature extrema", "extrema"),
+                           ("max |κ|", "max_curvature"), ("max |Δr'''|", "max_jump"),
+                           ("at breakpoint", "max_jump_index"),
+                           ("Sapidis Σ|Δκ_s|", "sapidis_sum")):
+            t.add_row(label, _fmt(a[key], 6))
+        con.print(t)
+        bad = item["bad_points"]
+        if not bad:
+            con.print("  no bad points\n")
+            continue
+        bt = Table(title=f"bad points (worst first, {min(top, len(bad))} of {len(bad)})",
+                   title_justify="left")
+        for col in ("rank", "index", "t", "measure", "kind"):
+            bt.add_column(col, justify="right" if col != "kind" else "left")
+        for r, b in enumerate(bad[:top], start=1):
+            bt.add_row(str(r), f"{b['index_of']} {b['index']}", _fmt(b["param"], 6),
+                       f"{b['measure_name']} = {_fmt(b['measure'], 4)}", b["kind"])
+        con.print(bt)
+        con.print()
+
+
+# ------------------------------------------------------------------------------------------
+# plot
+# ------------------------------------------------------------------------------------------
+@main.command("plot")
+@click.argument("infile", metavar="IN", type=click.Path(exists=True, dir_okay=False))
+@click.option("--compare", "other", metavar="OTHER",
+              type=click.Path(exists=True, dir_okay=False),
+              help="A second file with as many curves (e.g. the faired one): drawn over IN, "
+                   "with a deviation panel.")
+@click.option("-o", "--output", "out", metavar="FIG", required=True,
+              help="Figure file: .png, .svg or .pdf.")
+@click.option("--comb-scale", type=click.FloatRange(0, min_open=True), metavar="S",
+              help="Hair length per unit curvature [default: longest hair = 1/5 of the size].")
+@click.option("--comb-density", type=click.IntRange(min=1), metavar="D",
+              help="Hair intervals per curve segment [default: about 600 hairs].")
+@click.option("--no-comb", is_flag=True, help="Leave out the curvature comb.")
+@click.option("--no-markers", is_flag=True,
+              help="Leave out inflection, extremum and bad-point markers.")
+@click.option("--tol", type=click.FloatRange(0, min_open=True),
+              help="Tolerance line on the deviation panel.")
+@click.option("--projection", type=click.Choice(["plane", "xy", "xz", "yz"]), default="plane",
+              show_default=True, help="3-D curves: best-fit plane or a coordinate plane.")
+@click.option("--title", help="Figure title [default: the file name(s)].")
+@_reading_options
+@_quiet_option
+def plot_cmd(infile: str, other: str | None, out: str, comb_scale: float | None,
+             comb_density: int | None, no_comb: bool, no_markers: bool, tol: float | None,
+             projection: str, title: str | None, corner_angle: float, no_corners: bool,
+             quiet: bool) -> None:
+    """Draw the curves of IN with their curvature combs and curvature plots into FIG."""
+    _check_figure_path(out, "-o/--output")
+    from .plot import figure
+
+    corner = _corner(corner_angle, no_corners)
+    with _user_errors():
+        curves = [r.curve for r in _read(infile, corner)]
+        others = None if other is None else [r.curve for r in _read(other, corner)]
+        labels = (Path(infile).name, Path(other).name if other else "")
+        fig = figure(curves, compare=others, labels=labels, tol=tol, comb=not no_comb,
+                     comb_scale=comb_scale, comb_density=comb_density, markers=not no_markers,
+                     projection=projection,  # type: ignore[arg-type]
+                     title=title if title is not None else
+                     (f"{labels[0]} vs {labels[1]}" if other else labels[0]))
+        _save_figure(fig, out)
+    if not quiet:
+        click.echo(f"wrote {out}")
+
+
+# ------------------------------------------------------------------------------------------
+# fair
+# ------------------------------------------------------------------------------------------
+def _local_protect(rec: Any, user: Sequence[int]) -> list[int]:
+    """User indices (file point order for point lists, else the curve's own) + corners."""
+    idx = rec.source.get("indices") if hasattr(rec, "source") else None
+    if idx is not None and user:
+        pos = {int(fi): k for k, fi in enumerate(idx)}
+        mine = [pos[i] for i in user if i in pos]
+    else:
+        mine = list(user)
+    return sorted(set(mine) | set(rec.corners))
+
+
+@contextlib.contextmanager
+def _progress(total: int, enabled: bool) -> Iterator[Any]:
+    """A transient rich progress bar on stderr (only on a terminal)."""
+    if not enabled:
+        yield None
+        return
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    with Progress(TextColumn("[progress.description]{task.description}"), BarColumn(),
+                  MofNCompleteColumn(), TimeElapsedColumn(), console=_console(stderr=True),
+                  transient=True) as prog:
+        task = prog.add_task("fairing", total=total)
+        yield (prog, task)
+
+
+def _summary_table(rows: list[dict[str, Any]]) -> Any:
+    from rich.table import Table
+
+    t = Table(title="before → after", title_justify="left")
+    for col, just in (("#", "right"), ("curve", "left"), ("method", "left"), ("steps", "right"),
+                      ("energy", "right"), ("max |Δr'''|", "right"), ("inflections", "right"),
+                      ("κ extrema", "right"), ("max deviation (at)", "right"),
+                      ("time", "right")):
+        t.add_column(col, justify=just)  # type: ignore[arg-type]
+    for row in rows:
+        if row["status"] != "ok":
+            t.add_row(str(row["index"]), row["label"], "[red]failed[/red]", "-", "-", "-", "-",
+                      "-", "(error below)", "-")
+            continue
+        r = row["report"]
+        where = r.get("max_deviation_point")
+        at = "" if where is None else " (" + ", ".join(f"{v:.4g}" for v in where) + ")"
+        t.add_row(str(row["index"]), row["label"], r["method"],
+                  f"{r['steps']} ({r['stop_reason']})",
+                  _arrow(r["energy_before"], r["energy_after"]),
+                  _arrow(r["max_jump_before"], r["max_jump_after"]),
+                  _arrow(r["inflections_before"], r["inflections_after"]),
+                  _arrow(r["extrema_before"], r["extrema_after"]),
+                  _fmt(r["max_deviation"]) + at, f"{r['time_s']:.3g} s")
+    return t
+
+
+@main.command("fair", epilog="Default method per curve type: " + _default_methods_text()
+              + ". List all with 'curvefair methods'.")
+@click.argument("infile", metavar="IN", type=click.Path(exists=True, dir_okay=False))
+@click.option("-o", "--output", "out", metavar="OUT",
+              help="Output file; its extension picks the format (default: IN's format). "
+                   "Required unless --in-place.")
+@click.option("--in-place", is_flag=True, help="Allow OUT to be IN (or omit -o to replace IN).")
+@click.option("--method", "-m", metavar="M",
+              help="Fairing method (see 'curvefair methods'); default: the best general method "
+                   "for the curve type, " + _default_methods_text() + ".")
+@click.option("--tol", type=click.FloatRange(0, min_open=True), metavar="T",
+              help="No data/control point ends farther than T from where it was "
+                   "[default: no limit].")
+@click.option("--eps", type=click.FloatRange(min=0), metavar="E",
+              help="Stop when the worst point's measure is below E [default: method's].")
+@click.option("--max-steps", type=click.IntRange(min=0), metavar="N",
+              help="Step cap [default: method's].")
+@click.option("--clamp", type=click.Choice(["g0", "g1", "g2"]), default="g0", show_default=True,
+              help="Ends kept exactly: g0 end points, g1 also the tangents, g2 also curvature.")
+@click.option("--protect", metavar="I,J,...",
+              help="Point indices that never move (0-based; file order for point lists, "
+                   "control points for B-splines). Corners found on reading are always kept.")
+@click.option("--mode", type=click.Choice(["spline", "hermite"]), default="spline",
+              show_default=True,
+              help="Hermite methods: re-interpolate after each step, or keep the step's "
+                   "derivatives.")
+@click.option("--decimals", type=click.IntRange(min=0), metavar="N",
+              help="Text formats: write every number with N decimals [default: the input "
+                   "file's precision].")
+@click.option("--report", metavar="REPORT.json", help="Write the full report as JSON.")
+@click.option("--history", is_flag=True, help="Include every step in the JSON report.")
+@click.option("--plot", "plot_path", metavar="PLOT.png",
+              help="Write a before/after figure (.png, .svg or .pdf).")
+@_reading_options
+@_quiet_option
+def fair_cmd(infile: str, out: str | None, in_place: bool, method: str | None,
+             tol: float | None, eps: float | None, max_steps: int | None, clamp: str,
+             protect: str | None, mode: str, decimals: int | None, report: str | None,
+             history: bool,
+             plot_path: str | None, corner_angle: float, no_corners: bool,
+             quiet: bool) -> None:
+    """Fair every curve in IN and write them to OUT.
+
+    Prints a before/after table: strain energy, largest third-derivative jump, inflections,
+    curvature extrema, largest deviation and where, steps and time. A curve that cannot be
+    faired is reported and written unchanged; the others are still processed and the exit
+    code is 1.
+    """
+    from .io import detect_format
+
+    if out is None:
+        if not in_place:
+            raise click.UsageError("missing option '-o' / '--output' (or pass --in-place to "
+                                   "replace IN)")
+        out = infile
+    if os.path.abspath(out) == os.path.abspath(infile) or (
+            os.path.exists(out) and os.path.samefile(out, infile)):
+        if not in_place:
+            raise click.UsageError(f"OUT {out!r} is the input file; pass --in-place to replace "
+                                   "it")
+    user_protect = _parse_protect(protect)
+    if plot_path is not None:
+        _check_figure_path(plot_path, "--plot")
+    for p, opt in ((report, "--report"), (plot_path, "--plot"), (out, "-o/--output")):
+        if p is not None and not Path(p).resolve().parent.is_dir():
+            raise click.BadParameter(f"the folder of {p!r} does not exist", param_hint=opt)
+    from .fairing import METHODS
+
+    if method is not None and method not in METHODS:
+        raise click.BadParameter(f"unknown method {method!r}; valid: " + ", ".join(METHODS),
+                                 param_hint="--method")
+    with _user_errors():
+        in_fmt = detect_format(infile)
+        try:
+            out_fmt = detect_format(out)
+        except CurvefairError:
+            out_fmt = in_fmt
+        records = _read(infile, _corner(corner_angle, no_corners))
+    from . import fair, write_curves
+
+    rows: list[dict[str, Any]] = []
+    faired = []
+    t0 = time.perf_counter()
+    show_progress = not quiet and sys.stderr.isatty()
+    with _progress(len(records), show_progress) as prog:
+        for i, rec in enumerate(records):
+            label = _record_label(rec, i)
+            row: dict[str, Any] = {"index": i, "label": label, "name": rec.name,
+                                   "kind": rec.kind}
+            try:
+                res = fair(rec.curve, method, tol=tol, eps=eps, max_steps=max_steps,
+                           clamp=clamp, protect=_local_protect(rec, user_protect), mode=mode)
+            except CurvefairError as exc:
+                row.update(status="failed", error=str(exc))
+                faired.append(rec)
+            else:
+                row.update(status="ok", report=res.report)
+                if history:
+                    row["history"] = res.history.to_dict()
+                faired.append(rec.with_curve(res.curve))
+            rows.append(row)
+            if prog is not None:
+                prog[0].advance(prog[1])
+    failures = [r for r in rows if r["status"] != "ok"]
+    wrote_out = len(failures) < len(rows)  # nothing faired: nothing to write
+    with _user_errors():
+        if wrote_out:
+            write_curves(out, faired, template=infile if out_fmt == in_fmt else None,
+                         format=out_fmt, overwrite=in_place,  # type: ignore[arg-type]
+                         decimals=decimals)
+        if plot_path is not None:
+            from .plot import figure
+
+            fig = figure([r.curve for r in records], compare=[r.curve for r in faired],
+                         labels=("before", "after"), tol=tol,
+                         title=f"{Path(infile).name}: before and after fairing")
+            _save_figure(fig, plot_path)
+        if report is not None:
+            _write_json(report, {
+                "curvefair": __version__, "input": os.path.abspath(infile),
+                "output": os.path.abspath(out), "format": out_fmt,
+                "options": {"method": method, "tol": tol, "eps": eps, "max_steps": max_steps,
+                            "clamp": clamp, "protect": user_protect, "mode": mode,
+                            "corner_angle": _corner(corner_angle, no_corners)},
+                "n_curves": len(rows), "n_failed": len(failures), "output_written": wrote_out,
+                "time_s": time.perf_counter() - t0, "curves": rows})
+    if not quiet:
+        con = _console()
+        con.print(_summary_table(rows))
+        written = [f"wrote {out}" if wrote_out else f"{out} not written"]
+        written += [f"report {report}"] if report else []
+        written += [f"plot {plot_path}"] if plot_path else []
+        con.print(", ".join(written))
+    if failures:
+        for r in failures:
+            click.echo(f"Error: {infile}: curve {r['index']} ({r['label']}): {r['error']}",
+                       err=True)
+        raise SystemExit(EXIT_INPUT)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()
