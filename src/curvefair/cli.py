@@ -250,9 +250,10 @@ def _bad_point_list(curve: Any, a: Any) -> list[dict[str, Any]]:
                  "kinds": [int(k) for k in b.kinds]} for b in bad_points(curve)]
     import numpy as np
 
-    jumps, name = np.asarray(a.jumps), "|Δr'''|"
+    jumps, name, kind = np.asarray(a.jumps), "|Δr'''|", "third-derivative jump"
     if a.degree > 3 and not a.max_jump > 1e-9 * a.max_top_jump:
         jumps, name = np.asarray(a.top_jumps), f"|Δr^({a.degree})|"
+        kind = f"derivative-{a.degree} jump"
     if jumps.size == 0 or float(jumps.max()) <= 0.0:
         return []
     top = float(jumps.max())
@@ -260,7 +261,7 @@ def _bad_point_list(curve: Any, a: Any) -> list[dict[str, Any]]:
     of = "data point" if hasattr(curve, "points") else "breakpoint"
     return [{"index": int(a.jump_indices[i]), "index_of": of, "param": float(a.jump_params[i]),
              "measure": float(jumps[i]), "measure_name": name,
-             "kind": "derivative jump", "sapidis": float(a.sapidis[i])}
+             "kind": kind, "sapidis": float(a.sapidis[i])}
             for i in order if jumps[i] > 1e-9 * top]
 
 

@@ -1,0 +1,291 @@
+"""Tests of the ``curvefair`` command.
+
+End-to-end behaviour runs the real command in subprocesses (``python -m curvefair`` and the
+console script), several at once where they are independent, on files the tests write. Argument
+parsing details use click's in-process runner. Reference values are independent of the code
+under test: point displacements measured from the files, third-derivative jumps by finite
+differences of curve positions, file bytes compared before and after.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+import curvefair
+from curvefair import interpolate_bspline, interpolate_cubic, read_curves, write_curves
+from curvefair.cli import main
+
+EX1 = "# Wang & Cao 2006, Example 1\nx,y\n1,1\n2,1\n3,1\n4.3,1.6\n5,1\n6,1\n7,1\n"
+
+
+def _env() -> dict[str, str]:
+    env = dict(os.environ)
+    env.pop("COLUMNS", None)
+    env["PYTHONWARNINGS"] = "ignore"
+    return env
+
+
+def cli_many(arglists: list[list[str]], cwd: Path, timeout: float = 120.0
+             ) -> list[subprocess.CompletedProcess]:
+    """Run ``python -m curvefair ARGS`` for each argument list, concurrently."""
+    procs = [subprocess.Popen([sys.executable, "-m", "curvefair", *args], cwd=cwd,
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                              env=_env()) for args in arglists]
+    out = []
+    for args, p in zip(arglists, procs, strict=True):
+        so, se = p.communicate(timeout=timeout)
+        out.append(subprocess.CompletedProcess(args, p.returncode, so, se))
+    return out
+
+
+def cli(args: list[str], cwd: Path) -> subprocess.CompletedProcess:
+    return cli_many([args], cwd)[0]
+
+
+def assert_user_error(res: subprocess.CompletedProcess, code: int, *needles: str) -> None:
+    assert res.returncode == code, (res.args, res.stdout, res.stderr)
+    assert "Traceback" not in res.stderr and "Traceback" not in res.stdout
+    for n in needles:
+        assert n in res.stderr, (n, res.stderr)
+
+
+def fd_third_derivative_jumps(c) -> np.ndarray:
+    """|r'''(t_k+) - r'''(t_k-)| at interior breakpoints, by third differences of positions.
+
+    r''' is constant on each cubic segment; the forward third difference is exact up to
+    rounding.
+    """
+    br = c.piecewise.breaks
+    h = np.diff(br) / 4
+    d3 = np.array([(c(b + 3 * hh) - 3 * c(b + 2 * hh) + 3 * c(b + hh) - c(b)) / hh**3
+                   for b, hh in zip(br[:-1], h, strict=True)])
+    return np.linalg.norm(np.diff(d3, axis=0), axis=1)
+
+
+@pytest.fixture
+def ex1(tmp_path: Path) -> Path:
+    p = tmp_path / "ex1.csv"
+    p.write_text(EX1)
+    return p
+
+
+# ---------------------------------------------------------------------------------------------
+def test_fair_csv_end_to_end(tmp_path: Path, ex1: Path):
+    before = ex1.read_bytes()
+    tol = 0.3
+    res = cli(["fair", "ex1.csv", "-o", "out.csv", "--tol", str(tol), "--no-corners",
+               "--decimals", "12", "--report", "rep.json", "--plot", "fig.png"], tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert ex1.read_bytes() == before  # input untouched, byte for byte
+    for col in ("energy", "inflections", "extrema", "max deviation", "steps", "time"):
+        assert col in res.stdout
+    assert "poliakoff" in res.stdout  # the default method for point lists (cubic Hermite)
+    p0 = np.loadtxt(ex1, delimiter=",", skiprows=2)
+    (rec,) = read_curves(tmp_path / "out.csv")
+    p1 = np.asarray(rec.points)
+    assert p1.shape == p0.shape
+    moved = np.linalg.norm(p1 - p0, axis=1)
+    assert moved.max() <= tol * (1 + 1e-9) + 1e-12  # the tolerance holds
+    assert moved[0] == 0.0 and moved[-1] == 0.0  # g0 clamp: ends stay
+    assert moved[3] > 0.1  # P4 (0-based 3), the bad point, moved
+    assert (tmp_path / "out.csv").read_text().startswith("# Wang & Cao 2006")  # layout kept
+    rep = json.loads((tmp_path / "rep.json").read_text())
+    assert rep["n_curves"] == 1 and rep["n_failed"] == 0
+    r = rep["curves"][0]["report"]
+    assert r["energy_after"] < r["energy_before"]
+    assert r["max_point_displacement"] == pytest.approx(moved.max(), abs=1e-9)
+    assert (tmp_path / "fig.png").read_bytes()[:4] == b"\x89PNG"
+    leftovers = sorted(f.name for f in tmp_path.iterdir())
+    assert leftovers == ["ex1.csv", "fig.png", "out.csv", "rep.json"]  # no temp files left
+
+
+MALFORMED = {
+    # name: (content, expected text in the message besides the file name)
+    "truncated.csv": ("x,y\n1,1\n2,1\n3,", "truncated.csv:4"),
+    "garbage.csv": (b"\x00\x01\xff\xfegarbage\n", "garbage.csv:1"),
+    "empty.csv": ("", "empty"),
+    "nocurve.csv": ("x,y\n", "no data"),
+    "nan.csv": ("x,y\n1,1\n2,nan\n3,1\n4,2\n", "nan.csv:3"),
+    "dup.csv": ("x,y\n1,1\n2,1\n2,1\n3,1\n", "dup.csv:4"),
+}
+
+
+def test_malformed_inputs_exit_1_with_file_and_line(tmp_path: Path):
+    for name, (content, _) in MALFORMED.items():
+        f = tmp_path / name
+        if isinstance(content, bytes):
+            f.write_bytes(content)
+        else:
+            f.write_text(content)
+    runs = cli_many([["fair", name, "-o", "out_" + name] for name in MALFORMED]
+                    + [["analyze", "nan.csv"], ["plot", "dup.csv", "-o", "f.png"]], tmp_path)
+    for (name, (_, needle)), res in zip(MALFORMED.items(), runs, strict=False):
+        assert_user_error(res, 1, name, needle)
+        assert not (tmp_path / ("out_" + name)).exists()
+    assert_user_error(runs[-2], 1, "nan.csv:3")
+    assert_user_error(runs[-1], 1, "dup.csv:4")
+    assert not (tmp_path / "f.png").exists()
+
+
+def test_out_equal_in_refused_and_in_place(tmp_path: Path, ex1: Path):
+    before = ex1.read_bytes()
+    (tmp_path / "sub").mkdir()
+    runs = cli_many([["fair", "ex1.csv", "-o", "ex1.csv", "--no-corners"],
+                     ["fair", "ex1.csv", "-o", "sub/../ex1.csv", "--no-corners"],
+                     ["fair", "ex1.csv", "--no-corners"]], tmp_path)
+    for res in runs:
+        assert_user_error(res, 2)
+        assert "--in-place" in res.stderr
+    assert ex1.read_bytes() == before
+    res = cli(["fair", "ex1.csv", "--in-place", "--tol", "0.2", "--no-corners", "-q"], tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert res.stdout == ""  # --quiet
+    assert ex1.read_bytes() != before
+    (rec,) = read_curves(ex1)
+    p0 = np.loadtxt(EX1.splitlines()[2:], delimiter=",")
+    assert np.max(np.linalg.norm(np.asarray(rec.points) - p0, axis=1)) <= 0.2 + 0.05  # 1 decimal
+    assert sorted(f.name for f in tmp_path.iterdir()) == ["ex1.csv", "sub"]
+
+
+def test_analyze_json_ranks_bad_points_by_fd_third_derivative_jumps(tmp_path: Path, ex1: Path):
+    res = cli(["analyze", "ex1.csv", "--json", "--no-corners"], tmp_path)
+    assert res.returncode == 0, res.stderr
+    doc = json.loads(res.stdout)
+    (item,) = doc["curves"]
+    bad = item["bad_points"]
+    c = interpolate_cubic(np.loadtxt(ex1, delimiter=",", skiprows=2))  # chord, natural: as read
+    jumps = fd_third_derivative_jumps(c)
+    order = np.argsort(-jumps) + 1  # breakpoint k = data point k
+    assert [b["index"] for b in bad] == order.tolist()
+    np.testing.assert_allclose([b["measure"] for b in bad], jumps[order - 1], rtol=1e-6)
+    assert bad[0]["index"] == 3 and bad[0]["index_of"] == "data point"
+    assert item["analysis"]["inflections"] == 4  # sign changes of the curvature (Fig. 1b)
+
+
+def test_plot_command_compare_and_bad_extension(tmp_path: Path, ex1: Path):
+    q = np.loadtxt(ex1, delimiter=",", skiprows=2)
+    q[3] = (4.2, 1.05)
+    np.savetxt(tmp_path / "other.csv", q, delimiter=",", header="x,y", comments="")
+    runs = cli_many([["plot", "ex1.csv", "--compare", "other.csv", "-o", "cmp.svg",
+                      "--comb-density", "4", "--no-corners", "--tol", "0.6"],
+                     ["plot", "ex1.csv", "-o", "fig.jpg"]], tmp_path)
+    assert runs[0].returncode == 0, runs[0].stderr
+    svg = (tmp_path / "cmp.svg").read_text()
+    assert svg.startswith("<?xml") and "<svg" in svg
+    assert_user_error(runs[1], 2, ".png")
+    assert not (tmp_path / "fig.jpg").exists()
+
+
+def test_partial_failure_processes_the_other_curves(tmp_path: Path):
+    x = np.linspace(0, 4, 9)
+    y = np.sin(x)
+    y[4] += 0.3
+    herm = interpolate_cubic(np.c_[x, y])
+    bsp = interpolate_bspline(np.c_[x, np.cos(x) + 3])
+    write_curves(tmp_path / "two.json", [herm, bsp])
+    before = (tmp_path / "two.json").read_bytes()
+    res = cli(["fair", "two.json", "-o", "out.json", "--method", "poliakoff", "--tol", "0.2"],
+              tmp_path)
+    assert_user_error(res, 1, "curve 1", "BSplineCurve")
+    assert (tmp_path / "two.json").read_bytes() == before
+    a, b = read_curves(tmp_path / "out.json")
+    moved = np.linalg.norm(np.asarray(a.curve.points) - herm.points, axis=1)
+    assert 0 < moved.max() <= 0.2 * (1 + 1e-9)
+    np.testing.assert_array_equal(b.curve.control_points, bsp.control_points)  # unchanged
+
+
+def test_dxf_spline_fairing(tmp_path: Path):
+    ezdxf = pytest.importorskip("ezdxf")
+    x = np.linspace(0, 10, 12)
+    y = np.sin(x / 2)
+    y[5] += 0.4
+    b = interpolate_bspline(np.c_[x, y])
+    doc = ezdxf.new()
+    doc.modelspace().add_open_spline([(px, py, 0.0) for px, py in b.control_points], degree=3,
+                                     knots=list(b.knots))
+    doc.saveas(tmp_path / "part.dxf")
+    before = (tmp_path / "part.dxf").read_bytes()
+    res = cli(["fair", "part.dxf", "-o", "out.dxf", "--tol", "0.05"], tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert "eck-hadenfeld" in res.stdout  # the default B-spline method
+    assert (tmp_path / "part.dxf").read_bytes() == before
+    (rec,) = read_curves(tmp_path / "out.dxf")
+    moved = np.linalg.norm(np.asarray(rec.curve.control_points) - b.control_points, axis=1)
+    assert 0 < moved.max() <= 0.05 * (1 + 1e-9)
+
+
+def test_console_script_and_version(tmp_path: Path):
+    script = Path(sys.executable).with_name("curvefair")
+    if not script.exists():
+        pytest.skip("console script not installed in this environment")
+    res = subprocess.run([str(script), "--version"], capture_output=True, text=True,
+                         cwd=tmp_path, env=_env(), timeout=120)
+    assert res.returncode == 0
+    assert res.stdout.strip() == f"curvefair {curvefair.__version__}"
+
+
+# --- in-process: argument parsing and help ---------------------------------------------------
+def test_help_lists_examples_and_default_methods():
+    from curvefair.fairing import METHODS
+
+    r = CliRunner().invoke(main, ["--help"])
+    assert r.exit_code == 0
+    assert "Examples" in r.output and "curvefair fair" in r.output
+    r = CliRunner().invoke(main, ["fair", "--help"])
+    assert r.exit_code == 0
+    text = " ".join(r.output.split())
+    for spec in METHODS.values():
+        if spec.default:
+            for t in spec.curve_types:
+                assert f"{t.__name__}: {spec.name}" in text.replace("- ", "-")
+
+
+def test_methods_listing_matches_registry():
+    from curvefair.fairing import METHODS
+
+    r = CliRunner().invoke(main, ["methods", "--json"])
+    assert r.exit_code == 0
+    rows = json.loads(r.output)
+    assert [x["name"] for x in rows] == list(METHODS)
+    assert all(x["source"] and x["summary"] for x in rows)
+    r = CliRunner().invoke(main, ["methods"])
+    assert r.exit_code == 0
+    for name in METHODS:
+        assert name in r.output
+
+
+@pytest.mark.parametrize("args", [
+    ["fair", "ex1.csv", "-o", "o.csv", "--protect", "1,x"],
+    ["fair", "ex1.csv", "-o", "o.csv", "--protect", "-1"],
+    ["fair", "ex1.csv", "-o", "o.csv", "--tol", "0"],
+    ["fair", "ex1.csv", "-o", "o.csv", "--clamp", "g3"],
+    ["fair", "ex1.csv", "-o", "o.csv", "--method", "nope"],
+    ["fair", "missing.csv", "-o", "o.csv"],
+    ["fair", "ex1.csv", "-o", "nofolder/o.csv"],
+    ["plot", "ex1.csv", "-o", "f.gif"],
+    ["fair", "ex1.csv", "--bogus"],
+])
+def test_usage_errors_exit_2(tmp_path: Path, ex1: Path, args, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    r = CliRunner().invoke(main, args)
+    assert r.exit_code == 2, r.output
+    assert not (tmp_path / "o.csv").exists()
+
+
+def test_protect_indices_follow_file_order(tmp_path: Path, ex1: Path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    r = CliRunner().invoke(main, ["fair", "ex1.csv", "-o", "o.csv", "--protect", "3",
+                                  "--no-corners", "--decimals", "12", "-q"])
+    assert r.exit_code == 0, r.output
+    (rec,) = read_curves(tmp_path / "o.csv")
+    p0 = np.loadtxt(ex1, delimiter=",", skiprows=2)
+    np.testing.assert_array_equal(np.asarray(rec.points)[3], p0[3])  # protected P4 stays
+    assert np.max(np.abs(np.asarray(rec.points) - p0)) > 1e-3  # others moved
