@@ -106,6 +106,13 @@ def test_invariance_and_determinism(case, k):
     R = _rotation(rng, dim)
     b = rng.normal(size=dim) * 5
     moved = run(method, curve.replace(control_points=curve.control_points @ R.T + b), tol, clamp)
+    if method == "global" and curve.closed:
+        # nothing is fixed on a closed curve and E is blind to translations: the minimiser may be
+        # a whole face of the ball product, so only the optimal value is invariant
+        assert abs(energy(moved) - energy(out)) <= 1e-9 * energy(curve)
+        back = (moved.control_points - b) @ R
+        assert np.linalg.norm(back - curve.control_points, axis=1).max() <= tol * (1 + 1e-9)
+        return
     np.testing.assert_allclose(moved.control_points, out.control_points @ R.T + b,
                                atol=1e-7 * max(1.0, np.abs(curve.control_points).max()))
 

@@ -9,11 +9,12 @@ This is the problem every local method of :func:`curvefair.fair` on B-splines wo
 control point at a time (Eck & Hadenfeld's ranking list is block Gauss-Seidel on it), solved
 here for all points at once: it is never worse than any of them at the same tolerance.
 
-Solver: a primal-dual interior-point method (Mehrotra predictor-corrector). Each iteration
-factorises one symmetric block-banded matrix (bandwidth ``(degree + 1) dim - 1`` with the
+Solver: a primal-dual interior-point method with strictly feasible iterates (Boyd &
+Vandenberghe, *Convex Optimization*, sec. 11.7). Each iteration factorises one symmetric
+block-banded matrix (bandwidth ``(degree + 1) dim - 1`` with the
 coordinates interleaved) by banded Cholesky (LAPACK ``pbtrf`` via
 :func:`scipy.linalg.cholesky_banded`) for open curves, or a sparse LU (SuperLU, minimum-degree
-ordering) for closed (cyclic) ones: ``O(n)`` per iteration, typically 15-25 iterations.
+ordering) for closed (cyclic) ones: ``O(n)`` per iteration, typically 15-30 iterations.
 """
 
 from __future__ import annotations
@@ -184,13 +185,14 @@ def global_fair(curve: BSplineCurve, *, tol: float | None = None, l: Any = 2,  #
     Notes
     -----
     Convex QP: ``min sum_coords d^T G d`` s.t. ``|d_i - o_i|^2 <= tol^2`` (``G`` the exact Gram
-    matrix of :meth:`BSplineCurve.gram_band`). Primal-dual interior point (Nocedal & Wright,
-    ch. 19; Mehrotra's predictor-corrector) on ``E(d)/E(o)`` with the constraints
-    ``(|d_i - o_i|^2 / tol^2 - 1) / 2 + s_i = 0``, ``s, lambda >= 0``; the Newton system is
-    reduced to ``d`` (per-point ``dim x dim`` blocks ``lambda_i I / tol^2 +
-    (lambda_i / s_i) a_i a_i^T``). Stops when the duality gap ``m mu < gap`` and the residuals are
-    ``< 1e-10`` (or when rounding stops the progress: the last good iterate is kept). A point
-    that ends a rounding error outside its ball is put back on it. The returned multipliers
+    matrix of :meth:`BSplineCurve.gram_band`). Primal-dual interior point with feasible
+    iterates (Boyd & Vandenberghe, sec. 11.7, ``mu = 10``) on ``E(d)/E(o)`` with the constraints
+    ``f_i = (|d_i - o_i|^2 / tol^2 - 1) / 2 <= 0``; the Newton system is reduced to ``d``
+    (per-point ``dim x dim`` blocks ``lambda_i I / tol^2 + (lambda_i / -f_i) a_i a_i^T``,
+    ``a_i = (d_i - o_i) / tol^2``); the step keeps ``lambda > 0`` and every point strictly inside
+    its ball and backtracks on the (scale-invariant) residual norm. Stops when the surrogate
+    duality gap is below ``gap`` and the dual residual below ``1e-10`` of its initial size (or
+    when rounding stalls the progress just above that). The returned multipliers
     (``E(o) lambda_i / tol^2``) satisfy ``2 (G d)_i + lambda_i (d_i - o_i) = 0``.
     Without a tolerance the free points solve ``G_FF d_F = -G_FC d_C`` (a ``1e-15`` Tikhonov
     term towards the original points picks the closest minimiser when the fixed points do not
@@ -248,66 +250,74 @@ def global_fair(curve: BSplineCurve, *, tol: float | None = None, l: Any = 2,  #
         return GlobalResult(out, E0, energy(x), lam, 1, "unconstrained",
                             np.zeros(0, dtype=np.int64))
 
-    # primal-dual interior point (Mehrotra predictor-corrector) on
-    #   min F(x) = E(x)/E0   s.t.   c_i(x) = (|x_i - o_i|^2 / tol^2 - 1) / 2 + s_i = 0, s >= 0
+    # primal-dual interior point with feasible iterates (Boyd & Vandenberghe, sec. 11.7) on
+    #   min F(x) = E(x)/E0   s.t.   f_i(x) = (|x_i - o_i|^2 / tol^2 - 1) / 2 <= 0
     x = o.copy()
-    s_ = np.full(m, 0.5)
     lam_ = np.full(m, 1.0)
     t2 = tolv * tolv
     steps = 0
     reason = "max_steps"
-    gscale = 1.0
-    prev = (x, s_, lam_, np.inf, np.inf)
+
+    def residuals(x: FloatArray, lam_: FloatArray, tinv: float
+                  ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        v = x - o
+        fi = 0.5 * (np.sum(v * v, axis=1) / t2 - 1.0)
+        rd = 2.0 * (A @ x + bvec) / E0 + lam_[:, None] * (v / t2)
+        rc = -lam_ * fi - tinv
+        return rd, rc, fi, v
+
+    rd0, _, fi0, _ = residuals(x, lam_, 0.0)
+    gscale = float(np.abs(rd0).max()) or 1.0  # scales like rd: scale-invariant stopping test
+    eta_prev = np.inf
     while steps < max_steps:
         v = x - o
-        a = v / t2  # gradient of c_i
-        rd = 2.0 * (A @ x + bvec) / E0 + lam_[:, None] * a
-        rp = 0.5 * (np.sum(v * v, axis=1) / t2 - 1.0) + s_
-        mu = float(lam_ @ s_) / m
-        if steps == 0:
-            gscale = max(float(np.abs(rd).max()), 1.0)
-        res_now = max(float(np.abs(rp).max()), float(np.abs(rd).max()) / gscale)
-        if not np.isfinite(res_now) or (m * mu < gap and res_now > 10.0 * prev[3]):
-            # rounding has taken over (lambda/s ~ 1e16 on active points): keep the last good
-            # iterate
-            x, s_, lam_ = prev[0], prev[1], prev[2]
-            reason = "converged" if prev[4] < 1e3 * gap else "numerical"
+        fi = 0.5 * (np.sum(v * v, axis=1) / t2 - 1.0)
+        eta = float(-(fi @ lam_))  # surrogate duality gap
+        tinv = eta / (10.0 * m)  # 1/t with t = mu m / eta, mu = 10
+        rd, rc, fi, v = residuals(x, lam_, tinv)
+        if eta < 1e3 * gap and eta > 0.9 * eta_prev:
+            reason = "converged"  # stalled at rounding level just above the target
             break
-        if m * mu < gap and res_now < 1e-10:
+        eta_prev = eta
+        if eta < gap and float(np.abs(rd).max()) < 1e-10 * gscale:
             reason = "converged"
             break
-        prev = (x, s_, lam_, res_now, m * mu)
-        w = lam_ / s_
+        a = v / t2
+        w = lam_ / (-fi)
         blocks = (lam_ / t2)[:, None, None] * eye + w[:, None, None] * a[:, :, None] * a[:, None, :]
         try:
             fac = solver.factor(E0 * blocks)
         except (np.linalg.LinAlgError, RuntimeError):  # as far as rounding allows
-            reason = "converged" if m * mu < 1e3 * gap else "numerical"
+            reason = "converged" if eta < 1e3 * gap else "numerical"
             break
-
-        def direction(rc: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
-            rhs = -rd - a * (w * (rp - rc / lam_))[:, None]
-            dx = solver.solve_factored(fac, E0 * rhs)
-            adx = np.sum(a * dx, axis=1)
-            dlam = w * (adx + rp - rc / lam_)
-            ds = -rp - adx
-            return dx, ds, dlam
-
-        def max_step(z: FloatArray, dz: FloatArray) -> float:
-            neg = dz < 0
-            return min(1.0, float((-z[neg] / dz[neg]).min())) if neg.any() else 1.0
-
-        # predictor (affine scaling)
-        dx, ds, dl = direction(lam_ * s_)
-        alpha = min(max_step(s_, ds), max_step(lam_, dl))
-        mu_aff = float((lam_ + alpha * dl) @ (s_ + alpha * ds)) / m
-        sigma = (mu_aff / mu) ** 3 if mu > 0 else 0.0
-        # corrector
-        dx, ds, dl = direction(lam_ * s_ + ds * dl - sigma * mu)
-        alpha = min(1.0, 0.995 * min(max_step(s_, ds), max_step(lam_, dl)))
-        x = x + alpha * dx
-        s_ = s_ + alpha * ds
-        lam_ = lam_ + alpha * dl
+        rhs = -rd - a * (rc / fi)[:, None]
+        dx = solver.solve_factored(fac, E0 * rhs)
+        adx = np.sum(a * dx, axis=1)
+        dlam = (rc - lam_ * adx) / fi
+        # step: keep lambda > 0, x strictly inside every ball, then decrease the residual norm
+        neg = dlam < 0
+        smax = min(1.0, float((-lam_[neg] / dlam[neg]).min())) if neg.any() else 1.0
+        st = 0.99 * smax
+        a2 = np.sum(dx * dx, axis=1)
+        a1 = np.sum(v * dx, axis=1)
+        c0 = np.sum(v * v, axis=1) - t2
+        with np.errstate(divide="ignore", invalid="ignore"):
+            tmax = np.where(a2 > 0, (-a1 + np.sqrt(np.maximum(a1 * a1 - a2 * c0, 0.0))) / a2,
+                            np.inf)
+        st = min(st, 0.99 * float(tmax.min()))
+        # residual norm with the dual part in units of its initial size: scale-invariant
+        rnorm = np.sqrt(float(np.sum((rd / gscale) ** 2) + np.sum(rc * rc)))
+        while st > 1e-14:
+            rd1, rc1, fi1, _ = residuals(x + st * dx, lam_ + st * dlam, tinv)
+            if np.all(fi1 < 0) and np.sqrt(float(np.sum((rd1 / gscale) ** 2)
+                                                 + np.sum(rc1 * rc1))) <= (1.0 - 0.01 * st) * rnorm:
+                break
+            st *= 0.5
+        if st <= 1e-14:  # no progress possible in floating point
+            reason = "converged" if eta < 1e3 * gap else "numerical"
+            break
+        x = x + st * dx
+        lam_ = lam_ + st * dlam
         steps += 1
     v = x - o
     # the linearised constraint is met only in the limit: put any point that ends a rounding
