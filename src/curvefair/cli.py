@@ -404,6 +404,33 @@ def _progress(total: int, enabled: bool) -> Iterator[Any]:
         yield (prog, task)
 
 
+def _where(r: dict[str, Any]) -> str:
+    where = r.get("max_deviation_point")
+    return "" if where is None else " at (" + ", ".join(f"{v:.4g}" for v in where) + ")"
+
+
+def _summary_card(row: dict[str, Any]) -> Any:
+    """One curve's before/after summary as a narrow table."""
+    from rich.table import Table
+
+    if row["status"] != "ok":
+        return f"[bold]#{row['index']} {row['label']}[/bold]: [red]failed[/red] (error below)"
+    r = row["report"]
+    from rich.console import Group
+
+    head = (f"[bold]#{row['index']} {row['label']}[/bold]: {r['method']}, {r['steps']} steps "
+            f"({r['stop_reason']}), {r['time_s']:.3g} s")
+    t = Table()
+    t.add_column("")
+    t.add_column("before", justify="right")
+    t.add_column("after", justify="right")
+    for label, key in (("energy", "energy"), ("max |Δr" + "'" * 3 + "|", "max_jump"),
+                       ("inflections", "inflections"), ("κ extrema", "extrema")):
+        t.add_row(label, _fmt(r[f"{key}_before"]), _fmt(r[f"{key}_after"]))
+    t.add_row("max deviation", "", _fmt(r["max_deviation"]) + _where(r))
+    return Group(head, t)
+
+
 def _summary_table(rows: list[dict[str, Any]]) -> Any:
     from rich.table import Table
 
@@ -419,15 +446,13 @@ def _summary_table(rows: list[dict[str, Any]]) -> Any:
                       "-", "(error below)", "-")
             continue
         r = row["report"]
-        where = r.get("max_deviation_point")
-        at = "" if where is None else " (" + ", ".join(f"{v:.4g}" for v in where) + ")"
         t.add_row(str(row["index"]), row["label"], r["method"],
                   f"{r['steps']} ({r['stop_reason']})",
                   _arrow(r["energy_before"], r["energy_after"]),
                   _arrow(r["max_jump_before"], r["max_jump_after"]),
                   _arrow(r["inflections_before"], r["inflections_after"]),
                   _arrow(r["extrema_before"], r["extrema_after"]),
-                  _fmt(r["max_deviation"]) + at, f"{r['time_s']:.3g} s")
+                  _fmt(r["max_deviation"]) + _where(r), f"{r['time_s']:.3g} s")
     return t
 
 
@@ -559,7 +584,11 @@ def fair_cmd(infile: str, out: str | None, in_place: bool, method: str | None,
                 "time_s": time.perf_counter() - t0, "curves": rows})
     if not quiet:
         con = _console()
-        con.print(_summary_table(rows))
+        if con.width >= 130:
+            con.print(_summary_table(rows))
+        else:  # a narrow terminal: one small before/after table per curve
+            for row in rows:
+                con.print(_summary_card(row))
         written = [f"wrote {out}" if wrote_out else f"{out} not written"]
         written += [f"report {report}"] if report else []
         written += [f"plot {plot_path}"] if plot_path else []
