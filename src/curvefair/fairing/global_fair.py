@@ -320,8 +320,7 @@ def global_fair(curve: BSplineCurve, *, tol: float | None = None, l: Any = 2,  #
         lam_ = lam_ + st * dlam
         steps += 1
     v = x - o
-    # the linearised constraint is met only in the limit: put any point that ends a rounding
-    # error outside its ball back on it
+    # the iterates are strictly feasible; guard against a rounding error all the same
     dist = np.sqrt(np.sum(v * v, axis=1))
     out_ = dist > tolv
     x[out_] = o[out_] + v[out_] * (tolv / dist[out_])[:, None]
