@@ -34,5 +34,9 @@ test: $(VENV)/.stamp-test
 bench: $(VENV)/.stamp-bench
 	$(PY) benchmarks/run_all.py
 
+## bench-quality: fairing quality benchmark (all methods and peers); regenerates docs/benchmarks.md
+bench-quality: $(VENV)/.stamp-bench
+	$(PY) benchmarks/quality/run.py
+
 clean:
 	rm -rf $(VENV) demo_out .pytest_cache .hypothesis

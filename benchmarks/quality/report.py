@@ -1,0 +1,463 @@
+"""Aggregation of the benchmark rows into docs/benchmarks.md and the figures under docs/img/bench/.
+
+Everything on the page is computed from the rows of one run of ``run.py``; the figures are drawn
+in the same run (the tool is re-run on the chosen case in the main process, deterministically).
+"""
+
+from __future__ import annotations
+
+import importlib.metadata as md
+import math
+import os
+from collections import defaultdict
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+import corpus as C
+import peers as P
+
+CORPORA = ("ground-truth", "airfoils", "glyphs")
+BASELINE = "interpolant"
+
+
+def versions() -> str:
+    out = []
+    for pkg in ("curvefair", "numpy", "scipy", "csaps", "splipy", "fonttools", "matplotlib"):
+        try:
+            out.append(f"{pkg} {md.version(pkg)}")
+        except md.PackageNotFoundError:
+            out.append(f"{pkg} (not installed)")
+    return ", ".join(out)
+
+
+# ---------------------------------------------------------------------------------------------
+def _f(x: Any) -> float:
+    try:
+        v = float(x)
+    except (TypeError, ValueError):
+        return math.nan
+    return v
+
+
+def _q(vals: list[float], q: float) -> float:
+    v = np.array([x for x in vals if math.isfinite(x)])
+    return float(np.quantile(v, q)) if v.size else math.nan
+
+
+def _fmt(x: float, digits: int = 3) -> str:
+    if not math.isfinite(x):
+        return "-"
+    if x == 0:
+        return "0"
+    if abs(x) >= 1000 or abs(x) < 1e-3:
+        return f"{x:.2e}"
+    if float(x).is_integer():
+        return f"{int(x)}"
+    return f"{x:.{digits}g}"
+
+
+def _pct(k: int, n: int) -> str:
+    return f"{100.0 * k / n:.0f}% ({k}/{n})" if n else "-"
+
+
+def _tool_label(t: str) -> str:
+    return t.removeprefix("cf:").removeprefix("peer:") if t != BASELINE else "interpolant (input)"
+
+
+class Table:
+    """Rows of one corpus indexed by (case, tool), with per-case baseline values."""
+
+    def __init__(self, rows: list[dict[str, Any]], corpus: str) -> None:
+        self.rows = [r for r in rows if r["corpus"] == corpus]
+        self.cases = list(dict.fromkeys(r["case"] for r in self.rows))
+        self.tools = list(dict.fromkeys(r["tool"] for r in self.rows))
+        self.by = {(r["case"], r["tool"]): r for r in self.rows}
+
+    def tool_rows(self, tool: str) -> list[dict[str, Any]]:
+        return [self.by[(c, tool)] for c in self.cases if (c, tool) in self.by]
+
+    def ok_rows(self, tool: str) -> list[dict[str, Any]]:
+        return [r for r in self.tool_rows(tool) if int(r.get("ok") or 0)]
+
+    def ratio(self, tool: str, key: str) -> list[float]:
+        out = []
+        for r in self.ok_rows(tool):
+            b = self.by.get((r["case"], BASELINE))
+            if b is None or not int(b.get("ok") or 0):
+                continue
+            den = _f(b.get(key))
+            num = _f(r.get(key))
+            if den > 0 and math.isfinite(num):
+                out.append(num / den)
+        return out
+
+    def values(self, tool: str, key: str) -> list[float]:
+        return [_f(r.get(key)) for r in self.ok_rows(tool)]
+
+    def hits(self, tool: str, key: str = "hit_extrema") -> tuple[int, int]:
+        rows = self.tool_rows(tool)
+        n = len(self.cases)
+        return sum(int(_f(r.get(key)) == 1) for r in rows if int(r.get("ok") or 0)), n
+
+    def failures(self, tool: str) -> tuple[int, int]:
+        rows = self.tool_rows(tool)
+        na = sum(1 for r in rows if not int(r.get("ok") or 0) and int(r.get("na") or 0))
+        fail = sum(1 for r in rows if not int(r.get("ok") or 0) and not int(r.get("na") or 0))
+        return fail, na
+
+    def violations(self, tool: str) -> list[dict[str, Any]]:
+        return [r for r in self.ok_rows(tool) if int(r.get("violation") or 0)]
+
+
+def _mq(vals: list[float]) -> str:
+    return f"{_fmt(_q(vals, 0.5))} / {_fmt(_q(vals, 0.9))}"
+
+
+# ---------------------------------------------------------------------------------------------
+def table_ground_truth(t: Table) -> list[str]:
+    head = ("| tool | true extrema count reached | true inflection count reached | extrema - true "
+            "(median / p90) | E2 / E2(input) | E3 / E3(input) | int kappa_s^2 ds / input | "
+            "max dev / tol (median / p90 / max) | distance to true curve / tol | time ms | "
+            "failed |")
+    out = [head, "|" + "---|" * 11]
+    for tool in t.tools:
+        rows = t.ok_rows(tool)
+        h, n = t.hits(tool)
+        hi, _ = t.hits(tool, "hit_inflections")
+        n_inf = sum(1 for c in t.cases if t.by.get((c, BASELINE), {}).get("true_inflections")
+                    not in ("", None))
+        excess = [_f(r["extrema"]) - _f(r["true_extrema"]) for r in rows]
+        dev = t.values(tool, "dev_over_tol")
+        dist = [_f(r.get("truth_dist")) / _f(r["tol"]) for r in rows]
+        tms = [1000 * _f(r.get("time_s")) for r in rows]
+        fail, na = t.failures(tool)
+        viol = len(t.violations(tool))
+        devs = (f"{_fmt(_q(dev, 0.5))} / {_fmt(_q(dev, 0.9))} / "
+                f"{_fmt(max(dev) if dev else math.nan)}") + (
+                    f" **{viol} VIOLATIONS**" if viol else "")
+        out.append(f"| {_tool_label(tool)} | {_pct(h, n)} | {_pct(hi, n_inf)} | {_mq(excess)} | "
+                   f"{_mq(t.ratio(tool, 'E2'))} | {_mq(t.ratio(tool, 'E3'))} | "
+                   f"{_mq(t.ratio(tool, 'dkds'))} | {devs} | {_mq(dist)} | "
+                   f"{_fmt(_q(tms, 0.5))} | {fail}{f' (+{na} n/a)' if na else ''} |")
+    return out
+
+
+def table_share_by(t: Table, key: str) -> list[str]:
+    groups = list(dict.fromkeys(str(r[key]) for r in t.rows))
+    out = ["| tool | " + " | ".join(groups) + " | all |", "|" + "---|" * (len(groups) + 2)]
+    for tool in t.tools:
+        cells = []
+        for g in groups:
+            rows = [r for r in t.tool_rows(tool) if str(r[key]) == g]
+            k = sum(1 for r in rows if int(r.get("ok") or 0) and _f(r.get("hit_extrema")) == 1)
+            cells.append(f"{k}/{len(rows)}")
+        h, n = t.hits(tool)
+        out.append(f"| {_tool_label(tool)} | " + " | ".join(cells) + f" | **{h}/{n}** |")
+    return out
+
+
+def table_real(t: Table) -> list[str]:
+    head = ("| tool | extrema (median / p90) | extrema / input (median / p90) | fewer extrema "
+            "than input | inflections (median / p90) | E2 / E2(input) | E3 / E3(input) | "
+            "int kappa_s^2 ds / input | max dev / tol (median / p90 / max) | time ms | failed |")
+    out = [head, "|" + "---|" * 11]
+    for tool in t.tools:
+        rows = t.ok_rows(tool)
+        fewer = 0
+        for r in rows:
+            b = t.by.get((r["case"], BASELINE))
+            if b is not None and int(b.get("ok") or 0) and _f(r["extrema"]) < _f(b["extrema"]):
+                fewer += 1
+        dev = t.values(tool, "dev_over_tol")
+        tms = [1000 * _f(r.get("time_s")) for r in rows]
+        fail, na = t.failures(tool)
+        viol = len(t.violations(tool))
+        devs = (f"{_fmt(_q(dev, 0.5))} / {_fmt(_q(dev, 0.9))} / "
+                f"{_fmt(max(dev) if dev else math.nan)}") + (
+                    f" **{viol} VIOLATIONS**" if viol else "")
+        out.append(f"| {_tool_label(tool)} | {_mq(t.values(tool, 'extrema'))} | "
+                   f"{_mq(t.ratio(tool, 'extrema'))} | "
+                   f"{_pct(fewer, len(t.cases)) if tool != BASELINE else '-'} | "
+                   f"{_mq(t.values(tool, 'inflections'))} | {_mq(t.ratio(tool, 'E2'))} | "
+                   f"{_mq(t.ratio(tool, 'E3'))} | {_mq(t.ratio(tool, 'dkds'))} | {devs} | "
+                   f"{_fmt(_q(tms, 0.5))} | {fail}{f' (+{na} n/a)' if na else ''} |")
+    return out
+
+
+# ---------------------------------------------------------------------------------------------
+def best_tool(t: Table, prefix: str) -> str | None:
+    """The tool with ``prefix`` reaching the true extrema count most often (ties: smaller
+    median excess)."""
+    cands = [x for x in t.tools if x.startswith(prefix)]
+    if not cands:
+        return None
+
+    def key(tool: str) -> tuple[float, float]:
+        h, _ = t.hits(tool)
+        ex = [abs(_f(r["extrema"]) - _f(r["true_extrema"])) for r in t.ok_rows(tool)]
+        return (-h, _q(ex, 0.5) if ex else math.inf)
+
+    return min(cands, key=key)
+
+
+def best_real_tool(t: Table, prefix: str) -> str | None:
+    """Fewest extrema relative to the input (median ratio), among tools with no violation."""
+    cands = [x for x in t.tools if x.startswith(prefix) and not t.violations(x)]
+    if not cands:
+        return None
+    return min(cands, key=lambda x: (_q(t.ratio(x, "extrema"), 0.5), -len(t.ok_rows(x))))
+
+
+def rerun(case: C.Case, tool: str) -> Any:
+    """The curve ``tool`` produces on ``case`` (deterministic re-run in this process)."""
+    import run as R
+
+    import curvefair as cf
+
+    if tool == BASELINE:
+        return R.initial_curve("poliakoff", case.points, case.closed)[0]
+    if tool.startswith("cf:"):
+        m, _, e = tool[3:].partition("/")
+        c0, _ = R.initial_curve(m, case.points, case.closed)
+        return cf.fair(c0, m, tol=case.tol, eps=0.0 if e == "eps0" else None).curve
+    return P.run_peer(tool[5:], case.points, case.closed, case.tol).curve
+
+
+def draw(case: C.Case, tool: str, path: Path, title: str) -> str | None:
+    """Before (input interpolant) / after comb figure; returns an error text on failure."""
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        from curvefair.plot import figure
+
+        before = rerun(case, BASELINE)
+        after = rerun(case, tool)
+        if after is None:
+            return "no curve"
+        fig = figure(before, compare=after, labels=("input interpolant", _tool_label(tool)),
+                     tol=case.tol, title=title)
+        if case.truth is not None and case.dim == 2:
+            poly = case.truth.polyline(4001)
+            fig.axes[0].plot(poly[:, 0], poly[:, 1], ":", color="0.3", lw=0.8,
+                             label="true curve")
+        fig.savefig(path, dpi=80)
+        return None
+    except Exception as exc:  # noqa: BLE001
+        return repr(exc)[:200]
+
+
+# ---------------------------------------------------------------------------------------------
+def write_page(rows: list[dict[str, Any]], cases: list[C.Case], info: dict[str, Any],
+               out: Path, img: Path) -> None:
+    out.parent.mkdir(parents=True, exist_ok=True)
+    img.mkdir(parents=True, exist_ok=True)
+    for old in img.glob("*.png"):
+        old.unlink()
+    by_name = {c.name: c for c in cases}
+    tabs = {k: Table(rows, k) for k in CORPORA}
+    gt, af, gl = tabs["ground-truth"], tabs["airfoils"], tabs["glyphs"]
+    rel_img = os.path.relpath(img, out.parent)
+
+    L: list[str] = []
+    L += ["# Fairing quality benchmark", "",
+          "*Generated by `" + info["command"] + "` on " + info["date"] + " ("
+          + f"{info['elapsed_s'] / 60:.1f} min on {info['jobs']} processes; {info['machine']}). "
+          + "Do not edit by hand: every number and figure on this page comes from that run.*", "",
+          f"Versions: {info['versions']}.", ""]
+    if info.get("quick"):
+        L += ["> **Quick run** (`--quick`): a tiny subset, for checking the pipeline only. "
+              "Run `make bench-quality` for the real figures.", ""]
+
+    L += ["The question: *at the deviation I can accept, which tool gives me the fairest curve?* "
+          "Every tool below receives the same points and the same allowed maximum deviation "
+          "`tol`; curvefair's methods are called as `fair(curve, method, tol=tol)` (and with "
+          "`eps=0`, i.e. run until the tolerance blocks every move or the step cap is hit), the "
+          "peers' smoothing parameter is bisected until their maximum deviation reaches `tol`.", ""]
+
+    # verdict ---------------------------------------------------------------------------------
+    L += ["## Verdict", ""]
+    viol_all = [(tl, r) for k, t in tabs.items() for tl in t.tools if tl.startswith("cf:")
+                for r in t.violations(tl)]
+    if viol_all:
+        L += [f"> **TOLERANCE VIOLATIONS: {len(viol_all)} curvefair results deviate from the "
+              "input by more than `tol`.** Listed under *Tolerance violations* below.", ""]
+    else:
+        L += ["- No curvefair result broke its tolerance (max deviation <= tol on every curve "
+              "of every corpus, every method).", ""]
+    if gt.cases:
+        bc = best_tool(gt, "cf:")
+        bp = best_tool(gt, "peer:")
+        hc, n = gt.hits(bc) if bc else (0, len(gt.cases))
+        hp, _ = gt.hits(bp) if bp else (0, len(gt.cases))
+        hb, _ = gt.hits(BASELINE)
+        verdict = ("**met**" if hc > hp else "**not met**")
+        L += [f"- Ground truth ({n} curves): curvefair's best method, `{_tool_label(bc)}`, "
+              f"reaches the true curvature-extrema count on {_pct(hc, n)} of the curves; the "
+              f"best peer, `{_tool_label(bp)}`, on {_pct(hp, n)}; the unfaired interpolant on "
+              f"{_pct(hb, n)}. Goal (more than any peer, at equal maximum deviation): "
+              f"{verdict}.", ""]
+    if af.cases:
+        ba = best_real_tool(af, "cf:")
+        if ba:
+            r_af = af.ratio(ba, "extrema")
+            fewer = sum(1 for r in af.ok_rows(ba) if _f(r["extrema"]) < _f(
+                af.by[(r["case"], BASELINE)].get("extrema")))
+            b_ext = af.values(BASELINE, "extrema")
+            a_ext = af.values(ba, "extrema")
+            bpa = best_real_tool(af, "peer:")
+            L += [f"- Airfoils ({len(af.cases)} UIUC files, tol = {C.AIRFOIL_TOL:g} chord): "
+                  f"`{_tool_label(ba)}` lowers the curvature-extrema count on "
+                  f"{_pct(fewer, len(af.cases))} of them (median {_fmt(_q(b_ext, 0.5))} -> "
+                  f"{_fmt(_q(a_ext, 0.5))}; median ratio {_fmt(_q(r_af, 0.5))}), with "
+                  f"{len(af.violations(ba))} tolerance violations."
+                  + (f" Best peer by the same measure: `{_tool_label(bpa)}`, median ratio "
+                     f"{_fmt(_q(af.ratio(bpa, 'extrema'), 0.5))}." if bpa else ""), ""]
+
+    # corpus ---------------------------------------------------------------------------------
+    L += ["## Corpus", "",
+          "Built by `benchmarks/quality/corpus.py` (nothing but the aerosandbox wheel is "
+          "fetched, by `pip download`, and only its `.dat` files are read; aerosandbox is never "
+          "imported):", ""]
+    fams = defaultdict(int)
+    for c in cases:
+        if c.corpus == "ground-truth":
+            fams[c.family] += 1
+    if gt.cases:
+        lv = sorted({c.noise for c in cases if c.corpus == "ground-truth"})
+        L += [f"- **ground truth**: {len(gt.cases)} curves = "
+              + ", ".join(f"{k} {v}" for k, v in fams.items())
+              + f"; each true curve sampled at jittered arc-length spacing (NACA: parameter "
+              f"spacing, clustered at the leading edge) and perturbed by Gaussian noise of "
+              f"sigma = {', '.join(f'{x:g}' for x in lv)} of the bounding-box diagonal; "
+              f"`tol = {C.TOL_FACTOR:g} sigma`. True extrema/inflection counts by dense exact "
+              "evaluation (checked against the closed forms in the tests); extrema narrower "
+              "than the sample spacing are not counted (this only concerns the NACA 00xx "
+              "double curvature peak 5e-5 chord behind the leading edge).", ""]
+    if af.cases:
+        L += [f"- **airfoils**: {len(af.cases)} UIUC coordinate files (of those in the "
+              f"aerosandbox {C.AEROSANDBOX_VERSION} wheel that parse as Selig or Lednicer, have "
+              f"30-400 distinct points and no spike), evenly spread over the sorted file names; "
+              f"open curves from trailing edge to trailing edge; `tol = {C.AIRFOIL_TOL:g} "
+              "chord`.", ""]
+    if gl.cases:
+        L += [f"- **glyphs**: {len(gl.cases)} smooth runs of DejaVu Sans / Serif outlines "
+              "(the TrueType files inside matplotlib, read with fontTools), split at corners "
+              "(tangent turn > 8 degrees), sampled about every 0.02 em along the quadratic "
+              f"arcs; closed when a contour has no corner; `tol = {C.GLYPH_TOL:g} em`.", ""]
+
+    # method ---------------------------------------------------------------------------------
+    L += ["## How the numbers are made comparable", "",
+          "- **One parameter.** Every tool fits the input points at their chord-length "
+          "parameters, and every result is a curvefair curve on that same parameter domain "
+          "(scipy and splipy results via `BSplineCurve.from_scipy`/`BSplineCurve`, csaps via "
+          "its piecewise-polynomial form). E2 = int |r''|^2 du and E3 = int |r'''|^2 du are "
+          "parametric, hence shown relative to the input interpolant's on the same curve "
+          "(Kjellander's method uses equally spaced parameters over the same range, so its "
+          "E2/E3 ratios are not strictly comparable).",
+          "- **One analysis.** Extrema, inflections, E2, E3 and int (dkappa/ds)^2 ds all come "
+          "from `curvefair.analyze` (exact sign counts: sign changes of dkappa/ds, across knots "
+          "included, with a 1e-9 relative noise band). Open curves count interior extrema, "
+          "closed ones all.",
+          "- **One deviation.** `max_i |C(u_i) - p_i|` over the input points at each tool's "
+          "parameters: what the smoothing splines fit and what curvefair's `tol` bounds (a data "
+          "point or control point of the interpolant never moves farther than tol). It is "
+          "checked for every curvefair result.",
+          "- **Peers at equal deviation.** csaps (`smooth`), scipy `make_smoothing_spline` "
+          "(`lam`) and `make_splprep` (`s`) are bisected on a log scale for the smoothest result "
+          "with max deviation <= tol (converged when within 2 % of tol; FITPACK's knot "
+          "placement makes `make_splprep` non-monotone, so it may stop lower). splipy has no "
+          "smoothing fit: its `utils.smooth.smooth` (control-point averaging) is applied to the "
+          "interpolating B-spline as many times as the tolerance allows (open curves only). "
+          "csaps and `make_smoothing_spline` have no periodic mode; closed inputs are wrapped "
+          "(three periods, middle one kept).",
+          "- **Distance to the true curve**: largest distance from the result (24 samples per "
+          "segment) to a 20 001-vertex polyline of the true curve.", ""]
+
+    # tables ---------------------------------------------------------------------------------
+    if gt.cases:
+        L += ["## Ground truth", "",
+              "Medians and 90th percentiles over the curves. 'failed' counts errors; "
+              "'n/a' a tool that does not handle the curve (splipy on closed curves).", ""]
+        L += table_ground_truth(gt) + [""]
+        L += ["### True extrema count reached, by family", ""] + table_share_by(gt, "family") + [""]
+        L += ["### True extrema count reached, by noise level (sigma / diagonal)", ""]
+        L += table_share_by(gt, "noise") + [""]
+    if af.cases:
+        L += ["## Airfoils (UIUC)", "", "No true curve: 'fewer extrema than input' compares with "
+              "the natural cubic interpolant of the file's points.", ""]
+        L += table_real(af) + [""]
+    if gl.cases:
+        L += ["## Glyph outlines (DejaVu)", ""] + table_real(gl) + [""]
+
+    # violations -----------------------------------------------------------------------------
+    if viol_all:
+        L += ["## Tolerance violations", "", "| tool | case | max dev / tol | at point |",
+              "|---|---|---|---|"]
+        for tl, r in viol_all[:200]:
+            L.append(f"| {_tool_label(tl)} | {r['case']} | {_fmt(_f(r['dev_over_tol']), 6)} | "
+                     f"{r.get('dev_index')} |")
+        L.append("")
+
+    # figures --------------------------------------------------------------------------------
+    figs: list[tuple[str, str, str, str]] = []  # (file stem, caption, case, tool)
+    if gt.cases:
+        bc = best_tool(gt, "cf:")
+        bp = best_tool(gt, "peer:")
+        base = {r["case"]: r for r in gt.ok_rows(BASELINE)}
+        rows = [r for r in gt.ok_rows(bc) if r["case"] in base] if bc else []
+        hit = [r for r in rows if _f(r.get("hit_extrema")) == 1]
+        if hit:
+            b = max(hit, key=lambda r: _f(base[r["case"]]["extrema"]) - _f(r["extrema"]))
+            figs.append(("gt-best", f"Ground truth, best case for `{_tool_label(bc)}`: "
+                         f"{b['case']} (true extrema {b['true_extrema']}, input interpolant "
+                         f"{base[b['case']]['extrema']}, result {b['extrema']})", b["case"], bc))
+        if rows:
+            w = max(rows, key=lambda r: abs(_f(r["extrema"]) - _f(r["true_extrema"])))
+            figs.append(("gt-worst", f"Ground truth, worst case for `{_tool_label(bc)}`: "
+                         f"{w['case']} (true extrema {w['true_extrema']}, result "
+                         f"{w['extrema']})", w["case"], bc))
+            if bp:
+                pr = gt.by.get((w["case"], bp), {})
+                figs.append(("gt-worst-peer", f"The same case with the best peer "
+                             f"`{_tool_label(bp)}` (result {pr.get('extrema', '-')} extrema)",
+                             w["case"], bp))
+    for key, label in (("airfoils", "Airfoil"), ("glyphs", "Glyph run")):
+        t = tabs[key]
+        bt = best_real_tool(t, "cf:") if t.cases else None
+        if not bt:
+            continue
+        base = {r["case"]: r for r in t.ok_rows(BASELINE)}
+        rows = [r for r in t.ok_rows(bt) if r["case"] in base]
+        if not rows:
+            continue
+
+        def gain(r: dict[str, Any], base: dict[str, Any] = base) -> float:
+            return _f(base[r["case"]]["extrema"]) - _f(r["extrema"])
+
+        b, w = max(rows, key=gain), min(rows, key=gain)
+        figs.append((f"{key}-best", f"{label} with the largest extrema reduction by "
+                     f"`{_tool_label(bt)}`: {b['case']} ({base[b['case']]['extrema']} -> "
+                     f"{b['extrema']})", b["case"], bt))
+        if key == "airfoils":
+            figs.append((f"{key}-worst", f"{label} with the smallest reduction: {w['case']} "
+                         f"({base[w['case']]['extrema']} -> {w['extrema']})", w["case"], bt))
+    if figs:
+        L += ["## Curvature combs (before / after)", "",
+              "Top: input interpolant (grey) and result with their curvature combs at the same "
+              "scale (true curve dotted where known); middle: curvature against arc length; "
+              "bottom: deviation of the result from the interpolant.", ""]
+        for slug, caption, case_name, tool in figs:
+            fname = f"{slug}.png"
+            err = draw(by_name[case_name], tool, img / fname, caption.replace("`", ""))
+            if err:
+                L += [f"*{caption}: figure failed ({err})*", ""]
+            else:
+                L += [f"**{caption}**", "", f"![{slug}]({rel_img}/{fname})", ""]
+
+    L += ["## Reproduce", "", "```", "make bench-quality        # full run (writes this page)",
+          "python benchmarks/quality/run.py --quick   # pipeline check on a tiny subset", "```",
+          "", f"Per-curve results of this run: `{info['csv']}` (one row per curve and tool).", ""]
+    out.write_text("\n".join(L))

@@ -1,0 +1,314 @@
+"""Fairing quality benchmark: every curvefair method and the peers at equal maximum deviation.
+
+Usage (from the repository root)::
+
+    make bench-quality                      # full run, regenerates docs/benchmarks.md
+    python benchmarks/quality/run.py --quick  # a tiny subset (writes the same page)
+
+Every tool gets the same input points and the same allowed deviation ``tol``:
+
+* curvefair: ``fair(curve, method, tol=tol)`` with every registered method, once with the
+  method's default ``eps`` and once with ``eps=0`` (run until the tolerance blocks every move or
+  the step cap is reached). The Hermite methods start from ``interpolate_cubic`` /
+  ``interpolate_quintic`` (natural ends, or periodic), the B-spline methods from
+  ``interpolate_bspline``; all with chord-length parameters, except Kjellander's method, which is
+  defined for uniform parameters and gets equally spaced ones over the same range.
+* peers (``peers.py``): smoothing parameter bisected so that the maximum deviation reaches
+  ``tol`` from below.
+
+Metrics (one definition for all tools): ``curvefair.analyze`` on the resulting curve (extrema,
+inflections, E2, E3, integral of (dkappa/ds)^2 ds); the deviation ``max_i |C(u_i) - p_i|`` at
+each tool's own parameters (and its index); on the ground-truth corpus the largest distance from
+the curve to the true curve (dense polyline of 20 001 vertices) and whether the extrema and
+inflection counts equal the true ones.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import datetime as _dt
+import math
+import multiprocessing as mp
+import os
+import platform
+import sys
+import time
+import traceback
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent.parent
+sys.path.insert(0, str(HERE))
+
+import corpus as C  # noqa: E402
+import peers as P  # noqa: E402
+
+import curvefair as cf  # noqa: E402
+
+HERMITE_CUBIC = ("kjellander", "poliakoff", "wang-cao")
+HERMITE_QUINTIC = ("wang-quintic",)
+BSPLINE = ("eck-hadenfeld", "knot-removal", "cheng-yu", "global")
+METHODS = HERMITE_CUBIC + HERMITE_QUINTIC + BSPLINE
+BASELINE = "interpolant"  # natural cubic interpolating spline of the input: "before"
+
+
+def curvefair_tools() -> list[tuple[str, str, float | None]]:
+    """``(tool name, method, eps)`` for every registered method, default eps and eps=0."""
+    from curvefair.fairing.fair import METHODS as REGISTERED
+
+    names = [m for m in METHODS if m in REGISTERED] + [m for m in REGISTERED if m not in METHODS]
+    out = []
+    for m in names:
+        out.append((f"cf:{m}", m, None))
+        out.append((f"cf:{m}/eps0", m, 0.0))
+    return out
+
+
+def initial_curve(method: str, points: np.ndarray, closed: bool
+                  ) -> tuple[cf.PiecewiseCurve, np.ndarray]:
+    """The curve ``method`` starts from, and the parameters of the input points on it."""
+    u = P.chord_params(points, closed)
+    if method == "kjellander":
+        u = np.linspace(0.0, u[-1], u.shape[0])
+    bc = "periodic" if closed else "natural"
+    if method in HERMITE_QUINTIC:
+        return cf.interpolate_quintic(points, u, bc), u
+    if method in BSPLINE or method not in HERMITE_CUBIC:
+        return cf.interpolate_bspline(points, 3, u, closed=closed), u
+    return cf.interpolate_cubic(points, u, bc), u
+
+
+# ---------------------------------------------------------------------------------------------
+def _polyline_distance(q: np.ndarray, poly: np.ndarray, tree: Any) -> np.ndarray:
+    """Distance of each point of ``q`` to the polyline ``poly`` (nearest vertex's two edges)."""
+    _, j = tree.query(q)
+    best = np.linalg.norm(q - poly[j], axis=1)
+    for a, b in ((j - 1, j), (j, j + 1)):
+        ok = (a >= 0) & (b < len(poly))
+        a, b = np.clip(a, 0, len(poly) - 1), np.clip(b, 0, len(poly) - 1)
+        e = poly[b] - poly[a]
+        ee = np.maximum(np.sum(e * e, axis=1), 1e-300)
+        t = np.clip(np.sum((q - poly[a]) * e, axis=1) / ee, 0.0, 1.0)
+        d = np.linalg.norm(q - (poly[a] + t[:, None] * e), axis=1)
+        best = np.where(ok, np.minimum(best, d), best)
+    return best
+
+
+def dense_samples(curve: cf.PiecewiseCurve, per_segment: int = 24) -> np.ndarray:
+    pp = curve.piecewise
+    return pp.segment_values(np.linspace(0.0, 1.0, per_segment + 1), 0).reshape(-1, pp.dim)
+
+
+_TRUTH: dict[int, tuple[np.ndarray, Any]] = {}
+
+
+def truth_distance(case: C.Case, curve: cf.PiecewiseCurve) -> float:
+    from scipy.spatial import cKDTree
+
+    key = id(case.truth)
+    if key not in _TRUTH:
+        poly = case.truth.polyline()
+        _TRUTH[key] = (poly, cKDTree(poly))
+    poly, tree = _TRUTH[key]
+    return float(_polyline_distance(dense_samples(curve), poly, tree).max())
+
+
+def metrics(case: C.Case, curve: cf.PiecewiseCurve) -> dict[str, Any]:
+    a = cf.analyze(curve)
+    row: dict[str, Any] = {
+        "extrema": int(a.extrema), "inflections": int(a.inflections),
+        "E2": float(a.energy2), "E3": float(a.energy3), "dkds": float(a.dkds_energy),
+        "n_segments": int(a.n_segments),
+    }
+    if case.truth is not None:
+        row["truth_dist"] = truth_distance(case, curve)
+        row["hit_extrema"] = int(a.extrema == case.true_extrema)
+        if case.true_inflections is not None:
+            row["hit_inflections"] = int(a.inflections == case.true_inflections)
+    return row
+
+
+def _base_row(case: C.Case, tool: str) -> dict[str, Any]:
+    return {"corpus": case.corpus, "family": case.family, "case": case.name, "tool": tool,
+            "n_points": int(len(case.points)), "closed": int(case.closed), "tol": case.tol,
+            "noise": case.noise if case.noise is not None else "",
+            "true_extrema": case.true_extrema if case.true_extrema is not None else "",
+            "true_inflections": (case.true_inflections
+                                 if case.true_inflections is not None else "")}
+
+
+def run_case(case: C.Case, tools: list[str] | None = None) -> list[dict[str, Any]]:
+    rows = []
+    pts = case.points
+
+    def want(name: str) -> bool:
+        return tools is None or name in tools or name == BASELINE
+
+    # baseline: the natural (periodic) cubic interpolant, i.e. what the Hermite methods start from
+    row = _base_row(case, BASELINE)
+    try:
+        t0 = time.perf_counter()
+        c0, u = initial_curve("poliakoff", pts, case.closed)
+        row.update(ok=1, time_s=time.perf_counter() - t0)
+        d, i = P.data_deviation(c0, pts, u)
+        row.update(dev=d, dev_index=i, dev_over_tol=d / case.tol)
+        row.update(metrics(case, c0))
+    except Exception as exc:  # noqa: BLE001
+        row.update(ok=0, error=repr(exc)[:300])
+    rows.append(row)
+
+    for tool, method, eps in curvefair_tools():
+        if not want(tool):
+            continue
+        row = _base_row(case, tool)
+        try:
+            t0 = time.perf_counter()
+            c0, u = initial_curve(method, pts, case.closed)
+            res = cf.fair(c0, method, tol=case.tol, eps=eps)
+            dt = time.perf_counter() - t0
+            d, i = P.data_deviation(res.curve, pts, u)
+            rep = res.report
+            row.update(ok=1, time_s=dt, dev=d, dev_index=i, dev_over_tol=d / case.tol,
+                       violation=int(d > case.tol * (1 + 1e-9)),
+                       steps=rep.get("steps"), stop_reason=rep.get("stop_reason"),
+                       curve_dev=rep.get("max_deviation"))
+            row.update(metrics(case, res.curve))
+        except Exception as exc:  # noqa: BLE001
+            row.update(ok=0, error=(repr(exc) + " " + traceback.format_exc(limit=-1))[:300])
+        rows.append(row)
+
+    for name in P.PEERS:
+        tool = f"peer:{name}"
+        if not want(tool):
+            continue
+        row = _base_row(case, tool)
+        try:
+            t0 = time.perf_counter()
+            r = P.run_peer(name, pts, case.closed, case.tol)
+            dt = time.perf_counter() - t0
+            if r.curve is None:
+                row.update(ok=0, error=r.note or "no result within the target deviation",
+                           na=int(bool(r.note)))
+            else:
+                row.update(ok=1, time_s=dt, dev=r.dev, dev_index=r.dev_index,
+                           dev_over_tol=r.dev / case.tol,
+                           violation=int(r.dev > case.tol * (1 + 1e-9)),
+                           converged=int(r.converged), param=r.param, steps=r.evaluations)
+                row.update(metrics(case, r.curve))
+        except Exception as exc:  # noqa: BLE001
+            row.update(ok=0, error=repr(exc)[:300])
+        rows.append(row)
+    return rows
+
+
+# ---------------------------------------------------------------------------------------------
+_CASES: list[C.Case] = []
+
+
+def _work(i: int) -> list[dict[str, Any]]:
+    import warnings
+
+    warnings.simplefilter("ignore")
+    return run_case(_CASES[i])
+
+
+def run_all(cases: list[C.Case], jobs: int) -> list[dict[str, Any]]:
+    global _CASES
+    _CASES = cases
+    order = sorted(range(len(cases)), key=lambda i: -len(cases[i].points))  # big ones first
+    rows: list[dict[str, Any]] = []
+    t0 = time.perf_counter()
+    if jobs > 1:
+        ctx = mp.get_context("fork")
+        with ctx.Pool(jobs) as pool:
+            for k, r in enumerate(pool.imap_unordered(_work, order, chunksize=1)):
+                rows.extend(r)
+                if (k + 1) % 25 == 0:
+                    print(f"  {k + 1}/{len(cases)} cases, {time.perf_counter() - t0:.0f} s",
+                          flush=True)
+    else:
+        for k, i in enumerate(order):
+            rows.extend(_work(i))
+            if (k + 1) % 25 == 0:
+                print(f"  {k + 1}/{len(cases)} cases, {time.perf_counter() - t0:.0f} s", flush=True)
+    key = {c.name: j for j, c in enumerate(cases)}
+    tool_order = {t: j for j, t in enumerate(all_tools())}
+    rows.sort(key=lambda r: (key[r["case"]], tool_order.get(r["tool"], 999)))
+    return rows
+
+
+def all_tools() -> list[str]:
+    return [BASELINE] + [t for t, _, _ in curvefair_tools()] + [f"peer:{n}" for n in P.PEERS]
+
+
+# ---------------------------------------------------------------------------------------------
+def write_csv(rows: list[dict[str, Any]], path: Path) -> None:
+    cols: list[str] = []
+    for r in rows:
+        for k in r:
+            if k not in cols:
+                cols.append(k)
+    with open(path, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=cols)
+        w.writeheader()
+        for r in rows:
+            w.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in r.items()})
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--quick", action="store_true", help="a tiny subset (about a minute)")
+    ap.add_argument("--jobs", type=int, default=min(2, os.cpu_count() or 1))
+    ap.add_argument("--out", type=Path, default=ROOT / "docs" / "benchmarks.md")
+    ap.add_argument("--img", type=Path, default=ROOT / "docs" / "img" / "bench")
+    ap.add_argument("--csv", type=Path, default=HERE / "results.csv")
+    ap.add_argument("--airfoils", type=int, default=None, help="number of UIUC airfoils")
+    ap.add_argument("--glyphs", type=int, default=None, help="number of glyph runs")
+    ap.add_argument("--instances", type=int, default=None,
+                    help="ground-truth instances per family and noise level")
+    args = ap.parse_args(argv)
+
+    t_start = time.perf_counter()
+    if args.quick:
+        gt = C.ground_truth_cases(instances=args.instances or 1, levels=(1e-3,))
+        af = C.airfoil_cases(args.airfoils or 6)
+        gl = C.glyph_cases(args.glyphs or 6)
+    else:
+        gt = C.ground_truth_cases(instances=args.instances or 4)
+        af = C.airfoil_cases(args.airfoils or 240)
+        gl = C.glyph_cases(args.glyphs or 80)
+    cases = gt + af + gl
+    print(f"corpus: {len(gt)} ground-truth, {len(af)} airfoils, {len(gl)} glyph runs; "
+          f"{len(all_tools())} tools; {args.jobs} processes", flush=True)
+    rows = run_all(cases, args.jobs)
+    elapsed = time.perf_counter() - t_start
+    args.csv.parent.mkdir(parents=True, exist_ok=True)
+    write_csv(rows, args.csv)
+
+    import report
+
+    cmd = "make bench-quality" if not args.quick else "python benchmarks/quality/run.py --quick"
+    info = {
+        "command": cmd,
+        "date": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+        "elapsed_s": elapsed,
+        "jobs": args.jobs,
+        "machine": f"{platform.machine()}, {os.cpu_count()} cores, Python "
+                   f"{platform.python_version()}",
+        "versions": report.versions(),
+        "quick": args.quick,
+        "csv": os.path.relpath(args.csv, args.out.parent),
+    }
+    report.write_page(rows, cases, info, args.out, args.img)
+    n_viol = sum(int(r.get("violation") or 0) for r in rows if r["tool"].startswith("cf:"))
+    print(f"wrote {args.out} and {args.csv} in {elapsed:.0f} s; "
+          f"curvefair tolerance violations: {n_viol}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
