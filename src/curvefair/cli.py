@@ -345,7 +345,7 @@ def analyze_cmd(infile: str, as_json: bool, top: int, corner_angle: float, no_co
 @click.option("--no-comb", is_flag=True, help="Leave out the curvature comb.")
 @click.option("--no-markers", is_flag=True,
               help="Leave out inflection, extremum and bad-point markers.")
-@click.option("--tol", type=click.FloatRange(0, min_open=True),
+@click.option("--tol", type=click.FloatRange(0, min_open=True), metavar="T",
               help="Tolerance line on the deviation panel.")
 @click.option("--projection", type=click.Choice(["plane", "xy", "xz", "yz"]), default="plane",
               show_default=True, help="3-D curves: best-fit plane or a coordinate plane.")
