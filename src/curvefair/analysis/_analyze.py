@@ -8,11 +8,11 @@ from typing import Any
 import numpy as np
 
 from .._typing import FloatArray
+from .._validate import as_positive
 from ..curves.piecewise import PiecewiseCurve
-from ..errors import InputError
 from ._core import bounding_diagonal, check_curve, falling
 from ._energy import segment_energies
-from ._sampling import sample_curve, scan_sign_changes
+from ._sampling import QUAD_RTOL, sample_curve, scan_sign_changes
 
 __all__ = ["Analysis", "analyze", "derivative_jumps", "ZERO_RTOL", "PLANAR_RTOL"]
 
@@ -93,6 +93,8 @@ class Analysis:
     energy3: float
     arc_length: float
     dkds_energy: float
+    arc_length_error: float
+    dkds_energy_error: float
     jump_indices: np.ndarray
     jump_params: FloatArray
     jumps: FloatArray
@@ -184,7 +186,7 @@ def _argmax_or_none(values: FloatArray, idx: np.ndarray) -> tuple[float, int | N
     return float(values[k]), int(idx[k])
 
 
-def analyze(curve: object, *, nodes: int | None = None) -> Analysis:
+def analyze(curve: object, *, quad_rtol: float = QUAD_RTOL) -> Analysis:
     """Analyse the fairness of a curve: energies, jumps, Sapidis measure, inflections, extrema.
 
     Parameters
@@ -261,13 +263,8 @@ def analyze(curve: object, *, nodes: int | None = None) -> Analysis:
     True
     """
     c = check_curve(curve)
-    if nodes is None:
-        k_nodes = 0
-    elif isinstance(nodes, bool) or not isinstance(nodes, (int, np.integer)) or not (
-            2 <= nodes <= 64):
-        raise InputError(f"nodes must be None or an integer in [2, 64], got {nodes!r}")
-    else:
-        k_nodes = int(nodes)
+    rtol = as_positive(quad_rtol, "quad_rtol")
+    assert rtol is not None
     pp = c.piecewise
     coeffs = np.asarray(pp.coeffs)
     breaks = np.asarray(pp.breaks)
@@ -284,7 +281,7 @@ def analyze(curve: object, *, nodes: int | None = None) -> Analysis:
             planar = True
             cw = np.ascontiguousarray(coeffs @ E)  # (m, p1, 2): coordinates in the plane
 
-    smp = sample_curve(cw, h, planar, closed, k_nodes)
+    smp = sample_curve(cw, h, planar, closed, rtol)
     if dim == 2:
         L = smp.diagonal
     jidx, _ = _knots(m, closed)
@@ -326,7 +323,8 @@ def analyze(curve: object, *, nodes: int | None = None) -> Analysis:
     return Analysis(
         dim=int(dim), degree=int(degree), n_segments=int(m), closed=closed, planar=planar,
         energy2=e2, energy3=e3, arc_length=float(smp.arc_length),
-        dkds_energy=float(smp.dkds_energy),
+        dkds_energy=float(smp.dkds_energy), arc_length_error=float(smp.arc_length_error),
+        dkds_energy_error=float(smp.dkds_energy_error),
         jump_indices=_ro(jidx.astype(np.int64)), jump_params=_ro(breaks[jidx].copy()),
         jumps=_ro(jumps), max_jump=max_jump, max_jump_index=max_jump_index,
         top_order=int(degree), top_jumps=_ro(top), max_top_jump=max_top,

@@ -1,12 +1,18 @@
-"""The sampling pass of :func:`curvefair.analyze`: curvature and ``dkappa/ds`` on a
-Gauss-Lobatto grid per segment, quadratures, and the exact sign structure of both.
+"""The sampling pass of :func:`curvefair.analyze`: curvature and ``dkappa/ds`` on a fixed grid
+per segment, adaptive quadratures, and the exact sign structure of both.
 
-Layout: every segment is sampled at ``K`` Gauss-Lobatto fractions ``x_0 = 0 < ... <
-x_{K-1} = 1`` (both one-sided limits at each knot are samples). The sign of the curvature is the
-sign of the polynomial ``N = x'y'' - y'x''`` and the sign of ``dkappa/ds`` that of a polynomial
-numerator ``E``; both are recovered exactly (up to rounding) from their ``K`` sampled values,
-``K`` being larger than their degree, and their Bernstein coefficients certify that no sign
-change hides between two samples, or locate it (see :func:`sample_curve`).
+Grid: every segment is cut into ``P`` equal pieces, each sampled at the 7 nodes of the
+Gauss-Kronrod-Lobatto pair of Gander & Gautschi (the 4-point Gauss-Lobatto rule and its 7-point
+Kronrod extension, exact for degree 5 and 9): ``K = 6 P + 1`` fractions ``x_0 = 0 < ... <
+x_{K-1} = 1``, so both one-sided limits at each knot are samples. The integrals use the 7-point
+rule, the difference to the 4-point rule estimates the error, and segments whose estimate is too
+large are integrated again on 2, 4, 8, ... times as many pieces (within a work budget).
+
+Signs: the sign of the curvature is the sign of the polynomial ``N = x'y'' - y'x''`` and the
+sign of ``dkappa/ds`` that of a polynomial numerator ``E``; both are recovered exactly (up to
+rounding) from their ``K`` sampled values, ``K`` exceeding their degree, and their Bernstein
+coefficients certify that no sign change hides between two samples, or locate it (see
+:func:`sample_curve`).
 """
 
 from __future__ import annotations
@@ -19,9 +25,9 @@ import numpy as np
 from numba import njit
 
 from .._typing import FloatArray
-from ._core import CROSS_RTOL, SPEED_RTOL, derivs_at, falling, frenet, lobatto
+from ._core import CROSS_RTOL, SPEED_RTOL, derivs_at, falling, frenet
 
-__all__ = ["Samples", "sample_curve", "scan_sign_changes"]
+__all__ = ["Samples", "sample_curve", "scan_sign_changes", "QUAD_RTOL"]
 
 #: Rounding level of curvature-type quantities computed from floating-point spline data: on a
 #: segment of length scale ``ell`` starting at distance ``pos`` from the origin, the
@@ -30,7 +36,18 @@ __all__ = ["Samples", "sample_curve", "scan_sign_changes"]
 #: derivatives to ``eps * ell`` bend a straight segment that much (about 1e3 machine
 #: epsilons, a margin of about 100 over the rounding estimates).
 ROUNDING_FLOOR = 1e3 * float(np.finfo(float).eps)
+#: Default relative accuracy requested from the adaptive quadratures.
+QUAD_RTOL = 1e-9
 _MAX_SPLITS = 48
+_MAX_LEVELS = 10
+_FM = {"contract", "arcp", "reassoc"}
+
+# Gander & Gautschi (2000): 4-point Gauss-Lobatto and 7-point Kronrod extension on [-1, 1]
+_R23 = float(np.sqrt(2.0 / 3.0))
+_R15 = float(1.0 / np.sqrt(5.0))
+_GK_X = np.array([-1.0, -_R23, -_R15, 0.0, _R15, _R23, 1.0])
+_GK_W7 = np.array([11 / 210, 72 / 245, 125 / 294, 16 / 35, 125 / 294, 72 / 245, 11 / 210])
+_GK_W4 = np.array([1 / 6, 0.0, 5 / 6, 0.0, 5 / 6, 0.0, 1 / 6])
 
 
 def _bernstein_basis(d: int, u: FloatArray) -> FloatArray:
@@ -42,33 +59,38 @@ def _bernstein_basis(d: int, u: FloatArray) -> FloatArray:
 
 @dataclass(frozen=True)
 class _Plan:
-    K: int
-    x: FloatArray
-    w: FloatArray
+    P: int  # pieces per segment
+    K: int  # nodes per segment, 6 P + 1
+    x: FloatArray  # (K,) fractions
+    xk: FloatArray  # (7,) Kronrod nodes on [0, 1]
+    w7: FloatArray  # (7,) Kronrod weights on [0, 1]
+    w4: FloatArray  # (7,) Lobatto weights on [0, 1] (zeros at the Kronrod-only nodes)
     tab: FloatArray  # (3, K, p1): derivative nu (1, 2, 3) of u^j at x_q
     fit: tuple[FloatArray | None, FloatArray]  # values (K) -> Bernstein coeffs on [0, 1]
     sub: tuple[FloatArray | None, FloatArray]  # values (K) -> Bernstein coeffs per gap
     degs: tuple[int, int]
 
 
-def min_nodes(degree: int, planar: bool) -> int:
-    """Smallest number of Lobatto nodes per segment the sign certificate needs."""
+def numerator_degrees(degree: int, planar: bool) -> tuple[int, int]:
+    """Degrees of the curvature numerator ``N`` (planar) and the ``dkappa/ds`` numerator ``E``.
+
+    The leading coefficients of ``r'`` and ``r''`` are parallel, so ``N = x'y'' - y'x''`` has
+    degree ``2p - 4`` (not ``2p - 3``), ``N' = x'y''' - y'x'''`` degree ``2p - 5`` and
+    ``E = N' |r'|^2 - 3 N (r'.r'')`` degree ``4p - 7``; in 3-D, with ``C = r' x r''``,
+    ``E = (C.C') |r'|^2 - 3 |C|^2 (r'.r'')`` has degree ``6p - 11``.
+    """
     p = degree
-    d_n = max(2 * p - 4, 0)
-    d_e = max(4 * p - 7 if planar else 6 * p - 11, 0)
-    return max(d_e + 1, d_n + 2, p + 3)
+    return max(2 * p - 4, 0), max(4 * p - 7 if planar else 6 * p - 11, 0)
 
 
 @lru_cache(maxsize=32)
-def _plan(degree: int, planar: bool, nodes: int = 0) -> _Plan:
+def _plan(degree: int, planar: bool) -> _Plan:
     p = degree
-    # degrees: the leading coefficients of r' and r'' are parallel, so N = x'y'' - y'x'' has
-    # degree 2p - 4 (not 2p - 3), N' = x'y''' - y'x''' degree 2p - 5, and the numerator E of
-    # dkappa/ds degree 4p - 7 (planar) or 6p - 11 (3-D: |C|^2 (r'.r''), C = r' x r'')
-    d_n = max(2 * p - 4, 0)
-    d_e = max(4 * p - 7 if planar else 6 * p - 11, 0)
-    K = max(min_nodes(p, planar), nodes)
-    x, w = lobatto(K)
+    d_n, d_e = numerator_degrees(p, planar)
+    P = max(1, -(-max(d_e, d_n + 1, p + 2) // 6))  # K = 6P + 1 > every degree
+    K = 6 * P + 1
+    xk = 0.5 * (_GK_X + 1.0)
+    x = np.concatenate([[0.0]] + [(k + xk[1:]) / P for k in range(P)])
     tab = np.zeros((3, K, p + 1))
     for nu in range(1, 4):
         for j in range(nu, p + 1):
@@ -87,12 +109,11 @@ def _plan(degree: int, planar: bool, nodes: int = 0) -> _Plan:
         S = np.empty((K - 1, K, d + 1))
         for q in range(K - 1):
             vv = x[q] + (x[q + 1] - x[q]) * v
-            # values at vv from the global Bernstein coefficients, then refit on the gap
-            to_vals = _bernstein_basis(d, vv) @ pinv  # (K, K): sample values -> values at vv
+            to_vals = _bernstein_basis(d, vv) @ pinv  # sample values -> values at vv
             S[q] = (np.linalg.pinv(_bernstein_basis(d, v)) @ to_vals).T
         subs.append(S)
-    return _Plan(K=K, x=x, w=w, tab=tab, fit=(fits[0], fits[1]),
-                 sub=(subs[0], subs[1]), degs=(d_n, d_e))
+    return _Plan(P=P, K=K, x=x, xk=xk, w7=0.5 * _GK_W7, w4=0.5 * _GK_W4, tab=tab,
+                 fit=(fits[0], fits[1]), sub=(subs[0], subs[1]), degs=(d_n, d_e))
 
 
 def _variations(b: FloatArray) -> np.ndarray:
@@ -134,6 +155,8 @@ class Samples:
     dkds: FloatArray  # (m, K)
     arc_length: float
     dkds_energy: float
+    arc_length_error: float
+    dkds_energy_error: float
     n_singular: int
     max_kappa: float
     max_dkds: float
@@ -145,6 +168,7 @@ class Samples:
     extra: tuple[tuple[np.ndarray, FloatArray, FloatArray], ...]  # per quantity: seg, u, value
 
 
+# -- compiled kernels ----------------------------------------------------------------------------
 @njit(cache=True)
 def _variations_1d(b, n):  # type: ignore[no-untyped-def]
     """Sign changes (zeros skipped) of ``b[:n]``."""
@@ -165,22 +189,91 @@ def _variations_1d(b, n):  # type: ignore[no-untyped-def]
     return v
 
 
-@njit(cache=True, fastmath={"contract", "arcp", "reassoc"})
-def _pass_kernel(cw, h, tab, w, fall, fits, nfit, subs, speed_rtol, cross_rtol, closed,
-                 kap, dks, knots, energies, box, ell, pos, gaps):  # type: ignore[no-untyped-def]
+@njit(cache=True, fastmath=_FM, inline="always")
+def _setup(cw, i, hi, fall, e):  # type: ignore[no-untyped-def]
+    """Scaled coefficients ``e_j = c_j h^j`` of segment ``i`` and the sizes of its first and
+    second derivative polynomials (for the zero-speed and zero-curvature tests)."""
+    p1, dim = e.shape
+    sc1 = 0.0
+    sc2 = 0.0
+    hp = 1.0
+    for j in range(p1):
+        nrm = 0.0
+        for d in range(dim):
+            v = cw[i, j, d]
+            e[j, d] = v * hp
+            nrm += v * v
+        if j >= 1:
+            nrm = np.sqrt(nrm) * hp
+            sc1 += fall[j, 1] * nrm
+            if j >= 2:
+                sc2 += fall[j, 2] * nrm
+        hp *= hi
+    ih = 1.0 / hi
+    return sc1 * ih, sc2 * ih * ih
+
+
+@njit(cache=True, fastmath=_FM, inline="always")
+def _frenet_node(r1, r2, r3, sc1, sc2, speed_rtol, cross_rtol):  # type: ignore[no-untyped-def]
+    """``(kappa, dkds, speed, N, E, singular)`` at one node (see ``_core.frenet``)."""
+    dim = r1.shape[0]
+    s2 = 0.0
+    dot12 = 0.0
+    for d in range(dim):
+        s2 += r1[d] * r1[d]
+        dot12 += r1[d] * r2[d]
+    sp = np.sqrt(s2)
+    k_ = 0.0
+    ks = 0.0
+    ok = sp > speed_rtol * sc1
+    if dim == 2:
+        num = r1[0] * r2[1] - r1[1] * r2[0]
+        num1 = r1[0] * r3[1] - r1[1] * r3[0]
+        enum = num1 * s2 - 3.0 * num * dot12
+        if ok:
+            inv = 1.0 / s2
+            k_ = num * inv / sp
+            ks = enum * (inv * inv) * inv
+    else:
+        num = 0.0
+        c0 = r1[1] * r2[2] - r1[2] * r2[1]
+        c1 = r1[2] * r2[0] - r1[0] * r2[2]
+        c2 = r1[0] * r2[1] - r1[1] * r2[0]
+        d0 = r1[1] * r3[2] - r1[2] * r3[1]
+        d1 = r1[2] * r3[0] - r1[0] * r3[2]
+        d2 = r1[0] * r3[1] - r1[1] * r3[0]
+        cc = c0 * c0 + c1 * c1 + c2 * c2
+        cn = np.sqrt(cc)
+        enum = (c0 * d0 + c1 * d1 + c2 * d2) * s2 - 3.0 * cc * dot12
+        if ok and cn > cross_rtol * sp * sc2:
+            inv = 1.0 / s2
+            k_ = cn * inv / sp
+            ks = enum / cn * (inv * inv) * inv
+    singular = not ok or not (np.isfinite(k_) and np.isfinite(ks))
+    if singular:
+        k_ = 0.0
+        ks = 0.0
+    return k_, ks, sp, num, enum, singular
+
+
+@njit(cache=True, fastmath=_FM)
+def _pass_kernel(cw, h, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cross_rtol,
+                 closed, kap, dks, knots, energies, quad, box, ell, pos,
+                 gaps):  # type: ignore[no-untyped-def]
     """One fused pass over the segments (see :func:`sample_curve`).
 
     ``tab[nu-1, q, j] = j!/(j-nu)! x_q^(j-nu)`` (derivative ``nu`` of ``u^j`` at node ``q``),
-    ``fall[j, nu] = j!/(j-nu)!``; ``fits[k]`` (K, dmax+1) maps sampled numerator values to
-    Bernstein coefficients (``nfit[k]`` of them; 0: not wanted), ``subs[k]`` (K-1, K, dmax+1)
-    the same per gap. Writes ``kap``/``dks`` (m, K); ``knots[i]`` = jumps at breakpoint ``i``
-    of the third derivative, of the ``degree``-th derivative and of ``dkappa/ds`` (row 0:
-    the seam of a closed curve, else 0); ``energies[i, 0/1]`` (exact ``int |r''|^2`` and
-    ``int |r'''|^2``); ``box`` (2, dim) the bounding box of the breakpoint positions; ``ell``
-    (m,) each segment's length scale (size of its derivative polynomial times its width),
-    ``pos`` (m,) the norm of its start point; and
-    ``gaps`` (rows ``(which, segment, gap)`` whose gap Bernstein coefficients still vary at
-    least twice). Returns ``(arc, dke, n_singular, max|kappa|, max|dkds|, n_gaps)``.
+    ``w7``/``w4`` the Kronrod/Lobatto weights of one piece on [0, 1], ``fall[j, nu] =
+    j!/(j-nu)!``; ``fits[k]`` (K, dmax+1) maps sampled numerator values to Bernstein
+    coefficients (``nfit[k]`` of them; 0: not wanted), ``subs[k]`` (K-1, K, dmax+1) the same
+    per gap. Writes ``kap``/``dks`` (m, K); ``knots[i]`` = jumps at breakpoint ``i`` of the
+    third derivative, of the ``degree``-th derivative and of ``dkappa/ds`` (row 0: the seam of
+    a closed curve, else 0); ``energies[i]`` (exact ``int |r''|^2``, ``int |r'''|^2``);
+    ``quad[i]`` (7-point arc length, its error estimate, the same for ``int kappa_s^2 ds``);
+    ``box`` (2, dim) the bounding box of the breakpoint positions; ``ell`` each segment's length
+    scale; ``pos`` the norm of its start point; and ``gaps`` (rows ``(which, segment, gap)``
+    whose gap Bernstein coefficients still vary at least twice). Returns ``(n_singular,
+    max|kappa|, max|dkds|, n_gaps)``.
     """
     m, p1, dim = cw.shape
     K = tab.shape[1]
@@ -190,14 +283,14 @@ def _pass_kernel(cw, h, tab, w, fall, fits, nfit, subs, speed_rtol, cross_rtol, 
     r2 = np.empty(dim)
     r3 = np.empty(dim)
     vals = np.empty((2, K))
+    fa = np.empty(K)
+    fd = np.empty(K)
     bb = np.empty(fits.shape[2])
     endv = np.zeros((2, dim))  # left limits at the previous segment's end
     first = np.zeros((2, dim))  # right limits at the first segment's start
     for d in range(dim):
         box[0, d] = cw[0, 0, d]
         box[1, d] = cw[0, 0, d]
-    arc = 0.0
-    dke = 0.0
     nsing = 0
     maxk = 0.0
     maxks = 0.0
@@ -207,35 +300,18 @@ def _pass_kernel(cw, h, tab, w, fall, fits, nfit, subs, speed_rtol, cross_rtol, 
         ih = 1.0 / hi
         ih2 = ih * ih
         ih3 = ih2 * ih
-        sc1 = 0.0
-        sc2 = 0.0
-        hp = 1.0
+        sc1, sc2 = _setup(cw, i, hi, fall, e)
+        ell[i] = sc1 * hi
+        c0n = 0.0
         for d in range(dim):
             v = cw[i, 0, d]
+            c0n += v * v
             if v < box[0, d]:
                 box[0, d] = v
             if v > box[1, d]:
                 box[1, d] = v
-        for j in range(p1):
-            nrm = 0.0
-            for d in range(dim):
-                v = cw[i, j, d]
-                e[j, d] = v * hp
-                nrm += v * v
-            if j >= 1:
-                nrm = np.sqrt(nrm) * hp
-                sc1 += fall[j, 1] * nrm
-                if j >= 2:
-                    sc2 += fall[j, 2] * nrm
-            hp *= hi
-        ell[i] = sc1
-        c0n = 0.0
-        for d in range(dim):
-            c0n += cw[i, 0, d] * cw[i, 0, d]
         pos[i] = np.sqrt(c0n)
-        sc1 *= ih
-        sc2 *= ih2
-        # exact energies: int_0^1 |sum_j g_j u^j|^2 du * h with g_j = fall[j+o, o] e_{j+o} / h^o
+        # exact energies: h int_0^1 |sum_j g_j u^j|^2 du with g_j = fall[j+o, o] e_{j+o} / h^o
         for o in range(2, 4):
             acc = 0.0
             if o <= p:
@@ -264,8 +340,6 @@ def _pass_kernel(cw, h, tab, w, fall, fits, nfit, subs, speed_rtol, cross_rtol, 
                         acc += fall[j, nu] * e[j, d]
                 endv[slot, d] = acc * ih ** nu
             knots[i, slot] = np.sqrt(jj) if i > 0 else 0.0
-        seg_arc = 0.0
-        seg_dke = 0.0
         for qn in range(K):
             for d in range(dim):
                 a1 = 0.0
@@ -278,45 +352,11 @@ def _pass_kernel(cw, h, tab, w, fall, fits, nfit, subs, speed_rtol, cross_rtol, 
                 r1[d] = a1 * ih
                 r2[d] = a2 * ih2
                 r3[d] = a3 * ih3
-            s2 = 0.0
-            dot12 = 0.0
-            for d in range(dim):
-                s2 += r1[d] * r1[d]
-                dot12 += r1[d] * r2[d]
-            sp = np.sqrt(s2)
-            k_ = 0.0
-            ks = 0.0
-            ok = sp > speed_rtol * sc1
-            if dim == 2:
-                num = r1[0] * r2[1] - r1[1] * r2[0]
-                num1 = r1[0] * r3[1] - r1[1] * r3[0]
-                enum = num1 * s2 - 3.0 * num * dot12
-                vals[0, qn] = num
-                vals[1, qn] = enum
-                if ok:
-                    inv = 1.0 / s2
-                    k_ = num * inv / sp
-                    ks = enum * (inv * inv) * inv
-            else:
-                c0 = r1[1] * r2[2] - r1[2] * r2[1]
-                c1 = r1[2] * r2[0] - r1[0] * r2[2]
-                c2_ = r1[0] * r2[1] - r1[1] * r2[0]
-                d0 = r1[1] * r3[2] - r1[2] * r3[1]
-                d1 = r1[2] * r3[0] - r1[0] * r3[2]
-                d2 = r1[0] * r3[1] - r1[1] * r3[0]
-                cc = c0 * c0 + c1 * c1 + c2_ * c2_
-                cn = np.sqrt(cc)
-                enum = (c0 * d0 + c1 * d1 + c2_ * d2) * s2 - 3.0 * cc * dot12
-                vals[0, qn] = 0.0
-                vals[1, qn] = enum
-                if ok and cn > cross_rtol * sp * sc2:
-                    inv = 1.0 / s2
-                    k_ = cn * inv / sp
-                    ks = enum / cn * (inv * inv) * inv
-            if not ok or not (np.isfinite(k_) and np.isfinite(ks)):
-                k_ = 0.0
-                ks = 0.0
-                nsing += 1
+            k_, ks, sp, num, enum, sing = _frenet_node(r1, r2, r3, sc1, sc2, speed_rtol,
+                                                       cross_rtol)
+            vals[0, qn] = num
+            vals[1, qn] = enum
+            nsing += sing
             kap[i, qn] = k_
             dks[i, qn] = ks
             ak = abs(k_)
@@ -325,10 +365,32 @@ def _pass_kernel(cw, h, tab, w, fall, fits, nfit, subs, speed_rtol, cross_rtol, 
                 maxk = ak
             if aks > maxks:
                 maxks = aks
-            seg_arc += w[qn] * sp
-            seg_dke += w[qn] * (ks * ks * sp)
-        arc += seg_arc * hi
-        dke += seg_dke * hi
+            fa[qn] = sp
+            fd[qn] = ks * ks * sp
+        # 7-point Kronrod and 4-point Lobatto on each of the P pieces
+        qa = 0.0
+        ea = 0.0
+        qd = 0.0
+        ed = 0.0
+        for k in range(P):
+            a7 = 0.0
+            a4 = 0.0
+            d7 = 0.0
+            d4 = 0.0
+            for j in range(7):
+                a7 += w7[j] * fa[6 * k + j]
+                a4 += w4[j] * fa[6 * k + j]
+                d7 += w7[j] * fd[6 * k + j]
+                d4 += w4[j] * fd[6 * k + j]
+            qa += a7
+            ea += abs(a7 - a4)
+            qd += d7
+            ed += abs(d7 - d4)
+        sw = hi / P
+        quad[i, 0] = qa * sw
+        quad[i, 1] = ea * sw
+        quad[i, 2] = qd * sw
+        quad[i, 3] = ed * sw
         knots[i, 2] = abs(dks[i, 0] - dks[i - 1, K - 1]) if i > 0 else 0.0
         # certificate: can a sign change of N (E) hide between two samples?
         for which in range(2):
@@ -371,7 +433,114 @@ def _pass_kernel(cw, h, tab, w, fall, fits, nfit, subs, speed_rtol, cross_rtol, 
             box[0, d] = acc
         if acc > box[1, d]:
             box[1, d] = acc
-    return arc, dke, nsing, maxk, maxks, ngap
+    return nsing, maxk, maxks, ngap
+
+
+@njit(cache=True)
+def _allowances(quad, h, rtol, allow, worst):  # type: ignore[no-untyped-def]
+    """Error allowance of each segment for the arc length and the dkds energy:
+    ``rtol (|Q_i| + |total| h_i / sum h)``; ``worst`` = largest estimate / allowance ratio.
+    Returns the number of segments over their allowance."""
+    m = quad.shape[0]
+    ta = 0.0
+    td = 0.0
+    th = 0.0
+    for i in range(m):
+        ta += quad[i, 0]
+        td += quad[i, 2]
+        th += h[i]
+    ta = abs(ta) / th
+    td = abs(td) / th
+    n = 0
+    for i in range(m):
+        aa = rtol * (abs(quad[i, 0]) + ta * h[i])
+        ad = rtol * (abs(quad[i, 2]) + td * h[i])
+        allow[i, 0] = aa
+        allow[i, 1] = ad
+        wa = quad[i, 1] / aa if aa > 0.0 else (np.inf if quad[i, 1] > 0.0 else 0.0)
+        wd = quad[i, 3] / ad if ad > 0.0 else (np.inf if quad[i, 3] > 0.0 else 0.0)
+        w = wa if wa > wd else wd
+        worst[i] = w
+        if w > 1.0:
+            n += 1
+    return n
+
+
+@njit(cache=True, fastmath=_FM)
+def _refine_kernel(cw, h, segs, base, allow, P, xk, w7, fall, speed_rtol, cross_rtol,
+                   max_levels, budget, out):  # type: ignore[no-untyped-def]
+    """Adaptive re-integration of the segments ``segs`` (worst first).
+
+    Level ``L`` integrates segment ``i`` with the 7-point rule on ``P 2^L`` equal pieces; it
+    stops when both integrals changed by at most ``allow[n, 0/1]`` from the previous level
+    (level 0: ``base[n]`` from the pass), at ``max_levels``, or when the work budget (pieces)
+    is spent. ``base`` and ``out`` rows: (arc length, its error estimate, dkds energy, its
+    error estimate); rows left when the budget is spent are copied from ``base``. Returns the
+    pieces used.
+    """
+    m, p1, dim = cw.shape
+    e = np.empty((p1, dim))
+    r1 = np.empty(dim)
+    r2 = np.empty(dim)
+    r3 = np.empty(dim)
+    used = 0
+    for n in range(segs.shape[0]):
+        i = segs[n]
+        hi = h[i]
+        ih = 1.0 / hi
+        sc1, sc2 = _setup(cw, i, hi, fall, e)
+        prev_a = base[n, 0]
+        err_a = base[n, 1]
+        prev_d = base[n, 2]
+        err_d = base[n, 3]
+        done = False
+        for lev in range(1, max_levels + 1):
+            npc = P << lev
+            if used + npc > budget:
+                break
+            used += npc
+            qa = 0.0
+            qd = 0.0
+            inv_n = 1.0 / npc
+            for k in range(npc):
+                for j in range(7):
+                    u = (k + xk[j]) * inv_n
+                    for d in range(dim):
+                        a1 = 0.0
+                        a2 = 0.0
+                        a3 = 0.0
+                        for jj in range(p1 - 1, 0, -1):
+                            a1 = a1 * u + fall[jj, 1] * e[jj, d]
+                            if jj >= 2:
+                                a2 = a2 * u + fall[jj, 2] * e[jj, d]
+                            if jj >= 3:
+                                a3 = a3 * u + fall[jj, 3] * e[jj, d]
+                        r1[d] = a1 * ih
+                        r2[d] = a2 * ih * ih
+                        r3[d] = a3 * ih * ih * ih
+                    k_, ks, sp, num, enum, sing = _frenet_node(r1, r2, r3, sc1, sc2,
+                                                               speed_rtol, cross_rtol)
+                    qa += w7[j] * sp
+                    qd += w7[j] * ks * ks * sp
+            qa *= hi * inv_n
+            qd *= hi * inv_n
+            err_a = abs(qa - prev_a)
+            err_d = abs(qd - prev_d)
+            prev_a = qa
+            prev_d = qd
+            if err_a <= allow[n, 0] and err_d <= allow[n, 1]:
+                done = True
+                break
+        out[n, 0] = prev_a
+        out[n, 1] = err_a
+        out[n, 2] = prev_d
+        out[n, 3] = err_d
+        if not done and used + (P << 1) > budget:
+            for r in range(n + 1, segs.shape[0]):
+                for c in range(4):
+                    out[r, c] = base[r, c]
+            break
+    return used
 
 
 def _speed_scales(cc: FloatArray, hh: FloatArray) -> tuple[FloatArray, FloatArray]:
@@ -440,16 +609,19 @@ def _refine_gaps(cw: FloatArray, h: FloatArray, plan: _Plan, gaps: np.ndarray
 
 
 def sample_curve(cw: FloatArray, h: FloatArray, planar: bool, closed: bool,
-                 nodes: int = 0) -> Samples:
+                 rtol: float = QUAD_RTOL) -> Samples:
     """Sample ``kappa`` and ``dkappa/ds`` on every segment; integrate; certify signs.
 
     ``cw`` are power coefficients ``(m, p+1, dim)`` (``dim`` 2 for planar curves, 3 for
     twisted ones), ``h`` the segment widths. One compiled pass over the segments (fused:
-    no temporaries of the sample grid's size besides the two results).
+    no temporaries of the sample grid's size besides the two results), then adaptive
+    re-integration of the segments whose error estimate exceeds ``rtol`` (relative, with an
+    equal share of ``rtol`` times the total per unit parameter length), worst first, within a
+    budget of ``max(200000, m / 4)`` pieces of 7 nodes.
     """
     m, p1, dim = cw.shape
     p = p1 - 1
-    plan = _plan(p, planar, nodes)
+    plan = _plan(p, planar)
     K = plan.K
     dmax = max(plan.degs) + 1
     fits = np.zeros((2, K, dmax))
@@ -469,6 +641,7 @@ def sample_curve(cw: FloatArray, h: FloatArray, planar: bool, closed: bool,
     dks = np.empty((m, K))
     knots = np.empty((m, 3))
     energies = np.empty((m, 2))
+    quad = np.empty((m, 4))
     box = np.empty((2, dim))
     ell = np.empty(m)
     pos = np.empty(m)
@@ -476,12 +649,32 @@ def sample_curve(cw: FloatArray, h: FloatArray, planar: bool, closed: bool,
     hc = np.ascontiguousarray(h, dtype=np.float64)
     gaps = np.empty((max(1 << 12, m // 4), 3), dtype=np.int64)
     while True:
-        arc, dke, nsing, maxk, maxks, ngap = _pass_kernel(
-            cwc, hc, plan.tab, plan.w, fall, fits, nfit, subs, SPEED_RTOL, CROSS_RTOL,
-            bool(closed), kap, dks, knots, energies, box, ell, pos, gaps)
+        nsing, maxk, maxks, ngap = _pass_kernel(
+            cwc, hc, plan.tab, plan.w7, plan.w4, plan.P, fall, fits, nfit, subs, SPEED_RTOL,
+            CROSS_RTOL, bool(closed), kap, dks, knots, energies, quad, box, ell, pos, gaps)
         if ngap <= gaps.shape[0]:
             break
         gaps = np.empty((ngap, 3), dtype=np.int64)  # rare: the buffer was too small; redo
+
+    # adaptive quadrature where the 7-point/4-point estimate is too large
+    allow = np.empty((m, 2))
+    worst = np.empty(m)
+    nbad = _allowances(quad, hc, float(rtol), allow, worst)
+    if nbad:
+        budget = max(200_000, m // 4)
+        bad = np.flatnonzero(worst > 1.0)
+        worst = worst[bad]
+        top = budget // (2 * plan.P)  # at most this many segments get even one level
+        if bad.size > top:
+            keep = np.argpartition(-worst, top)[:top]
+            bad, worst = bad[keep], worst[keep]
+        bad = bad[np.argsort(-worst, kind="stable")]
+        out = np.empty((bad.size, 4))
+        _refine_kernel(cwc, hc, bad, np.ascontiguousarray(quad[bad]),
+                       np.ascontiguousarray(allow[bad]), plan.P, plan.xk, plan.w7, fall,
+                       SPEED_RTOL, CROSS_RTOL, _MAX_LEVELS, budget, out)
+        quad[bad] = out
+
     refined = _refine_gaps(cw, h, plan, gaps[:ngap])
     extra = []
     for which, (segs, us) in enumerate(refined):
@@ -492,12 +685,14 @@ def sample_curve(cw: FloatArray, h: FloatArray, planar: bool, closed: bool,
         segs, us = segs[order], us[order]
         fr = _frenet_at(cw, h, segs, us)
         extra.append((segs, us, fr["kappa"] if which == 0 else fr["dkds"]))
-    return Samples(x=plan.x, kappa=kap, dkds=dks, arc_length=float(arc),
-                   dkds_energy=float(dke), n_singular=int(nsing), max_kappa=float(maxk),
+    return Samples(x=plan.x, kappa=kap, dkds=dks, arc_length=float(np.sum(quad[:, 0])),
+                   dkds_energy=float(np.sum(quad[:, 2])),
+                   arc_length_error=float(np.sum(quad[:, 1])),
+                   dkds_energy_error=float(np.sum(quad[:, 3])),
+                   n_singular=int(nsing), max_kappa=float(maxk),
                    max_dkds=float(maxks), knots=knots, energies=energies,
                    diagonal=float(np.sqrt(np.sum((box[1] - box[0]) ** 2))), ell=ell,
-                   pos=pos,
-                   extra=(extra[0], extra[1]))
+                   pos=pos, extra=(extra[0], extra[1]))
 
 
 @njit(cache=True)
@@ -518,8 +713,11 @@ def _scan_kernel(vals, x, breaks, ex_seg, ex_u, ex_val, tol, ell, pos, floor, po
         hw = breaks[i + 1] - t0
         q = 0
         tl = tol
-        if ell[i] > 0.0:
-            fl = floor * (ell[i] + pos[i]) / ell[i] ** (power + 1.0)
+        li = ell[i]
+        if li > 0.0:
+            fl = floor * (li + pos[i]) / (li * li)
+            if power == 2:
+                fl /= li
             if fl > tl:
                 tl = fl
         while e < ne and ex_seg[e] < i:
@@ -572,7 +770,7 @@ def scan_sign_changes(vals: FloatArray, x: FloatArray, breaks: FloatArray,
         np.ascontiguousarray(ex_val), float(tol), np.ascontiguousarray(ell),
         np.ascontiguousarray(pos),
         ROUNDING_FLOOR,
-        float(power), out)
+        int(power), out)
     loc = out[:n].copy()
     if closed and fs != 0 and ls != fs:
         period = float(breaks[-1] - breaks[0])

@@ -1,0 +1,127 @@
+"""deviation(): maximum distance between two curves, checked against brute-force sampling.
+
+Reference: |a(t) - b(t)| at 10^6 equally spaced parameters (plus the breakpoints), evaluated by
+scipy's own spline objects where possible; it is a lower bound of the true maximum, within
+O(spacing^2) of it.
+"""
+
+import json
+
+import numpy as np
+import pytest
+from scipy.interpolate import CubicHermiteSpline
+
+import curvefair as cf
+from curvefair.errors import InputError
+
+
+def _brute(fa, fb, t0, t1, extra=()):
+    t = np.concatenate([np.linspace(t0, t1, 1_000_001), np.asarray(extra, dtype=float)])
+    d = np.linalg.norm(fa(t) - fb(t), axis=1)
+    k = int(np.argmax(d))
+    return float(d[k]), float(t[k])
+
+
+def _check(dev, brute, scale):
+    # brute force never exceeds the certified maximum, and is close to it
+    assert dev.max_distance >= brute - 1e-12 * scale
+    assert dev.max_distance <= brute + 1e-7 * scale
+    assert dev.upper_bound >= dev.max_distance
+    assert dev.upper_bound - dev.max_distance <= 1e-12 * dev.max_distance + 1e-12 * scale
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_same_breakpoints_vs_brute_force(dim):
+    rng = np.random.default_rng(dim)
+    pts = np.cumsum(rng.normal(size=(30, dim)), axis=0)
+    a = cf.interpolate_cubic(pts)
+    moved = pts + 0.05 * rng.normal(size=pts.shape)
+    b = cf.interpolate_cubic(moved, param=a.params)
+    dev = cf.deviation(a, b)
+    ref_a = CubicHermiteSpline(a.params, a.points, a.tangents, axis=0)
+    ref_b = CubicHermiteSpline(b.params, b.points, b.tangents, axis=0)
+    brute, tb = _brute(ref_a, ref_b, *a.domain, a.params)
+    _check(dev, brute, np.abs(pts).max())
+    assert dev.param == pytest.approx(tb, abs=1e-3 * np.ptp(a.params))
+    np.testing.assert_allclose(dev.point_a, ref_a(dev.param), atol=1e-12)
+    np.testing.assert_allclose(dev.point_b, ref_b(dev.param), atol=1e-12)
+    assert np.linalg.norm(dev.point_a - dev.point_b) == pytest.approx(dev.max_distance,
+                                                                      rel=1e-12)
+    d = np.linalg.norm(pts - moved, axis=1)
+    assert dev.point_index == int(np.argmax(d))
+    assert dev.max_point_displacement == pytest.approx(d.max(), rel=1e-15)
+
+
+def test_different_breakpoints_and_degrees():
+    # a: cubic through 17 points, b: quintic through 11 others, both on parameters [0, 1]
+    f = lambda t: np.c_[np.cos(3 * t), np.sin(2 * t)]  # noqa: E731
+    ta, tb = np.linspace(0, 1, 17), np.sort(np.r_[0, np.random.default_rng(1).uniform(0, 1, 9), 1])
+    a = cf.interpolate_cubic(f(ta), param=ta)
+    b = cf.interpolate_quintic(f(tb), param=tb)
+    dev = cf.deviation(a, b)
+    brute, _ = _brute(a, b, 0.0, 1.0, np.r_[ta, tb])
+    _check(dev, brute, 1.0)
+    assert dev.max_point_displacement is None and dev.point_index is None  # counts differ
+    # symmetric
+    assert cf.deviation(b, a).max_distance == pytest.approx(dev.max_distance, rel=1e-12)
+
+
+def test_closed_curves_and_bspline():
+    th = np.linspace(0, 2 * np.pi, 25)[:-1]
+    pts = np.c_[np.cos(th), 0.6 * np.sin(th), 0.1 * np.sin(3 * th)]
+    a = cf.interpolate_cubic(pts, bc="periodic")
+    b = cf.interpolate_cubic(pts * 1.01, param=a.params, bc="periodic")
+    dev = cf.deviation(a, b)
+    brute, _ = _brute(a, b, *a.domain)
+    _check(dev, brute, 1.0)
+    assert dev.point_index is not None and dev.point_index < 24
+    bs = cf.interpolate_bspline(pts[:12, :2], degree=3, param=np.linspace(0, 1, 12))
+    cub = cf.interpolate_cubic(pts[:12, :2] + 0.01, param=np.linspace(0, 1, 12))
+    dev2 = cf.deviation(bs, cub)
+    brute2, _ = _brute(bs, cub, 0.0, 1.0)
+    _check(dev2, brute2, 1.0)
+    assert dev2.max_point_displacement is None  # control points vs data points: not compared
+
+
+def test_bspline_control_point_displacement_bounds_deviation():
+    # lecture notes 004 eqs. (8.34)-(8.36): on equal knots the curve moves at most as far as
+    # the farthest control point
+    rng = np.random.default_rng(4)
+    a = cf.interpolate_bspline(np.cumsum(rng.normal(size=(12, 2)), axis=0), degree=3)
+    ctrl = np.array(a.control_points)
+    ctrl[5] += [0.3, -0.2]
+    b = a.replace(control_points=ctrl)
+    dev = cf.deviation(a, b)
+    assert dev.point_index == 5
+    assert dev.max_point_displacement == pytest.approx(np.hypot(0.3, 0.2), rel=1e-15)
+    assert dev.max_distance <= dev.max_point_displacement + 1e-15
+    brute, _ = _brute(a, b, *a.domain)
+    _check(dev, brute, np.abs(ctrl).max())
+
+
+def test_identical_and_translated_curves():
+    rng = np.random.default_rng(5)
+    pts = np.cumsum(rng.normal(size=(2000, 2)), axis=0)
+    a = cf.interpolate_cubic(pts)
+    dev0 = cf.deviation(a, a)
+    assert dev0.max_distance == 0.0 and dev0.upper_bound == 0.0
+    # a translated copy is at constant distance: the bound search must not explode
+    b = cf.CubicHermite(a.points + [3.0, 4.0], a.tangents, a.params)
+    dev = cf.deviation(a, b)
+    assert dev.max_distance == pytest.approx(5.0, rel=1e-12)
+    assert dev.upper_bound == pytest.approx(5.0, rel=1e-12)
+
+
+def test_to_dict_and_bad_input():
+    a = cf.interpolate_cubic([[0, 0], [1, 1], [2, 0], [3, 1]])
+    d = cf.deviation(a, cf.interpolate_cubic(a.points + 0.1, param=a.params)).to_dict()
+    json.dumps(d, allow_nan=False)
+    assert isinstance(d["point_a"], list) and isinstance(d["point_index"], int)
+    with pytest.raises(InputError, match="domain"):
+        cf.deviation(a, cf.interpolate_cubic(a.points, param=a.params * 2))
+    with pytest.raises(InputError, match="3-D"):
+        cf.deviation(a, cf.interpolate_cubic(np.c_[a.points, np.zeros(4)], param=a.params))
+    with pytest.raises(InputError, match="curve_b"):
+        cf.deviation(a, a.points)
+    with pytest.raises(InputError, match="curve_a"):
+        cf.deviation(None, a)
