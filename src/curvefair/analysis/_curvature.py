@@ -64,7 +64,7 @@ def curvature(curve: object, u: ArrayLike, *, side: str = "right") -> Any:
     >>> from curvefair import interpolate_cubic, curvature
     >>> a = np.linspace(0, np.pi, 41)
     >>> c = interpolate_cubic(np.c_[2 * np.cos(a), 2 * np.sin(a)])
-    >>> round(curvature(c, c.params[20]), 4)      # counter-clockwise circle of radius 2
+    >>> round(curvature(c, c.params[20]), 3)      # counter-clockwise circle of radius 2
     0.5
     """
     out, shape, scalar = _frenet_at(curve, u, side)
@@ -100,8 +100,10 @@ def curvature_derivative(curve: object, u: ArrayLike, *, side: str = "right") ->
     >>> import numpy as np
     >>> from curvefair import interpolate_cubic
     >>> from curvefair.analysis import curvature_derivative
-    >>> c = interpolate_cubic([[0, 0], [1, 0], [2, 1], [3, 3]])
-    >>> float(curvature_derivative(c, 1.0)) == float(curvature_derivative(c, 1.0, side="right"))
+    >>> c = interpolate_cubic([[0, 0], [1, 0], [2, 1], [3, 3]], param="uniform")
+    >>> left = curvature_derivative(c, 1.0, side="left")    # a knot: kappa_s jumps there
+    >>> right = curvature_derivative(c, 1.0)
+    >>> bool(abs(right - left) > 0.1)
     True
     """
     out, shape, scalar = _frenet_at(curve, u, side)

@@ -6,11 +6,12 @@ from dataclasses import dataclass, fields
 from typing import Any
 
 import numpy as np
+from numba import njit
 
 from .._typing import FloatArray
 from ..curves.piecewise import PiecewiseCurve
 from ..errors import InputError
-from ._core import check_curve, taylor_shift, to_bernstein
+from ._core import bernstein_matrix, check_curve, taylor_shift, to_bernstein
 
 __all__ = ["Deviation", "deviation", "DEVIATION_RTOL"]
 
@@ -117,6 +118,49 @@ def _de_casteljau_split(b: FloatArray) -> tuple[FloatArray, FloatArray]:
     return left, right
 
 
+@njit(cache=True)
+def _first_pass(d, w, M, U):  # type: ignore[no-untyped-def]
+    """Per piece: ``U[i]`` = max norm of the Bernstein control points of ``d`` on piece ``i``
+    (``M`` maps scaled power coefficients to Bernstein ones); returns the largest sampled
+    ``|d|`` (ends and quarter points), its piece and fraction."""
+    m, q, dim = d.shape
+    ds = np.empty((q, dim))
+    best = -1.0
+    bi = 0
+    bf = 0.0
+    fr = np.array([0.0, 0.25, 0.5, 0.75, 1.0])
+    for i in range(m):
+        hp = 1.0
+        for j in range(q):
+            for c in range(dim):
+                ds[j, c] = d[i, j, c] * hp
+            hp *= w[i]
+        u = 0.0
+        for r in range(q):
+            nn = 0.0
+            for c in range(dim):
+                acc = 0.0
+                for k in range(r + 1):
+                    acc += M[r, k] * ds[k, c]
+                nn += acc * acc
+            if nn > u:
+                u = nn
+        U[i] = np.sqrt(u)
+        for t in range(5):
+            f = fr[t]
+            nn = 0.0
+            for c in range(dim):
+                acc = 0.0
+                for j in range(q - 1, -1, -1):
+                    acc = acc * f + ds[j, c]
+                nn += acc * acc
+            if nn > best:
+                best = nn
+                bi = i
+                bf = f
+    return np.sqrt(max(best, 0.0)), bi, bf
+
+
 def _norms(b: FloatArray) -> FloatArray:
     return np.sqrt(np.sum(b * b, axis=-1))
 
@@ -188,40 +232,30 @@ def deviation(curve_a: object, curve_b: object) -> Deviation:
         if br.shape[0] < 2:
             br = np.array([a0, a1])
     starts, ends = br[:-1], br[1:]
-    mids = 0.5 * (starts + ends)
     q = max(a.piecewise.degree, b.piecewise.degree) + 1
-    d = _on_breaks(a, starts, mids, q) - _on_breaks(b, starts, mids, q)
+    ca, cb = np.asarray(a.piecewise.coeffs), np.asarray(b.piecewise.coeffs)
+    if br is ba and ca.shape == cb.shape:
+        d = ca - cb  # same breakpoints and degree: no re-expansion
+    else:
+        mids = 0.5 * (starts + ends)
+        d = _on_breaks(a, starts, mids, q) - _on_breaks(b, starts, mids, q)
     w = ends - starts
-    bern = to_bernstein(d, w)  # (m, q, dim)
-
-    scale = max(float(np.max(np.abs(a.piecewise.coeffs[:, 0, :]))),
-                float(np.max(np.abs(b.piecewise.coeffs[:, 0, :]))), np.finfo(float).tiny)
+    scale = max(float(np.max(np.abs(ca[:, 0, :]))), float(np.max(np.abs(cb[:, 0, :]))),
+                np.finfo(float).tiny)
     atol = 1e-13 * scale
 
-    # samples: ends (exact) and quarter points of every piece
-    fr = np.array([0.25, 0.5, 0.75])
-    ds = d * (w[:, None] ** np.arange(q)[None, :])[:, :, None]
-    vals = [_norms(bern[:, 0]), _norms(bern[:, -1])]
-    for f in fr:
-        acc = ds[:, -1].copy()
-        for j in range(q - 2, -1, -1):
-            acc = acc * f + ds[:, j]
-        vals.append(_norms(acc))
-    V = np.stack(vals, axis=1)  # (m, 5)
-    frac_all = np.concatenate([[0.0, 1.0], fr])
-    k = int(np.argmax(V))
-    i, j = divmod(k, V.shape[1])
-    best = float(V[i, j])
-    best_t = float(starts[i] + frac_all[j] * w[i])
-
-    U = np.max(_norms(bern), axis=1)
+    # every piece: Bernstein bound U and samples at the ends (exact) and quarter points
+    U = np.empty(d.shape[0])
+    best, i, f = _first_pass(np.ascontiguousarray(d), np.ascontiguousarray(w),
+                             bernstein_matrix(q - 1), U)
+    best_t = float(starts[i] + f * w[i])
 
     def tol() -> float:
         return DEVIATION_RTOL * best + atol
 
-    sel = U > best + tol()
-    ub = float(np.max(U[~sel])) if np.any(~sel) else 0.0
-    cb, lo, hi = bern[sel], starts[sel], ends[sel]
+    sel = np.flatnonzero(U > best + tol())
+    ub = float(np.max(U)) if sel.size == 0 else float(np.max(np.where(U > best + tol(), 0.0, U)))
+    cb, lo, hi = to_bernstein(d[sel], w[sel]), starts[sel], ends[sel]
     for _ in range(_MAX_LEVELS):
         if cb.shape[0] == 0:
             break
