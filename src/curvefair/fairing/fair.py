@@ -329,9 +329,13 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
         A name from :func:`available_methods`; default: the curve type's default
         (``"poliakoff"`` for cubic, ``"wang-quintic"`` for quintic Hermite splines).
     tol : float > 0, optional
-        No data point ever ends farther than ``tol`` from its ORIGINAL position: each step is
-        clamped onto the ball of radius ``tol`` around the original point (ERRATA, Eck &
-        Hadenfeld); a point whose clamped move is ~0 is skipped.
+        Neither the output curve nor any data point ends farther than ``tol`` from the input.
+        Each step is clamped onto the ball of radius ``tol`` around the ORIGINAL point (ERRATA,
+        Eck & Hadenfeld); a point whose clamped move is ~0 is skipped. B-spline methods bound
+        control points, so the curve follows by the convex hull property; the Hermite methods
+        also check the whole curve with the certified bound of :func:`curvefair.deviation` and
+        shrink the moves where an interpolant bulges between its points (their option
+        ``tol_on="points"`` bounds only the data points, as the papers do).
     eps : float >= 0, optional
         Stop when the largest ranking measure is below ``eps``; ``0`` runs until ``max_steps``
         or until the tolerance blocks every move. Default: method-specific (relative to the

@@ -44,6 +44,13 @@ The loop (Wang & Cao 2006, "Algorithm", steps 1-6)
    Kjellander and Poliakoff keep the tangents).
 5. Repeat until the largest measure is below ``eps``, ``max_steps`` steps were made, or the
    tolerance/protection blocks every remaining move.
+6. Tolerance on the whole curve, not only on the data points: the loop keeps every data point
+   within ``tol`` of its original, but an interpolating spline can bulge between its points. If
+   the certified deviation bound of :func:`curvefair.deviation` exceeds ``tol``, the loop is run
+   again (at most twice) with the point tolerance shrunk by ``tol / deviation``, and if the
+   curve still strays, every move is scaled back by the common factor that brings the bound to
+   ``tol`` (the curve's change is linear in the moves; scaling back never raises the strain
+   energy above the start's). The report's ``curve_tolerance`` entry says what was done.
 
 Defaults: ``eps`` = 1e-2 x the initial largest measure for the cubic methods (third-derivative
 jump) and 1e-4 x for ``wang-quintic`` (an energy, quadratic in the move: the same 1 % in
@@ -281,21 +288,99 @@ def prepare(curve: HermiteSpline, *, method: str, tol: float | None, eps: float 
             K0, pe, q, fixed, Hinv, _W0[degree], _WMAX, _THR, measure, values, tv, ti,
             blocked, block_measure)
     return {"args": args, "extra": extra, "held": held, "eligible": eligible, "m0": m0,
+            "P0": P.copy(), "D0": D.copy(),
             "eps": eps_eff, "max_steps": max_eff, "n_elig": n_elig, "measure": measure,
             "P": P, "D": D, "spline": spline, "degree": degree, "nd": nd, "Hinv": Hinv}
 
 
+_CURVE_TOL_RERUNS = 2
+_SHRINK = 0.98
+
+
+def _curve_deviation(curve: HermiteSpline, P: FloatArray, D: FloatArray) -> float:
+    """Certified upper bound of ``max_t |curve(t) - new(t)|`` (Bernstein hull bound)."""
+    from ..analysis import deviation
+
+    return float(deviation(curve, rebuild(curve, P, D)).upper_bound)
+
+
+def _enforce_curve_tol(curve: HermiteSpline, st: dict[str, Any], tol: float,
+                       dev: float) -> tuple[float, float]:
+    """Make the whole output curve, not only its data points, stay within ``tol``.
+
+    The output differs from the (re-interpolated) start by ``s * (P - P0, D - D0)`` with
+    ``s = 1``; both the spline re-interpolation and the Hermite form are linear in the data, so
+    the curve's change scales with ``s`` exactly. If the certified deviation bound exceeds
+    ``tol``, ``s`` is reduced (closed form, then bisection if the start itself differs from the
+    input) until it does not. Scaling a move towards the start never raises the convex strain
+    energy above the start's. Updates ``st["P"]``, ``st["D"]`` in place; returns ``(s, bound)``.
+    """
+    if dev <= tol:
+        return 1.0, dev
+    P, D, P0, D0 = st["P"], st["D"], st["P0"], st["D0"]
+    dP, dD = P - P0, D - D0
+
+    def at(s: float) -> float:
+        return _curve_deviation(curve, P0 + s * dP, D0 + s * dD)
+
+    d0 = at(0.0)
+    if d0 > tol:
+        raise InputError(
+            f"re-interpolating the input already moves the curve by {d0:.6g} > tol = {tol:.6g}; "
+            "use mode='hermite' or an input that is already an interpolating spline")
+    s = (1.0 - 1e-9) * (tol - d0) / max(dev - d0, 1e-300)  # exact when d0 == 0
+    d = at(s)
+    if d > tol:  # the start differs from the input: bisect, keeping a feasible lower end
+        lo, hi, d = 0.0, s, d0
+        for _ in range(40):
+            mid = 0.5 * (lo + hi)
+            dm = at(mid)
+            if dm <= tol:
+                lo, d = mid, dm
+            else:
+                hi = mid
+            if hi - lo <= 1e-3 * hi:
+                break
+        s = lo
+    P[...] = P0 + s * dP
+    D[...] = D0 + s * dD
+    return float(s), float(d)
+
+
 def hermite_driver(curve: HermiteSpline, *, method: str, tol: float | None, eps: float | None,
                    max_steps: int | None, clamp: tuple[str, str], protect: frozenset[int],
-                   mode: str = "spline", **options: Any) -> DriverOutput:
-    """Driver of the four Hermite methods (see the module docstring); called by :func:`fair`."""
+                   mode: str = "spline", tol_on: str = "curve", **options: Any) -> DriverOutput:
+    """Driver of the four Hermite methods (see the module docstring); called by :func:`fair`.
+
+    ``tol_on="curve"`` (default) keeps the whole output curve within ``tol`` of the input
+    (step 6 of the module docstring); ``tol_on="points"`` bounds only the data points, as the
+    papers' loop does, and the curve may then bulge past ``tol`` between them.
+    """
     if options:
         raise InputError(f"method {method!r} got unknown options {sorted(options)}")
+    from .._validate import choice
+
+    choice(tol_on, ("curve", "points"), "tol_on")
     t0 = time.perf_counter()
-    st = prepare(curve, method=method, tol=tol, eps=eps, max_steps=max_steps, clamp=clamp,
-                 protect=protect, mode=mode)
-    (steps, stop, h_idx, h_meas, h_disp, blocked, n_trunc, n_skip,
-     max_window) = _k.drive(*st["args"])
+    kw = dict(method=method, eps=eps, max_steps=max_steps, clamp=clamp, protect=protect, mode=mode)
+    point_tol = tol
+    for attempt in range(_CURVE_TOL_RERUNS + 1):
+        st = prepare(curve, tol=point_tol, **kw)
+        (steps, stop, h_idx, h_meas, h_disp, blocked, n_trunc, n_skip,
+         max_window) = _k.drive(*st["args"])
+        if tol is None or tol_on == "points":
+            break
+        dev = _curve_deviation(curve, st["P"], st["D"])
+        if dev <= tol or attempt == _CURVE_TOL_RERUNS:
+            break
+        # the curve between the data points strays farther than the points: fair again with
+        # the points held proportionally closer (the curve change is linear in the moves)
+        point_tol = point_tol * _SHRINK * tol / dev
+    if tol is not None and tol_on == "curve":
+        scale, dev = _enforce_curve_tol(curve, st, tol, dev)
+        st["extra"]["curve_tolerance"] = {
+            "point_tol_used": float(point_tol), "reruns": attempt, "scale": scale,
+            "deviation_upper_bound": float(dev)}
     P, D, measure, eligible = st["P"], st["D"], st["measure"], st["eligible"]
     eps_eff, n_elig, spline, degree = st["eps"], st["n_elig"], st["spline"], st["degree"]
     extra, held, m0, Hinv, nd = st["extra"], st["held"], st["m0"], st["Hinv"], st["nd"]
