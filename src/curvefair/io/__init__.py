@@ -35,7 +35,7 @@ The record
 - ``corners``: indices of points to keep fixed (sharp corners, an airfoil's trailing edge):
   give them to the fairing as ``protect``.
 
-Corners: a point list turning by ``corner_angle`` degrees (default 60) or more at a point is
+Corners: a point list turning by ``corner_angle`` degrees (default 90) or more at a point is
 split into several records there, so that each record is smooth between its ends and the
 corner stays a corner; writing the records back joins the pieces again. Open airfoils also
 mark their first and last points (the trailing edge).
@@ -123,7 +123,7 @@ def _module(fmt: str) -> Any:
 
 
 def read_curves(path: str | os.PathLike[str], *, format: FormatName | None = None,
-                corner_angle: float | None = 60.0,
+                corner_angle: float | None = 90.0,
                 on_unsupported: Literal["raise", "skip"] = "raise") -> list[CurveRecord]:
     """Read every curve of a file.
 

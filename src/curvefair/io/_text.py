@@ -87,8 +87,10 @@ def format_number(v: float, tok: Token, column_decimals: int,
     1. ``decimals`` given: that many decimals, the token's style (fixed or exponent).
     2. The token's own number of decimals if that writes ``v`` exactly (untouched values come
        back character for character).
-    3. Otherwise the column's largest number of decimals in the file (the file's precision:
-       the value is rounded to it), or the shortest exact representation for integer columns.
+    3. Otherwise the column's largest number of decimals in the file if that writes ``v``
+       exactly, else the shortest representation that reads back as exactly ``v``. A faired
+       value is never rounded to the file's precision behind the user's back: rounding could
+       move a point past the fairing tolerance (pass ``decimals`` to round on purpose).
     """
     if decimals is not None:
         return _render(v, tok, int(decimals))
@@ -96,7 +98,9 @@ def format_number(v: float, tok: Token, column_decimals: int,
     if float(s) == v:
         return s
     if column_decimals > 0 or tok.exponent:
-        return _render(v, tok, max(column_decimals, 1))
+        s = _render(v, tok, max(column_decimals, 1))
+        if float(s) == v:
+            return s
     return _shortest(v)
 
 
