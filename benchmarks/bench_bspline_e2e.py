@@ -12,7 +12,7 @@ fairing.
 Peer, measured in the same run: csaps' cubic smoothing spline ``csaps(t, points.T, smooth=p)``,
 with ``p`` found by bisection so that ITS largest deviation from the data equals the largest
 deviation of the curvefair result ("equal maximum deviation"). Timed: one csaps fit at that
-``p`` (the bisection is reported separately).
+``p``, best of 3 (the bisection is reported separately).
 
 Reported per curve: time, largest deviation from the data at the data parameters, RMS
 deviation, ``E2 = int |r''|^2 dt``, ``E3 = int |r'''|^2 dt`` (exact, piecewise), curvature sign
@@ -137,9 +137,11 @@ def main() -> None:
         tb = time.perf_counter()
         p = csaps_matching(t, pts, target, args.bisect)
         t_bis = time.perf_counter() - tb
-        t0 = time.perf_counter()
-        spl = csaps_fit(t, pts, p)
-        t_cs = time.perf_counter() - t0
+        t_cs = np.inf
+        for _ in range(3):  # best of 3: the machine may be shared
+            t0 = time.perf_counter()
+            spl = csaps_fit(t, pts, p)
+            t_cs = min(t_cs, time.perf_counter() - t0)
         peers[name] = (t_cs, csaps_metrics(spl, t, pts), f"smooth={p:.6g}, bisection {t_bis:.1f}s")
 
     print(f"n = {args.n}, sigma = {args.sigma}, tol = {args.tol}, seed = {args.seed}")
