@@ -245,3 +245,19 @@ def test_protect_everything_and_stop_reasons():
     assert res.stop_reason == "eps"
     res = eck_hadenfeld_fair(c, eps=0.0, max_steps=7)
     assert res.stop_reason == "max_steps" and res.steps == 7
+
+
+@pytest.mark.parametrize("n", [4, 5, 6, 7])
+def test_small_closed_curves_wrap_onto_themselves(n):
+    # n < 2p + 1: a control point's band wraps onto itself; steps, ranking numbers and the
+    # loop must still be exact (dense quadrature reference)
+    rng = np.random.default_rng(n)
+    c = BSplineCurve(rng.normal(size=(n, 2)), np.r_[0, np.cumsum(rng.uniform(0.5, 1.5, n))], 3,
+                     closed=True)
+    e0 = quad_energy(c, 2)
+    z = ranking_numbers(c, 2)
+    for r in range(n):
+        assert abs(e0 - quad_energy(steps.eck_hadenfeld(c, r, 2), 2) - z[r]) <= 1e-12 * e0
+    res = eck_hadenfeld_fair(c, tol=0.1, eps=0.0, max_steps=500)
+    assert abs(res.energy_after - quad_energy(res.curve, 2)) <= 1e-12 * e0
+    assert np.linalg.norm(res.curve.control_points - c.control_points, axis=1).max() <= 0.1 + 1e-15
