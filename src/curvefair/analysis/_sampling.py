@@ -17,6 +17,7 @@ coefficients certify that no sign change hides between two samples, or locate it
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from functools import lru_cache
 from math import comb
@@ -41,6 +42,7 @@ QUAD_RTOL = 1e-9
 _MAX_SPLITS = 48
 _MAX_LEVELS = 10
 _FM = {"contract", "arcp", "reassoc"}
+_F32_MAX = 1e38
 
 # Gander & Gautschi (2000): 4-point Gauss-Lobatto and 7-point Kronrod extension on [-1, 1]
 _R23 = float(np.sqrt(2.0 / 3.0))
@@ -151,8 +153,8 @@ class Samples:
     """Output of :func:`sample_curve` (internal)."""
 
     x: FloatArray  # (K,) fractions
-    kappa: FloatArray  # (m, K)
-    dkds: FloatArray  # (m, K)
+    kappa: np.ndarray  # (m, K) float32 (clamped to +-1e38)
+    dkds: np.ndarray  # (m, K) float32
     arc_length: float
     dkds_energy: float
     arc_length_error: float
@@ -257,12 +259,13 @@ def _frenet_node(r1, r2, r3, sc1, sc2, speed_rtol, cross_rtol):  # type: ignore[
 
 
 @njit(cache=True, fastmath=_FM)
-def _pass_kernel(cw, h, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cross_rtol,
+def _pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cross_rtol,
                  closed, kap, dks, knots, energies, quad, box, ell, pos,
                  gaps):  # type: ignore[no-untyped-def]
     """One fused pass over the segments (see :func:`sample_curve`).
 
-    ``tab[nu-1, q, j] = j!/(j-nu)! x_q^(j-nu)`` (derivative ``nu`` of ``u^j`` at node ``q``),
+    ``x`` the node fractions, ``tab[nu-1, q, j] = j!/(j-nu)! x_q^(j-nu)`` (derivative ``nu``
+    of ``u^j`` at node ``q``),
     ``w7``/``w4`` the Kronrod/Lobatto weights of one piece on [0, 1], ``fall[j, nu] =
     j!/(j-nu)!``; ``fits[k]`` (K, dmax+1) maps sampled numerator values to Bernstein
     coefficients (``nfit[k]`` of them; 0: not wanted), ``subs[k]`` (K-1, K, dmax+1) the same
@@ -282,6 +285,11 @@ def _pass_kernel(cw, h, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cros
     r1 = np.empty(dim)
     r2 = np.empty(dim)
     r3 = np.empty(dim)
+    c1 = np.empty(dim)
+    c2 = np.empty(dim)
+    c3 = np.empty(dim)
+    b0 = np.empty(dim)
+    b1 = np.empty(dim)
     vals = np.empty((2, K))
     fa = np.empty(K)
     fd = np.empty(K)
@@ -291,6 +299,13 @@ def _pass_kernel(cw, h, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cros
     for d in range(dim):
         box[0, d] = cw[0, 0, d]
         box[1, d] = cw[0, 0, d]
+    ks_start = 0.0
+    ks_end = 0.0
+    ks_prev_end = 0.0
+    ks_first = 0.0
+    hilb = np.empty(2 * p1)
+    for j in range(2 * p1):
+        hilb[j] = 1.0 / (j + 1.0)
     nsing = 0
     maxk = 0.0
     maxks = 0.0
@@ -320,13 +335,16 @@ def _pass_kernel(cw, h, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cros
                         dd = 0.0
                         for d in range(dim):
                             dd += e[j + o, d] * e[k + o, d]
-                        acc += dd * fall[j + o, o] * fall[k + o, o] / (j + k + 1.0)
+                        acc += dd * fall[j + o, o] * fall[k + o, o] * hilb[j + k]
                 acc *= ih2 * ih2 if o == 2 else ih3 * ih3
             energies[i, o - 2] = acc * hi
         # jumps at breakpoint i of the third and the degree-th derivative; then the left
         # limits at this segment's end for breakpoint i + 1
         for slot in range(2):
             nu = 3 if slot == 0 else p
+            ihn = 1.0
+            for _ in range(nu):
+                ihn *= ih
             jj = 0.0
             for d in range(dim):
                 right = fall[nu, nu] * cw[i, nu, d] if nu <= p else 0.0
@@ -338,27 +356,45 @@ def _pass_kernel(cw, h, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cros
                 if nu <= p:
                     for j in range(nu, p1):
                         acc += fall[j, nu] * e[j, d]
-                endv[slot, d] = acc * ih ** nu
+                endv[slot, d] = acc * ihn
             knots[i, slot] = np.sqrt(jj) if i > 0 else 0.0
-        for qn in range(K):
+        if p1 == 4:  # cubic: derivative polynomials in u written out (the common case)
             for d in range(dim):
-                a1 = 0.0
-                a2 = 0.0
-                a3 = 0.0
-                for j in range(1, p1):
-                    a1 += tab[0, qn, j] * e[j, d]
-                    a2 += tab[1, qn, j] * e[j, d]
-                    a3 += tab[2, qn, j] * e[j, d]
-                r1[d] = a1 * ih
-                r2[d] = a2 * ih2
-                r3[d] = a3 * ih3
+                c1[d] = e[1, d] * ih
+                c2[d] = 2.0 * e[2, d] * ih
+                c3[d] = 3.0 * e[3, d] * ih
+                b0[d] = 2.0 * e[2, d] * ih2
+                b1[d] = 6.0 * e[3, d] * ih2
+                r3[d] = 6.0 * e[3, d] * ih3
+        for qn in range(K):
+            if p1 == 4:
+                u = x[qn]
+                for d in range(dim):
+                    r1[d] = c1[d] + u * (c2[d] + u * c3[d])
+                    r2[d] = b0[d] + u * b1[d]
+            else:
+                for d in range(dim):
+                    a1 = 0.0
+                    a2 = 0.0
+                    a3 = 0.0
+                    for j in range(1, p1):
+                        a1 += tab[0, qn, j] * e[j, d]
+                        a2 += tab[1, qn, j] * e[j, d]
+                        a3 += tab[2, qn, j] * e[j, d]
+                    r1[d] = a1 * ih
+                    r2[d] = a2 * ih2
+                    r3[d] = a3 * ih3
             k_, ks, sp, num, enum, sing = _frenet_node(r1, r2, r3, sc1, sc2, speed_rtol,
                                                        cross_rtol)
             vals[0, qn] = num
             vals[1, qn] = enum
             nsing += sing
-            kap[i, qn] = k_
-            dks[i, qn] = ks
+            # stored in float32 (sign and rough size are all the counts need), clamped
+            kap[i, qn] = min(max(k_, -_F32_MAX), _F32_MAX)
+            dks[i, qn] = min(max(ks, -_F32_MAX), _F32_MAX)
+            if qn == 0:
+                ks_start = ks
+            ks_end = ks
             ak = abs(k_)
             aks = abs(ks)
             if ak > maxk:
@@ -391,18 +427,57 @@ def _pass_kernel(cw, h, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cros
         quad[i, 1] = ea * sw
         quad[i, 2] = qd * sw
         quad[i, 3] = ed * sw
-        knots[i, 2] = abs(dks[i, 0] - dks[i - 1, K - 1]) if i > 0 else 0.0
+        knots[i, 2] = abs(ks_start - ks_prev_end) if i > 0 else 0.0
+        if i == 0:
+            ks_first = ks_start
+        ks_prev_end = ks_end
         # certificate: can a sign change of N (E) hide between two samples?
         for which in range(2):
             nb = nfit[which]
             if nb == 0:
                 continue
+            if which == 0 and p1 == 4 and dim == 2:
+                # planar cubic: N is a quadratic n0 + n1 u + n2 u^2 (its cubic term cancels);
+                # a hidden pair of roots straddles its vertex, inside one gap
+                n1 = c1[0] * b1[1] + c2[0] * b0[1] - c1[1] * b1[0] - c2[1] * b0[0]
+                n2 = c2[0] * b1[1] + c3[0] * b0[1] - c2[1] * b1[0] - c3[1] * b0[0]
+                if n2 != 0.0:
+                    us = -0.5 * n1 / n2
+                    if 0.0 < us < 1.0:
+                        gq = 0
+                        while gq < K - 2 and x[gq + 1] <= us:
+                            gq += 1
+                        n0 = c1[0] * b0[1] - c1[1] * b0[0]
+                        nv = n0 + us * (n1 + us * n2)
+                        if nv * vals[0, gq] < 0.0 and nv * vals[0, gq + 1] < 0.0:
+                            if ngap < gaps.shape[0]:
+                                gaps[ngap, 0] = 0
+                                gaps[ngap, 1] = i
+                                gaps[ngap, 2] = gq
+                            ngap += 1
+                continue
+            # Bernstein sign variations of the polynomial vs those of its samples
+            vb = 0
+            lastb = 0.0
             for c in range(nb):
                 acc = 0.0
                 for qn in range(K):
                     acc += vals[which, qn] * fits[which, qn, c]
-                bb[c] = acc
-            if _variations_1d(bb, nb) <= _variations_1d(vals[which], K):
+                if acc != 0.0:
+                    if lastb * acc < 0.0:
+                        vb += 1
+                    lastb = acc
+            if vb == 0:
+                continue
+            vs = 0
+            lasts = 0.0
+            for qn in range(K):
+                v = vals[which, qn]
+                if v != 0.0:
+                    if lasts * v < 0.0:
+                        vs += 1
+                    lasts = v
+            if vb <= vs:
                 continue
             for gq in range(K - 1):
                 for c in range(nb):
@@ -423,7 +498,7 @@ def _pass_kernel(cw, h, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cros
                 diff = first[slot, d] - endv[slot, d]
                 jj += diff * diff
             knots[0, slot] = np.sqrt(jj)
-        knots[0, 2] = abs(dks[0, 0] - dks[m - 1, K - 1])
+        knots[0, 2] = abs(ks_first - ks_prev_end)
     # the end point of the last segment
     for d in range(dim):
         acc = 0.0
@@ -437,9 +512,10 @@ def _pass_kernel(cw, h, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cros
 
 
 @njit(cache=True)
-def _allowances(quad, h, rtol, allow, worst):  # type: ignore[no-untyped-def]
+def _allowances(quad, h, rtol, allow, worst, hist):  # type: ignore[no-untyped-def]
     """Error allowance of each segment for the arc length and the dkds energy:
-    ``rtol (|Q_i| + |total| h_i / sum h)``; ``worst`` = largest estimate / allowance ratio.
+    ``rtol (|Q_i| + |total| h_i / sum h)``; ``worst`` = largest estimate / allowance ratio;
+    ``hist[k]`` counts the segments with ``2^k < worst <= 2^(k+1)`` (k capped at 63).
     Returns the number of segments over their allowance."""
     m = quad.shape[0]
     ta = 0.0
@@ -463,20 +539,21 @@ def _allowances(quad, h, rtol, allow, worst):  # type: ignore[no-untyped-def]
         worst[i] = w
         if w > 1.0:
             n += 1
+            k = 63 if not w < 2.0**63 else math.frexp(w)[1] - 1
+            hist[k] += 1
     return n
 
 
 @njit(cache=True, fastmath=_FM)
-def _refine_kernel(cw, h, segs, base, allow, P, xk, w7, fall, speed_rtol, cross_rtol,
-                   max_levels, budget, out):  # type: ignore[no-untyped-def]
-    """Adaptive re-integration of the segments ``segs`` (worst first).
+def _refine_kernel(cw, h, quad, allow, worst, thresh, P, xk, w7, fall, speed_rtol,
+                   cross_rtol, max_levels, budget):  # type: ignore[no-untyped-def]
+    """Adaptive re-integration, in place, of the segments with ``worst > thresh``.
 
     Level ``L`` integrates segment ``i`` with the 7-point rule on ``P 2^L`` equal pieces; it
-    stops when both integrals changed by at most ``allow[n, 0/1]`` from the previous level
-    (level 0: ``base[n]`` from the pass), at ``max_levels``, or when the work budget (pieces)
-    is spent. ``base`` and ``out`` rows: (arc length, its error estimate, dkds energy, its
-    error estimate); rows left when the budget is spent are copied from ``base``. Returns the
-    pieces used.
+    stops when both integrals changed by at most ``allow[i, 0/1]`` from the previous level
+    (level 0: the pass's values in ``quad[i]``), at ``max_levels``, or when the work budget
+    (pieces) is spent. ``quad`` rows: (arc length, its error estimate, dkds energy, its error
+    estimate). Returns the pieces used.
     """
     m, p1, dim = cw.shape
     e = np.empty((p1, dim))
@@ -484,16 +561,18 @@ def _refine_kernel(cw, h, segs, base, allow, P, xk, w7, fall, speed_rtol, cross_
     r2 = np.empty(dim)
     r3 = np.empty(dim)
     used = 0
-    for n in range(segs.shape[0]):
-        i = segs[n]
+    for i in range(m):
+        if not worst[i] > thresh:
+            continue
+        if used + (P << 1) > budget:
+            break
         hi = h[i]
         ih = 1.0 / hi
         sc1, sc2 = _setup(cw, i, hi, fall, e)
-        prev_a = base[n, 0]
-        err_a = base[n, 1]
-        prev_d = base[n, 2]
-        err_d = base[n, 3]
-        done = False
+        prev_a = quad[i, 0]
+        err_a = quad[i, 1]
+        prev_d = quad[i, 2]
+        err_d = quad[i, 3]
         for lev in range(1, max_levels + 1):
             npc = P << lev
             if used + npc > budget:
@@ -528,18 +607,12 @@ def _refine_kernel(cw, h, segs, base, allow, P, xk, w7, fall, speed_rtol, cross_
             err_d = abs(qd - prev_d)
             prev_a = qa
             prev_d = qd
-            if err_a <= allow[n, 0] and err_d <= allow[n, 1]:
-                done = True
+            if err_a <= allow[i, 0] and err_d <= allow[i, 1]:
                 break
-        out[n, 0] = prev_a
-        out[n, 1] = err_a
-        out[n, 2] = prev_d
-        out[n, 3] = err_d
-        if not done and used + (P << 1) > budget:
-            for r in range(n + 1, segs.shape[0]):
-                for c in range(4):
-                    out[r, c] = base[r, c]
-            break
+        quad[i, 0] = prev_a
+        quad[i, 1] = err_a
+        quad[i, 2] = prev_d
+        quad[i, 3] = err_d
     return used
 
 
@@ -617,7 +690,7 @@ def sample_curve(cw: FloatArray, h: FloatArray, planar: bool, closed: bool,
     no temporaries of the sample grid's size besides the two results), then adaptive
     re-integration of the segments whose error estimate exceeds ``rtol`` (relative, with an
     equal share of ``rtol`` times the total per unit parameter length), worst first, within a
-    budget of ``max(200000, m / 4)`` pieces of 7 nodes.
+    budget of ``max(200000, m / 8)`` pieces of 7 nodes.
     """
     m, p1, dim = cw.shape
     p = p1 - 1
@@ -637,8 +710,8 @@ def sample_curve(cw: FloatArray, h: FloatArray, planar: bool, closed: bool,
     for j in range(p1):
         for nu in range(j + 1):
             fall[j, nu] = falling(j, nu)[0]
-    kap = np.empty((m, K))
-    dks = np.empty((m, K))
+    kap = np.empty((m, K), dtype=np.float32)
+    dks = np.empty((m, K), dtype=np.float32)
     knots = np.empty((m, 3))
     energies = np.empty((m, 2))
     quad = np.empty((m, 4))
@@ -650,30 +723,27 @@ def sample_curve(cw: FloatArray, h: FloatArray, planar: bool, closed: bool,
     gaps = np.empty((max(1 << 12, m // 4), 3), dtype=np.int64)
     while True:
         nsing, maxk, maxks, ngap = _pass_kernel(
-            cwc, hc, plan.tab, plan.w7, plan.w4, plan.P, fall, fits, nfit, subs, SPEED_RTOL,
+            cwc, hc, plan.x, plan.tab, plan.w7, plan.w4, plan.P, fall, fits, nfit, subs, SPEED_RTOL,
             CROSS_RTOL, bool(closed), kap, dks, knots, energies, quad, box, ell, pos, gaps)
         if ngap <= gaps.shape[0]:
             break
         gaps = np.empty((ngap, 3), dtype=np.int64)  # rare: the buffer was too small; redo
 
-    # adaptive quadrature where the 7-point/4-point estimate is too large
+    # adaptive quadrature where the 7-point/4-point estimate is too large: the worst segments
+    # (a power-of-two threshold on estimate/allowance chosen so that their first refinement
+    # level fits the budget), in curve order
     allow = np.empty((m, 2))
     worst = np.empty(m)
-    nbad = _allowances(quad, hc, float(rtol), allow, worst)
+    hist = np.zeros(64, dtype=np.int64)
+    nbad = _allowances(quad, hc, float(rtol), allow, worst, hist)
     if nbad:
-        budget = max(200_000, m // 4)
-        bad = np.flatnonzero(worst > 1.0)
-        worst = worst[bad]
+        budget = max(200_000, m // 8)
         top = budget // (2 * plan.P)  # at most this many segments get even one level
-        if bad.size > top:
-            keep = np.argpartition(-worst, top)[:top]
-            bad, worst = bad[keep], worst[keep]
-        bad = bad[np.argsort(-worst, kind="stable")]
-        out = np.empty((bad.size, 4))
-        _refine_kernel(cwc, hc, bad, np.ascontiguousarray(quad[bad]),
-                       np.ascontiguousarray(allow[bad]), plan.P, plan.xk, plan.w7, fall,
-                       SPEED_RTOL, CROSS_RTOL, _MAX_LEVELS, budget, out)
-        quad[bad] = out
+        above = np.cumsum(hist[::-1])[::-1]  # above[k]: segments with worst > 2^k
+        k = int(np.argmax(above <= top)) if above[0] > top else 0
+        thresh = 1.0 if k == 0 else float(2.0**k)
+        _refine_kernel(cwc, hc, quad, allow, worst, thresh, plan.P, plan.xk, plan.w7, fall,
+                       SPEED_RTOL, CROSS_RTOL, _MAX_LEVELS, budget)
 
     refined = _refine_gaps(cw, h, plan, gaps[:ngap])
     extra = []
@@ -709,9 +779,6 @@ def _scan_kernel(vals, x, breaks, ex_seg, ex_u, ex_val, tol, ell, pos, floor, po
     first_t = 0.0
     first_v = 0.0
     for i in range(m):
-        t0 = breaks[i]
-        hw = breaks[i + 1] - t0
-        q = 0
         tl = tol
         li = ell[i]
         if li > 0.0:
@@ -722,6 +789,34 @@ def _scan_kernel(vals, x, breaks, ex_seg, ex_u, ex_val, tol, ell, pos, floor, po
                 tl = fl
         while e < ne and ex_seg[e] < i:
             e += 1
+        has_extra = e < ne and ex_seg[e] == i
+        if not has_extra:
+            # fast path: no sign change within the segment's interior unless the samples show
+            # one; positions are only needed where a change happens
+            for q in range(K):
+                v = float(vals[i, q])
+                if v > tl:
+                    s = 1
+                elif v < -tl:
+                    s = -1
+                else:
+                    continue
+                if s != last_s:
+                    t = breaks[i] + (breaks[i + 1] - breaks[i]) * x[q]
+                    if last_s == 0:
+                        first_s = s
+                        first_t = t
+                        first_v = v
+                    else:
+                        out[n] = last_t + (t - last_t) * (last_v / (last_v - v))
+                        n += 1
+                    last_s = s
+                last_t = breaks[i] + (breaks[i + 1] - breaks[i]) * x[q]
+                last_v = v
+            continue
+        t0 = breaks[i]
+        hw = breaks[i + 1] - t0
+        q = 0
         while q < K or (e < ne and ex_seg[e] == i):
             if e < ne and ex_seg[e] == i and (q >= K or ex_u[e] < x[q]):
                 u = ex_u[e]
@@ -729,7 +824,7 @@ def _scan_kernel(vals, x, breaks, ex_seg, ex_u, ex_val, tol, ell, pos, floor, po
                 e += 1
             else:
                 u = x[q]
-                v = vals[i, q]
+                v = float(vals[i, q])
                 q += 1
             if v > tl:
                 s = 1
