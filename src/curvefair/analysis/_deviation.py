@@ -118,7 +118,7 @@ def _de_casteljau_split(b: FloatArray) -> tuple[FloatArray, FloatArray]:
     return left, right
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _first_pass(d, w, M, U):  # type: ignore[no-untyped-def]
     """Per piece: ``U[i]`` = max norm of the Bernstein control points of ``d`` on piece ``i``
     (``M`` maps scaled power coefficients to Bernstein ones); returns the largest sampled

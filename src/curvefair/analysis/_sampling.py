@@ -171,7 +171,7 @@ class Samples:
 
 
 # -- compiled kernels ----------------------------------------------------------------------------
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _variations_1d(b, n):  # type: ignore[no-untyped-def]
     """Sign changes (zeros skipped) of ``b[:n]``."""
     v = 0
@@ -191,7 +191,7 @@ def _variations_1d(b, n):  # type: ignore[no-untyped-def]
     return v
 
 
-@njit(cache=True, fastmath=_FM, inline="always")
+@njit(cache=True, fastmath=_FM, inline="always", error_model="numpy")
 def _setup(cw, i, hi, fall, e):  # type: ignore[no-untyped-def]
     """Scaled coefficients ``e_j = c_j h^j`` of segment ``i`` and the sizes of its first and
     second derivative polynomials (for the zero-speed and zero-curvature tests)."""
@@ -215,7 +215,7 @@ def _setup(cw, i, hi, fall, e):  # type: ignore[no-untyped-def]
     return sc1 * ih, sc2 * ih * ih
 
 
-@njit(cache=True, fastmath=_FM, inline="always")
+@njit(cache=True, fastmath=_FM, inline="always", error_model="numpy")
 def _frenet_node(r1, r2, r3, sc1, sc2, speed_rtol, cross_rtol):  # type: ignore[no-untyped-def]
     """``(kappa, dkds, speed, N, E, singular)`` at one node (see ``_core.frenet``)."""
     dim = r1.shape[0]
@@ -258,7 +258,7 @@ def _frenet_node(r1, r2, r3, sc1, sc2, speed_rtol, cross_rtol):  # type: ignore[
     return k_, ks, sp, num, enum, singular
 
 
-@njit(cache=True, fastmath=_FM)
+@njit(cache=True, fastmath=_FM, error_model="numpy")
 def _pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cross_rtol,
                  closed, kap, dks, knots, energies, quad, box, ell, pos,
                  gaps):  # type: ignore[no-untyped-def]
@@ -293,6 +293,7 @@ def _pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, c
     vals = np.empty((2, K))
     fa = np.empty(K)
     fd = np.empty(K)
+    ksa = np.empty(K)
     bb = np.empty(fits.shape[2])
     endv = np.zeros((2, dim))  # left limits at the previous segment's end
     first = np.zeros((2, dim))  # right limits at the first segment's start
@@ -366,43 +367,79 @@ def _pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, c
                 b0[d] = 2.0 * e[2, d] * ih2
                 b1[d] = 6.0 * e[3, d] * ih2
                 r3[d] = 6.0 * e[3, d] * ih3
-        for qn in range(K):
-            if p1 == 4:
+        if p1 == 4 and dim == 2:
+            # planar cubic, written branch-free so that the node loops vectorise; the same
+            # formulas as _frenet_node
+            thr = speed_rtol * sc1
+            for qn in range(K):
                 u = x[qn]
-                for d in range(dim):
-                    r1[d] = c1[d] + u * (c2[d] + u * c3[d])
-                    r2[d] = b0[d] + u * b1[d]
-            else:
-                for d in range(dim):
-                    a1 = 0.0
-                    a2 = 0.0
-                    a3 = 0.0
-                    for j in range(1, p1):
-                        a1 += tab[0, qn, j] * e[j, d]
-                        a2 += tab[1, qn, j] * e[j, d]
-                        a3 += tab[2, qn, j] * e[j, d]
-                    r1[d] = a1 * ih
-                    r2[d] = a2 * ih2
-                    r3[d] = a3 * ih3
-            k_, ks, sp, num, enum, sing = _frenet_node(r1, r2, r3, sc1, sc2, speed_rtol,
-                                                       cross_rtol)
-            vals[0, qn] = num
-            vals[1, qn] = enum
-            nsing += sing
-            # stored in float32 (sign and rough size are all the counts need), clamped
-            kap[i, qn] = min(max(k_, -_F32_MAX), _F32_MAX)
-            dks[i, qn] = min(max(ks, -_F32_MAX), _F32_MAX)
-            if qn == 0:
-                ks_start = ks
-            ks_end = ks
-            ak = abs(k_)
-            aks = abs(ks)
-            if ak > maxk:
-                maxk = ak
-            if aks > maxks:
-                maxks = aks
-            fa[qn] = sp
-            fd[qn] = ks * ks * sp
+                X1 = c1[0] + u * (c2[0] + u * c3[0])
+                Y1 = c1[1] + u * (c2[1] + u * c3[1])
+                X2 = b0[0] + u * b1[0]
+                Y2 = b0[1] + u * b1[1]
+                s2 = X1 * X1 + Y1 * Y1
+                num = X1 * Y2 - Y1 * X2
+                num1 = X1 * r3[1] - Y1 * r3[0]
+                vals[0, qn] = num
+                vals[1, qn] = num1 * s2 - 3.0 * num * (X1 * X2 + Y1 * Y2)
+                fa[qn] = np.sqrt(s2)
+                fd[qn] = s2
+            for qn in range(K):
+                s2 = fd[qn]
+                sp = fa[qn]
+                inv = 1.0 / s2
+                k_ = vals[0, qn] * inv / sp
+                ks = vals[1, qn] * (inv * inv) * inv
+                good = (sp > thr) and (abs(k_) < np.inf) and (abs(ks) < np.inf)
+                k_ = k_ if good else 0.0
+                ks = ks if good else 0.0
+                nsing += not good
+                kap[i, qn] = min(max(k_, -_F32_MAX), _F32_MAX)
+                dks[i, qn] = min(max(ks, -_F32_MAX), _F32_MAX)
+                maxk = max(maxk, abs(k_))
+                maxks = max(maxks, abs(ks))
+                ksa[qn] = ks
+                fd[qn] = ks * ks * sp
+            ks_start = ksa[0]
+            ks_end = ksa[K - 1]
+        else:
+            for qn in range(K):
+                if p1 == 4:
+                    u = x[qn]
+                    for d in range(dim):
+                        r1[d] = c1[d] + u * (c2[d] + u * c3[d])
+                        r2[d] = b0[d] + u * b1[d]
+                else:
+                    for d in range(dim):
+                        a1 = 0.0
+                        a2 = 0.0
+                        a3 = 0.0
+                        for j in range(1, p1):
+                            a1 += tab[0, qn, j] * e[j, d]
+                            a2 += tab[1, qn, j] * e[j, d]
+                            a3 += tab[2, qn, j] * e[j, d]
+                        r1[d] = a1 * ih
+                        r2[d] = a2 * ih2
+                        r3[d] = a3 * ih3
+                k_, ks, sp, num, enum, sing = _frenet_node(r1, r2, r3, sc1, sc2, speed_rtol,
+                                                           cross_rtol)
+                vals[0, qn] = num
+                vals[1, qn] = enum
+                nsing += sing
+                # stored in float32 (sign and rough size are all the counts need), clamped
+                kap[i, qn] = min(max(k_, -_F32_MAX), _F32_MAX)
+                dks[i, qn] = min(max(ks, -_F32_MAX), _F32_MAX)
+                if qn == 0:
+                    ks_start = ks
+                ks_end = ks
+                ak = abs(k_)
+                aks = abs(ks)
+                if ak > maxk:
+                    maxk = ak
+                if aks > maxks:
+                    maxks = aks
+                fa[qn] = sp
+                fd[qn] = ks * ks * sp
         # 7-point Kronrod and 4-point Lobatto on each of the P pieces
         qa = 0.0
         ea = 0.0
@@ -511,7 +548,7 @@ def _pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, c
     return nsing, maxk, maxks, ngap
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _allowances(quad, h, rtol, allow, worst, hist):  # type: ignore[no-untyped-def]
     """Error allowance of each segment for the arc length and the dkds energy:
     ``rtol (|Q_i| + |total| h_i / sum h)``; ``worst`` = largest estimate / allowance ratio;
@@ -544,7 +581,7 @@ def _allowances(quad, h, rtol, allow, worst, hist):  # type: ignore[no-untyped-d
     return n
 
 
-@njit(cache=True, fastmath=_FM)
+@njit(cache=True, fastmath=_FM, error_model="numpy")
 def _refine_kernel(cw, h, quad, allow, worst, thresh, P, xk, w7, fall, speed_rtol,
                    cross_rtol, max_levels, budget):  # type: ignore[no-untyped-def]
     """Adaptive re-integration, in place, of the segments with ``worst > thresh``.
@@ -765,7 +802,7 @@ def sample_curve(cw: FloatArray, h: FloatArray, planar: bool, closed: bool,
                    pos=pos, extra=(extra[0], extra[1]))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _scan_kernel(vals, x, breaks, ex_seg, ex_u, ex_val, tol, ell, pos, floor, power,
                  out):  # type: ignore[no-untyped-def]
     m, K = vals.shape
