@@ -1,5 +1,5 @@
 """Shared machinery of the analysis functions: input checks, locating parameters, local
-derivatives, the Frenet quantities and per-segment polynomial algebra.
+derivatives, the Frenet quantities and Bernstein/Taylor helpers.
 
 Everything works on the local power form ``r(t) = sum_j c[i, j] (t - t_i)**j`` of
 :attr:`curvefair.PiecewiseCurve.piecewise`, vectorised over segments and samples.
@@ -188,30 +188,6 @@ def _cross(a: Sequence[FloatArray], b: Sequence[FloatArray]) -> list[FloatArray]
 
 
 # -- per-segment polynomial algebra --------------------------------------------------------------
-def pmul(a: FloatArray, b: FloatArray) -> FloatArray:
-    """Product of per-segment polynomials: ``a`` (m, na), ``b`` (m, nb) -> (m, na+nb-1)."""
-    out = np.zeros((a.shape[0], a.shape[1] + b.shape[1] - 1))
-    for i in range(a.shape[1]):
-        out[:, i:i + b.shape[1]] += a[:, i:i + 1] * b
-    return out
-
-
-def padd(*polys: FloatArray) -> FloatArray:
-    """Sum of per-segment polynomials of possibly different lengths."""
-    n = max(p.shape[1] for p in polys)
-    out = np.zeros((polys[0].shape[0], n))
-    for p in polys:
-        out[:, :p.shape[1]] += p
-    return out
-
-
-def pder(a: FloatArray) -> FloatArray:
-    """Derivative of per-segment polynomials ``a`` (m, n) -> (m, max(n-1, 1))."""
-    if a.shape[1] == 1:
-        return np.zeros_like(a)
-    return a[:, 1:] * np.arange(1, a.shape[1], dtype=float)[None, :]
-
-
 def bernstein_matrix(d: int) -> FloatArray:
     """``M`` with ``b = M q``: power coefficients ``q`` on [0, 1] -> Bernstein coefficients."""
     M = np.zeros((d + 1, d + 1))
@@ -232,21 +208,6 @@ def to_bernstein(poly: FloatArray, h: FloatArray) -> FloatArray:
         q = poly * hp[:, :, None]
         return np.einsum("ik,mkd->mid", bernstein_matrix(d), q)
     return (poly * hp) @ bernstein_matrix(d).T
-
-
-def sign_variations(b: FloatArray) -> np.ndarray:
-    """Number of sign changes (zeros skipped) along axis 1 of ``b`` (m, n)."""
-    sg = np.sign(b)
-    nz = sg != 0
-    if nz.all():
-        return np.count_nonzero(sg[:, 1:] != sg[:, :-1], axis=1)
-    # forward-fill zeros with the previous non-zero sign
-    idx = np.where(nz, np.arange(sg.shape[1])[None, :], 0)
-    np.maximum.accumulate(idx, axis=1, out=idx)
-    filled = np.take_along_axis(sg, idx, axis=1)
-    prev = filled[:, :-1]
-    cur = sg[:, 1:]
-    return np.count_nonzero((cur != 0) & (prev != 0) & (cur != prev), axis=1)
 
 
 def taylor_shift(coeffs: FloatArray, delta: FloatArray) -> FloatArray:
@@ -273,16 +234,3 @@ def bounding_diagonal(pp: PiecewisePolynomial) -> float:
     return float(np.sqrt(np.sum((hi - lo) ** 2)))
 
 
-def lobatto(n: int) -> tuple[FloatArray, FloatArray]:
-    """Gauss-Lobatto nodes and weights on [0, 1] with ``n`` points (both ends included).
-
-    Exact for polynomials of degree ``2n - 3``.
-    """
-    from numpy.polynomial import legendre as L
-
-    c = np.zeros(n)
-    c[-1] = 1.0  # P_{n-1}
-    inner = np.sort(L.legroots(L.legder(c)))
-    x = np.concatenate([[-1.0], inner, [1.0]])
-    w = 2.0 / (n * (n - 1) * L.legval(x, c) ** 2)
-    return 0.5 * (x + 1.0), 0.5 * w
