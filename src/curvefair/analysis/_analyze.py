@@ -217,17 +217,19 @@ def analyze(curve: object, *, quad_rtol: float = QUAD_RTOL) -> Analysis:
     by the general formula of :func:`curvefair.analysis.curvature_derivative`. For a planar C2
     cubic it equals ``|r' x jump(r''')| / |r'|^4``.
 
-    **Sampling.** Every segment is cut into ``P`` equal pieces (``P = 1`` for planar cubics;
-    more for higher degrees and twisted 3-D curves, see below) and each piece is sampled at the
+    **Sampling.** Every segment is cut into ``P`` equal pieces and each piece is sampled at the
     7 nodes of the Gauss-Kronrod-Lobatto pair of Gander & Gautschi (2000), both ends included,
-    so both one-sided limits at every knot are samples.
+    so both one-sided limits at every knot are samples. ``P`` is the smallest number for which
+    the ``6P + 1`` nodes exceed the degrees of the sign polynomials below (``P = 1`` for
+    planar cubics, 2 for twisted cubics, 3 for planar and 4 for twisted quintics).
 
     **Quadratures.** ``arc_length = int |r'| dt`` and ``dkds_energy = int kappa_s^2 |r'| dt``
     use the 7-point Kronrod rule on each piece (exact for degree 9); the difference to the
     embedded 4-point Lobatto rule is a (pessimistic) error estimate. Segments whose estimate
     exceeds ``quad_rtol * (|Q_i| + |total| h_i / (t_end - t_start))`` are integrated again on
     2, 4, ..., 1024 times as many pieces until two levels agree to that allowance, worst
-    segments first, within a budget of ``max(200000, m/8)`` pieces. The reported
+    segments first (those whose estimate/allowance ratio exceeds a power of two chosen to fit
+    the budget), within a budget of ``max(200000, m/8)`` pieces. The reported
     ``arc_length_error`` and ``dkds_energy_error`` are the sums of the final per-segment
     estimates. Typical results (tested against ``scipy.integrate.quad``): relative error
     1e-13..1e-10 for arc length, 1e-12..1e-8 for ``dkds_energy`` on planar curves; in 3-D
@@ -258,7 +260,8 @@ def analyze(curve: object, *, quad_rtol: float = QUAD_RTOL) -> Analysis:
        where their Bernstein coefficients on the segment vary in sign more often than the
        samples do, the gaps between samples are halved (de Casteljau) until each piece's
        coefficients vary at most once, and the split points become extra samples: then every
-       sign change of the polynomial shows in the sample sequence (up to rounding).
+       sign change of the polynomial shows in the sample sequence (up to rounding). For a
+       planar cubic ``N`` is a quadratic and the check is its vertex.
 
     Limitation of the noise band: an excursion beyond the band that is narrower than the
     sample spacing while all its samples lie inside the band is not counted; this only
