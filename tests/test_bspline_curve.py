@@ -196,7 +196,7 @@ def test_fit_least_squares_optimal():
 # -- Gram matrices -------------------------------------------------------------------------
 @pytest.mark.parametrize("closed", [False, True])
 @pytest.mark.parametrize("p,l", [(3, 2), (3, 3), (4, 2), (5, 3), (2, 2)])
-def test_gram_matches_dense_quadrature(closed, p, l):
+def test_gram_matches_dense_quadrature(closed, p, l):  # noqa: E741
     rng = np.random.default_rng(100 + p + l)
     c = _random_closed(rng, 9, p) if closed else _random_open(rng, 9, p, repeat=False)
     G = c.gram_matrix(l).toarray()

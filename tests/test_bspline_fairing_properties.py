@@ -56,7 +56,7 @@ def run(method, curve, tol, clamp):
     return global_fair(curve, tol=tol, clamp=clamp).curve
 
 
-def energy(curve, l=2):
+def energy(curve, l=2):  # noqa: E741
     G = energy_matrix(curve, l)
     d = np.asarray(curve.control_points)
     return float(np.sum(d * (G @ d)))
@@ -74,11 +74,11 @@ def test_tolerance_energy_clamps(case):
     assert np.linalg.norm(out(u) - curve(u), axis=1).max() <= tol * (1 + 1e-12)
     # the minimisers never raise the energy they minimise
     if method.startswith("eh") or method == "global":
-        l = 3 if method == "eh3" else 2
+        l = 3 if method == "eh3" else 2  # noqa: E741
         assert energy(out, l) <= energy(curve, l) * (1 + 1e-12)
     # clamped ends: position, tangent, curvature vector kept as the clamp says
     if not curve.closed:
-        for end, c in zip(curve.domain, clamp):
+        for end, c in zip(curve.domain, clamp, strict=True):
             for nu in range(CLAMPS[c]):
                 ref = curve(end, nu)
                 assert np.abs(out(end, nu) - ref).max() <= 1e-12 * max(1.0, np.abs(ref).max())

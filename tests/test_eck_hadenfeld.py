@@ -22,7 +22,7 @@ from curvefair.fairing.eck_hadenfeld import (
 )
 
 
-def quad_energy(curve: BSplineCurve, l: int, nq: int = 10) -> float:
+def quad_energy(curve: BSplineCurve, l: int, nq: int = 10) -> float:  # noqa: E741
     """int |r^(l)|^2 dt by Gauss-Legendre on every knot span, evaluated with scipy."""
     spl = curve.to_scipy()
     t = np.unique(curve.knots[curve.degree:len(curve.knots) - curve.degree])
@@ -49,7 +49,7 @@ def test_uniform_cubic_weights_match_published(closed):
     # Eck & Hadenfeld / ERRATA: l=2: (-1, 0, 9, *, 9, 0, -1)/16; l=3: (1, -6, 15, *, 15, -6, 1)/20
     c = random_curve(np.random.default_rng(0), n=15, closed=closed, uniform=True)
     r = 7
-    for l, ref in [(2, np.array([-1, 0, 9, 9, 0, -1]) / 16),
+    for l, ref in [(2, np.array([-1, 0, 9, 9, 0, -1]) / 16),  # noqa: E741
                    (3, np.array([1, -6, 15, 15, -6, 1]) / 20)]:
         idx, g = eh_weights(c, r, l)
         assert idx.tolist() == [4, 5, 6, 8, 9, 10]
@@ -58,7 +58,7 @@ def test_uniform_cubic_weights_match_published(closed):
 
 @pytest.mark.parametrize("p,l", [(2, 2), (3, 2), (3, 3), (4, 2), (4, 3), (5, 3)])
 @pytest.mark.parametrize("closed", [False, True])
-def test_gammas_sum_to_one(p, l, closed):
+def test_gammas_sum_to_one(p, l, closed):  # noqa: E741
     rng = np.random.default_rng(10 * p + l + closed)
     c = random_curve(rng, n=13, p=p, closed=closed)
     for r in range(c.n_ctrl):
@@ -70,7 +70,7 @@ def test_gammas_sum_to_one(p, l, closed):
 # -- one step ------------------------------------------------------------------------------
 @pytest.mark.parametrize("closed", [False, True])
 @pytest.mark.parametrize("p,l", [(3, 2), (3, 3), (4, 2), (5, 3)])
-def test_step_is_exact_minimiser(closed, p, l):
+def test_step_is_exact_minimiser(closed, p, l):  # noqa: E741
     rng = np.random.default_rng(p * 7 + l + 3 * closed)
     c = random_curve(rng, n=11, p=p, closed=closed)
     for r in [0, 4, c.n_ctrl - 1]:
@@ -80,7 +80,7 @@ def test_step_is_exact_minimiser(closed, p, l):
 
         e0 = quad_energy(c, l)
 
-        def f(x, r=r):
+        def f(x, r=r, e0=e0):
             d = np.array(c.control_points)
             d[r] = x
             return quad_energy(c.replace(control_points=d), l) / e0
@@ -109,7 +109,7 @@ def test_step_affine_combination_of_neighbours():
 
 @pytest.mark.parametrize("closed", [False, True])
 @pytest.mark.parametrize("l", [2, 3])
-def test_ranking_number_is_exact_energy_drop(closed, l):
+def test_ranking_number_is_exact_energy_drop(closed, l):  # noqa: E741
     rng = np.random.default_rng(20 + l + closed)
     c = random_curve(rng, n=12, p=4, dim=3, closed=closed)
     z = ranking_numbers(c, l)
@@ -136,7 +136,7 @@ def test_step_errors():
 
 
 # -- the ranking-list loop -----------------------------------------------------------------
-def slow_ranking_loop(c, l, tol, n_steps, mask, eps_rel):
+def slow_ranking_loop(c, l, tol, n_steps, mask, eps_rel):  # noqa: E741
     """Reference: recompute every ranking number from scratch with numpy each step."""
     d = np.array(c.control_points)
     orig = d.copy()

@@ -19,7 +19,7 @@ from curvefair.fairing.global_fair import energy_matrix, global_fair
 from curvefair.fairing.knot_removal import knot_removal_fair
 
 
-def dense_gram(curve: BSplineCurve, l: int) -> np.ndarray:
+def dense_gram(curve: BSplineCurve, l: int) -> np.ndarray:  # noqa: E741
     """Gram matrix from scratch: 12-point Gauss per span of scipy basis derivatives."""
     t = np.asarray(curve.knots)
     p = curve.degree
@@ -49,7 +49,7 @@ def noisy(n=50, closed=False, seed=0, dim=2):
     return interpolate_bspline(pts, closed=closed)
 
 
-def check_kkt(c, res, tol, l, mask):
+def check_kkt(c, res, tol, l, mask):  # noqa: E741
     G = dense_gram(c, l)
     d = np.asarray(res.curve.control_points)
     v = d - c.control_points
@@ -67,7 +67,7 @@ def check_kkt(c, res, tol, l, mask):
 
 @pytest.mark.parametrize("closed", [False, True])
 @pytest.mark.parametrize("l", [2, 3])
-def test_kkt_conditions(closed, l):
+def test_kkt_conditions(closed, l):  # noqa: E741
     c = noisy(closed=closed, seed=l)
     tol = 0.02
     res = global_fair(c, tol=tol, l=l, clamp="g1")

@@ -71,7 +71,7 @@ def test_one_point_cubic_matches_errata_formula(closed):
         per = np.asarray(c.knots[3:3 + n + 1])
         T = per[-1] - per[0]
         i = np.arange(-5, n + 10)
-        t = dict(zip(i.tolist(), (per[(i - 3) % n] + T * ((i - 3) // n)).tolist()))
+        t = dict(zip(i.tolist(), (per[(i - 3) % n] + T * ((i - 3) // n)).tolist(), strict=True))
         D = {k: c.control_points[k % n] for k in i.tolist()}
     else:
         t = np.asarray(c.knots)
@@ -160,7 +160,7 @@ def test_jump_measure_against_finite_differences(dim):
             return cr / np.linalg.norm(r1, axis=-1) ** 3
         return np.linalg.norm(np.cross(r1, r2), axis=-1) / np.linalg.norm(r1, axis=-1) ** 3
 
-    for j, zj in zip(js, z):
+    for j, zj in zip(js, z, strict=True):
         tj = c.knots[j]
         h = 1e-5
         speed = np.linalg.norm(spl(tj, 1))

@@ -153,7 +153,7 @@ def eh_weights(curve: BSplineCurve, r: int,
     W = curve.gram_band(lv)
     idx, col = _neighbours(curve, r)
     gamma: dict[int, float] = {}
-    for i, c in zip(idx.tolist(), col.tolist()):
+    for i, c in zip(idx.tolist(), col.tolist(), strict=True):
         if c == curve.degree:
             continue
         gamma[i] = gamma.get(i, 0.0) - W[r, c] / W[r, curve.degree]

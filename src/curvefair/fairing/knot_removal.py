@@ -461,7 +461,7 @@ def knot_removal_fair(curve: BSplineCurve, *, variant: Variant = "one-point",
             break
         total = new_total
         z[tk] = znew
-        for kk, zz in zip(tk.tolist(), znew.tolist()):
+        for kk, zz in zip(tk.tolist(), znew.tolist(), strict=True):
             if rank[kk] >= 0:
                 rank[kk] = zz
                 tt_update(tv, ti, kk, zz)
