@@ -265,3 +265,14 @@ def test_builder_errors():
         interpolate_bspline(np.random.default_rng(0).normal(size=(10, 2)), degree=1)
     with pytest.raises(InputError, match="coincident"):
         interpolate_bspline([[0, 0], [1, 1], [1, 1], [2, 0], [3, 1]])
+
+
+def test_from_scipy_unclamped_open_spline():
+    rng = np.random.default_rng(21)
+    t = np.sort(rng.uniform(0, 10, 14))  # 14 knots, no multiplicity: not clamped
+    spl = BSpline(t, rng.normal(size=(10, 2)), 3)
+    c = BSplineCurve.from_scipy(spl)
+    assert c.domain == (t[3], t[10])
+    u = np.linspace(t[3], t[10], 500)
+    for nu in range(3):
+        np.testing.assert_allclose(c(u, nu), spl(u, nu), atol=1e-9 * np.abs(spl(u, nu)).max())

@@ -462,7 +462,9 @@ class BSplineCurve(PiecewiseCurve):
         """Build from a :class:`scipy.interpolate.BSpline` with coefficients ``(n, dim)``.
 
         ``closed=None`` detects a periodic spline (``extrapolate == "periodic"``, periodic knots,
-        last ``k`` coefficients repeating the first ``k``). Open splines must be clamped.
+        last ``k`` coefficients repeating the first ``k``). An unclamped open spline is converted
+        to the clamped knot vector with the same interior knots (the same curve on its domain
+        ``[t_k, t_n]``, found by interpolation at the Greville abscissae: exact up to rounding).
         """
         t = np.asarray(spl.t, dtype=float)
         k = int(spl.k)
@@ -481,6 +483,17 @@ class BSplineCurve(PiecewiseCurve):
                 raise InputError("closed=True needs the last k coefficients of spl.c to repeat "
                                  "the first k (scipy's periodic layout)")
             return cls(c[:n], t, k, closed=True)
+        n = c.shape[0]
+        if k >= 2 and n >= k + 1 and (np.any(t[:k + 1] != t[0]) or np.any(t[n:] != t[-1])):
+            # unclamped: the same curve on [t_k, t_n] on the clamped knot vector (the space is
+            # the same there), by interpolation at the Greville abscissae -- exact up to rounding
+            if not t[k] < t[n]:
+                raise InputError(f"the spline's domain [t[{k}], t[{n}]] is empty")
+            tc = np.r_[[t[k]] * (k + 1), t[k + 1:n], [t[n]] * (k + 1)]
+            xg = np.array([tc[i + 1:i + k + 1].mean() for i in range(n)])
+            old = BSpline(t, c, k)
+            new = make_interp_spline(xg, old(xg), k=k, t=tc, axis=0)
+            return cls(new.c, tc, k, closed=False)
         return cls(c, t, k, closed=False)
 
 
