@@ -133,3 +133,27 @@ def test_run_case_smoke_and_tolerance_check():
         assert r["truth_dist"] < 3 * case.tol
     # the interpolant passes through the points
     assert rows[0]["dev"] < 1e-12 * case.scale
+
+
+def test_run_all_survives_a_crashing_tool(monkeypatch):
+    """A tool that kills its process (as a memory error in compiled code would) is recorded as
+    failed for that case; the other tools and cases are unaffected."""
+    import os
+
+    import run as R
+
+    cases = C.ground_truth_cases(instances=1, levels=(1e-3,), families=("ellipse", "cubic"))
+    victim = cases[1].name
+
+    def fake(case, tools=None):
+        names = tools if tools is not None else R.all_tools()
+        if case.name == victim and "cf:poliakoff" in names:
+            os._exit(3)
+        return [dict(R._base_row(case, t), ok=1) for t in names]
+
+    monkeypatch.setattr(R, "run_case", fake)
+    rows = R.run_all(cases, jobs=2)
+    assert len(rows) == 2 * len(R.all_tools())
+    bad = [r for r in rows if not r["ok"]]
+    assert [(r["case"], r["tool"]) for r in bad] == [(victim, "cf:poliakoff")]
+    assert "crashed" in bad[0]["error"]

@@ -703,7 +703,8 @@ GLYPH_CHARS = "abcdefgjmnopqrsuCDGJOPQRSUB023568&@?$%"
 
 def glyph_cases(count: int | None = 80,
                 fonts: tuple[str, ...] = ("DejaVuSans.ttf", "DejaVuSerif.ttf")) -> list[Case]:
-    """Smooth outline runs of DejaVu glyphs, thinned evenly to ``count``. Tolerance ``GLYPH_TOL`` em."""
+    """Smooth outline runs of DejaVu glyphs, thinned evenly to ``count``; tolerance
+    ``GLYPH_TOL`` em."""
     out = []
     for f in fonts:
         for label, pts, closed, upem in glyph_runs(dejavu_path(f), GLYPH_CHARS):
@@ -713,11 +714,3 @@ def glyph_cases(count: int | None = 80,
         idx = np.unique(np.linspace(0, len(out) - 1, count).round().astype(int))
         out = [out[i] for i in idx]
     return out
-
-
-def build_corpus(quick: bool = False) -> list[Case]:
-    """All cases. ``quick``: one instance per family at one noise level, 6 airfoils, 6 glyph runs."""
-    if quick:
-        return (ground_truth_cases(instances=1, levels=(1e-3,))
-                + airfoil_cases(6) + glyph_cases(6))
-    return ground_truth_cases() + airfoil_cases() + glyph_cases()

@@ -13,10 +13,8 @@ from collections import defaultdict
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 import corpus as C
-import peers as P
+import numpy as np
 
 CORPORA = ("ground-truth", "airfoils", "glyphs")
 BASELINE = "interpolant"
@@ -111,6 +109,15 @@ class Table:
         return [r for r in self.ok_rows(tool) if int(r.get("violation") or 0)]
 
 
+def _worst_at(t: "Table", tool: str) -> str:
+    """``case #point (n points)`` of the largest deviation / tol of ``tool``."""
+    rows = [x for x in t.ok_rows(tool) if math.isfinite(_f(x.get("dev_over_tol")))]
+    if not rows or tool == BASELINE:
+        return "-"
+    w = max(rows, key=lambda x: _f(x["dev_over_tol"]))
+    return f"{w['case']} #{w.get('dev_index')}/{w['n_points']}"
+
+
 def _mq(vals: list[float]) -> str:
     return f"{_fmt(_q(vals, 0.5))} / {_fmt(_q(vals, 0.9))}"
 
@@ -119,9 +126,9 @@ def _mq(vals: list[float]) -> str:
 def table_ground_truth(t: Table) -> list[str]:
     head = ("| tool | true extrema count reached | true inflection count reached | extrema - true "
             "(median / p90) | E2 / E2(input) | E3 / E3(input) | int kappa_s^2 ds / input | "
-            "max dev / tol (median / p90 / max) | distance to true curve / tol | time ms | "
-            "failed |")
-    out = [head, "|" + "---|" * 11]
+            "max dev / tol (median / p90 / max) | largest at (curve #point/points) | "
+            "distance to true curve / tol | pieces (median) | time ms | failed |")
+    out = [head, "|" + "---|" * 13]
     for tool in t.tools:
         rows = t.ok_rows(tool)
         h, n = t.hits(tool)
@@ -139,14 +146,19 @@ def table_ground_truth(t: Table) -> list[str]:
                     f" **{viol} VIOLATIONS**" if viol else "")
         out.append(f"| {_tool_label(tool)} | {_pct(h, n)} | {_pct(hi, n_inf)} | {_mq(excess)} | "
                    f"{_mq(t.ratio(tool, 'E2'))} | {_mq(t.ratio(tool, 'E3'))} | "
-                   f"{_mq(t.ratio(tool, 'dkds'))} | {devs} | {_mq(dist)} | "
+                   f"{_mq(t.ratio(tool, 'dkds'))} | {devs} | {_worst_at(t, tool)} | "
+                   f"{_mq(dist)} | {_fmt(_q(t.values(tool, 'n_segments'), 0.5))} | "
                    f"{_fmt(_q(tms, 0.5))} | {fail}{f' (+{na} n/a)' if na else ''} |")
     return out
 
 
 def table_share_by(t: Table, key: str) -> list[str]:
     groups = list(dict.fromkeys(str(r[key]) for r in t.rows))
-    out = ["| tool | " + " | ".join(groups) + " | all |", "|" + "---|" * (len(groups) + 2)]
+    heads = []
+    for g in groups:
+        trues = sorted({int(_f(r["true_extrema"])) for r in t.rows if str(r[key]) == g})
+        heads.append(f"{g} (true: {', '.join(map(str, trues))})" if key == "family" else g)
+    out = ["| tool | " + " | ".join(heads) + " | all |", "|" + "---|" * (len(groups) + 2)]
     for tool in t.tools:
         cells = []
         for g in groups:
@@ -161,8 +173,9 @@ def table_share_by(t: Table, key: str) -> list[str]:
 def table_real(t: Table) -> list[str]:
     head = ("| tool | extrema (median / p90) | extrema / input (median / p90) | fewer extrema "
             "than input | inflections (median / p90) | E2 / E2(input) | E3 / E3(input) | "
-            "int kappa_s^2 ds / input | max dev / tol (median / p90 / max) | time ms | failed |")
-    out = [head, "|" + "---|" * 11]
+            "int kappa_s^2 ds / input | max dev / tol (median / p90 / max) | largest at "
+            "(curve #point/points) | pieces (median) | time ms | failed |")
+    out = [head, "|" + "---|" * 13]
     for tool in t.tools:
         rows = t.ok_rows(tool)
         fewer = 0
@@ -182,7 +195,9 @@ def table_real(t: Table) -> list[str]:
                    f"{_pct(fewer, len(t.cases)) if tool != BASELINE else '-'} | "
                    f"{_mq(t.values(tool, 'inflections'))} | {_mq(t.ratio(tool, 'E2'))} | "
                    f"{_mq(t.ratio(tool, 'E3'))} | {_mq(t.ratio(tool, 'dkds'))} | {devs} | "
-                   f"{_fmt(_q(tms, 0.5))} | {fail}{f' (+{na} n/a)' if na else ''} |")
+                   f"{_worst_at(t, tool)} | {_fmt(_q(t.values(tool, 'n_segments'), 0.5))} | "
+                   f"{_fmt(_q(tms, 0.5))} | {fail}"
+                   f"{f' (+{na} n/a)' if na else ''} |")
     return out
 
 
@@ -210,40 +225,40 @@ def best_real_tool(t: Table, prefix: str) -> str | None:
     return min(cands, key=lambda x: (_q(t.ratio(x, "extrema"), 0.5), -len(t.ok_rows(x))))
 
 
-def rerun(case: C.Case, tool: str) -> Any:
-    """The curve ``tool`` produces on ``case`` (deterministic re-run in this process)."""
-    import run as R
-
+def _comb_scale(curve: Any, extent: float) -> float | None:
+    """The 95th-percentile hair 6 % of the extent, the longest at most 35 % (so that one spike,
+    e.g. at a sharp trailing edge, does not flatten the comb everywhere else)."""
     import curvefair as cf
 
-    if tool == BASELINE:
-        return R.initial_curve("poliakoff", case.points, case.closed)[0]
-    if tool.startswith("cf:"):
-        m, _, e = tool[3:].partition("/")
-        c0, _ = R.initial_curve(m, case.points, case.closed)
-        return cf.fair(c0, m, tol=case.tol, eps=0.0 if e == "eps0" else None).curve
-    return P.run_peer(tool[5:], case.points, case.closed, case.tol).curve
+    t0, t1 = curve.domain
+    k = np.abs(cf.curvature(curve, np.linspace(t0, t1, 4001)))
+    k95, kmax = float(np.quantile(k, 0.95)), float(k.max())
+    return min(0.06 * extent / k95, 0.35 * extent / kmax) if k95 > 0 else None
 
 
-def draw(case: C.Case, tool: str, path: Path, title: str) -> str | None:
-    """Before (input interpolant) / after comb figure; returns an error text on failure."""
+def draw(case: C.Case, tool: str, paths: tuple[Path, Path], title: str) -> str | None:
+    """Two figures (input interpolant, result of ``tool``), each with its curvature comb and its
+    curvature plot, each at its own comb scale; returns an error text on failure."""
     try:
         import matplotlib
 
         matplotlib.use("Agg")
+        import run as R
+
         from curvefair.plot import figure
 
-        before = rerun(case, BASELINE)
-        after = rerun(case, tool)
-        if after is None:
-            return "no curve"
-        fig = figure(before, compare=after, labels=("input interpolant", _tool_label(tool)),
-                     tol=case.tol, title=title)
-        if case.truth is not None and case.dim == 2:
-            poly = case.truth.polyline(4001)
-            fig.axes[0].plot(poly[:, 0], poly[:, 1], ":", color="0.3", lw=0.8,
-                             label="true curve")
-        fig.savefig(path, dpi=80)
+        ext = float(np.ptp(case.points, axis=0).max())
+        for curve_tool, path, label in ((BASELINE, paths[0], "input interpolant"),
+                                        (tool, paths[1], _tool_label(tool))):
+            curve = R.run_tool(case, curve_tool)
+            if curve is None:
+                return "no curve"
+            fig = figure(curve, title=f"{label}: {title}", comb_scale=_comb_scale(curve, ext),
+                         figsize=(6.4, 7.2))
+            if case.truth is not None and case.dim == 2:
+                poly = case.truth.polyline(4001)
+                fig.axes[0].plot(poly[:, 0], poly[:, 1], ":", color="0.3", lw=0.8)
+            fig.savefig(path, dpi=72)
         return None
     except Exception as exc:  # noqa: BLE001
         return repr(exc)[:200]
@@ -299,6 +314,18 @@ def write_page(rows: list[dict[str, Any]], cases: list[C.Case], info: dict[str, 
               f"best peer, `{_tool_label(bp)}`, on {_pct(hp, n)}; the unfaired interpolant on "
               f"{_pct(hb, n)}. Goal (more than any peer, at equal maximum deviation): "
               f"{verdict}.", ""]
+        if bc and bp:
+            def med(tool: str, key: str, den: str | None = None) -> float:
+                rows = gt.ok_rows(tool)
+                return _q([_f(r[key]) / (_f(r[den]) if den else 1.0) for r in rows], 0.5)
+
+            L += [f"- On the same curves, the median distance to the *true* curve is "
+                  f"{_fmt(med(bc, 'truth_dist', 'tol'))} tol for `{_tool_label(bc)}` and "
+                  f"{_fmt(med(bp, 'truth_dist', 'tol'))} tol for `{_tool_label(bp)}`; the median "
+                  f"number of polynomial pieces is {_fmt(med(bc, 'n_segments'))} and "
+                  f"{_fmt(med(bp, 'n_segments'))} (the interpolant has one per input interval"
+                  + ("; `make_splprep` chooses its own, fewer, knots)." if bp ==
+                     "peer:scipy-splprep" else ")."), ""]
     if af.cases:
         ba = best_real_tool(af, "cf:")
         if ba:
@@ -376,6 +403,21 @@ def write_page(rows: list[dict[str, Any]], cases: list[C.Case], info: dict[str, 
           "- **Distance to the true curve**: largest distance from the result (24 samples per "
           "segment) to a 20 001-vertex polyline of the true curve.", ""]
 
+    L += ["## Reading notes", "",
+          "- *Reached* means the exact count from `curvefair.analyze` equals the true one: every "
+          "ripple of the curvature counts, however small. Circle arcs and helices have constant "
+          "curvature (true count 0); a spline fitted to noisy points practically never has a "
+          "curvature without any interior extremum, so no tool is expected to reach 0 there; "
+          "the 'extrema - true' column says how far each tool stays.",
+          "- A result with fewer polynomial pieces has fewer places where its curvature can "
+          "turn. curvefair's methods keep every input point (Hermite methods) or every control "
+          "point of the interpolant (B-spline methods) and move each within its own `tol` "
+          "ball; a point held on its ball typically leaves a small third-derivative jump, i.e. "
+          "a possible curvature extremum. The 'pieces' column shows the difference.",
+          "- `eps0` = `eps=0`; `l3` = the third-derivative energy E3 instead of E2 "
+          "(`fair(..., l=3)`). Methods that do not use eps give the same result in both rows.",
+          ""]
+
     # tables ---------------------------------------------------------------------------------
     if gt.cases:
         L += ["## Ground truth", "",
@@ -446,18 +488,26 @@ def write_page(rows: list[dict[str, Any]], cases: list[C.Case], info: dict[str, 
                          f"({base[w['case']]['extrema']} -> {w['extrema']})", w["case"], bt))
     if figs:
         L += ["## Curvature combs (before / after)", "",
-              "Top: input interpolant (grey) and result with their curvature combs at the same "
-              "scale (true curve dotted where known); middle: curvature against arc length; "
-              "bottom: deviation of the result from the interpolant.", ""]
+              "Left: the input interpolant (natural cubic spline through the points); right: "
+              "the result. Each panel: curve with its curvature comb (hairs on the convex side, "
+              "length proportional to curvature; each figure at its own scale, stated in its "
+              "corner), data points or control polygon, true curve dotted where known, "
+              "inflections and curvature extrema marked; below, curvature against arc length.",
+              ""]
         for slug, caption, case_name, tool in figs:
-            fname = f"{slug}.png"
-            err = draw(by_name[case_name], tool, img / fname, caption.replace("`", ""))
+            names = (f"{slug}-before.png", f"{slug}-after.png")
+            err = draw(by_name[case_name], tool, (img / names[0], img / names[1]),
+                       case_name)
             if err:
                 L += [f"*{caption}: figure failed ({err})*", ""]
             else:
-                L += [f"**{caption}**", "", f"![{slug}]({rel_img}/{fname})", ""]
+                L += [f"**{caption}**", "", "| before | after |", "|---|---|",
+                      f"| ![{slug} before]({rel_img}/{names[0]}) | "
+                      f"![{slug} after]({rel_img}/{names[1]}) |", ""]
 
     L += ["## Reproduce", "", "```", "make bench-quality        # full run (writes this page)",
           "python benchmarks/quality/run.py --quick   # pipeline check on a tiny subset", "```",
-          "", f"Per-curve results of this run: `{info['csv']}` (one row per curve and tool).", ""]
+          "", f"Per-curve results (one row per curve and tool, including the index of the point "
+          f"where each maximum deviation sits) are written to `{info['csv']}` by each run "
+          "(not committed).", ""]
     out.write_text("\n".join(L))

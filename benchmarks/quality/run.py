@@ -9,8 +9,9 @@ Every tool gets the same input points and the same allowed deviation ``tol``:
 
 * curvefair: ``fair(curve, method, tol=tol)`` with every registered method, once with the
   method's default ``eps`` and once with ``eps=0`` (run until the tolerance blocks every move or
-  the step cap is reached). The Hermite methods start from ``interpolate_cubic`` /
-  ``interpolate_quintic`` (natural ends, or periodic), the B-spline methods from
+  the step cap is reached), plus the ``l=3`` variants of ``VARIANTS``. The Hermite methods
+  start from ``interpolate_cubic`` / ``interpolate_quintic`` (natural ends, or periodic), the
+  B-spline methods from
   ``interpolate_bspline``; all with chord-length parameters, except Kjellander's method, which is
   defined for uniform parameters and gets equally spaced ones over the same range.
 * peers (``peers.py``): smoothing parameter bisected so that the maximum deviation reaches
@@ -28,7 +29,6 @@ from __future__ import annotations
 import argparse
 import csv
 import datetime as _dt
-import math
 import multiprocessing as mp
 import os
 import platform
@@ -56,16 +56,38 @@ METHODS = HERMITE_CUBIC + HERMITE_QUINTIC + BSPLINE
 BASELINE = "interpolant"  # natural cubic interpolating spline of the input: "before"
 
 
-def curvefair_tools() -> list[tuple[str, str, float | None]]:
-    """``(tool name, method, eps)`` for every registered method, default eps and eps=0."""
+# option variants worth showing besides each method's defaults: ``l=3`` (the third-derivative
+# energy) for the two methods that take it
+VARIANTS: dict[str, list[tuple[str, dict[str, Any]]]] = {
+    "eck-hadenfeld": [("l3+eps0", {"l": 3, "eps": 0.0})],
+    "global": [("l3", {"l": 3})],
+}
+
+
+def curvefair_tools() -> list[tuple[str, str, dict[str, Any]]]:
+    """``(tool name, method, fair() keywords)``: every registered method with its defaults and
+    with ``eps=0``, plus :data:`VARIANTS`."""
     from curvefair.fairing.fair import METHODS as REGISTERED
 
     names = [m for m in METHODS if m in REGISTERED] + [m for m in REGISTERED if m not in METHODS]
-    out = []
+    out: list[tuple[str, str, dict[str, Any]]] = []
     for m in names:
-        out.append((f"cf:{m}", m, None))
-        out.append((f"cf:{m}/eps0", m, 0.0))
+        out.append((f"cf:{m}", m, {}))
+        out.append((f"cf:{m}/eps0", m, {"eps": 0.0}))
+        for suffix, kw in VARIANTS.get(m, []):
+            out.append((f"cf:{m}/{suffix}", m, kw))
     return out
+
+
+def run_tool(case: C.Case, tool: str) -> Any:
+    """The curve ``tool`` produces on ``case`` (used to redraw figures in the main process)."""
+    if tool == BASELINE:
+        return initial_curve("poliakoff", case.points, case.closed)[0]
+    for name, method, kw in curvefair_tools():
+        if name == tool:
+            c0, _ = initial_curve(method, case.points, case.closed)
+            return cf.fair(c0, method, tol=case.tol, **kw).curve
+    return P.run_peer(tool.removeprefix("peer:"), case.points, case.closed, case.tol).curve
 
 
 def initial_curve(method: str, points: np.ndarray, closed: bool
@@ -161,14 +183,14 @@ def run_case(case: C.Case, tools: list[str] | None = None) -> list[dict[str, Any
         row.update(ok=0, error=repr(exc)[:300])
     rows.append(row)
 
-    for tool, method, eps in curvefair_tools():
+    for tool, method, kw in curvefair_tools():
         if not want(tool):
             continue
         row = _base_row(case, tool)
         try:
             t0 = time.perf_counter()
             c0, u = initial_curve(method, pts, case.closed)
-            res = cf.fair(c0, method, tol=case.tol, eps=eps)
+            res = cf.fair(c0, method, tol=case.tol, **kw)
             dt = time.perf_counter() - t0
             d, i = P.data_deviation(res.curve, pts, u)
             rep = res.report
@@ -209,32 +231,75 @@ def run_case(case: C.Case, tools: list[str] | None = None) -> list[dict[str, Any
 _CASES: list[C.Case] = []
 
 
-def _work(i: int) -> list[dict[str, Any]]:
+def _work(i: int, tools: list[str] | None = None) -> list[dict[str, Any]]:
     import warnings
 
     warnings.simplefilter("ignore")
-    return run_case(_CASES[i])
+    return run_case(_CASES[i], tools)
+
+
+def _isolated(ctx: Any, i: int) -> list[dict[str, Any]]:
+    """Run case ``i`` in a process of its own; if that process dies (a crash in compiled code),
+    run each tool in a process of its own and record the one that crashes as failed."""
+    from concurrent.futures import ProcessPoolExecutor
+    from concurrent.futures.process import BrokenProcessPool
+
+    try:
+        with ProcessPoolExecutor(1, mp_context=ctx) as ex:
+            return ex.submit(_work, i).result()
+    except BrokenProcessPool:
+        pass
+    rows: list[dict[str, Any]] = []
+    for tool in all_tools():
+        try:
+            with ProcessPoolExecutor(1, mp_context=ctx) as ex:
+                got = ex.submit(_work, i, [tool]).result()
+            rows += [r for r in got if r["tool"] == tool]
+        except BrokenProcessPool:
+            row = _base_row(_CASES[i], tool)
+            row.update(ok=0, error="the process crashed (memory corruption or abort) while "
+                                   "running this tool")
+            rows.append(row)
+            print(f"  CRASH: {tool} on {_CASES[i].name}", flush=True)
+    return rows
 
 
 def run_all(cases: list[C.Case], jobs: int) -> list[dict[str, Any]]:
+    """All tools on all cases, ``jobs`` worker processes (fork), biggest cases first. A worker
+    that dies does not stop the run: the unfinished cases are re-run in isolation."""
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+    from concurrent.futures.process import BrokenProcessPool
+
     global _CASES
     _CASES = cases
-    order = sorted(range(len(cases)), key=lambda i: -len(cases[i].points))  # big ones first
+    order = sorted(range(len(cases)), key=lambda i: -len(cases[i].points))
     rows: list[dict[str, Any]] = []
+    done: set[int] = set()
     t0 = time.perf_counter()
+
+    def progress() -> None:
+        if len(done) % 25 == 0:
+            print(f"  {len(done)}/{len(cases)} cases, {time.perf_counter() - t0:.0f} s",
+                  flush=True)
+
+    ctx = mp.get_context("fork")
     if jobs > 1:
-        ctx = mp.get_context("fork")
-        with ctx.Pool(jobs) as pool:
-            for k, r in enumerate(pool.imap_unordered(_work, order, chunksize=1)):
-                rows.extend(r)
-                if (k + 1) % 25 == 0:
-                    print(f"  {k + 1}/{len(cases)} cases, {time.perf_counter() - t0:.0f} s",
-                          flush=True)
-    else:
-        for k, i in enumerate(order):
-            rows.extend(_work(i))
-            if (k + 1) % 25 == 0:
-                print(f"  {k + 1}/{len(cases)} cases, {time.perf_counter() - t0:.0f} s", flush=True)
+        try:
+            with ProcessPoolExecutor(jobs, mp_context=ctx) as ex:
+                futs = {ex.submit(_work, i): i for i in order}
+                for f in as_completed(futs):
+                    rows.extend(f.result())
+                    done.add(futs[f])
+                    progress()
+        except BrokenProcessPool:
+            print("  a worker process died; re-running the unfinished cases in isolation",
+                  flush=True)
+    for i in order:
+        if i in done:
+            continue
+        rows.extend(_isolated(ctx, i) if jobs > 1 else _work(i))
+        done.add(i)
+        progress()
     key = {c.name: j for j, c in enumerate(cases)}
     tool_order = {t: j for j, t in enumerate(all_tools())}
     rows.sort(key=lambda r: (key[r["case"]], tool_order.get(r["tool"], 999)))
