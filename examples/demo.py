@@ -63,8 +63,8 @@ def main() -> int:
     pts = load_points(args.input)
     k = int(np.argmax(np.abs(pts[:, 1] - np.median(pts[:, 1]))))  # the bad point (P4)
     header = (f"{'run':<20} {'steps':>5} {'stop':<10} {'P' + str(k + 1) + ' after':<17} "
-              f"{'energy before -> after':<24} {'max jump before -> after':<25} "
-              f"{'infl':>6} {'max move':>9}")
+              f"{'energy before -> after':<24} {'top jump* before -> after':<25} "
+              f"{'infl':>5} {'extr':>6} {'max move':>9} {'max dev':>8}")
     print(f"input: {args.input.name}, {len(pts)} points, P{k + 1} = {tuple(pts[k].tolist())}")
     print(header)
     print("-" * len(header))
@@ -80,13 +80,17 @@ def main() -> int:
         print(f"{label:<20} {r['steps']:>5} {r['stop_reason']:<10} "
               f"({pk[0]:.4f}, {pk[1]:.4f}) "
               f"{r['energy_before']:>9.4g} -> {r['energy_after']:<10.4g} "
-              f"{r['max_jump_before']:>9.4g} -> {r['max_jump_after']:<11.4g} "
+              f"{r['max_top_jump_before']:>9.4g} -> {r['max_top_jump_after']:<11.4g} "
               f"{r['inflections_before']:>2}->{r['inflections_after']:<2} "
-              f"{r['max_point_displacement']:>9.4f}")
+              f"{r['extrema_before']:>2}->{r['extrema_after']:<2} "
+              f"{r['max_point_displacement']:>9.4f} {r['max_deviation']:>8.4f}")
         results[label] = {"method": method, "param": param, "options": kw,
                           "faired_points": res.curve.points.tolist(), "report": r}
     atomic_write_json({"example": "Wang & Cao 2006, Example 1", "input": str(args.input),
                        "points": pts.tolist(), "runs": results}, args.out)
+    print("* top jump: jump of the degree-th derivative at the data points (r''' for cubics,"
+          " r^(5) for quintics); infl/extr: inflections and curvature extrema; max dev: curve"
+          " deviation from the input")
     print(f"reports written to {args.out}")
     return 0
 

@@ -306,7 +306,11 @@ def _analysis_block(curve: PiecewiseCurve) -> dict[str, Any]:
     ext = a.extrema
     return {
         "energy": float(a.energy2),
+        "energy3": float(a.energy3),
         "max_jump": float(a.max_jump),
+        "max_top_jump": float(a.max_top_jump),
+        "sapidis_sum": float(a.sapidis_sum),
+        "dkds_energy": float(a.dkds_energy),
         "inflections": int(len(inf)) if not isinstance(inf, (int, np.integer)) else int(inf),
         "extrema": int(len(ext)) if not isinstance(ext, (int, np.integer)) else int(ext),
     }
@@ -369,7 +373,10 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
     The loop is Wang & Cao 2006's steps 1-6: rank the points, fair the worst, re-interpolate,
     repeat. The report holds ``method``, ``steps``, ``stop_reason``, ``moved`` (indices and
     their final displacement from the original), ``energy_before/after`` (``int |r''|^2``),
-    ``max_jump_before/after``, ``inflections_before/after``, ``extrema_before/after``,
+    ``max_jump_before/after`` (third derivative, seed 001), ``max_top_jump_before/after`` (jump
+    of the ``degree``-th derivative: the meaningful one for a C4 quintic),
+    ``energy3_before/after``, ``sapidis_sum_before/after``, ``dkds_energy_before/after``
+    (``int (dkappa/ds)^2 ds``), ``inflections_before/after``, ``extrema_before/after``,
     ``max_point_displacement`` (+ ``max_point_index``), ``max_deviation`` (+ where:
     ``max_deviation_param``, ``max_deviation_point``), ``tol``, ``eps``, ``max_steps``,
     ``clamp``, ``protect``, ``mode``, ``time_s`` and method-specific entries.
@@ -468,6 +475,14 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
         "energy_after": after["energy"],
         "max_jump_before": before["max_jump"],
         "max_jump_after": after["max_jump"],
+        "energy3_before": before["energy3"],
+        "energy3_after": after["energy3"],
+        "max_top_jump_before": before["max_top_jump"],
+        "max_top_jump_after": after["max_top_jump"],
+        "sapidis_sum_before": before["sapidis_sum"],
+        "sapidis_sum_after": after["sapidis_sum"],
+        "dkds_energy_before": before["dkds_energy"],
+        "dkds_energy_after": after["dkds_energy"],
         "inflections_before": before["inflections"],
         "inflections_after": after["inflections"],
         "extrema_before": before["extrema"],
