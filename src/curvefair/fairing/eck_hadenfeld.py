@@ -397,6 +397,8 @@ def _eh_loop(X, z, Wu, pat, p, closed, tol, eps_abs, max_steps,
                 lo2 = 0
                 hi2 = hi1 - n
             hi1 = n - 1
+        if hi1 >= n:  # open curve shorter than the band: both ends clipped
+            hi1 = n - 1
         for rng in range(2):
             lo = lo1 if rng == 0 else lo2
             hi = hi1 if rng == 0 else hi2
