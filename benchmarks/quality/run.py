@@ -76,13 +76,28 @@ def curvefair_tools() -> list[tuple[str, str, dict[str, Any]]]:
         out.append((f"cf:{m}/eps0", m, {"eps": 0.0}))
         for suffix, kw in VARIANTS.get(m, []):
             out.append((f"cf:{m}/{suffix}", m, kw))
+    out.append((POINTS_TOOL, "fair_points", {}))
     return out
+
+
+# ``curvefair.fair_points`` works on the points themselves (no start curve to move): the
+# minimiser of E3 over quintic splines with |C(u_i) - p_i| <= tol at the chord parameters
+POINTS_TOOL = "cf:fair-points"
+
+
+def run_fair_points(case: C.Case) -> tuple[Any, np.ndarray, dict[str, Any]]:
+    """``fair_points(points, tol)`` with its defaults (degree 5, E3, chord parameters)."""
+    u = P.chord_params(case.points, case.closed)
+    res = cf.fair_points(case.points, case.tol, closed=case.closed, param=u)
+    return res.curve, u, res.report
 
 
 def run_tool(case: C.Case, tool: str) -> Any:
     """The curve ``tool`` produces on ``case`` (used to redraw figures in the main process)."""
     if tool == BASELINE:
         return initial_curve("poliakoff", case.points, case.closed)[0]
+    if tool == POINTS_TOOL:
+        return run_fair_points(case)[0]
     for name, method, kw in curvefair_tools():
         if name == tool:
             c0, _ = initial_curve(method, case.points, case.closed)
@@ -189,16 +204,20 @@ def run_case(case: C.Case, tools: list[str] | None = None) -> list[dict[str, Any
         row = _base_row(case, tool)
         try:
             t0 = time.perf_counter()
-            c0, u = initial_curve(method, pts, case.closed)
-            res = cf.fair(c0, method, tol=case.tol, **kw)
+            if tool == POINTS_TOOL:
+                curve, u, rep = run_fair_points(case)
+                rep = dict(rep, steps=rep["iterations"])
+            else:
+                c0, u = initial_curve(method, pts, case.closed)
+                res = cf.fair(c0, method, tol=case.tol, **kw)
+                curve, rep = res.curve, res.report
             dt = time.perf_counter() - t0
-            d, i = P.data_deviation(res.curve, pts, u)
-            rep = res.report
+            d, i = P.data_deviation(curve, pts, u)
             row.update(ok=1, time_s=dt, dev=d, dev_index=i, dev_over_tol=d / case.tol,
                        violation=int(d > case.tol * (1 + 1e-9)),
                        steps=rep.get("steps"), stop_reason=rep.get("stop_reason"),
                        curve_dev=rep.get("max_deviation"))
-            row.update(metrics(case, res.curve))
+            row.update(metrics(case, curve))
         except Exception as exc:  # noqa: BLE001
             row.update(ok=0, error=(repr(exc) + " " + traceback.format_exc(limit=-1))[:300])
         rows.append(row)

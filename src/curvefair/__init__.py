@@ -29,6 +29,7 @@ from .analysis import (Analysis, Deviation, analyze, curvature,  # noqa: I001
                        curvature_derivative, deviation, energy, torsion)
 from . import steps  # noqa: I001
 from .fairing import FairingResult, fair  # noqa: I001
+from .fairing.pipeline import PointFairingResult, fair_points  # noqa: I001
 
 __all__ = [
     "energy",
@@ -41,6 +42,8 @@ __all__ = [
     "Deviation",
     "fair",
     "FairingResult",
+    "fair_points",
+    "PointFairingResult",
     "steps",
     "read_curves",
     "write_curves",
