@@ -290,7 +290,11 @@ def write_page(rows: list[dict[str, Any]], cases: list[C.Case], info: dict[str, 
           "Every tool below receives the same points and the same allowed maximum deviation "
           "`tol`; curvefair's methods are called as `fair(curve, method, tol=tol)` (and with "
           "`eps=0`, i.e. run until the tolerance blocks every move or the step cap is hit), the "
-          "peers' smoothing parameter is bisected until their maximum deviation reaches `tol`.", ""]
+          "peers' smoothing parameter is bisected until their maximum deviation reaches `tol`. "
+          "`fair-points` is `curvefair.fair_points(points, tol)` with its defaults: it starts "
+          "from the points, not from a curve (the minimiser of E3 over quintic splines with a "
+          "knot at every chord-length parameter, subject to |C(u_i) - p_i| <= tol at every "
+          "point).", ""]
 
     # verdict ---------------------------------------------------------------------------------
     L += ["## Verdict", ""]
@@ -414,6 +418,19 @@ def write_page(rows: list[dict[str, Any]], cases: list[C.Case], info: dict[str, 
           "point of the interpolant (B-spline methods) and move each within its own `tol` "
           "ball; a point held on its ball typically leaves a small third-derivative jump, i.e. "
           "a possible curvature extremum. The 'pieces' column shows the difference.",
+          "- `fair-points` has no per-point balls around an interpolant's control points: one "
+          "convex problem over the whole curve, and the quintic minimiser of E3 is C4, so an "
+          "active point leaves a jump only in the fifth derivative and dkappa/ds stays "
+          "continuous. Being an energy minimiser it uses the whole tolerance: every active point "
+          "sits exactly at `tol` (max dev / tol = 1), which is why its distance to the true "
+          "curve is larger than that of the smoothing splines, whose least-squares term keeps "
+          "most points well inside. It cannot reach 0 extrema on circles and helices (no tool "
+          "does). On open curves its optimality conditions impose natural ends (the third and "
+          "fourth derivatives vanish at both ends), which flattens the curvature there: on "
+          "every clothoid (monotone curvature, true count 0) it leaves exactly one extremum "
+          "near each end (3-17 % of the parameter range from it). A fix would be end "
+          "conditions that do not force r''' to 0 (e.g. end derivatives estimated from the "
+          "data, or the energy integrated over a shortened domain).",
           "- `eps0` = `eps=0`; `l3` = the third-derivative energy E3 instead of E2 "
           "(`fair(..., l=3)`). Methods that do not use eps give the same result in both rows.",
           ""]

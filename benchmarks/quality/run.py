@@ -14,6 +14,9 @@ Every tool gets the same input points and the same allowed deviation ``tol``:
   B-spline methods from
   ``interpolate_bspline``; all with chord-length parameters, except Kjellander's method, which is
   defined for uniform parameters and gets equally spaced ones over the same range.
+* ``cf:fair-points``: ``curvefair.fair_points(points, tol)`` with its defaults (the
+  minimiser of E3 over quintic splines with every point within ``tol`` at its chord-length
+  parameter); it starts from the points, not from an interpolant.
 * peers (``peers.py``): smoothing parameter bisected so that the maximum deviation reaches
   ``tol`` from below.
 

@@ -270,7 +270,6 @@ def _start_curve(pts: FloatArray, u: FloatArray, degree: int, closed: bool,
     shell = BSplineCurve(np.zeros((n, pts.shape[1])), t, p)
     G = _gram(shell, w)
     A = _collocation(shell, u)
-    m = u.shape[0]
     K = sp.bmat([[2.0 * G / float(G.diagonal().max()), A.T], [A, None]], format="csc")
     rhs = np.vstack([np.zeros((n, pts.shape[1])), pts])
     sol = splu(K, permc_spec="MMD_AT_PLUS_A").solve(rhs)
