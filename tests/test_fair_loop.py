@@ -91,8 +91,8 @@ def test_quintic_spline_mode_equals_reinterpolation(n):
     res = fair(q, "wang-quintic", tol=0.05, eps=0.0, max_steps=3 * n)
     assert res.report["steps"] > 0
     ref = interpolate_quintic(res.curve.points, q.params)  # natural, as the input
-    assert _rel(res.curve.d1, ref.d1) < 1e-10
-    assert _rel(res.curve.d2, ref.d2) < 1e-10
+    assert _rel(res.curve.d1, ref.d1) < 1e-12
+    assert _rel(res.curve.d2, ref.d2) < 1e-12
 
 
 @pytest.mark.parametrize("n", [30, 200])  # dense inverse path / windowed path
@@ -100,8 +100,8 @@ def test_quintic_closed_spline_mode(n):
     q = interpolate_quintic(_noisy(n, 3, seed=9, closed=True), bc="periodic")
     res = fair(q, "wang-quintic", tol=0.05, eps=0.0, max_steps=100)
     ref = interpolate_quintic(res.curve.points, q.params, bc="periodic")
-    assert _rel(res.curve.d1, ref.d1) < 1e-10
-    assert _rel(res.curve.d2, ref.d2) < 1e-10
+    assert _rel(res.curve.d1, ref.d1) < 1e-12
+    assert _rel(res.curve.d2, ref.d2) < 1e-12
 
 
 def test_spline_mode_replays_with_public_steps():

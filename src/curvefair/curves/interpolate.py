@@ -10,7 +10,8 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from scipy.interpolate import CubicSpline, make_interp_spline
+from scipy.interpolate import CubicSpline
+from scipy.linalg.lapack import dgbsv
 
 from .._typing import ArrayLike, FloatArray
 from .._validate import as_points, as_vectors, choice
@@ -164,6 +165,225 @@ def interpolate_cubic(points: ArrayLike, param: str | ArrayLike = "chord", bc: A
     return CubicHermite(pts, tangents, t, closed=periodic)
 
 
+# ----------------------------------------------------------------------------------------------
+# C4 quintic: a direct banded solve for the Hermite data (m_i, s_i) = (r'(t_i), r''(t_i))
+# ----------------------------------------------------------------------------------------------
+# Jerk-energy stiffness of one quintic Hermite segment of width h, unknowns (m_j, s_j, m_j+1,
+# s_j+1): entry [a, b] = _KE[a, b] / h**_KE_POW[a, b]. Its rows are the one-sided derivatives
+# r''''(t_j+), -r'''(t_j+), -r''''(t_j+1-), r'''(t_j+1-) of the segment (seed 000 eq. (2)
+# differentiated) without their position terms. Summed over the segments, the rows of point i
+# are jump(r'''') and -jump(r''') (C4 and C3), at an end r'''' and -r''' (natural conditions).
+_KE = np.array([[192.0, 36.0, 168.0, -24.0],
+                [36.0, 9.0, 24.0, -3.0],
+                [168.0, 24.0, 192.0, -36.0],
+                [-24.0, -3.0, -36.0, 9.0]])
+_KE_POW = np.array([[3, 2, 3, 2], [2, 1, 2, 1], [3, 2, 3, 2], [2, 1, 2, 1]])
+
+
+def _one_sided(h: FloatArray, delta: FloatArray, m: FloatArray, s: FloatArray
+               ) -> tuple[FloatArray, ...]:
+    """``r'''``, ``r''''`` at the left and right end of every segment and ``r^(5)``, each
+    ``(nseg, dim)``, of the quintic Hermite spline with data ``m``, ``s`` (``nseg + 1`` rows,
+    segment j from row j to row j+1); seed 000 eq. (2) with ``D = h``:
+    ``a_3 h^2 = 10 e1 - 4 e2 + e3 / 2``, ``a_4 h^3 = -15 e1 + 7 e2 - e3``,
+    ``a_5 h^4 = 6 e1 - 3 e2 + e3 / 2`` with ``e1 = b1 / h``, ``e2 = b2``, ``e3 = b3 h``."""
+    hh = h[:, None]
+    ih = 1.0 / hh
+    ih2 = ih * ih
+    e1 = (delta - (m[:-1] + 0.5 * s[:-1] * hh) * hh) * ih
+    e2 = m[1:] - m[:-1] - s[:-1] * hh
+    e3 = (s[1:] - s[:-1]) * hh
+    a3 = 10.0 * e1 - 4.0 * e2 + 0.5 * e3
+    a4 = -15.0 * e1 + 7.0 * e2 - e3
+    a5 = 6.0 * e1 - 3.0 * e2 + 0.5 * e3
+    r3l = 6.0 * a3 * ih2
+    r4l = 24.0 * a4 * (ih2 * ih)
+    r3r = (6.0 * a3 + 24.0 * a4 + 60.0 * a5) * ih2
+    r4r = (24.0 * a4 + 120.0 * a5) * (ih2 * ih)
+    return r3l, r4l, r3r, r4r, 120.0 * a5 * (ih2 * ih2)
+
+
+def _first_guess(h: FloatArray, delta: FloatArray, periodic: bool
+                 ) -> tuple[FloatArray, FloatArray]:
+    """Three-point (parabola) estimates of ``r'`` and ``r''`` at every distinct point: exact
+    for data from a quadratic, in particular on a straight line."""
+    sig = delta / h[:, None]
+    if periodic:
+        a, b = np.roll(h, 1)[:, None], h[:, None]
+        sa, sb = np.roll(sig, 1, axis=0), sig
+        return (b * sa + a * sb) / (a + b), 2.0 * (sb - sa) / (a + b)
+    n = h.size + 1
+    m = np.empty((n, sig.shape[1]))
+    s = np.zeros_like(m)
+    if n == 2:
+        m[:] = sig[0]
+        return m, s
+    a, b = h[:-1, None], h[1:, None]
+    m[1:-1] = (b * sig[:-1] + a * sig[1:]) / (a + b)
+    s[1:-1] = 2.0 * (sig[1:] - sig[:-1]) / (a + b)
+    s[0], s[-1] = s[1], s[-2]
+    m[0] = sig[0] - 0.5 * h[0] * s[0]
+    m[-1] = sig[-1] + 0.5 * h[-1] * s[-1]
+    return m, s
+
+
+def _banded(h: FloatArray, npt: int, nseg_band: int, lo: int, up: int
+            ) -> tuple[FloatArray, FloatArray]:
+    """Jacobi scale ``dsc = diag(K)**-1/2`` (shape ``(2 npt,)``, all ``h.size`` segments; a
+    periodic seam segment joins point ``npt-1`` to 0) and the scaled stiffness
+    ``diag(dsc) K diag(dsc)`` of segments ``0 .. nseg_band-1`` in ``solve_banded`` layout
+    (``ab[up + r - c, c] = K[r, c]``)."""
+    M = 2 * npt
+    ih = 1.0 / h
+    hp = {1: ih, 2: ih * ih}
+    hp[3] = hp[2] * ih
+    w = np.stack([192.0 * hp[3], 9.0 * ih], axis=1)
+    if h.size == npt:  # periodic: point i ends segment i-1 (mod npt) and starts segment i
+        diag = w + np.roll(w, 1, axis=0)
+    else:
+        diag = np.zeros((npt, 2))
+        diag[:-1] += w
+        diag[1:] += w
+    dsc = diag.reshape(M) ** -0.5
+    ab = np.zeros((lo + up + 1, M))
+    nb = nseg_band
+    ds = [dsc[e: e + 2 * nb: 2] for e in range(4)]  # unknown e of every band segment
+    for a in range(4):
+        for b in range(a, 4):
+            val = _KE[a, b] * hp[int(_KE_POW[a, b])][:nb] * ds[a] * ds[b]
+            ab[up + a - b, b: b + 2 * nb: 2] += val
+            if b != a:
+                ab[up + b - a, a: a + 2 * nb: 2] += val
+    return dsc, ab
+
+
+def _set_row(ab: FloatArray, F: FloatArray, lo: int, up: int, r: int, cols: FloatArray,
+             vals: FloatArray, rhs: FloatArray) -> None:
+    """Replace row ``r`` of the banded matrix and right-hand side (row scaled to max 1)."""
+    c = np.arange(max(r - lo, 0), min(r + up + 1, ab.shape[1]))
+    ab[up + r - c, c] = 0.0
+    scale = np.abs(vals).max()
+    ab[up + r - cols, cols] = vals / scale
+    F[r] = rhs / scale
+
+
+def _nak_row(k: int, h: FloatArray, dsc: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Columns and scaled coefficients of ``jump(r^(5))`` at interior point ``k`` in the
+    unknowns; ``r^(5) = (720 dp - 360 (m0 + m1) h + 60 (s1 - s0) h^2) / h^5`` per segment."""
+    a, b = h[k - 1], h[k]
+    cols = np.arange(2 * k - 2, 2 * k + 4)
+    vals = np.array([-360.0 / a**4, -60.0 / a**3, 360.0 / b**4 - 360.0 / a**4,
+                     60.0 / a**3 + 60.0 / b**3, 360.0 / b**4, -60.0 / b**3]) * dsc[cols]
+    return cols, vals
+
+
+def _solve(ab: FloatArray, lo: int, up: int, rhs: FloatArray) -> FloatArray:
+    """``solve_banded((lo, up), ab, rhs)``, calling its LAPACK driver ``dgbsv`` directly on
+    Fortran-ordered copies (saves scipy's checks and C-to-Fortran conversions)."""
+    a2 = np.empty((2 * lo + up + 1, ab.shape[1]), order="F")
+    a2[:lo] = 0.0
+    a2[lo:] = ab
+    _, _, y, info = dgbsv(lo, up, a2, np.asfortranarray(rhs), overwrite_ab=1, overwrite_b=1)
+    if info != 0 or not np.isfinite(y).all():
+        raise InputError("the quintic spline's end conditions do not determine it for these "
+                         "points (singular system)")
+    return y
+
+
+def _quintic_hermite_data(pts: FloatArray, t: FloatArray, left: Any, right: Any,
+                          periodic: bool) -> tuple[FloatArray, FloatArray]:
+    """First and second derivatives at ``t`` of the C4 quintic spline through ``pts``.
+
+    ``left``, ``right``: ``"not-a-knot"`` or two ``(order, vector)`` pairs with distinct orders
+    in 1..4 (given ``r'``, ``r''``, ``r'''``, ``r''''`` at that end; scipy's ``bc_type`` form);
+    ignored if ``periodic`` (``pts[-1] == pts[0]``). Returns ``(d1, d2)``, shape ``(n, dim)``.
+
+    Solved as a correction ``x = x0 + dx`` of the three-point estimate ``x0``: the right-hand
+    side is the residual of ``x0`` (its C3/C4 jumps and end-condition defects, computed
+    segment by segment), so the solve's rounding is relative to ``|dx|``, not ``|x|``; on a
+    straight line ``dx`` is rounding noise.
+    """
+    n, dim = pts.shape
+    hbar = (t[-1] - t[0]) / (n - 1)  # solve in t / hbar: no over/underflow of h**-5
+    h = np.diff(t) / hbar
+    delta = np.diff(pts, axis=0)
+    m0, s0 = _first_guess(h, delta, periodic)
+    npt = m0.shape[0]
+    if periodic:
+        r3l, r4l, r3r, r4r, _ = _one_sided(h, delta, np.vstack([m0, m0[:1]]),
+                                           np.vstack([s0, s0[:1]]))
+        rp = np.r_[1:npt, 0]
+    else:
+        r3l, r4l, r3r, r4r, r5 = _one_sided(h, delta, m0, s0)
+        rp = np.arange(1, npt)
+    res = np.zeros((npt, 2, dim))  # f - K x0 per point: (-jump(r''''), jump(r'''))
+    res[: h.size, 0] -= r4l
+    res[rp, 0] += r4r
+    res[: h.size, 1] += r3l
+    res[rp, 1] -= r3r
+    res = res.reshape(2 * npt, dim)
+    x0 = np.stack([m0, s0], axis=1).reshape(2 * npt, dim)
+    M = 2 * npt
+    if periodic:
+        dsc, ab = _banded(h, npt, npt - 1, 3, 3)
+        # A = B + E Ks E^T, B: the open chain without the seam segment (SPD for npt >= 3),
+        # Ks: the seam's scaled 4x4 stiffness on the unknowns E = (m, s at npt-1; m, s at 0).
+        idx = np.array([M - 2, M - 1, 0, 1])
+        Ks = _KE / h[-1] ** _KE_POW * dsc[idx][:, None] * dsc[idx][None, :]
+        E = np.zeros((M, 4))
+        E[idx, np.arange(4)] = 1.0
+        Y = _solve(ab, 3, 3, np.hstack([res * dsc[:, None], E]))
+        y0, Z = Y[:, :dim], Y[:, dim:]
+        # Woodbury: A^-1 f = y0 - Z (I + Ks E^T Z)^-1 Ks E^T y0
+        y = y0 - Z @ np.linalg.solve(np.eye(4) + Ks @ Z[idx], Ks @ y0[idx])
+        x = x0 + y * dsc[:, None]
+        x = np.vstack([x, x[:2]])
+    else:
+        nak = (left == "not-a-knot", right == "not-a-knot")
+        if n == 2 and not (nak[0] or nak[1]) and all(o in (3, 4) for o, _ in [*left, *right]):
+            # r''' and r'''' given at both ends of one segment never determine it: with r(t)
+            # any r + c (t - t0)(t - t1) satisfies them. Natural ends (zeros): the line, c = 0
+            # (the first guess), the member that also minimises int |r''|^2.
+            if any(np.any(np.asarray(v) != 0) for _, v in [*left, *right]):
+                raise InputError("two points with r''' and r'''' given at both ends do not "
+                                 "determine a quintic")
+            x = x0
+        else:
+            lo = 6 if nak[1] else 3
+            up = 6 if nak[0] else 3
+            dsc, ab = _banded(h, npt, npt - 1, lo, up)
+            F = res * dsc[:, None]
+            for side, cond in enumerate((left, right)):
+                pt = 0 if side == 0 else n - 1
+                # rows of the end point: r'''' (+ left, - right), r''' (- left, + right)
+                rows = (2 * pt, 2 * pt + 1)
+                if nak[side]:
+                    ks = (1, 2) if side == 0 else (n - 3, n - 2)
+                    for r, k in zip(rows, ks, strict=True):
+                        _set_row(ab, F, lo, up, r, *_nak_row(k, h, dsc), r5[k] - r5[k - 1])
+                    continue
+                c = np.arange(4) if side == 0 else np.arange(M - 4, M)  # the end segment's
+                orig = [(c, ab[up + r - c, c].copy(), F[r].copy()) for r in rows]
+                # a given r' or r'''' takes the r'''' row, r'' or r''' the r''' row
+                target = [0 if o in (1, 4) else 1 for o, _ in cond]
+                if target[0] == target[1]:
+                    target[1] = 1 - target[0]
+                for (o, v), w in zip(cond, target, strict=True):
+                    vhat = np.asarray(v, dtype=float) * hbar**o
+                    if o in (1, 2):
+                        u = 2 * pt + o - 1
+                        _set_row(ab, F, lo, up, rows[w], np.array([u]), np.array([dsc[u]]),
+                                 vhat - x0[u])
+                    else:
+                        src = 0 if o == 4 else 1
+                        sign = (1.0 if o == 4 else -1.0) * (1.0 if side == 0 else -1.0)
+                        c, vals, rhs = orig[src]
+                        _set_row(ab, F, lo, up, rows[w], c, vals,
+                                 rhs + sign * vhat * dsc[rows[src]])
+            x = x0 + _solve(ab, lo, up, F) * dsc[:, None]
+    return x[0::2] / hbar, x[1::2] / hbar**2
+
+
 def interpolate_quintic(points: ArrayLike, param: str | ArrayLike = "chord", bc: Any = "natural",
                         *, end_tangents: ArrayLike | None = None) -> QuinticHermite:
     """C4 interpolating parametric quintic spline, returned as a :class:`QuinticHermite`.
@@ -176,16 +396,45 @@ def interpolate_quintic(points: ArrayLike, param: str | ArrayLike = "chord", bc:
         ``"natural"``: ``r''' = r'''' = 0`` at both ends -- the natural end conditions of the
         quintic spline that minimises the jerk energy ``int |r'''|^2 dt`` among C2 interpolants.
         ``"clamped"``: given end tangent and ``r''' = 0`` (the natural complement).
-        ``"not-a-knot"`` (needs n >= 6), ``"periodic"`` (closed).
-        A pair per end: ``"natural"``, ``"clamped"``, ``"not-a-knot"``, ``(1, tangent)`` or
-        ``(2, second_derivative)``. A given tangent is completed by ``r''' = 0`` and a given second
-        derivative by ``r'''' = 0`` (the variational natural complements).
+        ``"not-a-knot"`` (needs n >= 6), ``"periodic"`` (closed; the first point is repeated last
+        unless it already is). A pair per end: ``"natural"``, ``"clamped"``, ``"not-a-knot"``
+        (n >= 4), ``(1, tangent)`` or ``(2, second_derivative)``. A given tangent is completed
+        by ``r''' = 0`` and a given second derivative by ``r'''' = 0`` (the variational natural
+        complements).
     end_tangents : array_like, shape (2, dim), optional
 
     Returns
     -------
     QuinticHermite
         With ``d1``, ``d2`` the spline's first and second derivatives at the data points.
+
+    Notes
+    -----
+    The unknowns are the Hermite data ``m_i = r'(t_i)``, ``s_i = r''(t_i)``; each segment is the
+    quintic Hermite interpolant of Wang 2005, eq. (2), so the spline interpolates and is C2 by
+    construction. Every interior point adds ``jump(r'''') = 0`` and ``jump(r''') = 0`` (C4 and
+    C3; one-sided values from eq. (2) differentiated). These two rows are, up to sign, the
+    gradient of the jerk energy ``int |r'''|^2 dt`` with respect to ``(m_i, s_i)``: the matrix
+    is the energy's Hessian (symmetric positive definite), and at an end the same rows read
+    ``r'''' = 0`` and ``r''' = 0`` (the natural conditions). A given ``r'`` replaces the
+    ``r''''`` row and keeps ``r''' = 0``; a given ``r''`` replaces the ``r'''`` row and keeps
+    ``r'''' = 0``; a not-a-knot end replaces both by "no jump of ``r^(5)``" at the second and
+    third points from that end, so the four end segments are one polynomial (the knots of
+    scipy's ``make_interp_spline(k=5)``; one such end needs n >= 4, two need n >= 6).
+
+    Solution: the unknowns are interleaved ``(m_0, s_0, m_1, s_1, ...)``, which makes the matrix
+    banded (3 diagonals on each side, 6 beside a not-a-knot end), and scaled symmetrically by
+    ``diag(K)**-1/2`` (about ``h**1.5`` for ``m`` and ``h**0.5`` for ``s``, ``h`` the local
+    spacing), which keeps it well conditioned for non-uniform spacing. The system is solved for
+    the correction to three-point (parabola) estimates of ``r'`` and ``r''`` -- exact on lines
+    and parabolas -- with their C3/C4 jumps and end-condition defects as the right-hand side,
+    so rounding in the solve is relative to the correction; the result is the spline of the
+    given (rounded) data to about 1e-15 relative, and collinear points give the line itself.
+    All coordinates are solved at once by LAPACK's banded ``dgbsv`` (what
+    ``scipy.linalg.solve_banded`` calls), O(n). A closed curve's cyclic matrix is the open
+    chain's band plus the seam segment's 4 x 4 block: Woodbury identity, 4 extra right-hand
+    sides. Two points with natural ends: the conditions leave ``c (t - t0)(t - t1)`` free; the
+    straight segment (the member that also minimises ``int |r''|^2``) is returned.
 
     Examples
     --------
@@ -194,23 +443,22 @@ def interpolate_quintic(points: ArrayLike, param: str | ArrayLike = "chord", bc:
     >>> q = interpolate_quintic(np.c_[np.cos(np.linspace(0, 3, 9)), np.sin(np.linspace(0, 3, 9))])
     >>> q.degree
     5
+    >>> line = interpolate_quintic([[0, 0], [1, 1], [3, 3], [3.5, 3.5]])
+    >>> bool(np.abs(line.d2).max() < 1e-14)
+    True
     """
     pts, t, periodic = _prepare(points, param, bc, min_points=2)
     n, dim = pts.shape
-    if periodic:
-        spl = make_interp_spline(t, pts, k=5, bc_type="periodic", axis=0)
-    else:
+    left = right = None
+    if not periodic:
         left, right = _bc_pair(bc, dim, (3, 4), end_tangents)
-        if left == "not-a-knot" or right == "not-a-knot":
-            if left != right:
-                raise InputError("for quintic splines, not-a-knot must be used at both ends")
-            if n < 6:
-                raise InputError(f"a not-a-knot quintic spline needs at least 6 points, got {n}")
-            spl = make_interp_spline(t, pts, k=5, bc_type=None, axis=0)
-        else:
-            spl = make_interp_spline(t, pts, k=5, bc_type=(left, right), axis=0)
-    d1 = spl(t, 1)
-    d2 = spl(t, 2)
+        naks = (left == "not-a-knot") + (right == "not-a-knot")
+        if naks == 2 and n < 6:
+            raise InputError(f"a not-a-knot quintic spline needs at least 6 points, got {n}")
+        if naks == 1 and n < 4:
+            raise InputError(f"a quintic spline with one not-a-knot end needs at least 4 points, "
+                             f"got {n}")
+    d1, d2 = _quintic_hermite_data(pts, t, left, right, periodic)
     if periodic:
         d1[-1] = d1[0]
         d2[-1] = d2[0]
