@@ -77,6 +77,51 @@ def basis_derivatives(knots: FloatArray, degree: int, span: np.ndarray, x: Float
 
 
 @njit(cache=True)
+def _ders_one(knots, p, s, u, base, nder, ndu, left, right, a, out, q):  # type: ignore[no-untyped-def]
+    """Basis derivatives at one parameter into ``out[q]`` (Piegl & Tiller A2.3); work arrays
+    ``ndu`` (p+1, p+1), ``left``/``right`` (p+1,), ``a`` (2, p+1)."""
+    ndu[0, 0] = 1.0
+    for j in range(1, p + 1):
+        left[j] = u - (knots[s + 1 - j] - base)
+        right[j] = (knots[s + j] - base) - u
+        saved = 0.0
+        for r in range(j):
+            ndu[j, r] = right[r + 1] + left[j - r]
+            temp = ndu[r, j - 1] / ndu[j, r]
+            ndu[r, j] = saved + right[r + 1] * temp
+            saved = left[j - r] * temp
+        ndu[j, j] = saved
+    for j in range(p + 1):
+        out[q, 0, j] = ndu[j, p]
+    for r in range(p + 1):
+        s1 = 0
+        s2 = 1
+        a[0, 0] = 1.0
+        for k in range(1, nder + 1):
+            d = 0.0
+            rk = r - k
+            pk = p - k
+            if r >= k:
+                a[s2, 0] = a[s1, 0] / ndu[pk + 1, rk]
+                d = a[s2, 0] * ndu[rk, pk]
+            j1 = 1 if rk >= -1 else -rk
+            j2 = k - 1 if r - 1 <= pk else p - r
+            for j in range(j1, j2 + 1):
+                a[s2, j] = (a[s1, j] - a[s1, j - 1]) / ndu[pk + 1, rk + j]
+                d += a[s2, j] * ndu[rk + j, pk]
+            if r <= pk:
+                a[s2, k] = -a[s1, k - 1] / ndu[pk + 1, r]
+                d += a[s2, k] * ndu[r, pk]
+            out[q, k, r] = d
+            s1, s2 = s2, s1
+    fac = float(p)
+    for k in range(1, nder + 1):
+        for j in range(p + 1):
+            out[q, k, j] *= fac
+        fac *= p - k
+
+
+@njit(cache=True)
 def _ders_kernel(knots, p, span, x, nder, local, out):  # type: ignore[no-untyped-def]
     ndu = np.empty((p + 1, p + 1))
     left = np.empty(p + 1)
@@ -84,47 +129,106 @@ def _ders_kernel(knots, p, span, x, nder, local, out):  # type: ignore[no-untype
     a = np.empty((2, p + 1))
     for q in range(x.shape[0]):
         s = span[q]
-        u = x[q]
-        base = knots[s] if local else 0.0
-        ndu[0, 0] = 1.0
-        for j in range(1, p + 1):
-            left[j] = u - (knots[s + 1 - j] - base)
-            right[j] = (knots[s + j] - base) - u
-            saved = 0.0
-            for r in range(j):
-                ndu[j, r] = right[r + 1] + left[j - r]
-                temp = ndu[r, j - 1] / ndu[j, r]
-                ndu[r, j] = saved + right[r + 1] * temp
-                saved = left[j - r] * temp
-            ndu[j, j] = saved
-        for j in range(p + 1):
-            out[q, 0, j] = ndu[j, p]
-        for r in range(p + 1):
-            s1 = 0
-            s2 = 1
-            a[0, 0] = 1.0
-            for k in range(1, nder + 1):
-                d = 0.0
-                rk = r - k
-                pk = p - k
-                if r >= k:
-                    a[s2, 0] = a[s1, 0] / ndu[pk + 1, rk]
-                    d = a[s2, 0] * ndu[rk, pk]
-                j1 = 1 if rk >= -1 else -rk
-                j2 = k - 1 if r - 1 <= pk else p - r
-                for j in range(j1, j2 + 1):
-                    a[s2, j] = (a[s1, j] - a[s1, j - 1]) / ndu[pk + 1, rk + j]
-                    d += a[s2, j] * ndu[rk + j, pk]
-                if r <= pk:
-                    a[s2, k] = -a[s1, k - 1] / ndu[pk + 1, r]
-                    d += a[s2, k] * ndu[r, pk]
-                out[q, k, r] = d
-                s1, s2 = s2, s1
-        fac = float(p)
-        for k in range(1, nder + 1):
+        _ders_one(knots, p, s, x[q], knots[s] if local else 0.0, nder, ndu, left, right, a,
+                  out, q)
+
+
+@njit(cache=True)
+def _gram_kernel(knots, p, spans, l, xq, wq, n, closed):  # type: ignore[no-untyped-def]  # noqa: E741
+    """Banded Gram matrix ``W`` (n, 2p+1) of ``int N_i^(l) N_j^(l)`` (see ``gram_band``).
+
+    One Gauss-Legendre rule per knot span, on local offsets ``x - knots[s]``; a span whose
+    local knot pattern (``knots[s-p+1 .. s+p] - knots[s]``) equals the previous span's reuses
+    its element matrix bitwise (uniform knots: a handful of evaluations in all).
+    """
+    nq = xq.shape[0]
+    W = np.zeros((n, 2 * p + 1))
+    ndu = np.empty((p + 1, p + 1))
+    left = np.empty(p + 1)
+    right = np.empty(p + 1)
+    a = np.empty((2, p + 1))
+    d = np.empty((nq, l + 1, p + 1))
+    M = np.empty((p + 1, p + 1))
+    prev = np.empty(2 * p)
+    have = False
+    for m in range(spans.shape[0]):
+        s = spans[m]
+        ts = knots[s]
+        same = have
+        for k in range(2 * p):
+            v = knots[s - p + 1 + k] - ts
+            if same and v != prev[k]:
+                same = False
+            prev[k] = v
+        if not same:
+            h = knots[s + 1] - ts
+            for q in range(nq):
+                _ders_one(knots, p, s, h * xq[q], ts, l, ndu, left, right, a, d, q)
+            for i in range(p + 1):
+                for j in range(p + 1):
+                    acc = 0.0
+                    for q in range(nq):
+                        acc += wq[q] * d[q, l, i] * d[q, l, j]
+                    M[i, j] = acc * h
+            have = True
+        for i in range(p + 1):
+            row = s - p + i
+            if closed:
+                row %= n
             for j in range(p + 1):
-                out[q, k, j] *= fac
-            fac *= p - k
+                W[row, p + j - i] += M[i, j]
+    return W
+
+
+@njit(cache=True)
+def band_residual(W, p, closed, x, out):  # type: ignore[no-untyped-def]
+    """``out = G x`` (per coordinate) for the Gram band ``W`` of :meth:`BSplineCurve.gram_band`,
+    in difference form ``(G x)_i = sum_{o != 0} W[i, p + o] (x_{i+o} - x_i)``.
+
+    Exact for ``l >= 1`` because the rows of ``G`` sum to zero (the basis functions sum to 1,
+    their derivatives to 0); unlike ``W @ x`` it does not lose the digits of large coordinates
+    (1e6-sized coordinates cost ``W @ x`` about 1e-9 relative).
+    """
+    n, dim = x.shape
+    for i in range(n):
+        interior = i >= p and i + p < n
+        for a in range(dim):
+            xi = x[i, a]
+            acc = 0.0
+            for o in range(-p, p + 1):
+                if o == 0:
+                    continue
+                j = i + o
+                if not interior and (j < 0 or j >= n):
+                    if not closed:
+                        continue
+                    j = j + n if j < 0 else j - n
+                acc += W[i, p + o] * (x[j, a] - xi)
+            out[i, a] = acc
+
+
+@njit(cache=True)
+def band_energy(W, p, closed, x):  # type: ignore[no-untyped-def]
+    """``x^T G x`` summed over the coordinates, in difference form
+    ``-sum_i sum_{o=1..p} W[i, p + o] |x_{i+o} - x_i|^2`` (see :func:`band_residual`): exact
+    for ``l >= 1`` and free of the cancellation of large coordinates."""
+    n, dim = x.shape
+    e = 0.0
+    for i in range(n):
+        for o in range(1, p + 1):
+            j = i + o
+            if j >= n:
+                if not closed:
+                    break
+                j -= n
+            w = W[i, p + o]
+            if w != 0.0:
+                d2 = 0.0
+                for a in range(dim):
+                    t = x[j, a] - x[i, a]
+                    d2 += t * t
+                e -= w * d2
+    return e
 
 
 def _gauss(nq: int) -> tuple[FloatArray, FloatArray]:
@@ -411,24 +515,10 @@ class BSplineCurve(PiecewiseCurve):
 
     def _gram_band(self, l: int) -> FloatArray:  # noqa: E741
         p = self.degree
-        t = self._knots
-        s = self.spans
-        nq = p - int(l) + 1
-        xq, wq = _gauss(nq)
-        h = t[s + 1] - t[s]
-        x = (h[:, None] * xq[None, :]).reshape(-1)
-        ss = np.repeat(s, nq)
-        d = basis_derivatives(t, p, ss, x, int(l), local=True)[:, int(l), :]
-        d = d.reshape(s.shape[0], nq, p + 1)
-        # M[m, a, b] = sum_q w_q h_m d[m,q,a] d[m,q,b]
-        M = np.einsum("q,mqa,mqb->mab", wq, d, d) * h[:, None, None]
-        n = self.n_ctrl
-        W = np.zeros((n, 2 * p + 1))
-        for a in range(p + 1):
-            rows = self.control_index(s - p + a)  # distinct for fixed a
-            for b in range(p + 1):
-                W[rows, p + b - a] += M[:, a, b]
-        return W
+        xq, wq = _gauss(p - int(l) + 1)
+        return _gram_kernel(np.ascontiguousarray(self._knots), p,
+                            np.ascontiguousarray(self.spans, dtype=np.int64), int(l), xq, wq,
+                            self.n_ctrl, self._closed)
 
     def gram_matrix(self, l: int) -> Any:  # noqa: E741
         """The Gram matrix of :meth:`gram_band` as a ``scipy.sparse`` CSR matrix ``(n, n)``."""
@@ -444,10 +534,10 @@ class BSplineCurve(PiecewiseCurve):
         return csr_matrix((vals[keep], (rows[keep], cols[keep])), shape=(n, n))
 
     def energy_l(self, l: int) -> float:  # noqa: E741
-        """``E_l = int |r^(l)(t)|^2 dt`` over the domain, from the exact Gram matrix."""
-        G = self.gram_matrix(l)
-        d = self._ctrl
-        return float(np.sum(d * (G @ d)))
+        """``E_l = int |r^(l)(t)|^2 dt`` over the domain, from the exact Gram matrix (in the
+        difference form of :func:`band_energy`, accurate whatever the coordinates)."""
+        W = np.ascontiguousarray(self.gram_band(l))
+        return float(band_energy(W, self.degree, self._closed, np.ascontiguousarray(self._ctrl)))
 
     # -- scipy interop ----------------------------------------------------------------------
     def to_scipy(self) -> BSpline:

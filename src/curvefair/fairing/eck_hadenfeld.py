@@ -21,7 +21,7 @@ import numpy as np
 from numba import njit
 
 from .._typing import FloatArray
-from ..curves.bspline import BSplineCurve
+from ..curves.bspline import BSplineCurve, band_energy, band_residual
 from ..errors import InputError
 
 __all__ = [
@@ -164,20 +164,18 @@ def eh_weights(curve: BSplineCurve, r: int,
 
 
 def _residual(curve: BSplineCurve, W: FloatArray) -> FloatArray:
-    """``g = G d`` (per coordinate) from the band, vectorised: shape (n, dim)."""
-    d = curve.control_points
-    n = curve.n_ctrl
-    p = curve.degree
-    g = np.zeros_like(d)
-    for c in range(2 * p + 1):
-        o = c - p
-        if curve.closed:
-            g += W[:, c, None] * np.roll(d, -o, axis=0)
-        else:
-            lo, hi = max(0, -o), min(n, n - o)
-            if lo < hi:
-                g[lo:hi] += W[lo:hi, c, None] * d[lo + o:hi + o]
+    """``g = G d`` (per coordinate) from the band, compiled, in difference form (accurate for
+    large coordinates, see :func:`curvefair.curves.bspline.band_residual`): shape (n, dim)."""
+    d = np.ascontiguousarray(curve.control_points)
+    g = np.empty_like(d)
+    band_residual(np.ascontiguousarray(W), curve.degree, curve.closed, d, g)
     return g
+
+
+def _energy(curve: BSplineCurve, W: FloatArray) -> float:
+    """``E_l = d^T G d`` in difference form (:func:`curvefair.curves.bspline.band_energy`)."""
+    return float(band_energy(np.ascontiguousarray(W), curve.degree, curve.closed,
+                             np.ascontiguousarray(curve.control_points)))
 
 
 def eck_hadenfeld(curve: BSplineCurve, r: int, l: int = 2) -> BSplineCurve:  # noqa: E741
@@ -587,7 +585,7 @@ def eck_hadenfeld_fair(curve: BSplineCurve, *, l: int = 2, tol: float | None = N
     X[:, :dim] = curve.control_points
     X[:, dim:2 * dim] = _residual(curve, W)
     X[:, 2 * dim:] = curve.control_points
-    e0 = float(np.sum(X[:, :dim] * X[:, dim:2 * dim]))
+    e0 = _energy(curve, W)
     eps_abs = epsv * e0 if eps_relative else epsv
     hist = np.zeros((int(min(max(history_max, 0), max_steps)), 3))
     z = np.where(mask, 0.0, -1.0)
@@ -596,7 +594,7 @@ def eck_hadenfeld_fair(curve: BSplineCurve, *, l: int = 2, tol: float | None = N
                                      eps_abs, int(max_steps), hist)
     out = curve.replace(control_points=X[:, :dim])
     g = _residual(out, W)
-    e1 = float(np.sum(out.control_points * g))
+    e1 = _energy(out, W)
     reason = STOP_REASONS[int(code)]
     if reason == "converged":
         free = np.sum(g * g, axis=1) / W[:, curve.degree]

@@ -9,12 +9,12 @@ This is the problem every local method of :func:`curvefair.fair` on B-splines wo
 control point at a time (Eck & Hadenfeld's ranking list is block Gauss-Seidel on it), solved
 here for all points at once: it is never worse than any of them at the same tolerance.
 
-Solver: a primal-dual interior-point method with strictly feasible iterates (Boyd &
-Vandenberghe, *Convex Optimization*, sec. 11.7). Each iteration factorises one symmetric
-block-banded matrix (bandwidth ``(degree + 1) dim - 1`` with the
-coordinates interleaved) by banded Cholesky (LAPACK ``pbtrf`` via
-:func:`scipy.linalg.cholesky_banded`) for open curves, or a sparse LU (SuperLU, minimum-degree
-ordering) for closed (cyclic) ones: ``O(n)`` per iteration, typically 15-30 iterations.
+Solver (see :func:`global_fair`): a Mehrotra predictor-corrector interior point with strictly
+feasible iterates, finished by an active-set (semismooth) Newton iteration that converges
+quadratically once the active balls are known. Each iteration factorises one symmetric
+block-banded matrix (bandwidth ``(degree + 1) dim - 1``, coordinates interleaved) by a compiled
+band Cholesky (closed curves: the cyclic band bordered by a small Schur complement), see
+:mod:`._global_kernels`: ``O(n)`` time and memory per iteration, typically 10-20 iterations.
 """
 
 from __future__ import annotations
@@ -25,12 +25,11 @@ from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.linalg import cho_solve_banded, cholesky_banded
-from scipy.sparse.linalg import splu
 
 from .._typing import FloatArray
-from ..curves.bspline import BSplineCurve
+from ..curves.bspline import BSplineCurve, band_energy, band_residual
 from ..errors import InputError
+from . import _global_kernels as _k
 from .eck_hadenfeld import check_bspline, movable_mask
 
 __all__ = ["global_fair", "GlobalResult", "energy_matrix"]
@@ -73,58 +72,118 @@ def energy_matrix(curve: BSplineCurve, l: Any = 2) -> sp.csr_matrix:  # noqa: E7
     return G.tocsr()
 
 
-class _Solver:
-    """Solve ``H x = rhs`` for ``H = 2 kron(A, I_dim) + blockdiag(B_i)`` (interleaved unknowns:
-    point ``i``, coordinate ``a`` is unknown ``i dim + a``)."""
+def _frames(nrm: FloatArray) -> FloatArray:
+    """Orthonormal frames ``Q_i`` (shape (m, dim, dim)) whose first column is the unit vector
+    ``nrm_i`` (2-D: the tangent is ``nrm`` turned by 90 degrees; 3-D: Duff et al. 2017,
+    "Building an orthonormal basis, revisited")."""
+    m, dim = nrm.shape
+    Q = np.zeros((m, dim, dim))
+    Q[:, :, 0] = nrm
+    if dim == 2:
+        Q[:, 0, 1] = -nrm[:, 1]
+        Q[:, 1, 1] = nrm[:, 0]
+        return Q
+    x, y, z = nrm[:, 0], nrm[:, 1], nrm[:, 2]
+    sgn = np.where(z >= 0.0, 1.0, -1.0)
+    a = -1.0 / (sgn + z)
+    b = x * y * a
+    Q[:, 0, 1] = 1.0 + sgn * x * x * a
+    Q[:, 1, 1] = sgn * b
+    Q[:, 2, 1] = -sgn * x
+    Q[:, 0, 2] = b
+    Q[:, 1, 2] = sgn + y * y * a
+    Q[:, 2, 2] = -y
+    return Q
 
-    def __init__(self, A: sp.csr_matrix, dim: int, banded: bool, band: int) -> None:
-        self.dim = dim
-        self.banded = banded
-        m = A.shape[0]
-        self.m = m
-        N = m * dim
-        K = sp.kron(2.0 * A, sp.identity(dim), format="coo")
-        K.sum_duplicates()
-        if banded:
-            u = band * dim + dim - 1
-            self.u = u
-            up = K.row <= K.col
-            ab = np.zeros((u + 1, N))
-            ab[u + K.row[up] - K.col[up], K.col[up]] = K.data[up]
-            self.ab = ab
+
+class _System:
+    """Newton systems ``Q^T (kron(K, I) + blockdiag(B)) Q`` with fixed unknowns (see
+    :mod:`._global_kernels`): band Cholesky (open curves), bordered cyclic band (closed), dense
+    for tiny closed curves. ``K`` is given by its band rows ``K[i, p + o] = K_{i, i+o}``;
+    ``fixed`` points never move. Work arrays are allocated once and reused."""
+
+    def __init__(self, K: FloatArray, p: int, dim: int, closed: bool, fixed: np.ndarray) -> None:
+        n = K.shape[0]
+        self.K, self.p, self.dim, self.closed, self.n = K, p, dim, closed, n
+        self.N = N = n * dim
+        self.kd = kd = (p + 1) * dim - 1
+        self.fix0 = np.repeat(fixed[:, None], dim, axis=1)
+        self.dense = closed and N < 3 * (kd + 1)
+        if self.dense:
+            Kd = np.zeros((n, n))
+            for o in range(-p, p + 1):
+                np.add.at(Kd, (np.arange(n), (np.arange(n) + o) % n), K[:, p + o])
+            self.Kd = np.kron(Kd, np.eye(dim))
         else:
-            self.K = K.tocsc()
-            i = np.arange(m)
-            a, b = np.meshgrid(np.arange(dim), np.arange(dim), indexing="ij")
-            self.brow = (i[:, None, None] * dim + a[None]).reshape(-1)
-            self.bcol = (i[:, None, None] * dim + b[None]).reshape(-1)
+            self.L = np.empty((N, kd + 1))
+            if closed:
+                self.Y = np.empty((N - kd, kd))
+                self.S = np.empty((kd, kd))
+        self.Q = np.zeros((n, dim, dim))
+        self.rot = np.zeros(n, dtype=np.bool_)
+        self.fix = self.fix0.copy()
+        self.B = np.zeros((n, dim, dim))
+        self.czero = np.zeros(n)
 
-    def factor(self, blocks: FloatArray) -> Any:
-        """Factorise ``H`` for the per-point ``blocks`` (shape (m, dim, dim), symmetric)."""
-        dim = self.dim
-        N = self.m * dim
-        if self.banded:
-            ab = self.ab.copy()
-            u = self.u
-            for a in range(dim):
-                for c in range(a, dim):
-                    ab[u + a - c, c::dim] += blocks[:, a, c]
-            return cholesky_banded(ab, lower=False, check_finite=False)
-        B = sp.csc_matrix((blocks.reshape(-1), (self.brow, self.bcol)), shape=(N, N))
-        return splu((self.K + B).tocsc(), permc_spec="MMD_AT_PLUS_A",
-                    options={"SymmetricMode": True})
-
-    def solve_factored(self, fac: Any, rhs: FloatArray) -> FloatArray:
-        b = rhs.reshape(-1)
-        if self.banded:
-            x = cho_solve_banded((fac, False), b, check_finite=False)
+    def factor(self, B: FloatArray, rot: np.ndarray | None = None,
+               nrm: FloatArray | None = None) -> bool:
+        """Factorise for blocks ``B`` (n, dim, dim); points ``rot`` get the frame whose first
+        axis is ``nrm`` and that axis fixed (a prescribed normal displacement). False if the
+        matrix is not positive definite in floating point."""
+        self.B = B
+        self.fix[:] = self.fix0
+        if rot is None or not rot.any():
+            self.rot[:] = False
         else:
-            x = fac.solve(b)
-        return x.reshape(self.m, self.dim)
+            self.rot[:] = rot
+            self.Q[rot] = _frames(nrm[rot])
+            self.fix[rot, 0] = True
+        if self.dense:
+            M = self.Kd + _blockdiag(B)
+            Qf = _blockdiag(np.where(self.rot[:, None, None], self.Q,
+                                     np.eye(self.dim)[None]))
+            M = Qf.T @ M @ Qf
+            f = self.fix.reshape(-1)
+            M[f, :] = 0.0
+            M[:, f] = 0.0
+            M[f, f] = 1.0
+            try:
+                self.C = np.linalg.cholesky(M)
+            except np.linalg.LinAlgError:
+                return False
+            return True
+        if self.closed:
+            _k.assemble(self.K, self.p, True, B, self.Q, self.rot, self.fix, self.L)
+            info = _k.cyclic_cholesky(self.L, self.Y, self.S)
+        else:
+            info = _k.assemble_cholesky(self.K, self.p, B, self.Q, self.rot, self.fix, self.L)
+        return info == 0
 
-    def solve(self, blocks: FloatArray, rhs: FloatArray) -> FloatArray:
-        """``blocks`` shape (m, dim, dim), symmetric; ``rhs`` shape (m, dim)."""
-        return self.solve_factored(self.factor(blocks), rhs)
+    def solve(self, rhs: FloatArray, c: FloatArray | None = None,
+              out: FloatArray | None = None) -> FloatArray:
+        """Displacement ``dx`` (n, dim): ``M dx = rhs`` on the unfixed unknowns, ``dx = 0`` at
+        fixed points, ``nrm_i . dx_i = c_i`` at the ``rot`` points."""
+        y = np.empty_like(rhs) if out is None else out
+        _k.prep_rhs(self.K, self.p, self.closed, self.B, self.Q, self.rot, self.fix, self.fix0,
+                    rhs, self.czero if c is None else c, y)
+        b = y.reshape(-1)
+        if self.dense:
+            b[:] = np.linalg.solve(self.C.T, np.linalg.solve(self.C, b))
+        elif self.closed:
+            _k.cyclic_solve_full(self.L, self.Y, self.S, b)
+        else:
+            _k.band_solve(self.L, self.N, b)
+        _k.post_solve(y, self.Q, self.rot, self.fix0)
+        return y
+
+
+def _blockdiag(B: FloatArray) -> FloatArray:
+    n, dim, _ = B.shape
+    out = np.zeros((n * dim, n * dim))
+    for a in range(dim):
+        for b in range(dim):
+            out[np.arange(n) * dim + a, np.arange(n) * dim + b] = B[:, a, b]
+    return out
 
 
 @dataclass(frozen=True)
@@ -174,9 +233,10 @@ def global_fair(curve: BSplineCurve, *, tol: float | None = None, l: Any = 2,  #
     clamp, protect
         Fixed control points, as for :func:`~curvefair.fairing.eck_hadenfeld.movable_mask`.
     gap : float
-        Stop when the duality gap is below ``gap * E(input)``.
+        Interior-point stopping threshold on the total complementarity
+        ``sum_i lambda_i s_i`` (in units of ``E(input)``).
     max_steps : int
-        Interior-point iteration cap.
+        Cap on the Newton iterations (interior point and active set together).
 
     Returns
     -------
@@ -185,17 +245,29 @@ def global_fair(curve: BSplineCurve, *, tol: float | None = None, l: Any = 2,  #
     Notes
     -----
     Convex QP: ``min sum_coords d^T G d`` s.t. ``|d_i - o_i|^2 <= tol^2`` (``G`` the exact Gram
-    matrix of :meth:`BSplineCurve.gram_band`). Primal-dual interior point with feasible
-    iterates (Boyd & Vandenberghe, sec. 11.7, ``mu = 10``) on ``E(d)/E(o)`` with the constraints
-    ``f_i = (|d_i - o_i|^2 / tol^2 - 1) / 2 <= 0``; the Newton system is reduced to ``d``
-    (per-point ``dim x dim`` blocks ``lambda_i I / tol^2 + (lambda_i / -f_i) a_i a_i^T``,
-    ``a_i = (d_i - o_i) / tol^2``); the step keeps ``lambda > 0`` and every point strictly inside
-    its ball and backtracks on the (scale-invariant) residual norm. Stops when the surrogate
-    duality gap is below ``gap`` and the dual residual below ``1e-10`` of its initial size, or
-    when rounding stalls the progress (three iterations without a 10 % gap reduction) with the gap
-    below ``1e-8`` and the dual residual below ``1e-8``: with a million constraints the rounding
-    of the ``f_i`` alone keeps the gap above ``1e-13``. The returned multipliers
-    (``E(o) lambda_i / tol^2``) satisfy ``2 (G d)_i + lambda_i (d_i - o_i) = 0``.
+    matrix of :meth:`BSplineCurve.gram_band`), solved on ``F = E(d)/E(o)`` with the constraints
+    ``f_i = (|d_i - o_i|^2 / tol^2 - 1) / 2 <= 0``:
+
+    1. start from the smoothing solve ``(2G/E(o) + mu_0 I) d = mu_0 o`` (one banded solve,
+       ``mu_0`` = 1 % of the mean diagonal);
+    2. Mehrotra predictor-corrector interior point with slacks ``s_i = -f_i`` (Nocedal & Wright,
+       *Numerical Optimization*, 2nd ed., alg. 16.4 / sec. 19.3): the Newton system is reduced
+       to ``d`` (per-point ``dim x dim`` blocks ``lambda_i I / tol^2 + (lambda_i / s_i) a_i
+       a_i^T``, ``a_i = (d_i - o_i) / tol^2``);
+    3. once the residuals are below ``1e-3``, a semismooth Newton (primal-dual active set)
+       iteration on the KKT system with the active set ``lambda_i + kappa f_i > 0``: the active
+       points move in the tangent plane of their sphere (the normal displacement is prescribed,
+       the Hessian of the Lagrangian ``2G/E(o) + lambda_i I / tol^2`` is used), which converges
+       quadratically once the active set is right; if it has not converged after 8 iterations
+       the interior point resumes from where it left.
+
+    Every Newton system is one symmetric block-banded matrix (bandwidth
+    ``(degree + 1) dim - 1``, coordinates interleaved) factorised by a compiled band Cholesky;
+    closed curves border the cyclic band with a small Schur complement: ``O(n)`` per iteration,
+    typically 10-20 iterations. Converged means: dual residual below ``1e-10`` of
+    ``|grad F(o)|_inf``, every point within ``tol (1 + 1e-12)`` (then projected onto its ball),
+    complementarity exact (active set) or below ``gap`` (interior point). The returned
+    multipliers (``E(o) lambda_i / tol^2``) satisfy ``2 (G d)_i + lambda_i (d_i - o_i) = 0``.
     Without a tolerance the free points solve ``G_FF d_F = -G_FC d_C`` (a ``1e-15`` Tikhonov
     term towards the original points picks the closest minimiser when the fixed points do not
     determine one, e.g. a closed curve without protected points).
@@ -218,124 +290,204 @@ def global_fair(curve: BSplineCurve, *, tol: float | None = None, l: Any = 2,  #
         if not (np.isfinite(tolv) and tolv >= 0):
             raise InputError(f"tol must be a finite number >= 0 or None, got {tol!r}")
     mask = movable_mask(curve, clamp, protect)
-    G = energy_matrix(curve, w)
+    p = curve.degree
+    closed = curve.closed
+    W = None
+    for k, v in w.items():
+        Wk = np.asarray(curve.gram_band(k)) * v
+        W = Wk if W is None else W + Wk
+    W = np.ascontiguousarray(W)
     d0 = np.array(curve.control_points)
     n, dim = d0.shape
-    E0 = float(np.sum(d0 * (G @ d0)))
+
+    def residual(K: FloatArray, x: FloatArray) -> FloatArray:  # K x, difference form
+        out = np.empty_like(x)
+        band_residual(K, p, closed, np.ascontiguousarray(x), out)
+        return out
+
+    def energy(x: FloatArray) -> float:
+        return float(band_energy(W, p, closed, np.ascontiguousarray(x)))
+
+    E0 = energy(d0)
     lam = np.zeros(n)
     free = np.flatnonzero(mask)
-    fixed = np.flatnonzero(~mask)
     if free.size == 0:
         return GlobalResult(curve, E0, E0, lam, 0, "no_movable_point", free)
     if E0 <= 0.0 or (tol is not None and tolv == 0.0):
         return GlobalResult(curve, E0, E0, lam, 0, "zero_energy" if E0 <= 0 else "converged",
                             np.zeros(0, dtype=np.int64))
-    A = G[free][:, free].tocsr()
-    bvec = G[free][:, fixed] @ d0[fixed] if fixed.size else np.zeros((free.size, dim))
-    solver = _Solver(A, dim, banded=not curve.closed, band=curve.degree)
-    o = d0[free]
-    m = free.size
-    eye = np.broadcast_to(np.eye(dim), (m, dim, dim))
-
-    def energy(x: FloatArray) -> float:
-        dd = d0.copy()
-        dd[free] = x
-        return float(np.sum(dd * (G @ dd)))
+    K = W * (2.0 / E0)  # F = E / E0: grad F = kron(K, I) d
+    system = _System(K, p, dim, closed, ~mask)
+    eye = np.broadcast_to(np.eye(dim), (n, dim, dim))
 
     if tol is None:
-        # (2A + 2 delta I) x = -2 b + 2 delta o
-        delta = 1e-15 * float(A.diagonal().max())
-        x = solver.solve(2.0 * delta * eye, -2.0 * bvec + 2.0 * delta * o)
-        d = d0.copy()
-        d[free] = x
-        out = curve.replace(control_points=d)
+        # (K + delta I) (d - o) = -K o on the free points
+        delta = 1e-15 * float(K[mask, p].max())
+        if not system.factor(delta * eye):
+            raise InputError("the energy matrix is singular on the free control points")
+        x = d0 + system.solve(-residual(K, d0))
+        out = curve.replace(control_points=x)
         return GlobalResult(out, E0, energy(x), lam, 1, "unconstrained",
                             np.zeros(0, dtype=np.int64))
 
-    # primal-dual interior point with feasible iterates (Boyd & Vandenberghe, sec. 11.7) on
-    #   min F(x) = E(x)/E0   s.t.   f_i(x) = (|x_i - o_i|^2 / tol^2 - 1) / 2 <= 0
-    x = o.copy()
-    lam_ = np.full(m, 1.0)
-    t2 = tolv * tolv
-    steps = 0
-    reason = "max_steps"
-
-    def residuals(x: FloatArray, lam_: FloatArray, tinv: float
-                  ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-        v = x - o
-        fi = 0.5 * (np.sum(v * v, axis=1) / t2 - 1.0)
-        rd = 2.0 * (A @ x + bvec) / E0 + lam_[:, None] * (v / t2)
-        rc = -lam_ * fi - tinv
-        return rd, rc, fi, v
-
-    rd0, _, fi0, _ = residuals(x, lam_, 0.0)
-    gscale = float(np.abs(rd0).max()) or 1.0  # scales like rd: scale-invariant stopping test
-    eta_prev = np.inf
-    stall = 0
-    while steps < max_steps:
-        v = x - o
-        fi = 0.5 * (np.sum(v * v, axis=1) / t2 - 1.0)
-        eta = float(-(fi @ lam_))  # surrogate duality gap
-        tinv = eta / (10.0 * m)  # 1/t with t = mu m / eta, mu = 10
-        rd, rc, fi, v = residuals(x, lam_, tinv)
-        stall = stall + 1 if eta > 0.9 * eta_prev else 0
-        if stall >= 3 and eta < 1e-8 and float(np.abs(rd).max()) < 1e-8 * gscale:
-            reason = "converged"  # stalled at rounding level above the target (large m)
+    v, lam_, steps, reason = _solve_balls(system, residual(K, d0), mask, tolv, gap, max_steps)
+    # strict feasibility in floating point, with a rounding margin (active points end on
+    # their sphere): every fl(x_i - o_i) and the evaluated curve stay within tol
+    margin = min(1e-9 * tolv, 1e-13 * tolv + 4.0 * np.finfo(float).eps * float(np.abs(d0).max()))
+    rmax = tolv - margin
+    dist = np.sqrt(np.sum(v * v, axis=1))
+    over = mask & (dist > rmax)
+    v[over] *= (rmax / dist[over])[:, None]
+    x = d0 + v
+    x[~mask] = d0[~mask]
+    for _ in range(8):  # o + v rounds: shrink until fl(x - o) is inside
+        w_ = x - d0
+        dist = np.sqrt(np.sum(w_ * w_, axis=1))
+        bad = mask & (dist > rmax)
+        if not bad.any():
             break
-        eta_prev = eta
-        if eta < gap and float(np.abs(rd).max()) < 1e-10 * gscale:
+        x[bad] = d0[bad] + w_[bad] * (rmax / dist[bad] * (1.0 - 2.0**-40))[:, None]
+    v = x - d0
+    t2 = tolv * tolv
+    lam[mask] = E0 * lam_[mask] / t2  # 2 (G d)_i + lam_i (d_i - o_i) = 0
+    out = curve.replace(control_points=x)
+    dist = np.sqrt(np.sum(v * v, axis=1))
+    active = free[dist[free] > (1 - 1e-6) * tolv]
+    return GlobalResult(out, E0, energy(x), lam, steps, reason, active)
+
+
+def _solve_balls(system: _System, g0: FloatArray, free: np.ndarray, tol: float, gap: float,
+                 max_steps: int, switch: float = 1e-2) -> tuple[FloatArray, FloatArray, int, str]:
+    """``min F(v) = F(o) + g0.v + v.K v / 2`` (``K = system.K``) over the displacements ``v``
+    from the original points, s.t. ``|v_i| <= tol`` at the free points (``v = 0`` at the
+    others): interior point, then active-set Newton (see :func:`global_fair`). Working with
+    displacements keeps full relative precision whatever the coordinates. Returns
+    ``(v, lambda, iterations, stop_reason)`` with ``g0 + K v + lambda v / tol^2 = 0`` at the
+    free points."""
+    n, dim = g0.shape
+    K, p, closed = system.K, system.p, system.closed
+    t2 = tol * tol
+    m = int(free.sum())
+    g0 = np.ascontiguousarray(np.where(free[:, None], g0, 0.0))
+    gscale = float(np.abs(g0).max())
+    if gscale == 0.0:  # already stationary: the input is optimal
+        return np.zeros_like(g0), np.zeros(n), 0, "converged"
+    eye = np.broadcast_to(np.eye(dim), (n, dim, dim))
+    # 1. start: smoothing solve (K + mu0 I) v = -g0, pulled inside the balls (|v| <= tol / 2)
+    mu0 = 0.01 * float(K[free, p].mean())
+    v = np.zeros_like(g0)
+    if system.factor(np.ascontiguousarray(mu0 * eye)):
+        v = system.solve(-g0)
+    r = np.sqrt(np.sum(v * v, axis=1))
+    big = r > 0.5 * tol
+    v[big] *= (0.5 * tol / r[big])[:, None]
+    vv = np.sum(v * v, axis=1)
+    g = g0 + _matvec(K, p, closed, v)
+    lam_floor = 0.1 * float(np.sqrt(np.sum(g0 * g0, axis=1))[free].mean()) * tol
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lam = np.where(vv > 0, -np.sum(g * v, axis=1) * t2 / vv, 0.0)
+    lam = np.where(free, np.maximum(lam, lam_floor), 0.0)
+    steps = 1
+    may_switch = True
+    rd = np.empty_like(v)
+    rhs = np.empty_like(v)
+    dv = np.empty_like(v)
+    s = np.empty(n)
+    rc = np.empty(n)
+    rp = np.empty(n)
+    ds = np.empty(n)
+    dl = np.empty(n)
+    B = np.empty((n, dim, dim))
+    reason = "max_steps"
+    while steps < max_steps:
+        rdm, smin, ls = _k.ip_eval(g0, K, p, closed, v, lam, free, t2, rd, s)
+        rdn = rdm / gscale
+        mu = ls / m
+        if rdn <= 1e-10 and ls <= gap:
             reason = "converged"
             break
-        a = v / t2
-        w = lam_ / (-fi)
-        blocks = (lam_ / t2)[:, None, None] * eye + w[:, None, None] * a[:, :, None] * a[:, None, :]
-        try:
-            fac = solver.factor(E0 * blocks)
-        except (np.linalg.LinAlgError, RuntimeError):  # as far as rounding allows
-            reason = "converged" if eta < max(1e3 * gap, 1e-8) else "numerical"
+        if may_switch and max(rdn, ls) < switch:
+            kappa = float(lam[free].mean()) / float(s[free].mean())
+            res = _active_set_newton(system, g0, free, tol, v, lam, kappa, gscale,
+                                     min(8, max_steps - steps))
+            steps += res[2]
+            if res[3]:
+                return res[0], res[1], steps, "converged"
+            may_switch = False  # resume the interior point from its last iterate
+            continue
+        _k.ip_blocks(v, lam, s, free, t2, B)
+        if not system.factor(B):
+            reason = "converged" if rdn <= 1e-8 and ls <= max(1e3 * gap, 1e-8) else "numerical"
             break
-        rhs = -rd - a * (rc / fi)[:, None]
-        dx = solver.solve_factored(fac, E0 * rhs)
-        adx = np.sum(a * dx, axis=1)
-        dlam = (rc - lam_ * adx) / fi
-        # step: keep lambda > 0, x strictly inside every ball, then decrease the residual norm
-        neg = dlam < 0
-        smax = min(1.0, float((-lam_[neg] / dlam[neg]).min())) if neg.any() else 1.0
-        st = 0.99 * smax
-        a2 = np.sum(dx * dx, axis=1)
-        a1 = np.sum(v * dx, axis=1)
-        c0 = np.sum(v * v, axis=1) - t2
-        with np.errstate(divide="ignore", invalid="ignore"):
-            tmax = np.where(a2 > 0, (-a1 + np.sqrt(np.maximum(a1 * a1 - a2 * c0, 0.0))) / a2,
-                            np.inf)
-        st = min(st, 0.99 * float(tmax.min()))
-        # residual norm with the dual part in units of its initial size: scale-invariant
-        rnorm = np.sqrt(float(np.sum((rd / gscale) ** 2) + np.sum(rc * rc)))
-        while st > 1e-14:
-            rd1, rc1, fi1, _ = residuals(x + st * dx, lam_ + st * dlam, tinv)
-            if np.all(fi1 < 0) and np.sqrt(float(np.sum((rd1 / gscale) ** 2)
-                                                 + np.sum(rc1 * rc1))) <= (1.0 - 0.01 * st) * rnorm:
-                break
-            st *= 0.5
-        if st <= 1e-14:  # no progress possible in floating point
-            reason = "converged" if eta < max(1e3 * gap, 1e-8) else "numerical"
+        # predictor (affine scaling): target lam s = 0, i.e. rc = lam s
+        np.multiply(lam, s, out=rc)
+        rp[:] = 0.0
+        _k.ip_rhs(rd, v, rc, rp, lam, s, free, t2, rhs)
+        system.solve(rhs, out=dv)
+        bm, lm = _k.ip_recover(dv, v, rc, rp, lam, s, free, t2, ds, dl)
+        ap, ad = min(1.0, bm), min(1.0, lm)
+        mu_aff = _k.ip_corrector(lam, s, dl, ds, ap, ad, free, rc) / m
+        sigma = min(1.0, (mu_aff / mu) ** 3) if mu > 0 else 0.0
+        # corrector: rc = lam s + dl_aff ds_aff - sigma mu, and the slack the predictor step
+        # loses to the curvature of the spheres
+        rc[free] -= sigma * mu
+        _k.second_order(dv, free, t2, rp)
+        _k.ip_rhs(rd, v, rc, rp, lam, s, free, t2, rhs)
+        system.solve(rhs, out=dv)
+        bm, lm = _k.ip_recover(dv, v, rc, rp, lam, s, free, t2, ds, dl)
+        st = min(1.0, 0.995 * min(bm, lm))
+        if not st > 1e-14:
+            reason = "converged" if rdn <= 1e-8 and ls <= max(1e3 * gap, 1e-8) else "numerical"
             break
-        x = x + st * dx
-        lam_ = lam_ + st * dlam
+        _k.ip_update(v, dv, lam, dl, st)
         steps += 1
-    v = x - o
-    # the iterates are strictly feasible; guard against a rounding error all the same
-    dist = np.sqrt(np.sum(v * v, axis=1))
-    out_ = dist > tolv
-    x[out_] = o[out_] + v[out_] * (tolv / dist[out_])[:, None]
-    v = x - o
-    lam[free] = E0 * lam_ / t2  # 2 (G d)_i + lam_i (d_i - o_i) = 0
-    d = d0.copy()
-    d[free] = x
-    out = curve.replace(control_points=d)
-    dist = np.sqrt(np.sum(v * v, axis=1))
-    active = free[dist > (1 - 1e-6) * tolv]
-    return GlobalResult(out, E0, energy(x), lam, steps, reason, active)
+    return v, lam, steps, reason
+
+
+def _matvec(K: FloatArray, p: int, closed: bool, x: FloatArray) -> FloatArray:
+    out = np.empty_like(x)
+    _k.band_matvec(K, p, closed, np.ascontiguousarray(x), out)
+    return out
+
+
+def _active_set_newton(system: _System, g0: FloatArray, free: np.ndarray, tol: float,
+                       v: FloatArray, lam: FloatArray, kappa: float, gscale: float, maxit: int
+                       ) -> tuple[FloatArray, FloatArray, int, bool]:
+    """Semismooth Newton on the KKT system from ``(v, lam)`` (not modified); returns
+    ``(v, lam, iterations, converged)``."""
+    n, dim = v.shape
+    K, p, closed = system.K, system.p, system.closed
+    t2 = tol * tol
+    delta = 1e-14 * float(np.abs(K[:, p]).max())
+    v = v.copy()
+    lam = lam.copy()
+    S = np.empty(n, dtype=np.bool_)
+    rd = np.empty_like(v)
+    f = np.empty(n)
+    rho = np.empty(n)
+    B = np.empty((n, dim, dim))
+    nrm = np.empty_like(v)
+    c = np.empty(n)
+    dv = np.empty_like(v)
+    kdv = np.empty_like(v)
+    for it in range(maxit + 1):
+        rdm, feas, fS = _k.ssn_eval(g0, K, p, closed, v, lam, free, t2, kappa, S, rd, f, rho)
+        stat = rdm / gscale
+        if not np.isfinite(stat):
+            return v, lam, it, False
+        if stat <= 1e-10 and feas <= 1e-12 and fS <= 1e-12:
+            return v, lam, it, True
+        if it == maxit:
+            break
+        _k.ssn_prepare(v, rho, f, S, lam, t2, delta, B, nrm, c)
+        if not system.factor(B, rot=S, nrm=nrm):
+            return v, lam, it, False
+        rd *= -1.0
+        system.solve(rd, c, out=dv)
+        rd *= -1.0
+        _k.band_matvec(K, p, closed, dv, kdv)
+        _k.ssn_update(v, dv, rd, kdv, lam, S, nrm, rho, t2)
+    return v, lam, maxit, False
 
 
 # ------------------------------------------------------------------------------------------

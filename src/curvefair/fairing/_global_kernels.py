@@ -1,0 +1,674 @@
+"""Compiled kernels of :mod:`curvefair.fairing.global_fair`: block-banded Newton systems.
+
+The Newton systems of the global fairing QP have the form (``n`` points, ``dim`` coordinates,
+unknowns interleaved: point ``i``, coordinate ``a`` is unknown ``i dim + a``)::
+
+    M = Q^T (kron(K, I_dim) + blockdiag(B_i)) Q,   K = 2 G / E0 (banded, bandwidth p),
+
+with one orthogonal ``dim x dim`` frame ``Q_i`` per point (the identity unless ``rot[i]``) and
+some unknowns fixed (``fix[i, a]``: row and column replaced by the identity). ``M`` is banded
+with bandwidth ``kd = (p + 1) dim - 1`` (open curves) or cyclic-banded (closed curves).
+
+Storage: ``L[r, k] = M[r + k, r]`` (``k = 0 .. kd``; closed curves: row ``(r + k) mod N``), one
+row per unknown, factorised in place (right-looking band Cholesky). Closed curves are solved
+by bordering: the last ``kd`` unknowns are eliminated through a ``kd x kd`` Schur complement,
+``O(N kd^2)`` in all. Everything is ``O(N)`` time and memory.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+# ------------------------------------------------------------------------------------------
+# assembly
+# ------------------------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def _assemble_range(K, p, closed, B, Q, rot, fix, L, i0, i1):  # type: ignore[no-untyped-def]
+    """Write the lower-band entries of the columns of points ``i0 .. i1 - 1`` into ``L``."""
+    n = K.shape[0]
+    dim = B.shape[1]
+    kd = L.shape[1] - 1
+    blk = np.empty((dim, dim))
+    qq = np.empty((dim, dim))
+    for i in range(i0, i1):
+        for a in range(dim):
+            for k in range(kd + 1):
+                L[i * dim + a, k] = 0.0
+        # fast path: no frame and no fixed unknown at i .. i + p
+        plain = True
+        for o in range(p + 1):
+            j = i + o
+            if j >= n:
+                if not closed:
+                    break
+                j -= n
+            if rot[j]:
+                plain = False
+                break
+            for a in range(dim):
+                if fix[j, a]:
+                    plain = False
+            if not plain:
+                break
+        if plain:
+            for a in range(dim):
+                C = i * dim + a
+                for o in range(p + 1):
+                    if i + o >= n and not closed:
+                        break
+                    L[C, o * dim] = K[i, p + o]
+                for b in range(a, dim):
+                    L[C, b - a] += B[i, b, a]
+            continue
+        ri = rot[i]
+        for o in range(p + 1):
+            j = i + o
+            if j >= n:
+                if not closed:
+                    break
+                j -= n
+            rj = rot[j]
+            kk = K[i, p + o]
+            # blk[b, a] = M[(j, b), (i, a)]
+            if not ri and not rj:
+                for b in range(dim):
+                    for a in range(dim):
+                        blk[b, a] = kk if a == b else 0.0
+            else:
+                for b in range(dim):
+                    for a in range(dim):
+                        if ri and rj:
+                            v = 0.0
+                            for c in range(dim):
+                                v += Q[j, c, b] * Q[i, c, a]
+                        elif ri:
+                            v = Q[i, b, a]
+                        else:
+                            v = Q[j, a, b]
+                        blk[b, a] = kk * v
+            if o == 0:
+                if ri:
+                    for b in range(dim):
+                        for c in range(dim):
+                            t = 0.0
+                            for e in range(dim):
+                                t += B[i, c, e] * Q[i, e, b]
+                            qq[c, b] = t
+                    for b in range(dim):
+                        for a in range(dim):
+                            t = 0.0
+                            for c in range(dim):
+                                t += Q[i, c, b] * qq[c, a]
+                            blk[b, a] += t
+                else:
+                    for b in range(dim):
+                        for a in range(dim):
+                            blk[b, a] += B[i, b, a]
+            for a in range(dim):
+                C = i * dim + a
+                fa = fix[i, a]
+                for b in range(dim):
+                    k = o * dim + b - a
+                    if k < 0:
+                        continue
+                    if fa or fix[j, b]:
+                        L[C, k] = 1.0 if k == 0 else 0.0
+                    else:
+                        L[C, k] = blk[b, a]
+
+
+@njit(cache=True)
+def assemble(K, p, closed, B, Q, rot, fix, L):  # type: ignore[no-untyped-def]
+    """Fill ``L`` (shape (n dim, kd + 1)) with the lower band of ``M`` (see module docstring)."""
+    _assemble_range(K, p, closed, B, Q, rot, fix, L, 0, K.shape[0])
+
+
+@njit(cache=True)
+def assemble_cholesky(K, p, B, Q, rot, fix, L):  # type: ignore[no-untyped-def]
+    """Assemble (open curves) and factorise in one pass: the columns of a point are written just
+    before the first elimination step that updates them, so ``L`` is streamed once.
+    Returns 0 or ``j + 1`` for a non-positive pivot ``j``."""
+    n = K.shape[0]
+    dim = B.shape[1]
+    N = n * dim
+    kd = L.shape[1] - 1
+    nxt = 0
+    for j in range(N):
+        if nxt < n and nxt * dim <= j + kd:
+            stop = min(n, nxt + 256)
+            _assemble_range(K, p, False, B, Q, rot, fix, L, nxt, stop)
+            nxt = stop
+        d = L[j, 0]
+        if not d > 0.0:
+            return j + 1
+        d = np.sqrt(d)
+        L[j, 0] = d
+        inv = 1.0 / d
+        kmax = min(kd, N - 1 - j)
+        for k in range(1, kmax + 1):
+            L[j, k] *= inv
+        for a in range(1, kmax + 1):
+            la = L[j, a]
+            if la != 0.0:
+                for b in range(a, kmax + 1):
+                    L[j + a, b - a] -= L[j, b] * la
+    return 0
+
+
+@njit(cache=True)
+def band_matvec(K, p, closed, x, out):  # type: ignore[no-untyped-def]
+    """``out = kron(K, I) x`` for points ``x`` (n, dim); ``K`` given by its band rows
+    ``K[i, p + o] = K_{i, i+o}`` (symmetric; closed: indices mod n)."""
+    n, dim = x.shape
+    for i in range(n):
+        interior = i >= p and i + p < n
+        for a in range(dim):
+            acc = 0.0
+            if interior:
+                for o in range(-p, p + 1):
+                    acc += K[i, p + o] * x[i + o, a]
+            else:
+                for o in range(-p, p + 1):
+                    j = i + o
+                    if j < 0 or j >= n:
+                        if not closed:
+                            continue
+                        j %= n
+                    acc += K[i, p + o] * x[j, a]
+            out[i, a] = acc
+
+
+# ------------------------------------------------------------------------------------------
+# band Cholesky (open curves)
+# ------------------------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def band_cholesky(L, N):  # type: ignore[no-untyped-def]
+    """In-place Cholesky of the first ``N`` rows of the lower band ``L`` (entries reaching
+    beyond row ``N - 1`` are left alone). Returns 0, or ``j + 1`` if pivot ``j`` is not
+    positive (not positive definite in floating point)."""
+    kd = L.shape[1] - 1
+    for j in range(N):
+        d = L[j, 0]
+        if not d > 0.0:
+            return j + 1
+        d = np.sqrt(d)
+        L[j, 0] = d
+        inv = 1.0 / d
+        kmax = min(kd, N - 1 - j)
+        for k in range(1, kmax + 1):
+            L[j, k] *= inv
+        for a in range(1, kmax + 1):
+            la = L[j, a]
+            if la != 0.0:
+                for b in range(a, kmax + 1):
+                    L[j + a, b - a] -= L[j, b] * la
+    return 0
+
+
+@njit(cache=True)
+def band_solve(L, N, x):  # type: ignore[no-untyped-def]
+    """Solve ``L L^T y = x`` in place for the first ``N`` entries of ``x`` (1-D)."""
+    kd = L.shape[1] - 1
+    for j in range(N):
+        v = x[j] / L[j, 0]
+        x[j] = v
+        kmax = min(kd, N - 1 - j)
+        if v != 0.0:
+            for k in range(1, kmax + 1):
+                x[j + k] -= L[j, k] * v
+    for i in range(N - 1, -1, -1):
+        s = x[i]
+        kmax = min(kd, N - 1 - i)
+        for k in range(1, kmax + 1):
+            s -= L[i, k] * x[i + k]
+        x[i] = s / L[i, 0]
+
+
+# ------------------------------------------------------------------------------------------
+# cyclic band (closed curves): bordering
+# ------------------------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def cyclic_cholesky(L, Y, S):  # type: ignore[no-untyped-def]
+    """Factorise the cyclic band ``L`` (N > 3 kd): band Cholesky of the leading
+    ``N - kd`` unknowns, ``Y = M_II^{-1} M_IB`` (shape (N - kd, kd)) and the Cholesky factor of
+    the Schur complement ``S = M_BB - M_IB^T Y`` (lower, (kd, kd)). Returns 0 or a failure
+    code."""
+    N = L.shape[0]
+    kd = L.shape[1] - 1
+    nI = N - kd
+    # coupling columns M_IB before the factorisation overwrites L[:nI]
+    for r in range(nI):
+        for c in range(kd):
+            Y[r, c] = 0.0
+    for r in range(nI - kd, nI):
+        for k in range(1, kd + 1):
+            R = r + k
+            if R >= nI:
+                Y[r, R - nI] = L[r, k]
+    for r in range(nI, N):
+        for k in range(1, kd + 1):
+            R = r + k
+            if R >= N:
+                Y[R - N, r - nI] = L[r, k]
+    for c in range(kd):
+        for c2 in range(kd):
+            S[c, c2] = 0.0
+    for r in range(nI, N):
+        for k in range(0, kd + 1):
+            R = r + k
+            if R < N:
+                S[R - nI, r - nI] = L[r, k]
+                S[r - nI, R - nI] = L[r, k]
+    # save the coupling block, then factorise the interior
+    info = band_cholesky(L, nI)
+    if info:
+        return info
+    Cb = Y.copy()
+    col = np.empty(nI)
+    for c in range(kd):
+        for r in range(nI):
+            col[r] = Y[r, c]
+        band_solve(L, nI, col)
+        for r in range(nI):
+            Y[r, c] = col[r]
+    for c in range(kd):
+        for c2 in range(kd):
+            acc = 0.0
+            for r in range(nI):
+                acc += Cb[r, c] * Y[r, c2]
+            S[c, c2] -= acc
+    # dense Cholesky of S (lower), in place
+    for j in range(kd):
+        d = S[j, j]
+        for m in range(j):
+            d -= S[j, m] * S[j, m]
+        if not d > 0.0:
+            return nI + j + 1
+        d = np.sqrt(d)
+        S[j, j] = d
+        for i in range(j + 1, kd):
+            v = S[i, j]
+            for m in range(j):
+                v -= S[i, m] * S[j, m]
+            S[i, j] = v / d
+    for j in range(kd):
+        for i in range(j):
+            S[i, j] = 0.0
+    return 0
+
+
+@njit(cache=True)
+def cyclic_solve_full(L, Y, S, x):  # type: ignore[no-untyped-def]
+    """Solve ``M y = x`` in place with the factorisation of :func:`cyclic_cholesky`."""
+    N = L.shape[0]
+    kd = L.shape[1] - 1
+    nI = N - kd
+    xb = np.empty(kd)
+    # x_B - M_IB^T M_II^{-1} x_I = x_B - Y^T x_I  (Y = M_II^{-1} M_IB, M_II symmetric)
+    for c in range(kd):
+        acc = x[nI + c]
+        for r in range(nI):
+            acc -= Y[r, c] * x[r]
+        xb[c] = acc
+    # S z = xb
+    for i in range(kd):
+        v = xb[i]
+        for m in range(i):
+            v -= S[i, m] * xb[m]
+        xb[i] = v / S[i, i]
+    for i in range(kd - 1, -1, -1):
+        v = xb[i]
+        for m in range(i + 1, kd):
+            v -= S[m, i] * xb[m]
+        xb[i] = v / S[i, i]
+    band_solve(L, nI, x)
+    for r in range(nI):
+        acc = 0.0
+        for c in range(kd):
+            acc += Y[r, c] * xb[c]
+        x[r] -= acc
+    for c in range(kd):
+        x[nI + c] = xb[c]
+
+
+# ------------------------------------------------------------------------------------------
+# right-hand sides in the rotated frames
+# ------------------------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def prep_rhs(K, p, closed, B, Q, rot, fix, fix0, rhs, c, out):  # type: ignore[no-untyped-def]
+    """``out = Q^T (rhs - (kron(K, I) + B) z)`` with ``z_i = c_i Q_i[:, 0]`` at the ``rot``
+    points (their prescribed normal displacement), fixed unknowns set to their values (``c_i``
+    for the normal of a ``rot`` point, 0 at fixed points)."""
+    n, dim = rhs.shape
+    anyrot = False
+    for i in range(n):
+        if rot[i]:
+            anyrot = True
+            break
+    for i in range(n):
+        for a in range(dim):
+            out[i, a] = rhs[i, a]
+    if anyrot:
+        for i in range(n):
+            for o in range(-p, p + 1):
+                j = i + o
+                if j < 0 or j >= n:
+                    if not closed:
+                        continue
+                    j %= n
+                if rot[j]:
+                    kc = K[i, p + o] * c[j]
+                    for a in range(dim):
+                        out[i, a] -= kc * Q[j, a, 0]
+            if rot[i]:
+                for a in range(dim):
+                    t = 0.0
+                    for b in range(dim):
+                        t += B[i, a, b] * Q[i, b, 0]
+                    out[i, a] -= t * c[i]
+        for i in range(n):
+            if rot[i]:
+                w0 = out[i, 0]
+                w1 = out[i, 1]
+                w2 = out[i, 2] if dim == 3 else 0.0
+                for a in range(dim):
+                    t = Q[i, 0, a] * w0 + Q[i, 1, a] * w1
+                    if dim == 3:
+                        t += Q[i, 2, a] * w2
+                    out[i, a] = t
+    for i in range(n):
+        for a in range(dim):
+            if fix[i, a]:
+                out[i, a] = c[i] if (rot[i] and a == 0 and not fix0[i, a]) else 0.0
+
+
+@njit(cache=True)
+def post_solve(y, Q, rot, fix0):  # type: ignore[no-untyped-def]
+    """Back to the original frame: ``y_i <- Q_i y_i`` at the ``rot`` points, 0 at fixed
+    points."""
+    n, dim = y.shape
+    for i in range(n):
+        if fix0[i, 0]:
+            for a in range(dim):
+                y[i, a] = 0.0
+        elif rot[i]:
+            w0 = y[i, 0]
+            w1 = y[i, 1]
+            w2 = y[i, 2] if dim == 3 else 0.0
+            for a in range(dim):
+                t = Q[i, a, 0] * w0 + Q[i, a, 1] * w1
+                if dim == 3:
+                    t += Q[i, a, 2] * w2
+                y[i, a] = t
+
+
+# ------------------------------------------------------------------------------------------
+# interior point (Mehrotra) per-point work; F = E/E0, f_i = (|v_i|^2 / t2 - 1) / 2 <= 0
+# ------------------------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def ip_eval(g0, K, p, closed, v, lam, free, t2, rd, s):  # type: ignore[no-untyped-def]
+    """Dual residual ``rd = g0 + K v + lam v / t2`` and slacks ``s = -f`` at the free points
+    (0 and 1 elsewhere); returns ``(max |rd|, min s, sum lam s)``. (Helpers inlined by hand:
+    numba's inlined helpers made this loop five times slower.)"""
+    n, dim = v.shape
+    rdm = 0.0
+    smin = np.inf
+    ls = 0.0
+    for i in range(n):
+        if not free[i]:
+            for a in range(dim):
+                rd[i, a] = 0.0
+            s[i] = 1.0
+            continue
+        vv = 0.0
+        li = lam[i]
+        interior = i >= p and i + p < n
+        for a in range(dim):
+            acc = 0.0
+            if interior:
+                for o in range(-p, p + 1):
+                    acc += K[i, p + o] * v[i + o, a]
+            else:
+                for o in range(-p, p + 1):
+                    j = i + o
+                    if j < 0 or j >= n:
+                        if not closed:
+                            continue
+                        j = j + n if j < 0 else j - n
+                    acc += K[i, p + o] * v[j, a]
+            va = v[i, a]
+            r = g0[i, a] + acc + li * (va / t2)
+            rd[i, a] = r
+            ar = abs(r)
+            if ar > rdm:
+                rdm = ar
+            vv += va * va
+        si = -0.5 * (vv / t2 - 1.0)
+        s[i] = si
+        if si < smin:
+            smin = si
+        ls += li * si
+    return rdm, smin, ls
+
+
+@njit(cache=True)
+def ip_blocks(v, lam, s, free, t2, B):  # type: ignore[no-untyped-def]
+    """``B_i = lam_i I / t2 + (lam_i / s_i) a_i a_i^T``, ``a_i = v_i / t2`` (identity at fixed
+    points, whose rows are replaced anyway)."""
+    n, dim = v.shape
+    for i in range(n):
+        if free[i]:
+            iso = lam[i] / t2
+            w = lam[i] / s[i]
+            for a in range(dim):
+                wa = w * (v[i, a] / t2)
+                for b in range(dim):
+                    B[i, a, b] = wa * (v[i, b] / t2) + (iso if a == b else 0.0)
+        else:
+            for a in range(dim):
+                for b in range(dim):
+                    B[i, a, b] = 1.0 if a == b else 0.0
+
+
+@njit(cache=True)
+def ip_rhs(rd, v, rc, rp, lam, s, free, t2, out):  # type: ignore[no-untyped-def]
+    """``out = -rd - a q``, ``q = (-rc + lam rp) / s`` (reduced Newton right-hand side,
+    ``a = v / t2``; ``rp`` a primal residual to remove, e.g. the second-order term)."""
+    n, dim = v.shape
+    for i in range(n):
+        if free[i]:
+            q = (rc[i] - lam[i] * rp[i]) / s[i]
+            for a in range(dim):
+                out[i, a] = -rd[i, a] + (v[i, a] / t2) * q
+        else:
+            for a in range(dim):
+                out[i, a] = 0.0
+
+
+@njit(cache=True)
+def ip_recover(dv, v, rc, rp, lam, s, free, t2, ds, dl):  # type: ignore[no-untyped-def]
+    """``ds = -rp - a.dv`` (linearised slack step), ``dl = (-rc + lam rp + lam a.dv) / s``;
+    returns the
+    largest steps keeping every point inside its ball (exact, the constraint is quadratic) and
+    ``lam`` non-negative (inf if unbounded)."""
+    n, dim = v.shape
+    bm = np.inf
+    lm = np.inf
+    for i in range(n):
+        if not free[i]:
+            ds[i] = 0.0
+            dl[i] = 0.0
+            continue
+        adv = 0.0
+        a2 = 0.0
+        a1 = 0.0
+        c0 = -t2
+        for a in range(dim):
+            adv += (v[i, a] / t2) * dv[i, a]
+            a2 += dv[i, a] * dv[i, a]
+            a1 += v[i, a] * dv[i, a]
+            c0 += v[i, a] * v[i, a]
+        e = (-rc[i] + lam[i] * rp[i] + lam[i] * adv) / s[i]
+        ds[i] = -rp[i] - adv
+        dl[i] = e
+        if e < 0.0:
+            t = -lam[i] / e
+            if t < lm:
+                lm = t
+        if a2 > 0.0:
+            # positive root of a2 t^2 + 2 a1 t + c0 = 0 (c0 < 0: inside)
+            disc = np.sqrt(max(a1 * a1 - a2 * c0, 0.0))
+            if a1 >= 0.0:
+                t = -c0 / (a1 + disc) if a1 + disc > 0.0 else np.inf
+            else:
+                t = (disc - a1) / a2
+            if t < bm:
+                bm = t
+    return bm, lm
+
+
+@njit(cache=True)
+def ip_corrector(lam, s, dl, ds, ap, ad, free, rc):  # type: ignore[no-untyped-def]
+    """Affine-scaling complementarity ``sum (lam + ad dl)(s + ap ds)`` and
+    ``rc = lam s + dl ds`` (the sigma mu term is subtracted by the caller)."""
+    n = lam.shape[0]
+    acc = 0.0
+    for i in range(n):
+        if free[i]:
+            acc += (lam[i] + ad * dl[i]) * (s[i] + ap * ds[i])
+            rc[i] = lam[i] * s[i] + dl[i] * ds[i]
+        else:
+            rc[i] = 0.0
+    return acc
+
+
+@njit(cache=True)
+def ip_update(v, dv, lam, dl, st):  # type: ignore[no-untyped-def]
+    n, dim = v.shape
+    for i in range(n):
+        for a in range(dim):
+            v[i, a] += st * dv[i, a]
+        lam[i] += st * dl[i]
+
+
+# ------------------------------------------------------------------------------------------
+# active-set (semismooth) Newton per-point work
+# ------------------------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def ssn_eval(g0, K, p, closed, v, lam, free, t2, kappa, S, rd, f, rho):  # type: ignore[no-untyped-def]
+    """Active set ``S = free & (lam + kappa f > 0) & (v != 0)``; ``lam`` clipped to
+    ``max(lam, 0)`` on ``S`` and 0 elsewhere; ``rd = g0 + K v + lam v / t2``. Returns
+    ``(max |rd|, max f over free, max |f| over S)``."""
+    n, dim = v.shape
+    rdm = 0.0
+    fm = -np.inf
+    fsm = 0.0
+    for i in range(n):
+        vv = 0.0
+        for a in range(dim):
+            vv += v[i, a] * v[i, a]
+        r = np.sqrt(vv)
+        fi = 0.5 * (vv / t2 - 1.0)
+        rho[i] = r
+        f[i] = fi
+        if not free[i]:
+            S[i] = False
+            lam[i] = 0.0
+            for a in range(dim):
+                rd[i, a] = 0.0
+            continue
+        act = lam[i] + kappa * fi > 0.0 and r > 0.0
+        S[i] = act
+        if act:
+            if lam[i] < 0.0:
+                lam[i] = 0.0
+            if abs(fi) > fsm:
+                fsm = abs(fi)
+        else:
+            lam[i] = 0.0
+        if fi > fm:
+            fm = fi
+        li = lam[i]
+        interior = i >= p and i + p < n
+        for a in range(dim):
+            acc = 0.0
+            if interior:
+                for o in range(-p, p + 1):
+                    acc += K[i, p + o] * v[i + o, a]
+            else:
+                for o in range(-p, p + 1):
+                    j = i + o
+                    if j < 0 or j >= n:
+                        if not closed:
+                            continue
+                        j = j + n if j < 0 else j - n
+                    acc += K[i, p + o] * v[j, a]
+            x = g0[i, a] + acc + li * (v[i, a] / t2)
+            rd[i, a] = x
+            if abs(x) > rdm:
+                rdm = abs(x)
+    return rdm, fm, fsm
+
+
+@njit(cache=True)
+def ssn_prepare(v, rho, f, S, lam, t2, delta, B, nrm, c):  # type: ignore[no-untyped-def]
+    """Blocks ``(lam_i / t2 + delta) I``, unit normals and prescribed normal displacements
+    ``c_i = -f_i t2 / rho_i`` (the linearised sphere) at the active points."""
+    n, dim = v.shape
+    for i in range(n):
+        iso = lam[i] / t2 + delta
+        for a in range(dim):
+            for b in range(dim):
+                B[i, a, b] = iso if a == b else 0.0
+        if S[i]:
+            for a in range(dim):
+                nrm[i, a] = v[i, a] / rho[i]
+            c[i] = -f[i] * t2 / rho[i]
+        else:
+            for a in range(dim):
+                nrm[i, a] = 0.0
+            c[i] = 0.0
+
+
+@njit(cache=True)
+def ssn_update(v, dv, rd, kdv, lam, S, nrm, rho, t2):  # type: ignore[no-untyped-def]
+    """Multiplier step from the normal component of the stationarity equation, then
+    ``v += dv``."""
+    n, dim = v.shape
+    for i in range(n):
+        if S[i]:
+            acc = 0.0
+            li = lam[i] / t2
+            for a in range(dim):
+                acc += nrm[i, a] * (rd[i, a] + kdv[i, a] + li * dv[i, a])
+            lam[i] = lam[i] - acc * t2 / rho[i]
+        else:
+            lam[i] = 0.0
+        for a in range(dim):
+            v[i, a] += dv[i, a]
+
+
+@njit(cache=True)
+def second_order(dv, free, t2, out):  # type: ignore[no-untyped-def]
+    """``out_i = |dv_i|^2 / (2 t2)``: the slack a full step loses to the curvature of the
+    sphere (the constraint is quadratic: ``f(v + dv) = f + a.dv + |dv|^2 / (2 t2)``)."""
+    n, dim = dv.shape
+    for i in range(n):
+        acc = 0.0
+        if free[i]:
+            for a in range(dim):
+                acc += dv[i, a] * dv[i, a]
+        out[i] = acc / (2.0 * t2)
