@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -10,7 +10,7 @@ import numpy as np
 from .._typing import FloatArray
 from .._validate import as_positive
 from ..curves.piecewise import PiecewiseCurve
-from ._core import bounding_diagonal, check_curve, falling
+from ._core import bounding_diagonal, check_curve, falling, fields_to_dict
 from ._energy import segment_energies
 from ._sampling import QUAD_RTOL, sample_curve, scan_sign_changes
 
@@ -120,20 +120,7 @@ class Analysis:
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON-serialisable dict: plain ``float``/``int``/``bool``/``None`` and lists."""
-        out: dict[str, Any] = {}
-        for f in fields(self):
-            v = getattr(self, f.name)
-            if isinstance(v, np.ndarray):
-                out[f.name] = v.tolist()
-            elif isinstance(v, (bool, np.bool_)):
-                out[f.name] = bool(v)
-            elif isinstance(v, (int, np.integer)):
-                out[f.name] = int(v)
-            elif isinstance(v, (float, np.floating)):
-                out[f.name] = float(v)
-            else:
-                out[f.name] = v
-        return out
+        return fields_to_dict(self)
 
 
 # ------------------------------------------------------------------------------------------------

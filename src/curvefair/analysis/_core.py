@@ -234,3 +234,21 @@ def bounding_diagonal(pp: PiecewisePolynomial) -> float:
     return float(np.sqrt(np.sum((hi - lo) ** 2)))
 
 
+def fields_to_dict(obj: object) -> dict[str, object]:
+    """A dataclass's fields as a JSON-serialisable dict of plain floats/ints/bools/lists/None."""
+    from dataclasses import fields
+
+    out: dict[str, object] = {}
+    for f in fields(obj):  # type: ignore[arg-type]
+        v = getattr(obj, f.name)
+        if isinstance(v, np.ndarray):
+            out[f.name] = v.tolist()
+        elif isinstance(v, (bool, np.bool_)):
+            out[f.name] = bool(v)
+        elif isinstance(v, (int, np.integer)):
+            out[f.name] = int(v)
+        elif isinstance(v, (float, np.floating)):
+            out[f.name] = float(v)
+        else:
+            out[f.name] = v
+    return out

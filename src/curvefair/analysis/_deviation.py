@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -11,7 +11,7 @@ from numba import njit
 from .._typing import FloatArray
 from ..curves.piecewise import PiecewiseCurve
 from ..errors import InputError
-from ._core import bernstein_matrix, check_curve, taylor_shift, to_bernstein
+from ._core import bernstein_matrix, check_curve, fields_to_dict, taylor_shift, to_bernstein
 
 __all__ = ["Deviation", "deviation", "DEVIATION_RTOL"]
 
@@ -55,18 +55,7 @@ class Deviation:
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON-serialisable dict of plain floats, ints, lists and None."""
-        out: dict[str, Any] = {}
-        for f in fields(self):
-            v = getattr(self, f.name)
-            if isinstance(v, np.ndarray):
-                out[f.name] = v.tolist()
-            elif isinstance(v, (int, np.integer)):
-                out[f.name] = int(v)
-            elif isinstance(v, (float, np.floating)):
-                out[f.name] = float(v)
-            else:
-                out[f.name] = v
-        return out
+        return fields_to_dict(self)
 
 
 def _data_points(curve: PiecewiseCurve) -> tuple[str, FloatArray] | None:

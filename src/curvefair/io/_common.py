@@ -199,6 +199,17 @@ def atomic_write(path: str | os.PathLike[str], data: str | bytes | Callable[[Any
 # ------------------------------------------------------------------------------------------
 # optional dependencies
 # ------------------------------------------------------------------------------------------
+class Unsupported(Exception):
+    """A curve entity curvefair cannot represent exactly (reported or skipped by the reader)."""
+
+
+def planar(xyz: FloatArray) -> tuple[FloatArray, float | None]:
+    """2-D points and their common z when all z are equal, else the 3-D points and None."""
+    if xyz.shape[0] and np.all(xyz[:, 2] == xyz[0, 2]):
+        return np.ascontiguousarray(xyz[:, :2]), float(xyz[0, 2])
+    return xyz, None
+
+
 def lazy_import(module: str, package: str, extra: str, what: str) -> Any:
     """Import ``module`` or raise :class:`MissingDependencyError` naming the extra."""
     try:

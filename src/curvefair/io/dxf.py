@@ -52,6 +52,7 @@ from ..curves.bspline import BSplineCurve
 from ..errors import CurvefairError, FileFormatError, InputError
 from ._common import (
     CurveRecord,
+    Unsupported,
     atomic_path,
     bspline_of,
     check_points,
@@ -59,6 +60,7 @@ from ._common import (
     is_clamped,
     joined_points,
     piece_values,
+    planar,
     point_records,
     points_curve,
 )
@@ -72,17 +74,6 @@ def _ezdxf(what: str) -> Any:
     from ._common import lazy_import
 
     return lazy_import("ezdxf", "ezdxf", "dxf", what)
-
-
-class _Unsupported(Exception):
-    pass
-
-
-def _planar(xyz: FloatArray) -> tuple[FloatArray, float | None]:
-    """2-D points and their common z, or the 3-D points and None."""
-    if xyz.shape[0] and np.all(xyz[:, 2] == xyz[0, 2]):
-        return np.ascontiguousarray(xyz[:, :2]), float(xyz[0, 2])
-    return xyz, None
 
 
 def _ring(pts: FloatArray, closed_flag: bool) -> tuple[FloatArray, np.ndarray, bool]:
@@ -102,7 +93,7 @@ def _spline_record(e: Any, base: dict[str, Any], path: object, corner_angle: flo
     p = int(e.dxf.degree)
     weights = np.asarray(e.weights, dtype=float)
     if weights.size and not np.all(weights == 1.0):
-        raise _Unsupported("rational spline (weights other than 1)")
+        raise Unsupported("rational spline (weights other than 1)")
     cps = np.asarray([tuple(v) for v in e.control_points], dtype=float).reshape(-1, 3)
     fits = np.asarray([tuple(v) for v in e.fit_points], dtype=float).reshape(-1, 3)
     closed_flag = bool(e.closed)
@@ -111,7 +102,7 @@ def _spline_record(e: Any, base: dict[str, Any], path: object, corner_angle: flo
             raise FileFormatError(f"SPLINE {base['handle']} has neither control points nor 2 "
                                   "fit points", path)
         check_points(fits, path, None, what=f"SPLINE {base['handle']} fit point")
-        pts, z = _planar(fits)
+        pts, z = planar(fits)
         distinct, row_map, closed = _ring(pts, closed_flag)
         src = dict(base, z=z, row_map=tuple(int(i) for i in row_map),
                    has_end_tangents=bool(e.dxf.hasattr("start_tangent")))
@@ -120,10 +111,10 @@ def _spline_record(e: Any, base: dict[str, Any], path: object, corner_angle: flo
     if not np.isfinite(cps).all():
         raise FileFormatError(f"SPLINE {base['handle']} has a non-finite control point", path)
     if p < 2:
-        raise _Unsupported(f"degree-{p} spline")
+        raise Unsupported(f"degree-{p} spline")
     knots = np.asarray(e.knots, dtype=float)
     N = cps.shape[0]
-    pts, z = _planar(cps)
+    pts, z = planar(cps)
     try:
         if knots.shape[0] == N + p + 1 and is_clamped(knots, p):
             curve = BSplineCurve(pts, knots, p, closed=False)
@@ -136,7 +127,7 @@ def _spline_record(e: Any, base: dict[str, Any], path: object, corner_angle: flo
             curve = BSplineCurve(pts, knots, p, closed=True)
             layout = "periodic_short"
         else:
-            raise _Unsupported(f"knot layout ({knots.shape[0]} knots for {N} control points "
+            raise Unsupported(f"knot layout ({knots.shape[0]} knots for {N} control points "
                                f"of degree {p}, neither clamped nor periodic)")
     except CurvefairError as exc:
         if isinstance(exc, FileFormatError):
@@ -152,19 +143,19 @@ def _polyline_record(e: Any, base: dict[str, Any], path: object,
     if kind == "LWPOLYLINE":
         raw = np.asarray(e.get_points("xyb"), dtype=float).reshape(-1, 3)
         if np.any(raw[:, 2] != 0):
-            raise _Unsupported("polyline with arc segments (bulges)")
+            raise Unsupported("polyline with arc segments (bulges)")
         pts = raw[:, :2]
         z: float | None = float(e.dxf.get("elevation", 0.0))
     else:
         if not (e.is_2d_polyline or e.is_3d_polyline):
             return []                     # polyface / mesh: not a curve
         if e.dxf.flags & 6:
-            raise _Unsupported("spline-fit or curve-fit POLYLINE")
+            raise Unsupported("spline-fit or curve-fit POLYLINE")
         verts = list(e.vertices)
         if any(v.dxf.get("bulge", 0.0) for v in verts):
-            raise _Unsupported("polyline with arc segments (bulges)")
+            raise Unsupported("polyline with arc segments (bulges)")
         xyz = np.asarray([tuple(v.dxf.location) for v in verts], dtype=float).reshape(-1, 3)
-        pts, z = _planar(xyz)
+        pts, z = planar(xyz)
     if pts.shape[0] < 2:
         raise FileFormatError(f"{kind} {base['handle']} has fewer than 2 vertices", path)
     check_points(pts, path, None, what=f"{kind} {base['handle']} vertex")
@@ -206,7 +197,7 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 90.0,
                     new = _spline_record(e, base, path, corner_angle, len(records))
                 else:
                     new = _polyline_record(e, base, path, corner_angle, len(records))
-            except _Unsupported as exc:
+            except Unsupported as exc:
                 msg = f"{t} {handle} on layer {layer!r}: unsupported {exc}"
                 if on_unsupported == "raise":
                     raise FileFormatError(msg + " (read_curves(..., on_unsupported='skip') "

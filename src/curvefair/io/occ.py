@@ -38,6 +38,7 @@ from ..curves.bspline import BSplineCurve
 from ..errors import CurvefairError, FileFormatError, InputError
 from ._common import (
     CurveRecord,
+    Unsupported,
     atomic_path,
     bspline_of,
     is_clamped,
@@ -56,10 +57,6 @@ def _occ(what: str) -> Any:
 def _fmt_of(path: object) -> str:
     ext = os.path.splitext(os.fspath(path))[1].lower()  # type: ignore[arg-type]
     return "iges" if ext in (".igs", ".iges") else "step"
-
-
-class _Unsupported(Exception):
-    pass
 
 
 @contextlib.contextmanager
@@ -162,7 +159,7 @@ def _bspline_of_edge(edge: Any) -> tuple[BSplineCurve, float | None]:
     if bs.IsRational():
         w = np.array([bs.Weight(i) for i in range(1, n + 1)])
         if not np.all(w == 1.0):
-            raise _Unsupported("rational B-spline (weights other than 1)")
+            raise Unsupported("rational B-spline (weights other than 1)")
     xyz = np.array([(bs.Pole(i).X(), bs.Pole(i).Y(), bs.Pole(i).Z()) for i in range(1, n + 1)])
     ks = bs.KnotSequence()
     flat = np.array([ks.Value(i) for i in range(ks.Lower(), ks.Upper() + 1)], dtype=float)
@@ -170,18 +167,18 @@ def _bspline_of_edge(edge: Any) -> tuple[BSplineCurve, float | None]:
     first, last = ad.FirstParameter(), ad.LastParameter()
     tol = 1e-12 * max(1.0, abs(first), abs(last))
     if abs(first - bs.FirstParameter()) > tol or abs(last - bs.LastParameter()) > tol:
-        raise _Unsupported(f"trimmed B-spline (edge range [{first}, {last}] of "
+        raise Unsupported(f"trimmed B-spline (edge range [{first}, {last}] of "
                            f"[{bs.FirstParameter()}, {bs.LastParameter()}])")
     z: float | None = None
     pts = xyz
     if np.all(xyz[:, 2] == xyz[0, 2]):
         pts, z = xyz[:, :2], float(xyz[0, 2])
     if p < 2:
-        raise _Unsupported(f"degree-{p} B-spline")
+        raise Unsupported(f"degree-{p} B-spline")
     if bs.IsPeriodic():
         return BSplineCurve(pts, flat, p, closed=True), z
     if not is_clamped(flat, p):
-        raise _Unsupported("unclamped non-periodic B-spline")
+        raise Unsupported("unclamped non-periodic B-spline")
     return BSplineCurve(pts, flat, p, closed=False), z
 
 
@@ -196,7 +193,7 @@ def read(path: str | os.PathLike[str], *, on_unsupported: str = "raise",
             curve, z = _bspline_of_edge(edge)
         except LookupError:
             continue
-        except _Unsupported as exc:
+        except Unsupported as exc:
             msg = f"edge {k}: unsupported {exc}"
             if on_unsupported == "raise":
                 raise FileFormatError(msg + " (read_curves(..., on_unsupported='skip') skips "

@@ -43,6 +43,7 @@ from ..curves.bspline import BSplineCurve
 from ..errors import CurvefairError, FileFormatError, InputError
 from ._common import (
     CurveRecord,
+    Unsupported,
     atomic_path,
     bspline_of,
     check_points,
@@ -51,6 +52,7 @@ from ._common import (
     joined_points,
     lazy_import,
     piece_values,
+    planar,
     point_records,
     points_curve,
 )
@@ -62,16 +64,6 @@ FORMAT = "3dm"
 
 def _rhino(what: str) -> Any:
     return lazy_import("rhino3dm", "rhino3dm", "rhino", what)
-
-
-class _Unsupported(Exception):
-    pass
-
-
-def _planar(xyz: FloatArray) -> tuple[FloatArray, float | None]:
-    if xyz.shape[0] and np.all(xyz[:, 2] == xyz[0, 2]):
-        return np.ascontiguousarray(xyz[:, :2]), float(xyz[0, 2])
-    return xyz, None
 
 
 def _load(path: object, what: str) -> Any:
@@ -106,20 +98,20 @@ def _records_of(obj: Any, i: int, base: dict[str, Any], path: object, rh: Any,
         return _polyline(xyz, base, path, corner_angle, index)
     if not isinstance(g, rh.NurbsCurve):
         if isinstance(g, rh.PolyCurve):
-            raise _Unsupported("PolyCurve")
+            raise Unsupported("PolyCurve")
         return []
     if g.IsRational:
         xyz, w, _, _ = _nurbs(g)
         if not np.all(w == 1.0):
-            raise _Unsupported("rational NurbsCurve (weights other than 1)")
+            raise Unsupported("rational NurbsCurve (weights other than 1)")
     xyz, _, full, p = _nurbs(g)
     if not np.isfinite(xyz).all() or not np.isfinite(full).all():
         raise FileFormatError(f"object {base['id']}: non-finite control point or knot", path)
     if p == 1:
         return _polyline(xyz, dict(base, nurbs_layout="degree1"), path, corner_angle, index)
     if p < 1:
-        raise _Unsupported(f"degree-{p} NurbsCurve")
-    pts, z = _planar(xyz)
+        raise Unsupported(f"degree-{p} NurbsCurve")
+    pts, z = planar(xyz)
     N = pts.shape[0]
     try:
         if is_clamped(full, p):
@@ -129,7 +121,7 @@ def _records_of(obj: Any, i: int, base: dict[str, Any], path: object, rh: Any,
             curve = BSplineCurve(pts[: N - p], full, p, closed=True)
             layout = "periodic"
         else:
-            raise _Unsupported("knot vector neither clamped nor periodic")
+            raise Unsupported("knot vector neither clamped nor periodic")
     except CurvefairError as exc:
         if isinstance(exc, FileFormatError):
             raise
@@ -147,7 +139,7 @@ def _polyline(xyz: FloatArray, base: dict[str, Any], path: object,
     if xyz.shape[0] < 2:
         raise FileFormatError(f"object {base['id']}: fewer than 2 vertices", path)
     check_points(xyz, path, None, what=f"object {base['id']} vertex")
-    pts, z = _planar(xyz)
+    pts, z = planar(xyz)
     n = pts.shape[0]
     closed = n >= 4 and bool(np.array_equal(pts[0], pts[-1]))
     distinct = pts[:-1] if closed else pts
@@ -175,7 +167,7 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 90.0,
                 "layer": layer, "geometry": type(obj.Geometry).__name__, "name": name}
         try:
             new = _records_of(obj, i, base, path, rh, corner_angle, len(records))
-        except _Unsupported as exc:
+        except Unsupported as exc:
             msg = f"object {ident} ({base['geometry']}, {name!r}): unsupported {exc}"
             if on_unsupported == "raise":
                 raise FileFormatError(msg + " (read_curves(..., on_unsupported='skip') skips "

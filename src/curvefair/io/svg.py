@@ -54,6 +54,7 @@ from ..curves.bspline import BSplineCurve
 from ..errors import FileFormatError, InputError
 from ._common import (
     CurveRecord,
+    Unsupported,
     atomic_write,
     bezier_pieces,
     check_points,
@@ -73,10 +74,6 @@ _D_RE = re.compile(r"""(\sd\s*=\s*)(["'])(.*?)\2""", re.DOTALL)
 
 def _svgpathtools(what: str) -> Any:
     return lazy_import("svgpathtools", "svgpathtools", "svg", what)
-
-
-class _Unsupported(Exception):
-    pass
 
 
 # ------------------------------------------------------------------------------------------
@@ -212,7 +209,7 @@ def _segments_to_cubics(seg: Any, spt: Any) -> FloatArray:
             p0, p1 = np.array(_xy(g.start)), np.array(_xy(g.end))
             out.append([p0, p0 + (p1 - p0) / 3, p0 + 2 * (p1 - p0) / 3, p1])
         else:
-            raise _Unsupported(f"{type(g).__name__} segment")
+            raise Unsupported(f"{type(g).__name__} segment")
     return np.array(out, dtype=float)
 
 
@@ -268,7 +265,7 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 90.0,
             try:
                 records.extend(_subpath_records(sub, spt, base, name, corner_angle, path,
                                                 len(records)))
-            except _Unsupported as exc:
+            except Unsupported as exc:
                 msg = f"<path> element {k} (id={ident!r}) subpath {j}: unsupported {exc}"
                 if on_unsupported == "raise":
                     raise FileFormatError(msg + " (read_curves(..., on_unsupported='skip') "
