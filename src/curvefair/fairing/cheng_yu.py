@@ -735,7 +735,7 @@ def cheng_yu_driver(curve: Any, *, tol: float | None = None, eps: float = 1e-8,
     >>> bool(res.indicator_after < res.indicator_before)
     True
     """
-    curve = _cubic_bspline(curve, "cheng_yu_driver")
+    curve = _cubic_bspline(curve, "method 'cheng-yu' (Cheng & Yu's second discrete curvature)")
     n = curve.n_ctrl
     closed = bool(curve.closed)
     if tol is None:
