@@ -27,7 +27,7 @@ import numpy as np
 from numba import njit
 
 from ..curves.hermite import cubic_hermite_coefficients, quintic_hermite_coefficients
-from .ranking import tt_build, tt_top, tt_update
+from .ranking import tt_build, tt_top, tt_update, tt_update_range
 
 # method codes (internal only; the public API uses names)
 KJELLANDER = 0
@@ -271,45 +271,6 @@ def measure_at(P, D, h, k, degree, spline):  # type: ignore[no-untyped-def]
     if degree == 3:
         return cubic_jump(P, D, h, k)
     return quintic_measure(P, D, h, k, spline)
-
-
-# ----------------------------------------------------------------------------------------------
-# tournament tree: update a contiguous range of leaves in O(len + log N)
-# ----------------------------------------------------------------------------------------------
-@njit(cache=True, inline="always")
-def _wins(v1, i1, v2, i2):  # type: ignore[no-untyped-def]
-    # same rule as ranking.tt_update: larger value, ties to the smaller valid index
-    if v1 > v2:
-        return True
-    if v1 < v2:
-        return False
-    if i2 < 0:
-        return True
-    if i1 < 0:
-        return False
-    return i1 <= i2
-
-
-@njit(cache=True)
-def tt_update_range(tv, ti, lo, hi, values):  # type: ignore[no-untyped-def]
-    """Set leaves ``lo..hi`` (inclusive) to ``values[lo..hi]`` and repair their ancestors."""
-    p = tv.shape[0] // 2
-    for i in range(lo, hi + 1):
-        tv[p + i] = values[i]
-    a = (p + lo) // 2
-    b = (p + hi) // 2
-    while a >= 1:
-        for j in range(a, b + 1):
-            x = 2 * j
-            y = x + 1
-            if _wins(tv[x], ti[x], tv[y], ti[y]):
-                tv[j] = tv[x]
-                ti[j] = ti[x]
-            else:
-                tv[j] = tv[y]
-                ti[j] = ti[y]
-        a //= 2
-        b //= 2
 
 
 # ----------------------------------------------------------------------------------------------
