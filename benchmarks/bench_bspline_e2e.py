@@ -17,6 +17,9 @@ deviation of the curvefair result ("equal maximum deviation"). Timed: one csaps 
 Reported per curve: time, largest deviation from the data at the data parameters, RMS
 deviation, ``E2 = int |r''|^2 dt``, ``E3 = int |r'''|^2 dt`` (exact, piecewise), curvature sign
 changes at the data parameters (inflections; the smooth curve has about ``N / (7 pi)``).
+``--eh-eps`` adds Eck-Hadenfeld runs with other stopping thresholds (relative ``eps * n``, the
+default is ``1e-4``), each against csaps at its own maximum deviation: the steps/fairness
+trade-off of the stopping rule. ``--profile-csaps`` prints where one csaps call spends its time.
 
 Usage::
 
@@ -108,6 +111,9 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--bisect", type=int, default=40, help="csaps bisection steps")
     ap.add_argument("--no-global", action="store_true")
+    ap.add_argument("--eh-eps", type=float, nargs="*", default=[],
+                    help="extra EH runs with eps = value / n (default rule: 1e-4)")
+    ap.add_argument("--profile-csaps", action="store_true")
     args = ap.parse_args()
     t, pts = data(args.n, args.sigma, args.seed)
     # warm up the compiled code outside the timing
@@ -121,15 +127,25 @@ def main() -> None:
 
     t0 = time.perf_counter()
     eh = eck_hadenfeld_fair(c, l=2, tol=args.tol, clamp=(None, None), max_steps=200 * args.n)
-    t_eh = time.perf_counter() - t0 + t_interp
+    t_fair = time.perf_counter() - t0
+    t_eh = t_fair + t_interp
     rows["curvefair eck-hadenfeld"] = (t_eh, bspline_metrics(eh.curve, t, pts),
-                                       f"{eh.steps} steps, {eh.stop_reason}")
+                                       f"{eh.steps} steps ({eh.steps / t_fair / 1e6:.2f} M/s "
+                                       f"incl. set-up), {eh.stop_reason}; interp "
+                                       f"{t_interp:.2f}s")
+    for e in args.eh_eps:
+        t0 = time.perf_counter()
+        r = eck_hadenfeld_fair(c, l=2, tol=args.tol, eps=e / c.n_ctrl, max_steps=200 * args.n)
+        t_e = time.perf_counter() - t0 + t_interp
+        rows[f"curvefair eck-hadenfeld eps={e:g}/n"] = (
+            t_e, bspline_metrics(r.curve, t, pts), f"{r.steps} steps, {r.stop_reason}")
     if not args.no_global:
         t0 = time.perf_counter()
         gl = global_fair(c, tol=args.tol, l=2)
         t_gl = time.perf_counter() - t0 + t_interp
         rows["curvefair global"] = (t_gl, bspline_metrics(gl.curve, t, pts),
-                                    f"{gl.iterations} IP iterations, {gl.stop_reason}")
+                                    f"{gl.iterations} Newton iterations, {gl.stop_reason}; "
+                                    f"interp {t_interp:.2f}s")
 
     peers = {}
     for name in list(rows)[1:]:
@@ -144,6 +160,21 @@ def main() -> None:
             t_cs = min(t_cs, time.perf_counter() - t0)
         peers[name] = (t_cs, csaps_metrics(spl, t, pts), f"smooth={p:.6g}, bisection {t_bis:.1f}s")
 
+    if args.profile_csaps:
+        import cProfile
+        import io
+        import pstats
+
+        prof = cProfile.Profile()
+        smooth = float(next(iter(peers.values()))[2].split(",")[0].split("=")[1])
+        t0 = time.perf_counter()
+        prof.runcall(csaps_fit, t, pts, smooth)
+        t_prof = time.perf_counter() - t0
+        buf = io.StringIO()
+        pstats.Stats(prof, stream=buf).sort_stats("tottime").print_stats(6)
+        print(f"one csaps call under cProfile: {t_prof:.2f} s; largest own times:")
+        print("\n".join(line for line in buf.getvalue().splitlines()
+                        if line.strip() and not line.startswith(("   Ordered", "   List"))))
     print(f"n = {args.n}, sigma = {args.sigma}, tol = {args.tol}, seed = {args.seed}")
     hdr = f"{'curve':<34} {'time s':>7} {'max dev':>9} {'rms dev':>9} {'E2':>11} {'E3':>11} " \
           f"{'inflect':>8}  note"

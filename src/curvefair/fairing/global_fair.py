@@ -406,7 +406,7 @@ def _solve_balls(system: _System, g0: FloatArray, free: np.ndarray, tol: float, 
         if rdn <= 1e-10 and ls <= gap:
             reason = "converged"
             break
-        if may_switch and max(rdn, ls) < switch:
+        if may_switch and rdn < switch and ls < _SWITCH_GAP:
             kappa = float(lam[free].mean()) / float(s[free].mean())
             res = _active_set_newton(system, g0, free, tol, v, lam, kappa, gscale,
                                      min(8, max_steps - steps))
@@ -444,6 +444,9 @@ def _solve_balls(system: _System, g0: FloatArray, free: np.ndarray, tol: float, 
     return v, lam, steps, reason
 
 
+_SWITCH_GAP = 1e-5
+
+
 def _matvec(K: FloatArray, p: int, closed: bool, x: FloatArray) -> FloatArray:
     out = np.empty_like(x)
     _k.band_matvec(K, p, closed, np.ascontiguousarray(x), out)
@@ -477,7 +480,7 @@ def _active_set_newton(system: _System, g0: FloatArray, free: np.ndarray, tol: f
             return v, lam, it, False
         if stat <= 1e-10 and feas <= 1e-12 and fS <= 1e-12:
             return v, lam, it, True
-        if it == maxit:
+        if it == maxit or feas > 1.0:  # feas > 1: a point went past sqrt(3) tol, diverging
             break
         _k.ssn_prepare(v, rho, f, S, lam, t2, delta, B, nrm, c)
         if not system.factor(B, rot=S, nrm=nrm):
