@@ -261,3 +261,23 @@ def test_small_closed_curves_wrap_onto_themselves(n):
     res = eck_hadenfeld_fair(c, tol=0.1, eps=0.0, max_steps=500)
     assert abs(res.energy_after - quad_energy(res.curve, 2)) <= 1e-12 * e0
     assert np.linalg.norm(res.curve.control_points - c.control_points, axis=1).max() <= 0.1 + 1e-15
+
+
+def test_large_curve_ranking_order():
+    # 70000 control points: above the size where the loop prefetches the runner-up; the point
+    # faired at step k must be the argmax of the ranking numbers recomputed from scratch
+    # (vectorised, from the Gram band) on the curve after k - 1 steps
+    rng = np.random.default_rng(21)
+    n = 70_000
+    d = np.c_[np.arange(n, dtype=float), rng.normal(size=n)]
+    t = np.r_[[0.0] * 3, np.arange(n - 2.0), [n - 3.0] * 3]
+    c = BSplineCurve(d, t, 3)
+    mask = movable_mask(c, "g2")
+    full = eck_hadenfeld_fair(c, eps=0.0, max_steps=3000, clamp="g2")
+    for k in (1, 40, 700, 3000):
+        before = eck_hadenfeld_fair(c, eps=0.0, max_steps=k - 1, clamp="g2").curve
+        z = np.where(mask, ranking_numbers(before, 2), -1.0)
+        assert int(full.history[k - 1, 0]) == int(np.argmax(z))
+        assert abs(full.history[k - 1, 1] - z.max()) <= 1e-9 * z.max()
+    assert abs(full.energy_before - full.energy_after - full.history[:, 1].sum()) \
+        <= 1e-9 * full.energy_before

@@ -165,3 +165,101 @@ def test_errors_and_trivial_cases():
     np.testing.assert_array_equal(res.curve.control_points, c.control_points)
     res = global_fair(c, tol=0.1, protect=range(c.n_ctrl))
     assert res.stop_reason == "no_movable_point"
+
+
+# -- the compiled Newton systems against dense linear algebra ------------------------------
+@pytest.mark.parametrize("closed", [False, True])
+@pytest.mark.parametrize("dim,p,n", [(2, 3, 30), (3, 3, 25), (2, 2, 7), (3, 4, 9), (2, 5, 40)])
+def test_band_system_matches_dense_solve(closed, dim, p, n):
+    """``_System`` (band / bordered cyclic / dense Cholesky with frames and fixed unknowns)
+    against numpy.linalg.solve on the explicitly assembled dense matrix."""
+    from curvefair.fairing.global_fair import _frames, _System
+
+    rng = np.random.default_rng(100 * dim + 10 * p + n + closed)
+    # a symmetric positive semi-definite band K (random Gram-like rows) plus SPD blocks
+    F = rng.normal(size=(n + p, n))
+    Kd = F.T @ F
+    band = np.abs(np.arange(n)[:, None] - np.arange(n)[None, :])
+    if closed:
+        band = np.minimum(band, n - band)
+    Kd[band > p] = 0.0
+    K = np.zeros((n, 2 * p + 1))
+    for o in range(-p, p + 1):
+        j = np.arange(n) + o
+        ok = (j >= 0) & (j < n) if not closed else np.ones(n, bool)
+        K[ok, p + o] = Kd[np.arange(n)[ok], j[ok] % n]
+    if closed and n < 2 * p + 1:
+        pytest.skip("wrapping band: covered by the dense path of the solver itself")
+    Bl = rng.normal(size=(n, dim, dim))
+    Bl = Bl @ Bl.transpose(0, 2, 1) + 0.1 * np.eye(dim)
+    fixed = np.zeros(n, bool)
+    fixed[[1, n // 2]] = True
+    rot = rng.random(n) < 0.4
+    rot &= ~fixed
+    nrm = rng.normal(size=(n, dim))
+    nrm /= np.linalg.norm(nrm, axis=1)[:, None]
+    c = rng.normal(size=n)
+    rhs = rng.normal(size=(n, dim))
+    sysm = _System(np.ascontiguousarray(K), p, dim, closed, fixed)
+    assert sysm.factor(Bl, rot=rot, nrm=nrm)
+    dx = sysm.solve(rhs.copy(), c)
+    # dense reference: unknowns dx; equations: fixed points dx = 0, rot points n.dx = c and
+    # the tangential part of (kron(K, I) + B) dx = rhs, free points the full equation
+    H = np.kron(Kd, np.eye(dim))
+    for i in range(n):
+        H[i * dim:(i + 1) * dim, i * dim:(i + 1) * dim] += Bl[i]
+    Q = _frames(nrm)
+    rows, rhs_d = [], []
+    for i in range(n):
+        sl = slice(i * dim, (i + 1) * dim)
+        if fixed[i]:
+            for a in range(dim):
+                e = np.zeros(n * dim)
+                e[i * dim + a] = 1.0
+                rows.append(e)
+                rhs_d.append(0.0)
+        elif rot[i]:
+            e = np.zeros(n * dim)
+            e[sl] = nrm[i]
+            rows.append(e)
+            rhs_d.append(c[i])
+            for a in range(1, dim):
+                rows.append(Q[i][:, a] @ H[sl])
+                rhs_d.append(Q[i][:, a] @ rhs[i])
+        else:
+            for a in range(dim):
+                rows.append(H[i * dim + a])
+                rhs_d.append(rhs[i, a])
+    ref = np.linalg.solve(np.array(rows), np.array(rhs_d)).reshape(n, dim)
+    np.testing.assert_allclose(dx, ref, rtol=1e-9, atol=1e-9 * np.abs(ref).max())
+
+
+@pytest.mark.parametrize("closed", [False, True])
+def test_band_residual_and_energy_match_gram_matrix(closed):
+    from curvefair.curves.bspline import band_energy, band_residual
+
+    rng = np.random.default_rng(3 + closed)
+    c = noisy(n=40, closed=closed, seed=11, dim=3)
+    for l in (1, 2, 3):  # noqa: E741
+        W = np.ascontiguousarray(c.gram_band(l))
+        G = dense_gram(c, l)  # independent: quadrature of scipy basis derivatives
+        x = rng.normal(size=(c.n_ctrl, 3)) + 1e8  # large offset: x^T G x would lose it all
+        g = np.empty_like(x)
+        band_residual(W, c.degree, closed, x, g)
+        np.testing.assert_allclose(g, G @ (x - 1e8), atol=1e-9 * np.abs(G).max())
+        e = band_energy(W, c.degree, closed, x)
+        assert abs(e - np.sum((x - 1e8) * (G @ (x - 1e8)))) <= 1e-9 * e
+
+
+def test_large_coordinates_keep_precision():
+    # a curve far from the origin: KKT in displacement terms is as accurate as near it
+    # (coordinates / tol = 5e5; at 5e7 the spacing of doubles alone, 1e-10, would exceed the
+    # complementarity tolerance of check_kkt)
+    c = noisy(n=50, seed=8)
+    far = c.replace(control_points=np.asarray(c.control_points) + 1e4)
+    a = global_fair(c, tol=0.02, clamp="g1")
+    b = global_fair(far, tol=0.02, clamp="g1")
+    assert b.stop_reason == "converged"
+    np.testing.assert_allclose(np.asarray(b.curve.control_points) - 1e4,
+                               a.curve.control_points, atol=1e-9)
+    check_kkt(far, b, 0.02, 2, movable_mask(far, "g1"))

@@ -9,7 +9,9 @@ from curvefair.fairing.ranking import tt_build, tt_top, tt_update, tt_value
 def _brute_top(values):
     finite = np.isfinite(values) | (values > 0)
     if not finite.any() or np.all(values == -np.inf):
-        return int(np.argmax(values)) if values.size else -1, float(values.max()) if values.size else -np.inf
+        if not values.size:
+            return -1, -np.inf
+        return int(np.argmax(values)), float(values.max())
     m = values.max()
     return int(np.flatnonzero(values == m)[0]), float(m)
 
@@ -36,3 +38,31 @@ def test_all_ineligible():
     tv, ti = tt_build(np.full(5, -np.inf))
     idx, val = tt_top(tv, ti)
     assert val == -np.inf and idx in range(5)
+
+
+@pytest.mark.parametrize("n", [1, 5, 16, 17, 33, 1000])
+def test_range_updates_match_argmax(n):
+    from curvefair.fairing.ranking import tt_update_range
+
+    rng = np.random.default_rng(1000 + n)
+    values = rng.integers(0, 10, n).astype(float)  # many ties
+    tv, ti = tt_build(values)
+    for _ in range(2 * n + 10):
+        lo = int(rng.integers(n))
+        hi = min(n - 1, lo + int(rng.integers(0, 40)))
+        new = rng.integers(0, 10, hi - lo + 1).astype(float)
+        new[rng.random(new.size) < 0.2] = -np.inf
+        values[lo:hi + 1] = new
+        tt_update_range(tv, ti, lo, hi, values)
+        for i in (lo, hi):
+            assert tt_value(tv, i) == values[i]
+        idx, val = tt_top(tv, ti)
+        bi, bv = _brute_top(values)
+        assert val == bv
+        if np.isfinite(bv):
+            assert idx == bi
+
+
+def test_empty_tree():
+    tv, ti = tt_build(np.zeros(0))
+    assert tt_top(tv, ti) == (-1, -np.inf)

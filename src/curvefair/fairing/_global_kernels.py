@@ -64,6 +64,78 @@ def _assemble_range(K, p, closed, B, Q, rot, fix, L, i0, i1):  # type: ignore[no
                     L[C, b - a] += B[i, b, a]
             continue
         ri = rot[i]
+        if dim == 2:
+            # planar: the 2 x 2 blocks written out (frames are rotations)
+            fi0 = fix[i, 0]
+            fi1 = fix[i, 1]
+            for o in range(p + 1):
+                j = i + o
+                if j >= n:
+                    if not closed:
+                        break
+                    j -= n
+                rj = rot[j]
+                kk = K[i, p + o]
+                if ri and rj:
+                    t00 = Q[j, 0, 0] * Q[i, 0, 0] + Q[j, 1, 0] * Q[i, 1, 0]
+                    t01 = Q[j, 0, 0] * Q[i, 0, 1] + Q[j, 1, 0] * Q[i, 1, 1]
+                    t10 = Q[j, 0, 1] * Q[i, 0, 0] + Q[j, 1, 1] * Q[i, 1, 0]
+                    t11 = Q[j, 0, 1] * Q[i, 0, 1] + Q[j, 1, 1] * Q[i, 1, 1]
+                elif ri:
+                    t00 = Q[i, 0, 0]
+                    t01 = Q[i, 0, 1]
+                    t10 = Q[i, 1, 0]
+                    t11 = Q[i, 1, 1]
+                elif rj:
+                    t00 = Q[j, 0, 0]
+                    t01 = Q[j, 1, 0]
+                    t10 = Q[j, 0, 1]
+                    t11 = Q[j, 1, 1]
+                else:
+                    t00 = 1.0
+                    t01 = 0.0
+                    t10 = 0.0
+                    t11 = 1.0
+                # m_ba = M[(j, b), (i, a)]
+                m00 = kk * t00
+                m01 = kk * t01
+                m10 = kk * t10
+                m11 = kk * t11
+                if o == 0:
+                    b00 = B[i, 0, 0]
+                    b01 = B[i, 0, 1]
+                    b10 = B[i, 1, 0]
+                    b11 = B[i, 1, 1]
+                    if ri and not (b01 == 0.0 and b10 == 0.0 and b00 == b11):
+                        q00 = Q[i, 0, 0]
+                        q01 = Q[i, 0, 1]
+                        q10 = Q[i, 1, 0]
+                        q11 = Q[i, 1, 1]
+                        # (Q^T B Q)[b, a]
+                        c00 = b00 * q00 + b01 * q10
+                        c01 = b00 * q01 + b01 * q11
+                        c10 = b10 * q00 + b11 * q10
+                        c11 = b10 * q01 + b11 * q11
+                        b00 = q00 * c00 + q10 * c10
+                        b01 = q00 * c01 + q10 * c11
+                        b10 = q01 * c00 + q11 * c10
+                        b11 = q01 * c01 + q11 * c11
+                    m00 += b00
+                    m01 += b01
+                    m10 += b10
+                    m11 += b11
+                fj0 = fix[j, 0]
+                fj1 = fix[j, 1]
+                C = 2 * i
+                k = 2 * o
+                # column (i, 0): rows (j, 0), (j, 1)
+                L[C, k] = (1.0 if k == 0 else 0.0) if (fi0 or fj0) else m00
+                L[C, k + 1] = 0.0 if (fi0 or fj1) else m10
+                # column (i, 1): rows (j, 0) (only o > 0), (j, 1)
+                if o > 0:
+                    L[C + 1, k - 1] = 0.0 if (fi1 or fj0) else m01
+                L[C + 1, k] = (1.0 if k == 0 else 0.0) if (fi1 or fj1) else m11
+            continue
         for o in range(p + 1):
             j = i + o
             if j >= n:

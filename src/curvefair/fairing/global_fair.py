@@ -108,6 +108,8 @@ class _System:
         self.N = N = n * dim
         self.kd = kd = (p + 1) * dim - 1
         self.fix0 = np.repeat(fixed[:, None], dim, axis=1)
+        self.fixed_points = np.flatnonzero(fixed)
+        self.anyrot = False
         self.dense = closed and N < 3 * (kd + 1)
         if self.dense:
             Kd = np.zeros((n, n))
@@ -132,7 +134,8 @@ class _System:
         matrix is not positive definite in floating point."""
         self.B = B
         self.fix[:] = self.fix0
-        if rot is None or not rot.any():
+        self.anyrot = rot is not None and bool(rot.any())
+        if not self.anyrot:
             self.rot[:] = False
         else:
             self.rot[:] = rot
@@ -164,8 +167,13 @@ class _System:
         """Displacement ``dx`` (n, dim): ``M dx = rhs`` on the unfixed unknowns, ``dx = 0`` at
         fixed points, ``nrm_i . dx_i = c_i`` at the ``rot`` points."""
         y = np.empty_like(rhs) if out is None else out
-        _k.prep_rhs(self.K, self.p, self.closed, self.B, self.Q, self.rot, self.fix, self.fix0,
-                    rhs, self.czero if c is None else c, y)
+        if self.anyrot:
+            _k.prep_rhs(self.K, self.p, self.closed, self.B, self.Q, self.rot, self.fix,
+                        self.fix0, rhs, self.czero if c is None else c, y)
+        else:
+            if y is not rhs:
+                y[:] = rhs
+            y[self.fixed_points] = 0.0
         b = y.reshape(-1)
         if self.dense:
             b[:] = np.linalg.solve(self.C.T, np.linalg.solve(self.C, b))
@@ -173,7 +181,10 @@ class _System:
             _k.cyclic_solve_full(self.L, self.Y, self.S, b)
         else:
             _k.band_solve(self.L, self.N, b)
-        _k.post_solve(y, self.Q, self.rot, self.fix0)
+        if self.anyrot:
+            _k.post_solve(y, self.Q, self.rot, self.fix0)
+        else:
+            y[self.fixed_points] = 0.0
         return y
 
 
@@ -391,7 +402,6 @@ def _solve_balls(system: _System, g0: FloatArray, free: np.ndarray, tol: float, 
     may_switch = True
     rd = np.empty_like(v)
     rhs = np.empty_like(v)
-    dv = np.empty_like(v)
     s = np.empty(n)
     rc = np.empty(n)
     rp = np.empty(n)
@@ -423,17 +433,17 @@ def _solve_balls(system: _System, g0: FloatArray, free: np.ndarray, tol: float, 
         np.multiply(lam, s, out=rc)
         rp[:] = 0.0
         _k.ip_rhs(rd, v, rc, rp, lam, s, free, t2, rhs)
-        system.solve(rhs, out=dv)
+        dv = system.solve(rhs, out=rhs)
         bm, lm = _k.ip_recover(dv, v, rc, rp, lam, s, free, t2, ds, dl)
         ap, ad = min(1.0, bm), min(1.0, lm)
         mu_aff = _k.ip_corrector(lam, s, dl, ds, ap, ad, free, rc) / m
         sigma = min(1.0, (mu_aff / mu) ** 3) if mu > 0 else 0.0
         # corrector: rc = lam s + dl_aff ds_aff - sigma mu, and the slack the predictor step
         # loses to the curvature of the spheres
-        rc[free] -= sigma * mu
+        rc -= sigma * mu  # (fixed points: ignored by the kernels)
         _k.second_order(dv, free, t2, rp)
         _k.ip_rhs(rd, v, rc, rp, lam, s, free, t2, rhs)
-        system.solve(rhs, out=dv)
+        dv = system.solve(rhs, out=rhs)
         bm, lm = _k.ip_recover(dv, v, rc, rp, lam, s, free, t2, ds, dl)
         st = min(1.0, 0.995 * min(bm, lm))
         if not st > 1e-14:
