@@ -716,10 +716,12 @@ def ssn_prepare(v, rho, f, S, lam, t2, delta, B, nrm, c):  # type: ignore[no-unt
 
 
 @njit(cache=True)
-def ssn_update(v, dv, rd, kdv, lam, S, nrm, rho, t2):  # type: ignore[no-untyped-def]
+def ssn_update(v, dv, rd, kdv, lam, S, nrm, rho, t2, retract):  # type: ignore[no-untyped-def]
     """Multiplier step from the normal component of the stationarity equation, then
-    ``v += dv``."""
+    ``v += dv``; with ``retract`` the active points are put back on their sphere (the
+    tangent-plane step overshoots radially by ``|dv_t|^2 / (2 tol)``)."""
     n, dim = v.shape
+    tol = np.sqrt(t2)
     for i in range(n):
         if S[i]:
             acc = 0.0
@@ -729,8 +731,14 @@ def ssn_update(v, dv, rd, kdv, lam, S, nrm, rho, t2):  # type: ignore[no-untyped
             lam[i] = lam[i] - acc * t2 / rho[i]
         else:
             lam[i] = 0.0
+        vv = 0.0
         for a in range(dim):
             v[i, a] += dv[i, a]
+            vv += v[i, a] * v[i, a]
+        if retract and S[i] and vv > 0.0:
+            f = tol / np.sqrt(vv)
+            for a in range(dim):
+                v[i, a] *= f
 
 
 @njit(cache=True)

@@ -455,6 +455,7 @@ def _solve_balls(system: _System, g0: FloatArray, free: np.ndarray, tol: float, 
 
 
 _SWITCH_GAP = 1e-5
+_RETRACT = True
 
 
 def _matvec(K: FloatArray, p: int, closed: bool, x: FloatArray) -> FloatArray:
@@ -499,7 +500,7 @@ def _active_set_newton(system: _System, g0: FloatArray, free: np.ndarray, tol: f
         system.solve(rd, c, out=dv)
         rd *= -1.0
         _k.band_matvec(K, p, closed, dv, kdv)
-        _k.ssn_update(v, dv, rd, kdv, lam, S, nrm, rho, t2)
+        _k.ssn_update(v, dv, rd, kdv, lam, S, nrm, rho, t2, _RETRACT)
     return v, lam, maxit, False
 
 
