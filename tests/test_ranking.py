@@ -66,3 +66,28 @@ def test_range_updates_match_argmax(n):
 def test_empty_tree():
     tv, ti = tt_build(np.zeros(0))
     assert tt_top(tv, ti) == (-1, -np.inf)
+
+
+@pytest.mark.parametrize("n", [70_000, 70_001 + 16 * 5])
+def test_blocked_tree_matches_argmax(n):
+    # above 65536 entries the tree holds blocks of 16: single and range updates vs brute force
+    from curvefair.fairing.ranking import tt_update_range
+
+    rng = np.random.default_rng(n)
+    values = rng.integers(0, 50, n).astype(float)
+    tv, ti = tt_build(values)
+    assert ti[0] == 4  # blocked layout in use
+    for step in range(3000):
+        if step % 3:
+            i = int(rng.integers(n))
+            values[i] = -np.inf if rng.random() < 0.2 else float(rng.integers(0, 60))
+            tt_update(tv, ti, i, values[i])
+        else:
+            lo = int(rng.integers(n))
+            hi = min(n - 1, lo + int(rng.integers(0, 40)))
+            values[lo:hi + 1] = rng.integers(0, 60, hi - lo + 1)
+            tt_update_range(tv, ti, lo, hi, values)
+        idx, val = tt_top(tv, ti)
+        bi, bv = _brute_top(values)
+        assert val == bv and idx == bi
+    assert all(tt_value(tv, i) == values[i] for i in rng.integers(0, n, 50))

@@ -5,16 +5,19 @@ neighbouring entries, and asks again (Eck & Hadenfeld's ranking list; seed 001's
 loop). A lazy heap grows without bound under such updates; the tournament tree keeps exactly one
 slot per entry: ``O(log N)`` per update, ``O(1)`` to read the maximum, no allocation after build.
 
-Layout (blocked, so that the tree stays small and cache-resident for millions of entries): the
-entries are grouped in blocks of ``16``; ``P`` = smallest power of two >= the number of blocks;
+Layout (blocked above 65536 entries, so that the tree stays small and cache-resident for millions
+of entries): the entries are grouped in blocks of ``16`` (of 1 for smaller trees, where a block
+rescan would cost more than the levels it saves; the block size is kept in ``ti[0]``);
+``P`` = smallest power of two >= the number of blocks;
 leaf ``P + b`` holds block ``b``'s largest value and its index, node ``j`` the larger of its
 children ``2j`` and ``2j + 1`` (ties go to the smaller index, so results are deterministic;
 empty padding blocks hold ``-inf`` and index -1). ``tv`` holds the tree values in
 ``tv[1 .. 2P - 1]``, the entries' own values in ``tv[2P .. 2P + N - 1]`` and ``N`` in ``tv[0]``;
 ``ti`` holds the tree indices. An update rewrites one entry, rescans its block (16 values,
 contiguous) and repairs the path to the root, stopping as soon as a node is unchanged. With one
-leaf per entry (the previous layout) a tree over a million entries spans 32 MB and every update
-of a far-away entry walked 20 cold cache lines. Ineligible entries hold ``-inf``.
+leaf per entry a tree over a million entries spans 32 MB and every update of a far-away entry
+walks 20 cold cache lines (a generic ranking loop at 1e6 entries runs about 20 % faster blocked;
+at 1e3 entries unblocked is 1.5 times faster). Ineligible entries hold ``-inf``.
 
 Examples
 --------
@@ -34,7 +37,8 @@ from numba import njit
 
 __all__ = ["tt_build", "tt_update", "tt_top", "tt_value", "tt_update_range"]
 
-_SHIFT = 4  # 16 entries per block
+_SHIFT = 4  # 16 entries per block above _BLOCKED entries
+_BLOCKED = 1 << 16
 
 
 @njit(cache=True, inline="always")
@@ -52,10 +56,10 @@ def _better(v1: float, i1: int, v2: float, i2: int) -> bool:
 
 
 @njit(cache=True)
-def _scan_block(tv, P, n, b):  # type: ignore[no-untyped-def]
+def _scan_block(tv, P, n, b, shift):  # type: ignore[no-untyped-def]
     """Largest value of block ``b`` and its first index (``(-inf, -1)`` if empty)."""
-    k0 = b << _SHIFT
-    k1 = min(k0 + (1 << _SHIFT), n)
+    k0 = b << shift
+    k1 = min(k0 + (1 << shift), n)
     if k0 >= k1:
         return -np.inf, -1
     base = 2 * P
@@ -73,17 +77,19 @@ def _scan_block(tv, P, n, b):  # type: ignore[no-untyped-def]
 def tt_build(values):  # type: ignore[no-untyped-def]
     """Build the tree over ``values`` (float64, shape (N,)); returns ``(tv, ti)``."""
     n = values.shape[0]
-    nb = (n + (1 << _SHIFT) - 1) >> _SHIFT
+    shift = _SHIFT if n > _BLOCKED else 0
+    nb = (n + (1 << shift) - 1) >> shift
     P = 1
     while P < nb:
         P *= 2
     tv = np.full(2 * P + n, -np.inf)
     ti = np.full(2 * P, -1, dtype=np.int64)
     tv[0] = n
+    ti[0] = shift
     for i in range(n):
         tv[2 * P + i] = values[i]
     for b in range(nb):
-        v, i = _scan_block(tv, P, n, b)
+        v, i = _scan_block(tv, P, n, b, shift)
         tv[P + b] = v
         ti[P + b] = i
     for j in range(P - 1, 0, -1):
@@ -131,8 +137,9 @@ def tt_update(tv, ti, i, value):  # type: ignore[no-untyped-def]
     n = int(tv[0])
     P = (tv.shape[0] - n) // 2
     tv[2 * P + i] = value
-    b = i >> _SHIFT
-    v, k = _scan_block(tv, P, n, b)
+    shift = ti[0]
+    b = i >> shift
+    v, k = _scan_block(tv, P, n, b, shift)
     if v == tv[P + b] and k == ti[P + b]:
         return
     tv[P + b] = v
@@ -150,11 +157,12 @@ def tt_update_range(tv, ti, lo, hi, values):  # type: ignore[no-untyped-def]
     P = (tv.shape[0] - n) // 2
     for i in range(lo, hi + 1):
         tv[2 * P + i] = values[i]
-    blo = lo >> _SHIFT
-    bhi = hi >> _SHIFT
+    shift = ti[0]
+    blo = lo >> shift
+    bhi = hi >> shift
     changed = False
     for b in range(blo, bhi + 1):
-        v, k = _scan_block(tv, P, n, b)
+        v, k = _scan_block(tv, P, n, b, shift)
         if v != tv[P + b] or k != ti[P + b]:
             tv[P + b] = v
             ti[P + b] = k
