@@ -105,14 +105,81 @@ def tt_build(values):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def _repair(tv, ti, P, a, b):  # type: ignore[no-untyped-def]
-    """Recompute the ancestors of leaves ``P + a .. P + b`` level by level (a contiguous range
-    per level), stopping when a whole level is unchanged."""
-    lo = (P + a) >> 1
-    hi = (P + b) >> 1
-    while lo >= 1:
+def tt_update(tv, ti, i, value):  # type: ignore[no-untyped-def]
+    """Set entry ``i`` to ``value`` and repair the path to the root (``O(16 + log N)``)."""
+    n = int(tv[0])
+    P = (tv.shape[0] - n) // 2
+    base = 2 * P
+    tv[base + i] = value
+    shift = ti[0]
+    if shift == 0:
+        nv = value
+        ni = i
+        j = P + i
+    else:
+        b = i >> shift
+        k0 = b << shift
+        k1 = min(k0 + (1 << shift), n)
+        ni = k0
+        nv = tv[base + k0]
+        for k in range(k0 + 1, k1):
+            zk = tv[base + k]
+            if zk > nv:
+                nv = zk
+                ni = k
+        j = P + b
+    if nv == tv[j] and ni == ti[j]:
+        return
+    tv[j] = nv
+    ti[j] = ni
+    j >>= 1
+    while j >= 1:
+        x = 2 * j
+        y = x + 1
+        if _better(tv[x], ti[x], tv[y], ti[y]):
+            nv = tv[x]
+            ni = ti[x]
+        else:
+            nv = tv[y]
+            ni = ti[y]
+        if nv == tv[j] and ni == ti[j]:
+            return  # unchanged: so are its ancestors
+        tv[j] = nv
+        ti[j] = ni
+        j >>= 1
+
+
+@njit(cache=True)
+def tt_update_range(tv, ti, lo, hi, values):  # type: ignore[no-untyped-def]
+    """Set entries ``lo..hi`` (inclusive) to ``values[lo..hi]`` and repair their ancestors
+    (``O(hi - lo + 16 + log N)``)."""
+    if hi < lo:
+        return
+    n = int(tv[0])
+    P = (tv.shape[0] - n) // 2
+    base = 2 * P
+    for i in range(lo, hi + 1):
+        tv[base + i] = values[i]
+    shift = ti[0]
+    blo = lo >> shift
+    bhi = hi >> shift
+    for b in range(blo, bhi + 1):
+        k0 = b << shift
+        k1 = min(k0 + (1 << shift), n)
+        ni = k0
+        nv = tv[base + k0]
+        for k in range(k0 + 1, k1):
+            zk = tv[base + k]
+            if zk > nv:
+                nv = zk
+                ni = k
+        tv[P + b] = nv
+        ti[P + b] = ni
+    a = (P + blo) >> 1
+    c = (P + bhi) >> 1
+    while a >= 1:
         changed = False
-        for j in range(lo, hi + 1):
+        for j in range(a, c + 1):
             x = 2 * j
             y = x + 1
             if _better(tv[x], ti[x], tv[y], ti[y]):
@@ -127,48 +194,8 @@ def _repair(tv, ti, P, a, b):  # type: ignore[no-untyped-def]
                 changed = True
         if not changed:
             return
-        lo >>= 1
-        hi >>= 1
-
-
-@njit(cache=True)
-def tt_update(tv, ti, i, value):  # type: ignore[no-untyped-def]
-    """Set entry ``i`` to ``value`` and repair the path to the root (``O(16 + log N)``)."""
-    n = int(tv[0])
-    P = (tv.shape[0] - n) // 2
-    tv[2 * P + i] = value
-    shift = ti[0]
-    b = i >> shift
-    v, k = _scan_block(tv, P, n, b, shift)
-    if v == tv[P + b] and k == ti[P + b]:
-        return
-    tv[P + b] = v
-    ti[P + b] = k
-    _repair(tv, ti, P, b, b)
-
-
-@njit(cache=True)
-def tt_update_range(tv, ti, lo, hi, values):  # type: ignore[no-untyped-def]
-    """Set entries ``lo..hi`` (inclusive) to ``values[lo..hi]`` and repair their ancestors
-    (``O(hi - lo + 16 + log N)``)."""
-    if hi < lo:
-        return
-    n = int(tv[0])
-    P = (tv.shape[0] - n) // 2
-    for i in range(lo, hi + 1):
-        tv[2 * P + i] = values[i]
-    shift = ti[0]
-    blo = lo >> shift
-    bhi = hi >> shift
-    changed = False
-    for b in range(blo, bhi + 1):
-        v, k = _scan_block(tv, P, n, b, shift)
-        if v != tv[P + b] or k != ti[P + b]:
-            tv[P + b] = v
-            ti[P + b] = k
-            changed = True
-    if changed:
-        _repair(tv, ti, P, blo, bhi)
+        a >>= 1
+        c >>= 1
 
 
 @njit(cache=True)
