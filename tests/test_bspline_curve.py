@@ -276,3 +276,26 @@ def test_from_scipy_unclamped_open_spline():
     u = np.linspace(t[3], t[10], 500)
     for nu in range(3):
         np.testing.assert_allclose(c(u, nu), spl(u, nu), atol=1e-9 * np.abs(spl(u, nu)).max())
+
+
+@pytest.mark.parametrize("spacing", ["chord", "uneven", "wild"])
+def test_open_cubic_interpolant_matches_scipy_natural(spacing):
+    # the O(m) tridiagonal path of interpolate_bspline against scipy's make_interp_spline
+    from scipy.interpolate import make_interp_spline
+
+    rng = np.random.default_rng(len(spacing))
+    for m in (4, 5, 9, 57):
+        pts = np.cumsum(rng.normal(size=(m, 3)), axis=0)
+        if spacing == "chord":
+            param = "chord"
+        elif spacing == "uneven":
+            param = np.cumsum(rng.uniform(0.05, 3.0, m))
+        else:
+            param = np.cumsum(np.r_[1.0, rng.choice([1e-3, 1.0, 100.0], m - 1)])
+        c = interpolate_bspline(pts, param=param)
+        t = curvefair.parameterize(pts, param)
+        ref = make_interp_spline(t, pts, k=3, bc_type="natural", axis=0)
+        np.testing.assert_array_equal(c.knots, ref.t)
+        scale = np.abs(ref.c).max()
+        np.testing.assert_allclose(c.control_points, ref.c, rtol=0, atol=1e-10 * scale)
+        np.testing.assert_allclose(c(t), pts, rtol=0, atol=1e-10 * scale)

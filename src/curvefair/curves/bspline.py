@@ -29,7 +29,7 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.linalg import spsolve
 
 from .._typing import ArrayLike, FloatArray
-from .._validate import _as_float, as_points, check_finite
+from .._validate import _as_float, as_params, as_points, check_finite
 from ..errors import InputError
 from .parameterize import parameterize
 from .piecewise import PiecewiseCurve, PiecewisePolynomial, readonly
@@ -651,10 +651,51 @@ def interpolate_bspline(points: ArrayLike, degree: int = 3, param: str | ArrayLi
         spl = make_interp_spline(t, loop, k=p, bc_type="periodic", axis=0)
         return BSplineCurve.from_scipy(spl, closed=True)
     pts = as_points(points, "points", min_points=p + 1)
-    t = parameterize(pts, param)
+    t = as_params(param, pts.shape[0], "param") if not isinstance(param, str) \
+        else parameterize(pts, param)
+    if p == 3 and pts.shape[0] >= 4:
+        return _natural_cubic(t, pts)
     bc = "natural" if p == 3 else None
     spl = make_interp_spline(t, pts, k=p, bc_type=bc, axis=0)
     return BSplineCurve.from_scipy(spl, closed=False)
+
+
+def _natural_cubic(u: FloatArray, pts: FloatArray) -> BSplineCurve:
+    """Clamped cubic B-spline through ``pts`` at ``u`` (m >= 4) with ``r'' = 0`` at both ends:
+    the tridiagonal system of the interior control points, solved by LAPACK ``gbsv`` (the same
+    curve as ``make_interp_spline(u, pts, 3, bc_type="natural")``, in O(m) numpy).
+
+    At a simple knot ``t_k`` the cubic B-splines are ``N_{k-3}(t_k) = (t_{k+1} - t_k)^2 /
+    ((t_{k+1} - t_{k-1}) (t_{k+1} - t_{k-2}))``, ``N_{k-1}(t_k) = (t_k - t_{k-1})^2 /
+    ((t_{k+1} - t_{k-1}) (t_{k+2} - t_{k-1}))`` and ``N_{k-2} = 1 - N_{k-3} - N_{k-1}``; the
+    natural end rows are ``(d_2 - d_1) / (u_2 - u_0) = (d_1 - d_0) / (u_1 - u_0)`` and its
+    mirror image (Piegl & Tiller, The NURBS Book, eq. (3.9) for the second derivative)."""
+    from scipy.linalg import solve_banded
+
+    m = u.shape[0]
+    T = np.concatenate([np.full(3, u[0]), u, np.full(3, u[-1])])  # full knot vector
+    k = np.arange(4, m + 2)  # the interior data knots t_k = u_{k-3}, k = 4 .. m + 1
+    tk = T[k]
+    den = T[k + 1] - T[k - 1]
+    lo_ = (T[k + 1] - tk) ** 2 / (den * (T[k + 1] - T[k - 2]))
+    up_ = (tk - T[k - 1]) ** 2 / (den * (T[k + 2] - T[k - 1]))
+    ab = np.zeros((3, m))  # unknowns d_1 .. d_m; ab[1 + i - j, j] = A[i, j]
+    rhs = np.empty((m, pts.shape[1]))
+    a0, b0 = 1.0 / (u[2] - u[0]), 1.0 / (u[1] - u[0])
+    ab[1, 0], ab[0, 1] = -(a0 + b0), a0
+    rhs[0] = -b0 * pts[0]
+    rows = np.arange(1, m - 1)  # data j = 1 .. m - 2: d_j, d_{j+1}, d_{j+2}
+    ab[2, rows - 1] = lo_
+    ab[1, rows] = 1.0 - lo_ - up_
+    ab[0, rows + 1] = up_
+    rhs[1:m - 1] = pts[1:m - 1]
+    a1, b1 = 1.0 / (u[-1] - u[-3]), 1.0 / (u[-1] - u[-2])
+    ab[2, m - 2], ab[1, m - 1] = a1, -(a1 + b1)
+    rhs[m - 1] = -b1 * pts[-1]
+    d = np.empty((m + 2, pts.shape[1]))
+    d[0], d[-1] = pts[0], pts[-1]
+    d[1:-1] = solve_banded((1, 1), ab, rhs, check_finite=False)
+    return BSplineCurve(d, T, 3)
 
 
 def fit_bspline(points: ArrayLike, n_ctrl: int, degree: int = 3,
