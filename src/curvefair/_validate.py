@@ -138,3 +138,28 @@ def choice(value: object, valid: Iterable[str], name: str) -> str:
             f"unknown {name} {value!r}; valid values are: {', '.join(repr(v) for v in valid)}"
         )
     return value
+
+
+def as_nonnegative(value: object, name: str, *, none_means: float | None = None) -> float:
+    """A finite float >= 0; ``None`` returns ``none_means`` (an error if that is None too)."""
+    if value is None:
+        if none_means is None:
+            raise InputError(f"{name} is required")
+        return none_means
+    alt = "" if none_means is None else " or None"
+    try:
+        v = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be a number >= 0{alt}, got {value!r}") from None
+    if not np.isfinite(v) or v < 0:
+        raise InputError(f"{name} must be a finite number >= 0{alt}, got {value!r}")
+    return v
+
+
+def as_step_count(value: object, name: str = "max_steps", *, default: int) -> int:
+    """A whole number >= 0 (``None`` gives ``default``); bools are refused."""
+    if value is None:
+        return int(default)
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
+        raise InputError(f"{name} must be an integer >= 0, got {value!r}")
+    return int(value)

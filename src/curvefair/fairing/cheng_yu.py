@@ -21,6 +21,7 @@ import numpy as np
 from numba import njit
 
 from .._typing import FloatArray
+from .._validate import as_nonnegative, as_step_count
 from ..analysis.discrete import (
     _cubic_bspline,
     corner_cut_ratios,
@@ -738,25 +739,9 @@ def cheng_yu_driver(curve: Any, *, tol: float | None = None, eps: float = 1e-8,
     curve = _cubic_bspline(curve, "method 'cheng-yu' (Cheng & Yu's second discrete curvature)")
     n = curve.n_ctrl
     closed = bool(curve.closed)
-    if tol is None:
-        e = -1.0
-    else:
-        try:
-            e = float(tol)
-        except (TypeError, ValueError):
-            raise InputError(f"tol must be a number > 0 or None, got {tol!r}") from None
-        if not np.isfinite(e) or e < 0:
-            raise InputError(f"tol must be a finite number >= 0 or None, got {tol!r}")
-    try:
-        epsv = float(eps)
-    except (TypeError, ValueError):
-        raise InputError(f"eps must be a number >= 0, got {eps!r}") from None
-    if not np.isfinite(epsv) or epsv < 0:
-        raise InputError(f"eps must be a finite number >= 0, got {eps!r}")
-    if max_steps is None:
-        max_steps = 100 * n
-    if isinstance(max_steps, bool) or not isinstance(max_steps, (int, np.integer)) or max_steps < 0:
-        raise InputError(f"max_steps must be an integer >= 0, got {max_steps!r}")
+    e = as_nonnegative(tol, "tol", none_means=-1.0)  # -1: no tolerance
+    epsv = as_nonnegative(eps, "eps")
+    max_steps = as_step_count(max_steps, default=100 * n)
     mask = _movable(curve, clamp, protect)
     sdc = second_discrete_curvature(curve)  # validates (raises at a true corner)
     knots = np.asarray(curve.knots, dtype=float)

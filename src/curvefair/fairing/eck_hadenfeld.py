@@ -21,6 +21,7 @@ import numpy as np
 from numba import njit
 
 from .._typing import FloatArray
+from .._validate import as_nonnegative, as_step_count
 from ..curves.bspline import BSplineCurve, band_energy, band_residual
 from ..errors import InputError
 from ._prefetch import prefetch
@@ -637,28 +638,9 @@ def eck_hadenfeld_fair(curve: BSplineCurve, *, l: int = 2, tol: float | None = N
     curve = check_bspline(curve)
     lv = check_l(l, curve.degree)
     n = curve.n_ctrl
-    if tol is None:
-        tolv = np.inf
-    else:
-        try:
-            tolv = float(tol)
-        except (TypeError, ValueError):
-            raise InputError(f"tol must be a number >= 0 or None, got {tol!r}") from None
-        if not np.isfinite(tolv) or tolv < 0:
-            raise InputError(f"tol must be a finite number >= 0 or None, got {tol!r}")
-    if eps is None:
-        epsv = default_eps(n) if eps_relative else 0.0
-    else:
-        try:
-            epsv = float(eps)
-        except (TypeError, ValueError):
-            raise InputError(f"eps must be a number >= 0, got {eps!r}") from None
-        if not np.isfinite(epsv) or epsv < 0:
-            raise InputError(f"eps must be a finite number >= 0, got {eps!r}")
-    if max_steps is None:
-        max_steps = 100 * n
-    if isinstance(max_steps, bool) or not isinstance(max_steps, (int, np.integer)) or max_steps < 0:
-        raise InputError(f"max_steps must be an integer >= 0, got {max_steps!r}")
+    tolv = as_nonnegative(tol, "tol", none_means=np.inf)
+    epsv = (default_eps(n) if eps_relative else 0.0) if eps is None else as_nonnegative(eps, "eps")
+    max_steps = as_step_count(max_steps, default=100 * n)
     mask = movable_mask(curve, clamp, protect)
     W = curve.gram_band(lv)
     dim = curve.dim
