@@ -406,23 +406,12 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
             f"method {spec.name!r} needs a {' or '.join(t.__name__ for t in spec.curve_types)}, "
             f"got {type(curve).__name__}; methods for this curve: "
             + ", ".join(repr(m) for m in available_methods(curve)))
-    from .._validate import as_positive
+    from .._validate import as_nonnegative, as_positive, as_step_count
 
     tol_v = as_positive(tol, "tol", allow_none=True)
-    if eps is not None:
-        try:
-            eps_v: float | None = float(eps)
-        except (TypeError, ValueError):
-            raise InputError(f"eps must be a number >= 0, got {eps!r}") from None
-        if not math.isfinite(eps_v) or eps_v < 0:
-            raise InputError(f"eps must be a finite number >= 0, got {eps!r}")
-    else:
-        eps_v = None
+    eps_v = None if eps is None else as_nonnegative(eps, "eps")
     if max_steps is not None:
-        if isinstance(max_steps, bool) or not isinstance(max_steps, (int, np.integer)) \
-                or max_steps < 0:
-            raise InputError(f"max_steps must be an integer >= 0, got {max_steps!r}")
-        max_steps = int(max_steps)
+        max_steps = as_step_count(max_steps, default=0)
     clamp_pair = normalize_clamp(clamp)
     prot = normalize_protect(protect, curve)
     if not isinstance(mode, str) or mode not in MODES:

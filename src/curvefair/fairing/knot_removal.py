@@ -19,6 +19,7 @@ from typing import Any, Literal
 import numpy as np
 
 from .._typing import FloatArray
+from .._validate import as_nonnegative, as_step_count
 from ..curves.bspline import BSplineCurve, basis_derivatives
 from ..errors import InputError
 from .eck_hadenfeld import check_bspline, movable_mask
@@ -383,29 +384,19 @@ def knot_removal_fair(curve: BSplineCurve, *, variant: Variant = "one-point",
                          + ", ".join(repr(v) for v in VARIANTS))
     if on_tol not in ("skip", "stop"):
         raise InputError(f"on_tol must be 'skip' or 'stop', got {on_tol!r}")
-    tolv = np.inf if tol is None else float(tol)
-    if not tolv >= 0:
-        raise InputError(f"tol must be a number >= 0 or None, got {tol!r}")
+    tolv = as_nonnegative(tol, "tol", none_means=np.inf)
     mask = movable_mask(curve, clamp, protect)
     kd = _KnotData(curve)
     js = kd.js
     nk = js.size
     d = np.array(curve.control_points)
     orig = d.copy()
-    if max_steps is None:
-        max_steps = 10 * nk
-    if isinstance(max_steps, bool) or not isinstance(max_steps, (int, np.integer)) or max_steps < 0:
-        raise InputError(f"max_steps must be an integer >= 0, got {max_steps!r}")
+    max_steps = as_step_count(max_steps, default=10 * nk)
     if nk == 0:
         return KRResult(curve, 0, "no_knots", 0.0, 0.0, np.zeros((0, 3)))
     z = kd.jumps(d)
     sum0 = float(z.sum())
-    if eps is None:
-        epsv = 1e-6 if eps_relative else 0.0
-    else:
-        epsv = float(eps)
-        if not (np.isfinite(epsv) and epsv >= 0):
-            raise InputError(f"eps must be a finite number >= 0, got {eps!r}")
+    epsv = (1e-6 if eps_relative else 0.0) if eps is None else as_nonnegative(eps, "eps")
     eps_abs = epsv * float(z.max()) if eps_relative else epsv
     # knot j's measure depends on the control points of basis functions j-p-1 .. j, so a moved
     # control point i touches the knots j = b .. b+p+1 for every basis index b of i
