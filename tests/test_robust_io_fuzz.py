@@ -125,22 +125,46 @@ def test_mutated_valid_files_only_documented_errors(tmp_path, valid_files, ext, 
     _read_checked(p)
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "rhino3dm 8.x File3dm.Read never returns (busy loop) on a 3dm file written by "
-    "write_curves with 10 random bytes inserted at offset 5537: tests/data/"
-    "robust_rhino3dm_hang.3dm; repro: python -c \"import rhino3dm; "
-    "rhino3dm.File3dm.Read('tests/data/robust_rhino3dm_hang.3dm')\". A third-party bug; "
-    "curvefair.read_curves inherits the hang (no timeout/subprocess isolation)."))
 def test_corrupt_3dm_does_not_hang():
+    """rhino3dm 8.x File3dm.Read never returns (busy loop) on this file (a 3dm written by
+    write_curves with 10 random bytes inserted at offset 5537; repro: python -c "import
+    rhino3dm; rhino3dm.File3dm.Read('tests/data/robust_rhino3dm_hang.3dm')"). read_curves reads
+    every 3dm file in a guard process first and turns the hang into a FileFormatError."""
     pytest.importorskip("rhino3dm")
     code = ("import curvefair as cf, sys\n"
             "try:\n    cf.read_curves(sys.argv[1])\n"
-            "except cf.CurvefairError:\n    pass\n")
+            "except cf.FileFormatError as exc:\n    print('ERROR', exc)\n")
+    env = dict(os.environ, CURVEFAIR_3DM_TIMEOUT="3")
     try:
-        subprocess.run([sys.executable, "-c", code, str(DATA / "robust_rhino3dm_hang.3dm")],
-                       timeout=8, capture_output=True)
+        out = subprocess.run([sys.executable, "-c", code, str(DATA / "robust_rhino3dm_hang.3dm")],
+                             timeout=30, capture_output=True, env=env, text=True)
     except subprocess.TimeoutExpired:
-        pytest.fail("read_curves did not return within 8 s")
+        pytest.fail("read_curves did not return within 30 s")
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.startswith("ERROR") and "did not finish reading the file within 3 s" \
+        in out.stdout, out.stdout
+
+
+def test_3dm_guard_process_failures(tmp_path, monkeypatch):
+    pytest.importorskip("rhino3dm")
+    from curvefair.io import rhino
+
+    p = tmp_path / "c.3dm"
+    cf.write_curves(p, [cf.BSplineCurve(np.array([[0.0, 0], [1, 2], [2, -1], [3, 0]]),
+                                        [0, 0, 0, 0, 1, 1, 1, 1], 3)])
+    assert len(cf.read_curves(p)) == 1  # the guard passes a good file
+    monkeypatch.setattr(rhino, "_PROBE", "import sys; sys.stderr.write('boom'); sys.exit(7)")
+    with pytest.raises(cf.FileFormatError, match=r"exit code 7\): boom"):
+        cf.read_curves(p)
+    monkeypatch.setattr(rhino, "_PROBE", "while True: pass")
+    monkeypatch.setenv("CURVEFAIR_3DM_TIMEOUT", "0.5")
+    with pytest.raises(cf.FileFormatError, match="within 0.5 s"):
+        cf.read_curves(p)
+    monkeypatch.setenv("CURVEFAIR_3DM_TIMEOUT", "0")  # guard off: the busy probe is not run
+    assert len(cf.read_curves(p)) == 1
+    monkeypatch.setenv("CURVEFAIR_3DM_TIMEOUT", "soon")
+    with pytest.raises(cf.InputError, match="CURVEFAIR_3DM_TIMEOUT"):
+        cf.read_curves(p)
 
 
 # ----------------------------------------------------------------------------------------------

@@ -27,11 +27,23 @@ degree) -- attributes, layers, materials, every other object untouched -- and th
 written (same archive version) to a temporary file next to the destination and moved into
 place. A curve whose control-point count or degree changed replaces the object's geometry
 (same attributes and id). Without a template: a new model (version 7) with the curves.
+
+Guard
+-----
+openNURBS never returns from ``File3dm.Read`` on some corrupted files (a busy loop in
+rhino3dm 8.x) and may crash the interpreter on others. Every file is therefore first read once
+in a separate Python process; if that process does not finish within
+``CURVEFAIR_3DM_TIMEOUT`` seconds (environment variable; default 20 s plus 1 s per MB of
+file; ``0`` turns the guard off) or dies, a :class:`~curvefair.FileFormatError` is raised and
+the caller's process is never exposed to the file. Cost: one extra process start and read
+(about 0.1 s for a small model).
 """
 
 from __future__ import annotations
 
 import os
+import subprocess
+import sys
 import warnings
 from collections.abc import Sequence
 from typing import Any
@@ -75,10 +87,51 @@ def _load(path: object, what: str) -> Any:
         raise FileFormatError(f"cannot read the file: {exc.strerror or exc}", path) from None
     if size == 0:
         raise FileFormatError("empty 3dm file", path)
+    _probe(p, size, path)
     model = rh.File3dm.Read(p)
     if model is None:
         raise FileFormatError("not a readable 3dm file (openNURBS could not read it)", path)
     return model
+
+
+_PROBE = ("import sys, rhino3dm\n"
+          "sys.exit(0 if rhino3dm.File3dm.Read(sys.argv[1]) is not None else 3)\n")
+
+
+def probe_timeout(size: int) -> float:
+    """Seconds allowed for the guard read of a ``size``-byte file (0: no guard)."""
+    env = os.environ.get("CURVEFAIR_3DM_TIMEOUT", "").strip()
+    if env:
+        try:
+            value = float(env)
+        except ValueError:
+            raise InputError(f"CURVEFAIR_3DM_TIMEOUT must be a number of seconds, got {env!r}") \
+                from None
+        if not value >= 0:
+            raise InputError(f"CURVEFAIR_3DM_TIMEOUT must be >= 0, got {env!r}")
+        return value
+    return 20.0 + size / 1e6
+
+
+def _probe(p: str, size: int, path: object) -> None:
+    """Read the file once in a child process first (see the module docstring: Guard)."""
+    timeout = probe_timeout(size)
+    if timeout == 0:
+        return
+    try:
+        proc = subprocess.run([sys.executable, "-c", _PROBE, p], timeout=timeout,
+                              capture_output=True, stdin=subprocess.DEVNULL)
+    except subprocess.TimeoutExpired:
+        raise FileFormatError(f"openNURBS (rhino3dm) did not finish reading the file within "
+                              f"{timeout:g} s: corrupted 3dm file? (set CURVEFAIR_3DM_TIMEOUT "
+                              f"to allow longer)", path) from None
+    if proc.returncode == 3:
+        raise FileFormatError("not a readable 3dm file (openNURBS could not read it)", path)
+    if proc.returncode != 0:
+        err = proc.stderr.decode(errors="replace").strip().splitlines()
+        why = f": {err[-1]}" if err else ""
+        raise FileFormatError(f"openNURBS (rhino3dm) failed reading the file in a guard "
+                              f"process (exit code {proc.returncode}){why}", path)
 
 
 def _nurbs(g: Any) -> tuple[FloatArray, FloatArray, FloatArray, int]:
