@@ -137,3 +137,22 @@ def test_registered_in_fair():
         assert r["energy_after"] <= r["energy_before"] or m == "knot-removal"
         assert len(res.history) == (res.report["steps"] if m != "global"
                                     else res.report["n_moved"])
+
+
+def test_available_methods_respects_accepts():
+    """cheng-yu is defined for cubic B-splines only: listed for a cubic, not for a quintic,
+    and an explicit request on a quintic is refused with a CurvefairError naming the degree."""
+    import pytest
+
+    import curvefair as cf
+    from curvefair.fairing import available_methods
+
+    rng = np.random.default_rng(3)
+    x = np.linspace(0, 8, 30)
+    pts = np.c_[x, np.sin(x) + 0.03 * rng.normal(size=30)]
+    assert "cheng-yu" in available_methods(cf.interpolate_bspline(pts, degree=3))
+    quintic = cf.interpolate_bspline(pts, degree=5)
+    names = available_methods(quintic)
+    assert "cheng-yu" not in names and "eck-hadenfeld" in names
+    with pytest.raises(cf.CurvefairError, match="cubic|degree"):
+        cf.fair(quintic, "cheng-yu", tol=0.01)

@@ -824,6 +824,7 @@ def _register() -> None:
         name="cheng-yu",
         curve_types=(BSplineCurve,),
         driver=_fair_driver,
+        accepts=lambda c: c.degree == 3,
         summary="Cheng & Yu: move the worst bad control points (second discrete curvature) "
                 "towards the local E2 minimiser within the tolerance",
         source="Cheng & Yu, second discrete curvature: Definitions 1-2, bad points, eqs. (8)-(9) "

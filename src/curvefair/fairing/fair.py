@@ -147,6 +147,10 @@ class MethodSpec:
     modes : tuple of str
         Values of ``fair(mode=...)`` the method accepts. A method declaring more than the plain
         ``("spline",)`` receives ``mode=`` as a keyword.
+    accepts : callable or None
+        ``accepts(curve) -> bool``: a further condition on curves of ``curve_types`` (e.g.
+        cubic B-splines only); :func:`available_methods` lists the method for a curve only if
+        it holds. ``fair`` still calls the driver, which explains a refusal.
     """
 
     name: str
@@ -156,6 +160,7 @@ class MethodSpec:
     source: str
     default: bool = False
     modes: tuple[str, ...] = ("spline",)
+    accepts: Callable[[Any], bool] | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -197,7 +202,8 @@ def available_methods(curve: object = None) -> list[str]:
     """Names of the registered methods (those accepting ``curve``'s type, if given)."""
     if curve is None:
         return list(METHODS)
-    return [n for n, s in METHODS.items() if isinstance(curve, s.curve_types)]
+    return [n for n, s in METHODS.items() if isinstance(curve, s.curve_types)
+            and (s.accepts is None or s.accepts(curve))]
 
 
 # ----------------------------------------------------------------------------------------------
