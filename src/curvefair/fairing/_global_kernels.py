@@ -208,25 +208,17 @@ def assemble_cholesky(K, p, B, Q, rot, fix, L):  # type: ignore[no-untyped-def]
     N = n * dim
     kd = L.shape[1] - 1
     nxt = 0
-    for j in range(N):
-        if nxt < n and nxt * dim <= j + kd:
-            stop = min(n, nxt + 256)
-            _assemble_range(K, p, False, B, Q, rot, fix, L, nxt, stop)
-            nxt = stop
-        d = L[j, 0]
-        if not d > 0.0:
-            return j + 1
-        d = np.sqrt(d)
-        L[j, 0] = d
-        inv = 1.0 / d
-        kmax = min(kd, N - 1 - j)
-        for k in range(1, kmax + 1):
-            L[j, k] *= inv
-        for a in range(1, kmax + 1):
-            la = L[j, a]
-            if la != 0.0:
-                for b in range(a, kmax + 1):
-                    L[j + a, b - a] -= L[j, b] * la
+    j = 0
+    while j < N:
+        stop = min(n, nxt + 256)
+        _assemble_range(K, p, False, B, Q, rot, fix, L, nxt, stop)
+        nxt = stop
+        # columns whose updates reach only assembled rows
+        j1 = N if nxt == n else max(j, nxt * dim - kd)
+        info = _chol_cols(L, j, j1, N)
+        if info:
+            return info
+        j = j1
     return 0
 
 
@@ -259,18 +251,62 @@ def band_matvec(K, p, closed, x, out):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def band_cholesky(L, N):  # type: ignore[no-untyped-def]
-    """In-place Cholesky of the first ``N`` rows of the lower band ``L`` (entries reaching
-    beyond row ``N - 1`` are left alone). Returns 0, or ``j + 1`` if pivot ``j`` is not
-    positive (not positive definite in floating point)."""
+def _chol_cols(L, j0, j1, N):  # type: ignore[no-untyped-def]
+    """Elimination steps ``j0 .. j1 - 1`` of the band Cholesky of the first ``N`` rows (right
+    looking; the planar cubic band ``kd = 7`` written out). Returns 0 or ``j + 1`` for a
+    non-positive pivot ``j``."""
     kd = L.shape[1] - 1
-    for j in range(N):
+    for j in range(j0, j1):
         d = L[j, 0]
         if not d > 0.0:
             return j + 1
         d = np.sqrt(d)
         L[j, 0] = d
         inv = 1.0 / d
+        if kd == 7 and j + 7 < N:
+            l1 = L[j, 1] * inv
+            l2 = L[j, 2] * inv
+            l3 = L[j, 3] * inv
+            l4 = L[j, 4] * inv
+            l5 = L[j, 5] * inv
+            l6 = L[j, 6] * inv
+            l7 = L[j, 7] * inv
+            L[j, 1] = l1
+            L[j, 2] = l2
+            L[j, 3] = l3
+            L[j, 4] = l4
+            L[j, 5] = l5
+            L[j, 6] = l6
+            L[j, 7] = l7
+            L[j + 1, 0] -= l1 * l1
+            L[j + 1, 1] -= l2 * l1
+            L[j + 1, 2] -= l3 * l1
+            L[j + 1, 3] -= l4 * l1
+            L[j + 1, 4] -= l5 * l1
+            L[j + 1, 5] -= l6 * l1
+            L[j + 1, 6] -= l7 * l1
+            L[j + 2, 0] -= l2 * l2
+            L[j + 2, 1] -= l3 * l2
+            L[j + 2, 2] -= l4 * l2
+            L[j + 2, 3] -= l5 * l2
+            L[j + 2, 4] -= l6 * l2
+            L[j + 2, 5] -= l7 * l2
+            L[j + 3, 0] -= l3 * l3
+            L[j + 3, 1] -= l4 * l3
+            L[j + 3, 2] -= l5 * l3
+            L[j + 3, 3] -= l6 * l3
+            L[j + 3, 4] -= l7 * l3
+            L[j + 4, 0] -= l4 * l4
+            L[j + 4, 1] -= l5 * l4
+            L[j + 4, 2] -= l6 * l4
+            L[j + 4, 3] -= l7 * l4
+            L[j + 5, 0] -= l5 * l5
+            L[j + 5, 1] -= l6 * l5
+            L[j + 5, 2] -= l7 * l5
+            L[j + 6, 0] -= l6 * l6
+            L[j + 6, 1] -= l7 * l6
+            L[j + 7, 0] -= l7 * l7
+            continue
         kmax = min(kd, N - 1 - j)
         for k in range(1, kmax + 1):
             L[j, k] *= inv
@@ -283,17 +319,40 @@ def band_cholesky(L, N):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
+def band_cholesky(L, N):  # type: ignore[no-untyped-def]
+    """In-place Cholesky of the first ``N`` rows of the lower band ``L`` (entries reaching
+    beyond row ``N - 1`` are left alone). Returns 0, or ``j + 1`` if pivot ``j`` is not
+    positive (not positive definite in floating point)."""
+    return _chol_cols(L, 0, N, N)
+
+
+@njit(cache=True)
 def band_solve(L, N, x):  # type: ignore[no-untyped-def]
     """Solve ``L L^T y = x`` in place for the first ``N`` entries of ``x`` (1-D)."""
     kd = L.shape[1] - 1
     for j in range(N):
         v = x[j] / L[j, 0]
         x[j] = v
+        if kd == 7 and j + 7 < N:
+            x[j + 1] -= L[j, 1] * v
+            x[j + 2] -= L[j, 2] * v
+            x[j + 3] -= L[j, 3] * v
+            x[j + 4] -= L[j, 4] * v
+            x[j + 5] -= L[j, 5] * v
+            x[j + 6] -= L[j, 6] * v
+            x[j + 7] -= L[j, 7] * v
+            continue
         kmax = min(kd, N - 1 - j)
         if v != 0.0:
             for k in range(1, kmax + 1):
                 x[j + k] -= L[j, k] * v
     for i in range(N - 1, -1, -1):
+        if kd == 7 and i + 7 < N:
+            s = (x[i] - L[i, 1] * x[i + 1] - L[i, 2] * x[i + 2] - L[i, 3] * x[i + 3]
+                 - L[i, 4] * x[i + 4] - L[i, 5] * x[i + 5] - L[i, 6] * x[i + 6]
+                 - L[i, 7] * x[i + 7])
+            x[i] = s / L[i, 0]
+            continue
         s = x[i]
         kmax = min(kd, N - 1 - i)
         for k in range(1, kmax + 1):
