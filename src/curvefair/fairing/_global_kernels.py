@@ -811,3 +811,189 @@ def second_order(dv, free, t2, out):  # type: ignore[no-untyped-def]
             for a in range(dim):
                 acc += dv[i, a] * dv[i, a]
         out[i] = acc / (2.0 * t2)
+
+
+# ------------------------------------------------------------------------------------------
+# ADMM warm start (open curves): one factorisation of K + rho I (n x n, bandwidth p), shared
+# by the coordinates
+# ------------------------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def shift_cholesky(K, p, rho, L):  # type: ignore[no-untyped-def]
+    """Band Cholesky of ``K + rho I`` (open curve, ``L`` shape (n, p + 1), ``L[r, k] =
+    M[r + k, r]``), with the RECIPROCAL pivots stored in ``L[:, 0]`` (for
+    :func:`admm_sweep`). Returns 0 or ``j + 1`` for a non-positive pivot ``j``."""
+    n = K.shape[0]
+    for i in range(n):
+        for o in range(p + 1):
+            L[i, o] = K[i, p + o] if i + o < n else 0.0
+        L[i, 0] += rho
+    if p == 3:
+        for j in range(n):
+            d = L[j, 0]
+            if not d > 0.0:
+                return j + 1
+            d = np.sqrt(d)
+            inv = 1.0 / d
+            L[j, 0] = inv
+            if j + 3 < n:
+                l1 = L[j, 1] * inv
+                l2 = L[j, 2] * inv
+                l3 = L[j, 3] * inv
+                L[j, 1] = l1
+                L[j, 2] = l2
+                L[j, 3] = l3
+                L[j + 1, 0] -= l1 * l1
+                L[j + 1, 1] -= l2 * l1
+                L[j + 1, 2] -= l3 * l1
+                L[j + 2, 0] -= l2 * l2
+                L[j + 2, 1] -= l3 * l2
+                L[j + 3, 0] -= l3 * l3
+            else:
+                kmax = n - 1 - j
+                for k in range(1, kmax + 1):
+                    L[j, k] *= inv
+                for a in range(1, kmax + 1):
+                    la = L[j, a]
+                    for b in range(a, kmax + 1):
+                        L[j + a, b - a] -= L[j, b] * la
+        return 0
+    info = _chol_cols(L, 0, n, n)
+    for j in range(n):
+        L[j, 0] = 1.0 / L[j, 0]
+    return info
+
+
+@njit(cache=True)
+def admm_sweep(L, y, z, u, g0, rho, r2, alpha):  # type: ignore[no-untyped-def]
+    """One over-relaxed ADMM iteration for ``min g0.x + x.K x / 2`` s.t. ``|z_i|^2 <= r2_i``,
+    ``x = z`` (Boyd et al. 2011, sec. 3.4.3 / 5.1, scaled dual ``u``): on entry ``y`` holds
+    ``-g0 + rho (z - u)``; ``x = (K + rho I)^{-1} y`` (factor ``L`` of :func:`shift_cholesky`,
+    reciprocal pivots), ``xh = alpha x + (1 - alpha) z``, ``z = P(xh + u)``, ``u += xh - z``; on
+    exit ``y`` holds the next right-hand side. The point updates are done inside the backward
+    substitution (the last solved ``x_i`` kept in registers / a ring buffer), so every array is
+    streamed at most twice per iteration. Returns the squared norms of the primal residual
+    ``x - z`` and of the change of ``z``."""
+    n, dim = y.shape
+    kd = L.shape[1] - 1
+    if kd == 3 and dim == 2 and n > 3:
+        return _admm_sweep_c2(L, y, z, u, g0, rho, r2, alpha)
+    R = 8
+    while R < kd + 1:
+        R *= 2
+    msk = R - 1
+    xb = np.zeros((R, dim))
+    for j in range(n):
+        inv = L[j, 0]
+        kmax = min(kd, n - 1 - j)
+        for a in range(dim):
+            v = y[j, a] * inv
+            y[j, a] = v
+            for k in range(1, kmax + 1):
+                y[j + k, a] -= L[j, k] * v
+    rr = 0.0
+    dz = 0.0
+    xi = np.empty(dim)
+    w = np.empty(dim)
+    for i in range(n - 1, -1, -1):
+        kmax = min(kd, n - 1 - i)
+        inv = L[i, 0]
+        q2 = 0.0
+        for a in range(dim):
+            s = y[i, a]
+            for k in range(1, kmax + 1):
+                s -= L[i, k] * xb[(i + k) & msk, a]
+            x = s * inv
+            xb[i & msk, a] = x
+            xi[a] = x
+            wa = alpha * x + (1.0 - alpha) * z[i, a] + u[i, a]
+            w[a] = wa
+            q2 += wa * wa
+        f = 1.0
+        if q2 > r2[i]:
+            f = np.sqrt(r2[i] / q2) if r2[i] > 0.0 else 0.0
+        for a in range(dim):
+            zn = w[a] * f
+            un = w[a] - zn
+            e = xi[a] - zn
+            rr += e * e
+            e = zn - z[i, a]
+            dz += e * e
+            z[i, a] = zn
+            u[i, a] = un
+            y[i, a] = -g0[i, a] + rho * (zn - un)
+    return rr, dz
+
+
+@njit(cache=True)
+def _admm_sweep_c2(L, y, z, u, g0, rho, r2, alpha):  # type: ignore[no-untyped-def]
+    """:func:`admm_sweep` for planar cubics (``p = 3``, ``dim = 2``), written out: left-looking
+    forward and backward substitutions with the last three unknowns in registers."""
+    n = y.shape[0]
+    # forward: v_j = (y_j - L[j-1,1] v_{j-1} - L[j-2,2] v_{j-2} - L[j-3,3] v_{j-3}) / L_jj
+    a1 = 0.0
+    a2 = 0.0
+    a3 = 0.0
+    b1 = 0.0
+    b2 = 0.0
+    b3 = 0.0
+    for j in range(n):
+        c1 = L[j - 1, 1] if j >= 1 else 0.0
+        c2 = L[j - 2, 2] if j >= 2 else 0.0
+        c3 = L[j - 3, 3] if j >= 3 else 0.0
+        inv = L[j, 0]
+        va = (y[j, 0] - c1 * a1 - c2 * a2 - c3 * a3) * inv
+        vb = (y[j, 1] - c1 * b1 - c2 * b2 - c3 * b3) * inv
+        y[j, 0] = va
+        y[j, 1] = vb
+        a3 = a2
+        a2 = a1
+        a1 = va
+        b3 = b2
+        b2 = b1
+        b1 = vb
+    rr = 0.0
+    dz = 0.0
+    a1 = 0.0
+    a2 = 0.0
+    a3 = 0.0
+    b1 = 0.0
+    b2 = 0.0
+    b3 = 0.0
+    beta = 1.0 - alpha
+    for i in range(n - 1, -1, -1):
+        l1 = L[i, 1]
+        l2 = L[i, 2]
+        l3 = L[i, 3]
+        inv = L[i, 0]
+        xa = (y[i, 0] - l1 * a1 - l2 * a2 - l3 * a3) * inv
+        xb = (y[i, 1] - l1 * b1 - l2 * b2 - l3 * b3) * inv
+        a3 = a2
+        a2 = a1
+        a1 = xa
+        b3 = b2
+        b2 = b1
+        b1 = xb
+        za = z[i, 0]
+        zb = z[i, 1]
+        wa = alpha * xa + beta * za + u[i, 0]
+        wb = alpha * xb + beta * zb + u[i, 1]
+        q2 = wa * wa + wb * wb
+        ri = r2[i]
+        f = 1.0
+        if q2 > ri:
+            f = np.sqrt(ri / q2) if ri > 0.0 else 0.0
+        zna = wa * f
+        znb = wb * f
+        una = wa - zna
+        unb = wb - znb
+        rr += (xa - zna) ** 2 + (xb - znb) ** 2
+        dz += (zna - za) ** 2 + (znb - zb) ** 2
+        z[i, 0] = zna
+        z[i, 1] = znb
+        u[i, 0] = una
+        u[i, 1] = unb
+        y[i, 0] = rho * (zna - una) - g0[i, 0]
+        y[i, 1] = rho * (znb - unb) - g0[i, 1]
+    return rr, dz

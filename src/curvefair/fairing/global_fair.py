@@ -384,6 +384,16 @@ def _solve_balls(system: _System, g0: FloatArray, free: np.ndarray, tol: float, 
     if gscale == 0.0:  # already stationary: the input is optimal
         return np.zeros_like(g0), np.zeros(n), 0, "converged"
     eye = np.broadcast_to(np.eye(dim), (n, dim, dim))
+    steps = 1
+    if _ADMM_ITERS > 0 and not closed and n > 2 * p + 2 and max_steps > 1:
+        # 0. ADMM warm start (one n x n band factorisation), then the active-set Newton
+        start = _admm_start(K, p, g0, free, tol)
+        if start is not None:
+            res = _active_set_newton(system, g0, free, tol, start[0], start[1], start[2],
+                                     gscale, min(_ADMM_SSN_MAXIT, max_steps - 1))
+            steps += res[2]
+            if res[3]:
+                return res[0], res[1], steps, "converged"
     # 1. start: smoothing solve (K + mu0 I) v = -g0, pulled inside the balls (|v| <= tol / 2)
     mu0 = 0.01 * float(K[free, p].mean())
     v = np.zeros_like(g0)
@@ -398,7 +408,6 @@ def _solve_balls(system: _System, g0: FloatArray, free: np.ndarray, tol: float, 
     with np.errstate(divide="ignore", invalid="ignore"):
         lam = np.where(vv > 0, -np.sum(g * v, axis=1) * t2 / vv, 0.0)
     lam = np.where(free, np.maximum(lam, lam_floor), 0.0)
-    steps = 1
     may_switch = True
     rd = np.empty_like(v)
     rhs = np.empty_like(v)
@@ -456,6 +465,59 @@ def _solve_balls(system: _System, g0: FloatArray, free: np.ndarray, tol: float, 
 
 _SWITCH_GAP = 1e-5
 _RETRACT = True
+_ADMM_ITERS = 40  # 0: no ADMM warm start
+_ADMM_ADAPT = 10
+_ADMM_RHO0 = 0.03
+_ADMM_ALPHA = 1.6
+_ADMM_SSN_MAXIT = 15
+
+
+def _admm_start(K: FloatArray, p: int, g0: FloatArray, free: np.ndarray, tol: float
+                ) -> tuple[FloatArray, FloatArray, float] | None:
+    """Approximate solution ``(v, lambda, kappa)`` of the ball-constrained QP (open curves)
+    by over-relaxed ADMM (Boyd et al. 2011, sec. 5.1): every iteration is one banded solve with
+    the single ``n x n`` factor of ``K + rho I`` (the coordinates share it) and a projection
+    onto the balls. ``rho`` starts at ``_ADMM_RHO0`` times the median diagonal of ``K`` and is
+    reset every ``_ADMM_ADAPT`` iterations to the median curvature ``lambda_i / tol^2`` of the
+    projected points (the scale at which the splitting converges fastest). None if the
+    factorisation fails."""
+    n, dim = g0.shape
+    t2 = tol * tol
+    r2 = np.where(free, t2, 0.0)
+    rho = _ADMM_RHO0 * float(np.median(K[free, p]))
+    if not rho > 0.0:
+        return None
+    L = np.empty((n, p + 1))
+    if _k.shift_cholesky(K, p, rho, L):
+        return None
+    z = np.zeros_like(g0)
+    u = np.zeros_like(g0)
+    y = -g0
+    for it in range(1, _ADMM_ITERS + 1):
+        _k.admm_sweep(L, y, z, u, g0, rho, r2, _ADMM_ALPHA)
+        if it % _ADMM_ADAPT == 0 and it < _ADMM_ITERS:
+            un = np.sqrt(np.einsum("ij,ij->i", u, u))
+            act = free & (un > 0.0)
+            if act.any():
+                new = float(np.median(un[act])) * rho / tol
+                new = min(max(new, 0.1 * rho), 10.0 * rho)
+                if new != rho:
+                    u *= rho / new
+                    rho = new
+                    if _k.shift_cholesky(K, p, rho, L):
+                        return None
+                    y = rho * (z - u)
+                    y -= g0
+    zz = np.einsum("ij,ij->i", z, z)
+    uz = np.einsum("ij,ij->i", u, z)
+    lam = np.zeros(n)
+    on = free & (zz > 0.0)
+    lam[on] = np.maximum(rho * t2 * uz[on] / zz[on], 0.0)
+    s = 0.5 * (1.0 - zz[free] / t2)
+    kappa = float(lam[free].mean()) / max(float(s.mean()), 1e-3)
+    if not kappa > 0.0:
+        kappa = rho * t2
+    return z, lam, kappa
 
 
 def _matvec(K: FloatArray, p: int, closed: bool, x: FloatArray) -> FloatArray:
