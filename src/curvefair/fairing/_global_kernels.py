@@ -330,34 +330,79 @@ def band_cholesky(L, N):  # type: ignore[no-untyped-def]
 def band_solve(L, N, x):  # type: ignore[no-untyped-def]
     """Solve ``L L^T y = x`` in place for the first ``N`` entries of ``x`` (1-D)."""
     kd = L.shape[1] - 1
+    if kd == 7 and N > 7:
+        _band_solve7(L, N, x)
+        return
     for j in range(N):
         v = x[j] / L[j, 0]
         x[j] = v
-        if kd == 7 and j + 7 < N:
-            x[j + 1] -= L[j, 1] * v
-            x[j + 2] -= L[j, 2] * v
-            x[j + 3] -= L[j, 3] * v
-            x[j + 4] -= L[j, 4] * v
-            x[j + 5] -= L[j, 5] * v
-            x[j + 6] -= L[j, 6] * v
-            x[j + 7] -= L[j, 7] * v
-            continue
         kmax = min(kd, N - 1 - j)
         if v != 0.0:
             for k in range(1, kmax + 1):
                 x[j + k] -= L[j, k] * v
     for i in range(N - 1, -1, -1):
-        if kd == 7 and i + 7 < N:
-            s = (x[i] - L[i, 1] * x[i + 1] - L[i, 2] * x[i + 2] - L[i, 3] * x[i + 3]
-                 - L[i, 4] * x[i + 4] - L[i, 5] * x[i + 5] - L[i, 6] * x[i + 6]
-                 - L[i, 7] * x[i + 7])
-            x[i] = s / L[i, 0]
-            continue
         s = x[i]
         kmax = min(kd, N - 1 - i)
         for k in range(1, kmax + 1):
             s -= L[i, k] * x[i + k]
         x[i] = s / L[i, 0]
+
+
+@njit(cache=True)
+def _band_solve7(L, N, x):  # type: ignore[no-untyped-def]
+    """:func:`band_solve` for ``kd = 7`` (planar cubics), ``N > 7``: left-looking substitutions
+    with the last seven unknowns in registers, the newest subtracted last (one multiply-add and
+    one multiply by the reciprocal pivot on the recurrence)."""
+    for j in range(7):
+        s = x[j]
+        for k in range(1, j + 1):
+            s -= L[j - k, k] * x[j - k]
+        x[j] = s / L[j, 0]
+    x1 = x[6]
+    x2 = x[5]
+    x3 = x[4]
+    x4 = x[3]
+    x5 = x[2]
+    x6 = x[1]
+    x7 = x[0]
+    for j in range(7, N):
+        r = 1.0 / L[j, 0]
+        s = (x[j] - L[j - 7, 7] * x7 - L[j - 6, 6] * x6 - L[j - 5, 5] * x5 - L[j - 4, 4] * x4
+             - L[j - 3, 3] * x3 - L[j - 2, 2] * x2)
+        v = (s - L[j - 1, 1] * x1) * r
+        x[j] = v
+        x7 = x6
+        x6 = x5
+        x5 = x4
+        x4 = x3
+        x3 = x2
+        x2 = x1
+        x1 = v
+    for i in range(N - 1, N - 8, -1):
+        s = x[i]
+        for k in range(1, N - i):
+            s -= L[i, k] * x[i + k]
+        x[i] = s / L[i, 0]
+    x1 = x[N - 7]
+    x2 = x[N - 6]
+    x3 = x[N - 5]
+    x4 = x[N - 4]
+    x5 = x[N - 3]
+    x6 = x[N - 2]
+    x7 = x[N - 1]
+    for i in range(N - 8, -1, -1):
+        r = 1.0 / L[i, 0]
+        s = (x[i] - L[i, 7] * x7 - L[i, 6] * x6 - L[i, 5] * x5 - L[i, 4] * x4 - L[i, 3] * x3
+             - L[i, 2] * x2)
+        v = (s - L[i, 1] * x1) * r
+        x[i] = v
+        x7 = x6
+        x6 = x5
+        x5 = x4
+        x4 = x3
+        x3 = x2
+        x2 = x1
+        x1 = v
 
 
 # ------------------------------------------------------------------------------------------
@@ -928,23 +973,41 @@ def admm_sweep(L, y, z, u, g0, rho, r2, alpha):  # type: ignore[no-untyped-def]
 
 @njit(cache=True)
 def _admm_sweep_c2(L, y, z, u, g0, rho, r2, alpha):  # type: ignore[no-untyped-def]
-    """:func:`admm_sweep` for planar cubics (``p = 3``, ``dim = 2``), written out: left-looking
-    forward and backward substitutions with the last three unknowns in registers."""
+    """:func:`admm_sweep` for planar cubics (``p = 3``, ``dim = 2``, ``n > 3``), written out:
+    left-looking forward and backward substitutions with the last three unknowns in registers
+    (the newest one subtracted last: one multiply-add on the recurrence), branch-free
+    projection."""
     n = y.shape[0]
-    # forward: v_j = (y_j - L[j-1,1] v_{j-1} - L[j-2,2] v_{j-2} - L[j-3,3] v_{j-3}) / L_jj
-    a1 = 0.0
-    a2 = 0.0
-    a3 = 0.0
-    b1 = 0.0
-    b2 = 0.0
-    b3 = 0.0
-    for j in range(n):
-        c1 = L[j - 1, 1] if j >= 1 else 0.0
-        c2 = L[j - 2, 2] if j >= 2 else 0.0
-        c3 = L[j - 3, 3] if j >= 3 else 0.0
+    # forward: v_j = (y_j - L[j-3,3] v_{j-3} - L[j-2,2] v_{j-2} - L[j-1,1] v_{j-1}) / L_jj
+    a1 = y[0, 0] * L[0, 0]
+    b1 = y[0, 1] * L[0, 0]
+    y[0, 0] = a1
+    y[0, 1] = b1
+    a2 = a1
+    b2 = b1
+    a1 = (y[1, 0] - L[0, 1] * a2) * L[1, 0]
+    b1 = (y[1, 1] - L[0, 1] * b2) * L[1, 0]
+    y[1, 0] = a1
+    y[1, 1] = b1
+    a3 = a2
+    b3 = b2
+    a2 = a1
+    b2 = b1
+    a1 = (y[2, 0] - L[0, 2] * a3 - L[1, 1] * a2) * L[2, 0]
+    b1 = (y[2, 1] - L[0, 2] * b3 - L[1, 1] * b2) * L[2, 0]
+    y[2, 0] = a1
+    y[2, 1] = b1
+    for j in range(3, n):
+        c1 = L[j - 1, 1]
+        c2 = L[j - 2, 2]
+        c3 = L[j - 3, 3]
         inv = L[j, 0]
-        va = (y[j, 0] - c1 * a1 - c2 * a2 - c3 * a3) * inv
-        vb = (y[j, 1] - c1 * b1 - c2 * b2 - c3 * b3) * inv
+        ta = y[j, 0] - c3 * a3
+        tb = y[j, 1] - c3 * b3
+        ta -= c2 * a2
+        tb -= c2 * b2
+        va = (ta - c1 * a1) * inv
+        vb = (tb - c1 * b1) * inv
         y[j, 0] = va
         y[j, 1] = vb
         a3 = a2
@@ -963,12 +1026,13 @@ def _admm_sweep_c2(L, y, z, u, g0, rho, r2, alpha):  # type: ignore[no-untyped-d
     b3 = 0.0
     beta = 1.0 - alpha
     for i in range(n - 1, -1, -1):
-        l1 = L[i, 1]
-        l2 = L[i, 2]
-        l3 = L[i, 3]
+        ta = y[i, 0] - L[i, 3] * a3
+        tb = y[i, 1] - L[i, 3] * b3
+        ta -= L[i, 2] * a2
+        tb -= L[i, 2] * b2
         inv = L[i, 0]
-        xa = (y[i, 0] - l1 * a1 - l2 * a2 - l3 * a3) * inv
-        xb = (y[i, 1] - l1 * b1 - l2 * b2 - l3 * b3) * inv
+        xa = (ta - L[i, 1] * a1) * inv
+        xb = (tb - L[i, 1] * b1) * inv
         a3 = a2
         a2 = a1
         a1 = xa
@@ -979,11 +1043,9 @@ def _admm_sweep_c2(L, y, z, u, g0, rho, r2, alpha):  # type: ignore[no-untyped-d
         zb = z[i, 1]
         wa = alpha * xa + beta * za + u[i, 0]
         wb = alpha * xb + beta * zb + u[i, 1]
-        q2 = wa * wa + wb * wb
         ri = r2[i]
-        f = 1.0
-        if q2 > ri:
-            f = np.sqrt(ri / q2) if ri > 0.0 else 0.0
+        den = max(wa * wa + wb * wb, ri)
+        f = np.sqrt(ri / den) if den > 0.0 else 1.0
         zna = wa * f
         znb = wb * f
         una = wa - zna
