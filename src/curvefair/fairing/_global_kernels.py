@@ -1059,3 +1059,132 @@ def _admm_sweep_c2(L, y, z, u, g0, rho, r2, alpha):  # type: ignore[no-untyped-d
         y[i, 0] = rho * (zna - una) - g0[i, 0]
         y[i, 1] = rho * (znb - unb) - g0[i, 1]
     return rr, dz
+
+
+# ------------------------------------------------------------------------------------------
+# per-point bookkeeping
+# ------------------------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def finish_points(d0, v, free, rmax, ract, x, act):  # type: ignore[no-untyped-def]
+    """``x = d0 + v`` with every free point pulled inside radius ``rmax`` so that the ROUNDED
+    ``fl(x_i - d0_i)`` is within ``rmax`` too (fixed points: ``x = d0``); ``act[i]``: the final
+    displacement is longer than ``ract``."""
+    n, dim = d0.shape
+    for i in range(n):
+        if not free[i]:
+            for a in range(dim):
+                x[i, a] = d0[i, a]
+            act[i] = False
+            continue
+        vv = 0.0
+        for a in range(dim):
+            vv += v[i, a] * v[i, a]
+        dist = np.sqrt(vv)
+        f = rmax / dist if dist > rmax else 1.0
+        for a in range(dim):
+            x[i, a] = d0[i, a] + v[i, a] * f
+        dist = 0.0
+        for _ in range(8):  # o + v rounds: shrink until fl(x - o) is inside
+            ww = 0.0
+            for a in range(dim):
+                w = x[i, a] - d0[i, a]
+                ww += w * w
+            dist = np.sqrt(ww)
+            if not dist > rmax:
+                break
+            f = rmax / dist * (1.0 - 2.0**-40)
+            for a in range(dim):
+                x[i, a] = d0[i, a] + (x[i, a] - d0[i, a]) * f
+        act[i] = dist > ract
+
+
+@njit(cache=True)
+def set_frames(nrm, rot, Q, fix, fix0):  # type: ignore[no-untyped-def]
+    """``fix = fix0`` plus the first axis of the ``rot`` points; ``Q_i`` the orthonormal frame
+    whose first column is the unit ``nrm_i`` at the ``rot`` points (2-D: the tangent is ``nrm``
+    turned by 90 degrees; 3-D: Duff et al. 2017, "Building an orthonormal basis, revisited"),
+    the same as ``global_fair._frames``."""
+    n, dim = nrm.shape
+    for i in range(n):
+        for a in range(dim):
+            fix[i, a] = fix0[i, a]
+        if not rot[i]:
+            continue
+        fix[i, 0] = True
+        if dim == 2:
+            Q[i, 0, 0] = nrm[i, 0]
+            Q[i, 1, 0] = nrm[i, 1]
+            Q[i, 0, 1] = -nrm[i, 1]
+            Q[i, 1, 1] = nrm[i, 0]
+        else:
+            x = nrm[i, 0]
+            y = nrm[i, 1]
+            z = nrm[i, 2]
+            sgn = 1.0 if z >= 0.0 else -1.0
+            a_ = -1.0 / (sgn + z)
+            b = x * y * a_
+            Q[i, 0, 0] = x
+            Q[i, 1, 0] = y
+            Q[i, 2, 0] = z
+            Q[i, 0, 1] = 1.0 + sgn * x * x * a_
+            Q[i, 1, 1] = sgn * b
+            Q[i, 2, 1] = -sgn * x
+            Q[i, 0, 2] = b
+            Q[i, 1, 2] = sgn + y * y * a_
+            Q[i, 2, 2] = -y
+
+
+@njit(cache=True)
+def admm_active_norms(u, free, out):  # type: ignore[no-untyped-def]
+    """``|u_i|`` of the free points with ``u_i != 0`` (the projected ones) packed into ``out``;
+    returns their number."""
+    n, dim = u.shape
+    m = 0
+    for i in range(n):
+        if free[i]:
+            uu = 0.0
+            for a in range(dim):
+                uu += u[i, a] * u[i, a]
+            if uu > 0.0:
+                out[m] = np.sqrt(uu)
+                m += 1
+    return m
+
+
+@njit(cache=True)
+def admm_rescale(z, u, g0, f, rho, y):  # type: ignore[no-untyped-def]
+    """``u *= f`` (new ``rho`` = old / ``f``) and ``y = rho (z - u) - g0``."""
+    n, dim = z.shape
+    for i in range(n):
+        for a in range(dim):
+            u[i, a] *= f
+            y[i, a] = rho * (z[i, a] - u[i, a]) - g0[i, a]
+
+
+@njit(cache=True)
+def admm_multipliers(z, u, free, rho, t2, lam):  # type: ignore[no-untyped-def]
+    """``lam_i = max(rho t2 (u_i . z_i) / |z_i|^2, 0)`` at the free points with ``z_i != 0``
+    (from ``g0 + K z + rho u = 0`` and ``g0 + K z + lam z / t2 = 0``), 0 elsewhere; returns the
+    sums over the free points of ``lam`` and of the slack ``(1 - |z|^2 / t2) / 2``, and their
+    number."""
+    n, dim = z.shape
+    sl = 0.0
+    ss = 0.0
+    m = 0
+    for i in range(n):
+        lam[i] = 0.0
+        if not free[i]:
+            continue
+        zz = 0.0
+        uz = 0.0
+        for a in range(dim):
+            zz += z[i, a] * z[i, a]
+            uz += u[i, a] * z[i, a]
+        if zz > 0.0:
+            lam[i] = max(rho * t2 * uz / zz, 0.0)
+        sl += lam[i]
+        ss += 0.5 * (1.0 - zz / t2)
+        m += 1
+    return sl, ss, m

@@ -173,14 +173,13 @@ class _System:
         axis is ``nrm`` and that axis fixed (a prescribed normal displacement). False if the
         matrix is not positive definite in floating point."""
         self.B = B
-        self.fix[:] = self.fix0
         self.anyrot = rot is not None and bool(rot.any())
         if not self.anyrot:
+            self.fix[:] = self.fix0
             self.rot[:] = False
         else:
             self.rot[:] = rot
-            self.Q[rot] = _frames(nrm[rot])
-            self.fix[rot, 0] = True
+            _k.set_frames(nrm, rot, self.Q, self.fix, self.fix0)
         if self.dense:
             M = self.Kd + _blockdiag(B)
             Qf = _blockdiag(np.where(self.rot[:, None, None], self.Q,
@@ -391,25 +390,12 @@ def _global_fair(curve: BSplineCurve, tol: float | None, l: Any,  # noqa: E741
     # strict feasibility in floating point, with a rounding margin (active points end on
     # their sphere): every fl(x_i - o_i) and the evaluated curve stay within tol
     margin = min(1e-9 * tolv, 1e-13 * tolv + 4.0 * np.finfo(float).eps * float(np.abs(d0).max()))
-    rmax = tolv - margin
-    dist = np.sqrt(np.sum(v * v, axis=1))
-    over = mask & (dist > rmax)
-    v[over] *= (rmax / dist[over])[:, None]
-    x = d0 + v
-    x[~mask] = d0[~mask]
-    for _ in range(8):  # o + v rounds: shrink until fl(x - o) is inside
-        w_ = x - d0
-        dist = np.sqrt(np.sum(w_ * w_, axis=1))
-        bad = mask & (dist > rmax)
-        if not bad.any():
-            break
-        x[bad] = d0[bad] + w_[bad] * (rmax / dist[bad] * (1.0 - 2.0**-40))[:, None]
-    v = x - d0
-    t2 = tolv * tolv
-    lam[mask] = E0 * lam_[mask] / t2  # 2 (G d)_i + lam_i (d_i - o_i) = 0
+    x = np.empty_like(d0)
+    act = np.empty(n, dtype=np.bool_)
+    _k.finish_points(d0, v, mask, tolv - margin, (1 - 1e-6) * tolv, x, act)
+    lam[mask] = E0 * lam_[mask] / (tolv * tolv)  # 2 (G d)_i + lam_i (d_i - o_i) = 0
     out = curve.replace(control_points=x)
-    dist = np.sqrt(np.sum(v * v, axis=1))
-    active = free[dist[free] > (1 - 1e-6) * tolv]
+    active = np.flatnonzero(act)
     return GlobalResult(out, E0, energy(x), lam, steps, reason, active)
 
 
@@ -539,28 +525,22 @@ def _admm_start(K: FloatArray, p: int, g0: FloatArray, free: np.ndarray, tol: fl
     z = np.zeros_like(g0)
     u = np.zeros_like(g0)
     y = -g0
+    un = np.empty(n)
     for it in range(1, _ADMM_ITERS + 1):
         _k.admm_sweep(L, y, z, u, g0, rho, r2, _ADMM_ALPHA)
         if it % _ADMM_ADAPT == 0 and it < _ADMM_ITERS:
-            un = np.sqrt(np.einsum("ij,ij->i", u, u))
-            act = free & (un > 0.0)
-            if act.any():
-                new = float(np.median(un[act])) * rho / tol
+            m = _k.admm_active_norms(u, free, un)
+            if m:
+                new = float(np.median(un[:m])) * rho / tol
                 new = min(max(new, 0.1 * rho), 10.0 * rho)
                 if new != rho:
-                    u *= rho / new
-                    rho = new
+                    rho_old, rho = rho, new
                     if _k.shift_cholesky(K, p, rho, L):
                         return None
-                    y = rho * (z - u)
-                    y -= g0
-    zz = np.einsum("ij,ij->i", z, z)
-    uz = np.einsum("ij,ij->i", u, z)
-    lam = np.zeros(n)
-    on = free & (zz > 0.0)
-    lam[on] = np.maximum(rho * t2 * uz[on] / zz[on], 0.0)
-    s = 0.5 * (1.0 - zz[free] / t2)
-    kappa = float(lam[free].mean()) / max(float(s.mean()), 1e-3)
+                    _k.admm_rescale(z, u, g0, rho_old / rho, rho, y)
+    lam = np.empty(n)
+    sl, ss, m = _k.admm_multipliers(z, u, free, rho, t2, lam)
+    kappa = (sl / m) / max(ss / m, 1e-3)
     if not kappa > 0.0:
         kappa = rho * t2
     return z, lam, kappa
