@@ -44,8 +44,7 @@ def prepare(c: BSplineCurve):
     X[:, 4:6] = c.control_points
     mask = eh.movable_mask(c, ("g2", "g2"))
     z = np.where(mask, 0.0, -1.0)
-    Wu, pat = eh.band_patterns(W)
-    return X, z, Wu, pat, np.ascontiguousarray(W), mask
+    return X, z, eh.band_patterns(W), np.ascontiguousarray(W), mask
 
 
 @njit(cache=True)

@@ -283,60 +283,72 @@ def _candidate(g0, g1, g2, d0, d1, d2, o0, o1, o2, gii, igii, tol):  # type: ign
     return gii * (s0 * s0 + s1 * s1 + s2 * s2), s0, s1, s2
 
 
-_BLOCK_SHIFT = 4  # 16 control points per leaf block of the tournament tree
+_BLOCK_SHIFT = 3  # 8 control points (one 64-byte line of z) per leaf of the tournament tree
 _SPECULATE_BYTES = 1 << 22  # prefetch the runner-up's data when the state exceeds ~4 MB
+_RUNNER_UP_LEVELS = 6  # the runner-up is sought among the siblings of the top 6 tree levels
+_PREFETCH_LEVELS = 8  # tree nodes prefetched on the runner-up's path (from its leaf up)
 
 
 @njit(cache=True, error_model="numpy")
-def _eh_loop(X, z, Wu, pat, p, closed, tol, eps_abs, max_steps,
+def _eh_loop(X, z, Wu, pat, upat, ulo, uhi, D, p, closed, tol, eps_abs, max_steps,
              hist):  # type: ignore[no-untyped-def]
     """Ranking-list loop, compiled; updates ``X`` and ``z`` in place.
 
-    ``X[i] = (d_i, g_i, orig_i)``, ``dim`` columns each (``X`` has ``3 dim`` columns),
+    ``X[i] = (d_i, g_i, orig_i)``, ``D`` columns each (``X`` has ``3 D`` columns),
     ``g = G d``; ``z[i]`` the ranking number (-1: never moves); ``G``'s band row ``i`` is
-    ``Wu[pat[i]]`` (rows shared by equal knot patterns, e.g. every interior row of a uniform
-    curve). Everything is written out in this one function: calling numba functions with array
-    arguments costs reference counting per call, which dominated an earlier version.
+    ``Wu[pat[i]]`` (rows shared by equal knot patterns), and every row ``ulo <= i < uhi`` is
+    ``Wu[upat]`` (the longest run of one pattern: the uniform interior, whose ``pat`` entries are
+    then never read). Everything is written out in this one function: calling numba functions
+    with array arguments costs reference counting per call, which dominated an earlier version.
 
-    Tournament tree over blocks of 16 control points: a leaf holds its block's largest ``z`` and
-    the index; node ``j`` holds the larger of ``2j``, ``2j + 1`` (ties to the smaller index).
-    After a move, the ``2p + 1`` changed ``z`` are recomputed (planar curves: branch-free, both
-    the free and the tolerance-clamped candidate are evaluated and selected, which avoids
-    unpredictable branches; the values are bitwise those of :func:`_candidate`), their one or
-    two blocks rescanned and the ancestors repaired level by level as a contiguous range:
-    ``O(p + log N)`` per step. On large curves the step is bound by memory latency (the next
-    point is usually far away); the data of the runner-up (the best sibling on the winner's
-    path, which is the next point whenever this move does not change its rank: 99.8 % of the
-    far jumps on noisy data) are then prefetched one step ahead, as long as far jumps are
-    frequent (a running share above 1/4; the slow tail of a fairing run moves locally).
+    Tournament tree over blocks of 8 control points, one array ``T`` of (value, index) pairs
+    (the index stored as a float, exact below 2**53; one cache line holds a node and its
+    sibling): a leaf holds its block's largest ``z`` and the index, node ``j`` the larger of
+    ``2j``, ``2j + 1`` (ties to the smaller index, hence to the smaller control point). After a
+    move, the ``2p + 1`` changed ``z`` are recomputed (planar curves: branch-free, both the free
+    and the tolerance-clamped candidate are evaluated and selected, which avoids unpredictable
+    branches; the values are bitwise those of :func:`_candidate`), their one or two blocks
+    rescanned and the ancestors repaired level by level as a contiguous range:
+    ``O(p + log N)`` per step.
+
+    On large curves the step is bound by memory latency (the next point is usually far away).
+    The data of the runner-up (which is the next point whenever this move does not change its
+    rank: on noisy data every far jump) are then prefetched one step ahead, as long as far jumps
+    are frequent (a running share above 1/4; the slow tail of a fairing run moves locally): its
+    band rows, ranking numbers and the lower levels of its tree path. The runner-up is sought
+    among the siblings of the top levels of the winner's path only (hot in the cache; walking the
+    whole path cost more than the prefetch saved), which finds it unless it shares the winner's
+    subtree 6 levels down. Prefetches never change results.
 
     ``hist`` (shape (cap, 3)) receives (index, z, displacement) of the first ``cap`` steps.
     Returns (steps, total energy drop, stop code, number of history rows).
     """
     n = X.shape[0]
     C = X.shape[1]
-    D = C // 3
     B = 1 << _BLOCK_SHIFT
     nb = (n + B - 1) >> _BLOCK_SHIFT
     P = 1
     while P < nb:
         P *= 2
-    tv = np.full(2 * P, -1.0)
-    ti = np.zeros(2 * P, dtype=np.int64)
+    T = np.empty((2 * P, 2))
+    for j in range(2 * P):
+        T[j, 0] = -1.0
+        T[j, 1] = 0.0
     tolf = tol if tol < np.inf else 0.0
     tol2 = tol * tol
     any_movable = False
     for i in range(n):
         if z[i] >= 0.0:
             any_movable = True
+            pi = upat if ulo <= i < uhi else pat[i]
             if D == 3:
                 z[i] = _candidate(X[i, 3], X[i, 4], X[i, 5], X[i, 0], X[i, 1], X[i, 2],
-                                  X[i, 6], X[i, 7], X[i, 8], Wu[pat[i], p],
-                                  Wu[pat[i], 2 * p + 1], tol)[0]
+                                  X[i, 6], X[i, 7], X[i, 8], Wu[pi, p],
+                                  Wu[pi, 2 * p + 1], tol)[0]
             else:
                 z[i] = _candidate(X[i, 2], X[i, 3], 0.0, X[i, 0], X[i, 1], 0.0,
-                                  X[i, 4], X[i, 5], 0.0, Wu[pat[i], p],
-                                  Wu[pat[i], 2 * p + 1], tol)[0]
+                                  X[i, 4], X[i, 5], 0.0, Wu[pi, p],
+                                  Wu[pi, 2 * p + 1], tol)[0]
     if not any_movable:
         return 0, 0.0, 2, 0
     for b in range(nb):
@@ -345,13 +357,14 @@ def _eh_loop(X, z, Wu, pat, p, closed, tol, eps_abs, max_steps,
         for k in range(k0 + 1, min(k0 + B, n)):
             if z[k] > z[best]:
                 best = k
-        tv[P + b] = z[best]
-        ti[P + b] = best
+        T[P + b, 0] = z[best]
+        T[P + b, 1] = best
     for j in range(P - 1, 0, -1):
         c = 2 * j
-        c += tv[c + 1] > tv[c]
-        tv[j] = tv[c]
-        ti[j] = ti[c]
+        c += T[c + 1, 0] > T[c, 0]
+        T[j, 0] = T[c, 0]
+        T[j, 1] = T[c, 1]
+    top = 1 << _RUNNER_UP_LEVELS
     steps = 0
     drop = 0.0
     code = 1
@@ -361,8 +374,8 @@ def _eh_loop(X, z, Wu, pat, p, closed, tol, eps_abs, max_steps,
     farrate = 0.0  # running share of far jumps (> 16 points from the previous step)
     prev = -(1 << 40)
     while steps < max_steps:
-        r = ti[1]
-        zr = tv[1]
+        r = int(T[1, 1])
+        zr = T[1, 0]
         if zr <= 0.0 or zr < eps_abs:
             code = 0
             break
@@ -370,33 +383,39 @@ def _eh_loop(X, z, Wu, pat, p, closed, tol, eps_abs, max_steps,
         prev = r
         if big and farrate > 0.25:
             j = P + (r >> _BLOCK_SHIFT)
+            while j >= top:
+                j >>= 1
             bz = -2.0
-            bi = r
+            bf = float(r)
             while j > 1:
                 sb = j ^ 1
-                if tv[sb] > bz:
-                    bz = tv[sb]
-                    bi = ti[sb]
+                if T[sb, 0] > bz:
+                    bz = T[sb, 0]
+                    bf = T[sb, 1]
                 j >>= 1
+            bi = int(bf)
             q0 = bi - p if bi >= p else 0
             for q in range(q0 * C, (q0 + 2 * p + 1) * C, 8):
                 prefetch(X, q)
+            prefetch(X, (q0 + 2 * p + 1) * C - 1)
             prefetch(z, q0)
-            prefetch(pat, q0)
-            prefetch(tv, P + (bi >> _BLOCK_SHIFT))
-            prefetch(ti, P + (bi >> _BLOCK_SHIFT))
+            prefetch(z, q0 + 2 * p)
+            j = P + (bi >> _BLOCK_SHIFT)
+            for _ in range(_PREFETCH_LEVELS):
+                prefetch(T, 2 * j)
+                j >>= 1
+        pr = upat if ulo <= r < uhi else pat[r]
         if D == 3:
             zz, e0, e1, e2 = _candidate(X[r, 3], X[r, 4], X[r, 5], X[r, 0], X[r, 1], X[r, 2],
-                                        X[r, 6], X[r, 7], X[r, 8], Wu[pat[r], p],
-                                        Wu[pat[r], 2 * p + 1], tol)
+                                        X[r, 6], X[r, 7], X[r, 8], Wu[pr, p],
+                                        Wu[pr, 2 * p + 1], tol)
             X[r, 2] += e2
         else:
             zz, e0, e1, e2 = _candidate(X[r, 2], X[r, 3], 0.0, X[r, 0], X[r, 1], 0.0,
-                                        X[r, 4], X[r, 5], 0.0, Wu[pat[r], p],
-                                        Wu[pat[r], 2 * p + 1], tol)
+                                        X[r, 4], X[r, 5], 0.0, Wu[pr, p],
+                                        Wu[pr, 2 * p + 1], tol)
         X[r, 0] += e0
         X[r, 1] += e1
-        pr = pat[r]
         for c in range(2 * p + 1):
             i = r + c - p
             if closed:
@@ -436,16 +455,18 @@ def _eh_loop(X, z, Wu, pat, p, closed, tol, eps_abs, max_steps,
             hi = hi1 if rng == 0 else hi2
             if hi < lo:
                 continue
+            inside = ulo <= lo and hi < uhi  # one pattern: no pat reads
             if D == 3:
                 for i in range(lo, hi + 1):
                     if z[i] < 0.0:
                         continue
+                    pi = upat if inside else pat[i]
                     z[i] = _candidate(X[i, 3], X[i, 4], X[i, 5], X[i, 0], X[i, 1], X[i, 2],
-                                      X[i, 6], X[i, 7], X[i, 8], Wu[pat[i], p],
-                                      Wu[pat[i], 2 * p + 1], tol)[0]
+                                      X[i, 6], X[i, 7], X[i, 8], Wu[pi, p],
+                                      Wu[pi, 2 * p + 1], tol)[0]
             elif tol2 == np.inf:
                 for i in range(lo, hi + 1):
-                    pi = pat[i]
+                    pi = upat if inside else pat[i]
                     gii = Wu[pi, p]
                     igii = Wu[pi, 2 * p + 1]
                     a0 = abs(X[i, 0])
@@ -461,7 +482,7 @@ def _eh_loop(X, z, Wu, pat, p, closed, tol, eps_abs, max_steps,
                     z[i] = zo if zo < 0.0 else zn
             else:
                 for i in range(lo, hi + 1):
-                    pi = pat[i]
+                    pi = upat if inside else pat[i]
                     gii = Wu[pi, p]
                     igii = Wu[pi, 2 * p + 1]
                     d0 = X[i, 0]
@@ -501,16 +522,16 @@ def _eh_loop(X, z, Wu, pat, p, closed, tol, eps_abs, max_steps,
                     gt = zk > zb
                     best = k if gt else best
                     zb = zk if gt else zb
-                tv[P + b] = zb
-                ti[P + b] = best
+                T[P + b, 0] = zb
+                T[P + b, 1] = best
             a = (P + blo) >> 1
             bb = (P + bhi) >> 1
             while a >= 1:
                 for j in range(a, bb + 1):
                     c = 2 * j
-                    c += tv[c + 1] > tv[c]  # branch-free select, ties to the left
-                    tv[j] = tv[c]
-                    ti[j] = ti[c]
+                    c += T[c + 1, 0] > T[c, 0]  # branch-free select, ties to the left
+                    T[j, 0] = T[c, 0]
+                    T[j, 1] = T[c, 1]
                 a >>= 1
                 bb >>= 1
         drop += zr
@@ -523,19 +544,57 @@ def _eh_loop(X, z, Wu, pat, p, closed, tol, eps_abs, max_steps,
     return steps, drop, code, nh
 
 
-def band_patterns(W: FloatArray) -> tuple[FloatArray, np.ndarray]:
+@njit(cache=True)
+def _patterns(W, Wu, pat):  # type: ignore[no-untyped-def]
+    """Fill ``pat`` and the distinct rows ``Wu`` (see :func:`band_patterns`); returns
+    ``(number of patterns, pattern of the longest run, its start, its end)``."""
+    n, w = W.shape
+    m = 0
+    run0 = 0
+    best = -1
+    blo = 0
+    bhi = 0
+    for i in range(n):
+        new = i == 0
+        if not new:
+            for c in range(w):
+                if W[i, c] != W[i - 1, c]:
+                    new = True
+                    break
+        if new:
+            if i > 0 and i - run0 > bhi - blo:
+                best, blo, bhi = m - 1, run0, i
+            for c in range(w):
+                Wu[m, c] = W[i, c]
+            Wu[m, w] = 1.0 / W[i, w // 2]
+            m += 1
+            run0 = i
+        pat[i] = m - 1
+    if n - run0 > bhi - blo:
+        best, blo, bhi = m - 1, run0, n
+    return m, best, blo, bhi
+
+
+def band_patterns(W: FloatArray) -> tuple[FloatArray, np.ndarray, int, int, int]:
     """Compress a band ``W`` into distinct rows ``Wu`` and ``pat`` with ``W[i] == Wu[pat[i]]``.
 
     Consecutive equal rows share one entry (uniform knots: a handful of rows in all). ``Wu``
-    has one more column: ``1 / G_ii``."""
+    has one more column: ``1 / G_ii``. Also returns the longest run of one pattern
+    ``(upat, ulo, uhi)``: ``pat[ulo:uhi] == upat``."""
     n, w = W.shape
-    new = np.ones(n, dtype=bool)
-    new[1:] = np.any(W[1:] != W[:-1], axis=1)
-    pat = (np.cumsum(new) - 1).astype(np.int64)
-    Wu = np.empty((int(new.sum()), w + 1))
-    Wu[:, :w] = W[new]
-    Wu[:, w] = 1.0 / Wu[:, w // 2]
-    return Wu, pat
+    Wu = np.empty((n, w + 1))
+    pat = np.empty(n, dtype=np.int32)
+    m, upat, ulo, uhi = _patterns(np.ascontiguousarray(W), Wu, pat)
+    return Wu[:m].copy(), pat, int(upat), int(ulo), int(uhi)
+
+
+def _aligned_empty(shape: tuple[int, ...]) -> FloatArray:
+    """``np.empty(shape)`` starting on a 64-byte cache line (the ranking-list loop's blocks of
+    8 ranking numbers are then exactly one line each)."""
+    size = int(np.prod(shape))
+    buf = np.empty(size + 8)
+    off = (-buf.ctypes.data % 64) // 8
+    return buf[off:off + size].reshape(shape)
 
 
 def default_eps(n: int) -> float:
@@ -642,24 +701,27 @@ def eck_hadenfeld_fair(curve: BSplineCurve, *, l: int = 2, tol: float | None = N
     epsv = (default_eps(n) if eps_relative else 0.0) if eps is None else as_nonnegative(eps, "eps")
     max_steps = as_step_count(max_steps, default=100 * n)
     mask = movable_mask(curve, clamp, protect)
-    W = curve.gram_band(lv)
+    W = np.ascontiguousarray(curve.gram_band(lv))
     dim = curve.dim
-    X = np.zeros((n, 3 * dim))
-    X[:, :dim] = curve.control_points
-    X[:, dim:2 * dim] = _residual(curve, W)
-    X[:, 2 * dim:] = curve.control_points
-    e0 = _energy(curve, W)
+    d = np.ascontiguousarray(curve.control_points)
+    X = _aligned_empty((n, 3 * dim))
+    X[:, :dim] = d
+    band_residual(W, curve.degree, curve.closed, d, X[:, dim:2 * dim])  # g = G d
+    X[:, 2 * dim:] = d
+    e0 = float(band_energy(W, curve.degree, curve.closed, d))
     eps_abs = epsv * e0 if eps_relative else epsv
     hist = np.zeros((int(min(max(history_max, 0), max_steps)), 3))
-    z = np.where(mask, 0.0, -1.0)
-    Wu, pat = band_patterns(W)
-    steps, drop, code, nh = _eh_loop(X, z, Wu, pat, curve.degree, curve.closed, tolv,
-                                     eps_abs, int(max_steps), hist)
+    z = _aligned_empty((n,))
+    z[:] = -1.0
+    z[mask] = 0.0
+    Wu, pat, upat, ulo, uhi = band_patterns(W)
+    steps, drop, code, nh = _eh_loop(X, z, Wu, pat, upat, ulo, uhi, dim, curve.degree,
+                                     curve.closed, tolv, eps_abs, int(max_steps), hist)
     out = curve.replace(control_points=X[:, :dim])
-    g = _residual(out, W)
     e1 = _energy(out, W)
     reason = STOP_REASONS[int(code)]
     if reason == "converged":
+        g = _residual(out, W)
         free = np.sum(g * g, axis=1) / W[:, curve.degree]
         zfree = float(free[mask].max()) if mask.any() else 0.0
         if zfree > eps_abs and zfree > 0.0:
