@@ -911,19 +911,38 @@ def shift_cholesky(K, p, rho, L):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def admm_sweep(L, y, z, u, g0, rho, r2, alpha):  # type: ignore[no-untyped-def]
+def admm_scale3(L, F):  # type: ignore[no-untyped-def]
+    """For :func:`admm_sweep` with ``p = 3``: from the factor of :func:`shift_cholesky` (reciprocal
+    pivots ``r_j``), ``F[j, 0] = r_j``, ``F[j, k] = L[j - k, k] r_j`` (forward substitution)
+    and ``L[i, k] *= r_i`` (backward substitution), so that each substitution step is
+    ``x_j = r_j y_j - sum_k F[j, k] x_{j-k}`` (one multiply-add on the recurrence)."""
+    n = L.shape[0]
+    for j in range(n):
+        r = L[j, 0]
+        F[j, 0] = r
+        for k in range(1, 4):
+            F[j, k] = L[j - k, k] * r if j >= k else 0.0
+    for i in range(n):
+        r = L[i, 0]
+        for k in range(1, 4):
+            L[i, k] *= r
+
+
+@njit(cache=True)
+def admm_sweep(L, F, y, z, u, g0, rho, r2, alpha):  # type: ignore[no-untyped-def]
     """One over-relaxed ADMM iteration for ``min g0.x + x.K x / 2`` s.t. ``|z_i|^2 <= r2_i``,
     ``x = z`` (Boyd et al. 2011, sec. 3.4.3 / 5.1, scaled dual ``u``): on entry ``y`` holds
     ``-g0 + rho (z - u)``; ``x = (K + rho I)^{-1} y`` (factor ``L`` of :func:`shift_cholesky`,
-    reciprocal pivots), ``xh = alpha x + (1 - alpha) z``, ``z = P(xh + u)``, ``u += xh - z``; on
-    exit ``y`` holds the next right-hand side. The point updates are done inside the backward
+    reciprocal pivots; ``p = 3``: scaled by :func:`admm_scale3` into ``L, F``; otherwise ``F`` is
+    unused), ``xh = alpha x + (1 - alpha) z``, ``z = P(xh + u)``, ``u += xh - z``; on exit ``y``
+    holds the next right-hand side. The point updates are done inside the backward
     substitution (the last solved ``x_i`` kept in registers / a ring buffer), so every array is
     streamed at most twice per iteration. Returns the squared norms of the primal residual
     ``x - z`` and of the change of ``z``."""
     n, dim = y.shape
     kd = L.shape[1] - 1
-    if kd == 3 and dim == 2 and n > 3:
-        return _admm_sweep_c2(L, y, z, u, g0, rho, r2, alpha)
+    if kd == 3:
+        return _admm_sweep3(L, F, y, z, u, g0, rho, r2, alpha)
     R = 8
     while R < kd + 1:
         R *= 2
@@ -972,42 +991,57 @@ def admm_sweep(L, y, z, u, g0, rho, r2, alpha):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def _admm_sweep_c2(L, y, z, u, g0, rho, r2, alpha):  # type: ignore[no-untyped-def]
-    """:func:`admm_sweep` for planar cubics (``p = 3``, ``dim = 2``, ``n > 3``), written out:
-    left-looking forward and backward substitutions with the last three unknowns in registers
-    (the newest one subtracted last: one multiply-add on the recurrence), branch-free
-    projection."""
-    n = y.shape[0]
-    # forward: v_j = (y_j - L[j-3,3] v_{j-3} - L[j-2,2] v_{j-2} - L[j-1,1] v_{j-1}) / L_jj
-    a1 = y[0, 0] * L[0, 0]
-    b1 = y[0, 1] * L[0, 0]
-    y[0, 0] = a1
-    y[0, 1] = b1
-    a2 = a1
-    b2 = b1
-    a1 = (y[1, 0] - L[0, 1] * a2) * L[1, 0]
-    b1 = (y[1, 1] - L[0, 1] * b2) * L[1, 0]
-    y[1, 0] = a1
-    y[1, 1] = b1
-    a3 = a2
-    b3 = b2
-    a2 = a1
-    b2 = b1
-    a1 = (y[2, 0] - L[0, 2] * a3 - L[1, 1] * a2) * L[2, 0]
-    b1 = (y[2, 1] - L[0, 2] * b3 - L[1, 1] * b2) * L[2, 0]
-    y[2, 0] = a1
-    y[2, 1] = b1
-    for j in range(3, n):
-        c1 = L[j - 1, 1]
-        c2 = L[j - 2, 2]
-        c3 = L[j - 3, 3]
-        inv = L[j, 0]
-        ta = y[j, 0] - c3 * a3
-        tb = y[j, 1] - c3 * b3
-        ta -= c2 * a2
-        tb -= c2 * b2
-        va = (ta - c1 * a1) * inv
-        vb = (tb - c1 * b1) * inv
+def _admm_sweep3(L, F, y, z, u, g0, rho, r2, alpha):  # type: ignore[no-untyped-def]
+    """:func:`admm_sweep` for cubics (``p = 3``; planar written out): substitutions with the last
+    three unknowns in registers, pre-scaled factors (one multiply-add on the recurrence, the
+    newest unknown subtracted last), branch-free projection."""
+    n, dim = y.shape
+    if dim != 2:
+        xs = np.zeros((n + 3, dim))  # x_{j-3} .. x_{j-1} at xs[j .. j + 2]
+        for j in range(n):
+            for a in range(dim):
+                xs[j + 3, a] = (F[j, 0] * y[j, a] - F[j, 3] * xs[j, a] - F[j, 2] * xs[j + 1, a]
+                                - F[j, 1] * xs[j + 2, a])
+        for j in range(n):
+            for a in range(dim):
+                y[j, a] = xs[j + 3, a]
+        xb = np.zeros((n + 3, dim))  # x_{i+1} .. x_{i+3} at xb[i + 1 .. i + 3]
+        rr = 0.0
+        dz = 0.0
+        w = np.empty(dim)
+        for i in range(n - 1, -1, -1):
+            q2 = 0.0
+            for a in range(dim):
+                x = (L[i, 0] * y[i, a] - L[i, 3] * xb[i + 3, a] - L[i, 2] * xb[i + 2, a]
+                     - L[i, 1] * xb[i + 1, a])
+                xb[i, a] = x
+                wa = alpha * x + (1.0 - alpha) * z[i, a] + u[i, a]
+                w[a] = wa
+                q2 += wa * wa
+            ri = r2[i]
+            den = max(q2, ri)
+            f = np.sqrt(ri / den) if den > 0.0 else 1.0
+            for a in range(dim):
+                zn = w[a] * f
+                un = w[a] - zn
+                rr += (xb[i, a] - zn) ** 2
+                dz += (zn - z[i, a]) ** 2
+                z[i, a] = zn
+                u[i, a] = un
+                y[i, a] = rho * (zn - un) - g0[i, a]
+        return rr, dz
+    a1 = 0.0
+    a2 = 0.0
+    a3 = 0.0
+    b1 = 0.0
+    b2 = 0.0
+    b3 = 0.0
+    for j in range(n):
+        ta = F[j, 0] * y[j, 0] - F[j, 3] * a3 - F[j, 2] * a2
+        tb = F[j, 0] * y[j, 1] - F[j, 3] * b3 - F[j, 2] * b2
+        c1 = F[j, 1]
+        va = ta - c1 * a1
+        vb = tb - c1 * b1
         y[j, 0] = va
         y[j, 1] = vb
         a3 = a2
@@ -1026,13 +1060,12 @@ def _admm_sweep_c2(L, y, z, u, g0, rho, r2, alpha):  # type: ignore[no-untyped-d
     b3 = 0.0
     beta = 1.0 - alpha
     for i in range(n - 1, -1, -1):
-        ta = y[i, 0] - L[i, 3] * a3
-        tb = y[i, 1] - L[i, 3] * b3
-        ta -= L[i, 2] * a2
-        tb -= L[i, 2] * b2
-        inv = L[i, 0]
-        xa = (ta - L[i, 1] * a1) * inv
-        xb = (tb - L[i, 1] * b1) * inv
+        r = L[i, 0]
+        ta = r * y[i, 0] - L[i, 3] * a3 - L[i, 2] * a2
+        tb = r * y[i, 1] - L[i, 3] * b3 - L[i, 2] * b2
+        l1 = L[i, 1]
+        xa = ta - l1 * a1
+        xb = tb - l1 * b1
         a3 = a2
         a2 = a1
         a1 = xa

@@ -520,14 +520,23 @@ def _admm_start(K: FloatArray, p: int, g0: FloatArray, free: np.ndarray, tol: fl
     if not rho > 0.0:
         return None
     L = np.empty((n, p + 1))
-    if _k.shift_cholesky(K, p, rho, L):
+    F = np.empty((n, p + 1) if p == 3 else (1, 1))
+
+    def factor(rho: float) -> bool:
+        if _k.shift_cholesky(K, p, rho, L):
+            return False
+        if p == 3:
+            _k.admm_scale3(L, F)
+        return True
+
+    if not factor(rho):
         return None
     z = np.zeros_like(g0)
     u = np.zeros_like(g0)
     y = -g0
     un = np.empty(n)
     for it in range(1, _ADMM_ITERS + 1):
-        _k.admm_sweep(L, y, z, u, g0, rho, r2, _ADMM_ALPHA)
+        _k.admm_sweep(L, F, y, z, u, g0, rho, r2, _ADMM_ALPHA)
         if it % _ADMM_ADAPT == 0 and it < _ADMM_ITERS:
             m = _k.admm_active_norms(u, free, un)
             if m:
@@ -535,7 +544,7 @@ def _admm_start(K: FloatArray, p: int, g0: FloatArray, free: np.ndarray, tol: fl
                 new = min(max(new, 0.1 * rho), 10.0 * rho)
                 if new != rho:
                     rho_old, rho = rho, new
-                    if _k.shift_cholesky(K, p, rho, L):
+                    if not factor(rho):
                         return None
                     _k.admm_rescale(z, u, g0, rho_old / rho, rho, y)
     lam = np.empty(n)
