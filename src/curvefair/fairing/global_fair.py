@@ -502,6 +502,7 @@ _ADMM_ADAPT = 10
 _ADMM_RHO0 = 0.03
 _ADMM_ALPHA = 1.6
 _ADMM_SSN_MAXIT = 15
+_CHORD_RATE = 1e-2
 
 
 def _admm_start(K: FloatArray, p: int, g0: FloatArray, free: np.ndarray, tol: float
@@ -581,6 +582,9 @@ def _active_set_newton(system: _System, g0: FloatArray, free: np.ndarray, tol: f
     c = np.empty(n)
     dv = np.empty_like(v)
     kdv = np.empty_like(v)
+    S_fac = np.zeros(n, dtype=np.bool_)  # active set of the current factorisation
+    have_fac = False
+    stat_prev = np.inf
     for it in range(maxit + 1):
         rdm, feas, fS = _k.ssn_eval(g0, K, p, closed, v, lam, free, t2, kappa, S, rd, f, rho)
         stat = rdm / gscale
@@ -591,8 +595,17 @@ def _active_set_newton(system: _System, g0: FloatArray, free: np.ndarray, tol: f
         if it == maxit or feas > 1.0:  # feas > 1: a point went past sqrt(3) tol, diverging
             break
         _k.ssn_prepare(v, rho, f, S, lam, t2, delta, B, nrm, c)
-        if not system.factor(B, rot=S, nrm=nrm):
-            return v, lam, it, False
+        # in the fast (quadratic) phase with an unchanged active set the matrix has changed
+        # only by the last, small step (frames, multipliers): reuse its factorisation (an
+        # inexact Newton step; the next step refactorises unless it too reduced the residual
+        # by _CHORD_RATE)
+        chord = have_fac and stat <= _CHORD_RATE * stat_prev and np.array_equal(S, S_fac)
+        stat_prev = stat
+        if not chord:
+            if not system.factor(B, rot=S, nrm=nrm):
+                return v, lam, it, False
+            S_fac[:] = S
+            have_fac = True
         rd *= -1.0
         system.solve(rd, c, out=dv)
         rd *= -1.0
