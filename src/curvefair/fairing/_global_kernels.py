@@ -520,8 +520,8 @@ def cyclic_solve_full(L, Y, S, x):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def prep_rhs(K, p, closed, B, Q, rot, fix, fix0, rhs, c, out):  # type: ignore[no-untyped-def]
-    """``out = Q^T (rhs - (kron(K, I) + B) z)`` with ``z_i = c_i Q_i[:, 0]`` at the ``rot``
+def prep_rhs(K, p, closed, B, Q, rot, fix, fix0, rhs, c, out, sgn=1.0):  # type: ignore[no-untyped-def]
+    """``out = Q^T (sgn rhs - (kron(K, I) + B) z)`` with ``z_i = c_i Q_i[:, 0]`` at the ``rot``
     points (their prescribed normal displacement), fixed unknowns set to their values (``c_i``
     for the normal of a ``rot`` point, 0 at fixed points)."""
     n, dim = rhs.shape
@@ -532,7 +532,7 @@ def prep_rhs(K, p, closed, B, Q, rot, fix, fix0, rhs, c, out):  # type: ignore[n
             break
     for i in range(n):
         for a in range(dim):
-            out[i, a] = rhs[i, a]
+            out[i, a] = sgn * rhs[i, a]
     if anyrot:
         for i in range(n):
             for o in range(-p, p + 1):
@@ -736,113 +736,6 @@ def ip_update(v, dv, lam, dl, st):  # type: ignore[no-untyped-def]
         for a in range(dim):
             v[i, a] += st * dv[i, a]
         lam[i] += st * dl[i]
-
-
-# ------------------------------------------------------------------------------------------
-# active-set (semismooth) Newton per-point work
-# ------------------------------------------------------------------------------------------
-
-
-@njit(cache=True)
-def ssn_eval(g0, K, p, closed, v, lam, free, t2, kappa, S, rd, f, rho):  # type: ignore[no-untyped-def]
-    """Active set ``S = free & (lam + kappa f > 0) & (v != 0)``; ``lam`` clipped to
-    ``max(lam, 0)`` on ``S`` and 0 elsewhere; ``rd = g0 + K v + lam v / t2``. Returns
-    ``(max |rd|, max f over free, max |f| over S)``."""
-    n, dim = v.shape
-    rdm = 0.0
-    fm = -np.inf
-    fsm = 0.0
-    for i in range(n):
-        vv = 0.0
-        for a in range(dim):
-            vv += v[i, a] * v[i, a]
-        r = np.sqrt(vv)
-        fi = 0.5 * (vv / t2 - 1.0)
-        rho[i] = r
-        f[i] = fi
-        if not free[i]:
-            S[i] = False
-            lam[i] = 0.0
-            for a in range(dim):
-                rd[i, a] = 0.0
-            continue
-        act = lam[i] + kappa * fi > 0.0 and r > 0.0
-        S[i] = act
-        if act:
-            if lam[i] < 0.0:
-                lam[i] = 0.0
-            if abs(fi) > fsm:
-                fsm = abs(fi)
-        else:
-            lam[i] = 0.0
-        if fi > fm:
-            fm = fi
-        li = lam[i]
-        interior = i >= p and i + p < n
-        for a in range(dim):
-            acc = 0.0
-            if interior:
-                for o in range(-p, p + 1):
-                    acc += K[i, p + o] * v[i + o, a]
-            else:
-                for o in range(-p, p + 1):
-                    j = i + o
-                    if j < 0 or j >= n:
-                        if not closed:
-                            continue
-                        j = j + n if j < 0 else j - n
-                    acc += K[i, p + o] * v[j, a]
-            x = g0[i, a] + acc + li * (v[i, a] / t2)
-            rd[i, a] = x
-            if abs(x) > rdm:
-                rdm = abs(x)
-    return rdm, fm, fsm
-
-
-@njit(cache=True)
-def ssn_prepare(v, rho, f, S, lam, t2, delta, B, nrm, c):  # type: ignore[no-untyped-def]
-    """Blocks ``(lam_i / t2 + delta) I``, unit normals and prescribed normal displacements
-    ``c_i = -f_i t2 / rho_i`` (the linearised sphere) at the active points."""
-    n, dim = v.shape
-    for i in range(n):
-        iso = lam[i] / t2 + delta
-        for a in range(dim):
-            for b in range(dim):
-                B[i, a, b] = iso if a == b else 0.0
-        if S[i]:
-            for a in range(dim):
-                nrm[i, a] = v[i, a] / rho[i]
-            c[i] = -f[i] * t2 / rho[i]
-        else:
-            for a in range(dim):
-                nrm[i, a] = 0.0
-            c[i] = 0.0
-
-
-@njit(cache=True)
-def ssn_update(v, dv, rd, kdv, lam, S, nrm, rho, t2, retract):  # type: ignore[no-untyped-def]
-    """Multiplier step from the normal component of the stationarity equation, then
-    ``v += dv``; with ``retract`` the active points are put back on their sphere (the
-    tangent-plane step overshoots radially by ``|dv_t|^2 / (2 tol)``)."""
-    n, dim = v.shape
-    tol = np.sqrt(t2)
-    for i in range(n):
-        if S[i]:
-            acc = 0.0
-            li = lam[i] / t2
-            for a in range(dim):
-                acc += nrm[i, a] * (rd[i, a] + kdv[i, a] + li * dv[i, a])
-            lam[i] = lam[i] - acc * t2 / rho[i]
-        else:
-            lam[i] = 0.0
-        vv = 0.0
-        for a in range(dim):
-            v[i, a] += dv[i, a]
-            vv += v[i, a] * v[i, a]
-        if retract and S[i] and vv > 0.0:
-            f = tol / np.sqrt(vv)
-            for a in range(dim):
-                v[i, a] *= f
 
 
 @njit(cache=True)
@@ -1221,3 +1114,150 @@ def admm_multipliers(z, u, free, rho, t2, lam):  # type: ignore[no-untyped-def]
         ss += 0.5 * (1.0 - zz / t2)
         m += 1
     return sl, ss, m
+
+
+# ------------------------------------------------------------------------------------------
+# active-set (semismooth) Newton per-point work
+# ------------------------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def ssn_eval_prep(g0, K, p, closed, v, lam, free, t2, kappa, delta, S, rd, f, rho,  # type: ignore[no-untyped-def]
+                  B, nrm, c, Q, fix, fix0):
+    """Semismooth Newton per-point work, one pass: active set ``S = free & (lam + kappa f > 0) &
+    (v != 0)`` (``f = (|v|^2 / t2 - 1) / 2``); ``lam`` clipped to ``max(lam, 0)`` on ``S`` and 0
+    elsewhere; ``rd = g0 + K v + lam v / t2``; blocks ``B = (lam / t2 + delta) I``; at the
+    active points the unit normals ``nrm``, the prescribed normal displacements ``c = -f t2 /
+    |v|`` (the linearised sphere), their frames ``Q`` (as :func:`set_frames`) and ``fix = fix0``
+    plus the normal axis. Returns ``(max |rd|, max f over free, max |f| over S, |S|)``."""
+    n, dim = v.shape
+    rdm = 0.0
+    fm = -np.inf
+    fsm = 0.0
+    ns = 0
+    for i in range(n):
+        vv = 0.0
+        for a in range(dim):
+            vv += v[i, a] * v[i, a]
+        r = np.sqrt(vv)
+        fi = 0.5 * (vv / t2 - 1.0)
+        rho[i] = r
+        f[i] = fi
+        for a in range(dim):
+            fix[i, a] = fix0[i, a]
+        if not free[i]:
+            S[i] = False
+            lam[i] = 0.0
+            for a in range(dim):
+                rd[i, a] = 0.0
+        else:
+            act = lam[i] + kappa * fi > 0.0 and r > 0.0
+            S[i] = act
+            if act:
+                ns += 1
+                if lam[i] < 0.0:
+                    lam[i] = 0.0
+                if abs(fi) > fsm:
+                    fsm = abs(fi)
+            else:
+                lam[i] = 0.0
+            if fi > fm:
+                fm = fi
+            li = lam[i]
+            interior = i >= p and i + p < n
+            for a in range(dim):
+                acc = 0.0
+                if interior:
+                    for o in range(-p, p + 1):
+                        acc += K[i, p + o] * v[i + o, a]
+                else:
+                    for o in range(-p, p + 1):
+                        j = i + o
+                        if j < 0 or j >= n:
+                            if not closed:
+                                continue
+                            j = j + n if j < 0 else j - n
+                        acc += K[i, p + o] * v[j, a]
+                x = g0[i, a] + acc + li * (v[i, a] / t2)
+                rd[i, a] = x
+                if abs(x) > rdm:
+                    rdm = abs(x)
+        iso = lam[i] / t2 + delta
+        for a in range(dim):
+            for b in range(dim):
+                B[i, a, b] = iso if a == b else 0.0
+        if S[i]:
+            for a in range(dim):
+                nrm[i, a] = v[i, a] / r
+            c[i] = -fi * t2 / r
+            fix[i, 0] = True
+            if dim == 2:
+                Q[i, 0, 0] = nrm[i, 0]
+                Q[i, 1, 0] = nrm[i, 1]
+                Q[i, 0, 1] = -nrm[i, 1]
+                Q[i, 1, 1] = nrm[i, 0]
+            else:
+                x0 = nrm[i, 0]
+                y0 = nrm[i, 1]
+                z0 = nrm[i, 2]
+                sgn = 1.0 if z0 >= 0.0 else -1.0
+                a_ = -1.0 / (sgn + z0)
+                b_ = x0 * y0 * a_
+                Q[i, 0, 0] = x0
+                Q[i, 1, 0] = y0
+                Q[i, 2, 0] = z0
+                Q[i, 0, 1] = 1.0 + sgn * x0 * x0 * a_
+                Q[i, 1, 1] = sgn * b_
+                Q[i, 2, 1] = -sgn * x0
+                Q[i, 0, 2] = b_
+                Q[i, 1, 2] = sgn + y0 * y0 * a_
+                Q[i, 2, 2] = -y0
+        else:
+            for a in range(dim):
+                nrm[i, a] = 0.0
+            c[i] = 0.0
+    return rdm, fm, fsm, ns
+
+
+@njit(cache=True)
+def ssn_update_k(K, p, closed, v, dv, rd, lam, S, nrm, rho, t2, retract):  # type: ignore[no-untyped-def]
+    """Semismooth Newton update: the multipliers of the active points from the normal component
+    of the stationarity equation (``K dv`` computed on the fly), then ``v += dv``; with
+    ``retract`` the active points are put back on their sphere (the tangent-plane step
+    overshoots radially by ``|dv_t|^2 / (2 tol)``)."""
+    n, dim = v.shape
+    tol = np.sqrt(t2)
+    kdv = np.empty(dim)
+    for i in range(n):
+        interior = i >= p and i + p < n
+        for a in range(dim):
+            acc = 0.0
+            if interior:
+                for o in range(-p, p + 1):
+                    acc += K[i, p + o] * dv[i + o, a]
+            else:
+                for o in range(-p, p + 1):
+                    j = i + o
+                    if j < 0 or j >= n:
+                        if not closed:
+                            continue
+                        j = j + n if j < 0 else j - n
+                    acc += K[i, p + o] * dv[j, a]
+            kdv[a] = acc
+        if S[i]:
+            acc = 0.0
+            li = lam[i] / t2
+            for a in range(dim):
+                acc += nrm[i, a] * (rd[i, a] + kdv[a] + li * dv[i, a])
+            lam[i] = lam[i] - acc * t2 / rho[i]
+        else:
+            lam[i] = 0.0
+    for i in range(n):
+        vv = 0.0
+        for a in range(dim):
+            v[i, a] += dv[i, a]
+            vv += v[i, a] * v[i, a]
+        if retract and S[i] and vv > 0.0:
+            f = tol / np.sqrt(vv)
+            for a in range(dim):
+                v[i, a] *= f

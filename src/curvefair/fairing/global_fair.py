@@ -90,9 +90,9 @@ def _small_pages() -> Iterator[None]:
     ``transparent_hugepage/defrag = madvise`` the first touch of such an array can stall on
     memory compaction. The work arrays here (the band factor alone has ``n dim^2 (p + 1)``
     doubles: 128 MB for a planar cubic with 1e6 points) are allocated once per call and
-    streamed a few times, so ordinary pages are cheaper: measured at 1e6 points, 2.75 s -> 2.0 s for a cold call, the first touch of the
-    128 MB factor 0.36 s -> 0.10 s. Only speed is affected; the previous setting is restored
-    (re-entrant, thread-safe)."""
+    streamed a few times, so ordinary pages are cheaper: measured at 1e6 points, a cold call
+    2.75 s -> 2.0 s, the first touch of the 128 MB factor 0.36 s -> 0.10 s. Only speed is
+    affected; the previous setting is restored (re-entrant, thread-safe)."""
     get = getattr(_np_ma, "_get_madvise_hugepage", None)
     put = getattr(_np_ma, "_set_madvise_hugepage", None)
     if get is None or put is None:
@@ -168,13 +168,20 @@ class _System:
         self.czero = np.zeros(n)
 
     def factor(self, B: FloatArray, rot: np.ndarray | None = None,
-               nrm: FloatArray | None = None) -> bool:
+               nrm: FloatArray | None = None, nrot: int | None = None) -> bool:
         """Factorise for blocks ``B`` (n, dim, dim); points ``rot`` get the frame whose first
-        axis is ``nrm`` and that axis fixed (a prescribed normal displacement). False if the
-        matrix is not positive definite in floating point."""
+        axis is ``nrm`` and that axis fixed (a prescribed normal displacement). ``nrot``: the
+        caller has already written ``self.rot``, ``self.Q`` and ``self.fix`` for ``nrot``
+        such points (:func:`._global_kernels.ssn_eval_prep`). False if the matrix is not
+        positive definite in floating point."""
         self.B = B
-        self.anyrot = rot is not None and bool(rot.any())
-        if not self.anyrot:
+        if nrot is not None:
+            self.anyrot = nrot > 0
+        else:
+            self.anyrot = rot is not None and bool(rot.any())
+        if nrot is not None:
+            pass
+        elif not self.anyrot:
             self.fix[:] = self.fix0
             self.rot[:] = False
         else:
@@ -202,15 +209,17 @@ class _System:
         return info == 0
 
     def solve(self, rhs: FloatArray, c: FloatArray | None = None,
-              out: FloatArray | None = None) -> FloatArray:
-        """Displacement ``dx`` (n, dim): ``M dx = rhs`` on the unfixed unknowns, ``dx = 0`` at
-        fixed points, ``nrm_i . dx_i = c_i`` at the ``rot`` points."""
+              out: FloatArray | None = None, sgn: float = 1.0) -> FloatArray:
+        """Displacement ``dx`` (n, dim): ``M dx = sgn rhs`` on the unfixed unknowns, ``dx = 0``
+        at fixed points, ``nrm_i . dx_i = c_i`` at the ``rot`` points."""
         y = np.empty_like(rhs) if out is None else out
         if self.anyrot:
             _k.prep_rhs(self.K, self.p, self.closed, self.B, self.Q, self.rot, self.fix,
-                        self.fix0, rhs, self.czero if c is None else c, y)
+                        self.fix0, rhs, self.czero if c is None else c, y, sgn)
         else:
-            if y is not rhs:
+            if sgn != 1.0:
+                np.multiply(rhs, sgn, out=y)
+            elif y is not rhs:
                 y[:] = rhs
             y[self.fixed_points] = 0.0
         b = y.reshape(-1)
@@ -573,7 +582,7 @@ def _active_set_newton(system: _System, g0: FloatArray, free: np.ndarray, tol: f
     delta = 1e-14 * float(np.abs(K[:, p]).max())
     v = v.copy()
     lam = lam.copy()
-    S = np.empty(n, dtype=np.bool_)
+    S = system.rot  # the active set is written straight into the system's frame flags
     rd = np.empty_like(v)
     f = np.empty(n)
     rho = np.empty(n)
@@ -581,12 +590,13 @@ def _active_set_newton(system: _System, g0: FloatArray, free: np.ndarray, tol: f
     nrm = np.empty_like(v)
     c = np.empty(n)
     dv = np.empty_like(v)
-    kdv = np.empty_like(v)
     S_fac = np.zeros(n, dtype=np.bool_)  # active set of the current factorisation
     have_fac = False
     stat_prev = np.inf
     for it in range(maxit + 1):
-        rdm, feas, fS = _k.ssn_eval(g0, K, p, closed, v, lam, free, t2, kappa, S, rd, f, rho)
+        rdm, feas, fS, nS = _k.ssn_eval_prep(g0, K, p, closed, v, lam, free, t2, kappa, delta,
+                                             S, rd, f, rho, B, nrm, c, system.Q, system.fix,
+                                             system.fix0)
         stat = rdm / gscale
         if not np.isfinite(stat):
             return v, lam, it, False
@@ -594,7 +604,6 @@ def _active_set_newton(system: _System, g0: FloatArray, free: np.ndarray, tol: f
             return v, lam, it, True
         if it == maxit or feas > 1.0:  # feas > 1: a point went past sqrt(3) tol, diverging
             break
-        _k.ssn_prepare(v, rho, f, S, lam, t2, delta, B, nrm, c)
         # in the fast (quadratic) phase with an unchanged active set the matrix has changed
         # only by the last, small step (frames, multipliers): reuse its factorisation (an
         # inexact Newton step; the next step refactorises unless it too reduced the residual
@@ -602,15 +611,12 @@ def _active_set_newton(system: _System, g0: FloatArray, free: np.ndarray, tol: f
         chord = have_fac and stat <= _CHORD_RATE * stat_prev and np.array_equal(S, S_fac)
         stat_prev = stat
         if not chord:
-            if not system.factor(B, rot=S, nrm=nrm):
+            if not system.factor(B, nrot=nS):
                 return v, lam, it, False
             S_fac[:] = S
             have_fac = True
-        rd *= -1.0
-        system.solve(rd, c, out=dv)
-        rd *= -1.0
-        _k.band_matvec(K, p, closed, dv, kdv)
-        _k.ssn_update(v, dv, rd, kdv, lam, S, nrm, rho, t2, _RETRACT)
+        system.solve(rd, c, out=dv, sgn=-1.0)
+        _k.ssn_update_k(K, p, closed, v, dv, rd, lam, S, nrm, rho, t2, _RETRACT)
     return v, lam, maxit, False
 
 
