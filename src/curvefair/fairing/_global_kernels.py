@@ -26,8 +26,70 @@ from numba import njit
 
 
 @njit(cache=True)
+def _assemble_range2(K, p, closed, B, Q, rot, fix, L, i0, i1):  # type: ignore[no-untyped-def]
+    """:func:`_assemble_range` for planar curves, branch-light: the frame of point ``i`` is the
+    rotation with first column ``q_i`` (``(1, 0)`` without frame), so the block
+    ``M[(j, .), (i, .)] = K_ij Q_j^T Q_i = K_ij [[C, -S], [S, C]]`` with ``C = q_j . q_i``,
+    ``S = q_j x q_i``; fixed unknowns enter as 0/1 weights."""
+    n = K.shape[0]
+    for i in range(i0, i1):
+        ri = rot[i]
+        qi0 = Q[i, 0, 0] if ri else 1.0
+        qi1 = Q[i, 1, 0] if ri else 0.0
+        wi0 = 0.0 if fix[i, 0] else 1.0
+        wi1 = 0.0 if fix[i, 1] else 1.0
+        C0 = 2 * i
+        C1 = C0 + 1
+        # diagonal block: K_ii I + Q_i^T B_i Q_i
+        b00 = B[i, 0, 0]
+        b01 = B[i, 0, 1]
+        b10 = B[i, 1, 0]
+        b11 = B[i, 1, 1]
+        if ri and not (b01 == 0.0 and b10 == 0.0 and b00 == b11):
+            # Q = [[q0, -q1], [q1, q0]]
+            c00 = b00 * qi0 + b01 * qi1
+            c01 = -b00 * qi1 + b01 * qi0
+            c10 = b10 * qi0 + b11 * qi1
+            c11 = -b10 * qi1 + b11 * qi0
+            b00 = qi0 * c00 + qi1 * c10
+            b10 = -qi1 * c00 + qi0 * c10
+            b11 = -qi1 * c01 + qi0 * c11
+        kk = K[i, p]
+        L[C0, 0] = (kk + b00) * wi0 + (1.0 - wi0)
+        L[C0, 1] = b10 * wi0 * wi1
+        L[C1, 0] = (kk + b11) * wi1 + (1.0 - wi1)
+        for o in range(1, p + 1):
+            j = i + o
+            k = 2 * o
+            if j >= n:
+                if not closed:
+                    L[C0, k] = 0.0
+                    L[C0, k + 1] = 0.0
+                    L[C1, k - 1] = 0.0
+                    L[C1, k] = 0.0
+                    continue
+                j -= n
+            rj = rot[j]
+            qj0 = Q[j, 0, 0] if rj else 1.0
+            qj1 = Q[j, 1, 0] if rj else 0.0
+            wj0 = 0.0 if fix[j, 0] else 1.0
+            wj1 = 0.0 if fix[j, 1] else 1.0
+            kk = K[i, p + o]
+            cc = kk * (qj0 * qi0 + qj1 * qi1)
+            sn = kk * (qj0 * qi1 - qj1 * qi0)
+            L[C0, k] = cc * (wi0 * wj0)
+            L[C0, k + 1] = sn * (wi0 * wj1)
+            L[C1, k - 1] = -sn * (wi1 * wj0)
+            L[C1, k] = cc * (wi1 * wj1)
+        L[C1, 2 * p + 1] = 0.0
+
+
+@njit(cache=True)
 def _assemble_range(K, p, closed, B, Q, rot, fix, L, i0, i1):  # type: ignore[no-untyped-def]
     """Write the lower-band entries of the columns of points ``i0 .. i1 - 1`` into ``L``."""
+    if B.shape[1] == 2:
+        _assemble_range2(K, p, closed, B, Q, rot, fix, L, i0, i1)
+        return
     n = K.shape[0]
     dim = B.shape[1]
     kd = L.shape[1] - 1
@@ -525,6 +587,9 @@ def prep_rhs(K, p, closed, B, Q, rot, fix, fix0, rhs, c, out, sgn=1.0):  # type:
     points (their prescribed normal displacement), fixed unknowns set to their values (``c_i``
     for the normal of a ``rot`` point, 0 at fixed points)."""
     n, dim = rhs.shape
+    if dim == 2:
+        _prep_rhs2(K, p, closed, B, Q, rot, fix, fix0, rhs, c, out, sgn)
+        return
     anyrot = False
     for i in range(n):
         if rot[i]:
@@ -565,6 +630,49 @@ def prep_rhs(K, p, closed, B, Q, rot, fix, fix0, rhs, c, out, sgn=1.0):  # type:
         for a in range(dim):
             if fix[i, a]:
                 out[i, a] = c[i] if (rot[i] and a == 0 and not fix0[i, a]) else 0.0
+
+
+@njit(cache=True)
+def _prep_rhs2(K, p, closed, B, Q, rot, fix, fix0, rhs, c, out, sgn):  # type: ignore[no-untyped-def]
+    """:func:`prep_rhs` for planar curves in one pass (selects instead of branches on the
+    frame flags of the neighbours)."""
+    n = rhs.shape[0]
+    for i in range(n):
+        w0 = sgn * rhs[i, 0]
+        w1 = sgn * rhs[i, 1]
+        interior = i >= p and i + p < n
+        for o in range(-p, p + 1):
+            j = i + o
+            if not interior:
+                if j < 0 or j >= n:
+                    if not closed:
+                        continue
+                    j = j + n if j < 0 else j - n
+            rj = rot[j]
+            kc = K[i, p + o] * (c[j] if rj else 0.0)
+            w0 -= kc * (Q[j, 0, 0] if rj else 0.0)
+            w1 -= kc * (Q[j, 1, 0] if rj else 0.0)
+        if rot[i]:
+            q0 = Q[i, 0, 0]
+            q1 = Q[i, 1, 0]
+            ci = c[i]
+            w0 -= (B[i, 0, 0] * q0 + B[i, 0, 1] * q1) * ci
+            w1 -= (B[i, 1, 0] * q0 + B[i, 1, 1] * q1) * ci
+            # Q^T w, Q = [[q0, -q1], [q1, q0]]
+            t0 = q0 * w0 + q1 * w1
+            w1 = -q1 * w0 + q0 * w1
+            w0 = t0
+            if fix[i, 0]:
+                w0 = 0.0 if fix0[i, 0] else ci
+            if fix[i, 1]:
+                w1 = 0.0
+        else:
+            if fix[i, 0]:
+                w0 = 0.0
+            if fix[i, 1]:
+                w1 = 0.0
+        out[i, 0] = w0
+        out[i, 1] = w1
 
 
 @njit(cache=True)
