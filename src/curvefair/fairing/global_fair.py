@@ -428,7 +428,7 @@ def _solve_balls(system: _System, g0: FloatArray, free: np.ndarray, tol: float, 
     steps = 1
     if _ADMM_ITERS > 0 and not closed and n > 2 * p + 2 and max_steps > 1:
         # 0. ADMM warm start (one n x n band factorisation), then the active-set Newton
-        start = _admm_start(K, p, g0, free, tol)
+        start = _admm_start(K, p, g0, free, tol, system.L.reshape(-1))
         if start is not None:
             res = _active_set_newton(system, g0, free, tol, start[0], start[1], start[2],
                                      gscale, min(_ADMM_SSN_MAXIT, max_steps - 1))
@@ -514,23 +514,35 @@ _ADMM_SSN_MAXIT = 15
 _CHORD_RATE = 1e-2
 
 
-def _admm_start(K: FloatArray, p: int, g0: FloatArray, free: np.ndarray, tol: float
-                ) -> tuple[FloatArray, FloatArray, float] | None:
+def _admm_start(K: FloatArray, p: int, g0: FloatArray, free: np.ndarray, tol: float,
+                scratch: FloatArray | None = None) -> tuple[FloatArray, FloatArray, float] | None:
     """Approximate solution ``(v, lambda, kappa)`` of the ball-constrained QP (open curves)
     by over-relaxed ADMM (Boyd et al. 2011, sec. 5.1): every iteration is one banded solve with
     the single ``n x n`` factor of ``K + rho I`` (the coordinates share it) and a projection
     onto the balls. ``rho`` starts at ``_ADMM_RHO0`` times the median diagonal of ``K`` and is
     reset every ``_ADMM_ADAPT`` iterations to the median curvature ``lambda_i / tol^2`` of the
-    projected points (the scale at which the splitting converges fastest). None if the
-    factorisation fails."""
+    projected points (the scale at which the splitting converges fastest; refactorised only
+    when that moves it by more than 30 %). The work arrays are carved from ``scratch`` (the
+    Newton system's band storage, unused until then: its pages are then already mapped when
+    the Newton iteration factorises) if it is large enough; the returned ``v`` may be a view
+    of it. None if the factorisation fails."""
     n, dim = g0.shape
     t2 = tol * tol
     r2 = np.where(free, t2, 0.0)
     rho = _ADMM_RHO0 * float(np.median(K[free, p]))
     if not rho > 0.0:
         return None
-    L = np.empty((n, p + 1))
-    F = np.empty((n, p + 1) if p == 3 else (1, 1))
+    shapes = [(n, p + 1), (n, p + 1) if p == 3 else (1, 1), (n, dim), (n, dim), (n, dim)]
+    sizes = [a * b for a, b in shapes]
+    if scratch is not None and scratch.size >= sum(sizes):
+        offs = np.cumsum([0] + sizes)[:-1]
+        L, F, z, u, y = (scratch[o:o + m].reshape(sh)
+                         for o, m, sh in zip(offs, sizes, shapes, strict=True))
+        z[:] = 0.0
+        u[:] = 0.0
+    else:
+        L, F, z, u, y = (np.zeros(sh) for sh in shapes)
+    np.negative(g0, out=y)
 
     def factor(rho: float) -> bool:
         if _k.shift_cholesky(K, p, rho, L):
@@ -541,9 +553,6 @@ def _admm_start(K: FloatArray, p: int, g0: FloatArray, free: np.ndarray, tol: fl
 
     if not factor(rho):
         return None
-    z = np.zeros_like(g0)
-    u = np.zeros_like(g0)
-    y = -g0
     un = np.empty(n)
     for it in range(1, _ADMM_ITERS + 1):
         _k.admm_sweep(L, F, y, z, u, g0, rho, r2, _ADMM_ALPHA)
