@@ -1239,6 +1239,7 @@ def ssn_eval_prep(g0, K, p, closed, v, lam, free, t2, kappa, delta, S, rd, f, rh
     |v|`` (the linearised sphere), their frames ``Q`` (as :func:`set_frames`) and ``fix = fix0``
     plus the normal axis. Returns ``(max |rd|, max f over free, max |f| over S, |S|)``."""
     n, dim = v.shape
+    c23 = dim == 2 and p == 3
     rdm = 0.0
     fm = -np.inf
     fsm = 0.0
@@ -1273,7 +1274,24 @@ def ssn_eval_prep(g0, K, p, closed, v, lam, free, t2, kappa, delta, S, rd, f, rh
                 fm = fi
             li = lam[i]
             interior = i >= p and i + p < n
+            if c23 and interior:
+                k0 = K[i, 0]
+                k1 = K[i, 1]
+                k2 = K[i, 2]
+                k3 = K[i, 3]
+                k4 = K[i, 4]
+                k5 = K[i, 5]
+                k6 = K[i, 6]
+                for a in range(2):
+                    acc = (k0 * v[i - 3, a] + k1 * v[i - 2, a] + k2 * v[i - 1, a] + k3 * v[i, a]
+                           + k4 * v[i + 1, a] + k5 * v[i + 2, a] + k6 * v[i + 3, a])
+                    x = g0[i, a] + acc + li * (v[i, a] / t2)
+                    rd[i, a] = x
+                    if abs(x) > rdm:
+                        rdm = abs(x)
             for a in range(dim):
+                if c23 and interior:
+                    break
                 acc = 0.0
                 if interior:
                     for o in range(-p, p + 1):
@@ -1334,23 +1352,27 @@ def ssn_update_k(K, p, closed, v, dv, rd, lam, S, nrm, rho, t2, retract):  # typ
     ``retract`` the active points are put back on their sphere (the tangent-plane step
     overshoots radially by ``|dv_t|^2 / (2 tol)``)."""
     n, dim = v.shape
+    if dim == 2 and p == 3 and n > 6:
+        _ssn_update23(K, closed, v, dv, rd, lam, S, nrm, rho, t2, retract, 3, n - 3)
+        lo = 3
+        hi = n - 3
+    else:
+        lo = 0
+        hi = 0
     tol = np.sqrt(t2)
     kdv = np.empty(dim)
     for i in range(n):
-        interior = i >= p and i + p < n
+        if lo <= i < hi:
+            continue
         for a in range(dim):
             acc = 0.0
-            if interior:
-                for o in range(-p, p + 1):
-                    acc += K[i, p + o] * dv[i + o, a]
-            else:
-                for o in range(-p, p + 1):
-                    j = i + o
-                    if j < 0 or j >= n:
-                        if not closed:
-                            continue
-                        j = j + n if j < 0 else j - n
-                    acc += K[i, p + o] * dv[j, a]
+            for o in range(-p, p + 1):
+                j = i + o
+                if j < 0 or j >= n:
+                    if not closed:
+                        continue
+                    j = j + n if j < 0 else j - n
+                acc += K[i, p + o] * dv[j, a]
             kdv[a] = acc
         if S[i]:
             acc = 0.0
@@ -1361,6 +1383,8 @@ def ssn_update_k(K, p, closed, v, dv, rd, lam, S, nrm, rho, t2, retract):  # typ
         else:
             lam[i] = 0.0
     for i in range(n):
+        if lo <= i < hi:
+            continue
         vv = 0.0
         for a in range(dim):
             v[i, a] += dv[i, a]
@@ -1369,3 +1393,29 @@ def ssn_update_k(K, p, closed, v, dv, rd, lam, S, nrm, rho, t2, retract):  # typ
             f = tol / np.sqrt(vv)
             for a in range(dim):
                 v[i, a] *= f
+
+
+@njit(cache=True, error_model="numpy")
+def _ssn_update23(K, closed, v, dv, rd, lam, S, nrm, rho, t2, retract, i0, i1):  # type: ignore[no-untyped-def]
+    """:func:`ssn_update_k` for planar cubics on the interior points ``i0 .. i1 - 1``: one
+    pass, selects instead of branches (numpy error model: the unselected quotients of inactive
+    points may be inf)."""
+    tol = np.sqrt(t2)
+    for i in range(i0, i1):
+        si = S[i]
+        li = lam[i] / t2
+        acc = 0.0
+        for a in range(2):
+            kd = (K[i, 0] * dv[i - 3, a] + K[i, 1] * dv[i - 2, a] + K[i, 2] * dv[i - 1, a]
+                  + K[i, 3] * dv[i, a] + K[i, 4] * dv[i + 1, a] + K[i, 5] * dv[i + 2, a]
+                  + K[i, 6] * dv[i + 3, a])
+            acc += nrm[i, a] * (rd[i, a] + kd + li * dv[i, a])
+        lnew = lam[i] - acc * t2 / rho[i]
+        lam[i] = lnew if si else 0.0
+        x0 = v[i, 0] + dv[i, 0]
+        x1 = v[i, 1] + dv[i, 1]
+        vv = x0 * x0 + x1 * x1
+        f = tol / np.sqrt(vv)
+        f = f if (retract and si and vv > 0.0) else 1.0
+        v[i, 0] = x0 * f
+        v[i, 1] = x1 * f
