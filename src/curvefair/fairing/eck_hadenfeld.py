@@ -308,7 +308,8 @@ def _eh_loop(X, z, Wu, pat, upat, ulo, uhi, D, p, closed, tol, eps_abs, max_step
     move, the ``2p + 1`` changed ``z`` are recomputed (planar curves: branch-free, both the free
     and the tolerance-clamped candidate are evaluated and selected, which avoids unpredictable
     branches; the values are bitwise those of :func:`_candidate`), their one or two blocks
-    rescanned and the ancestors repaired level by level as a contiguous range:
+    rescanned and the ancestors repaired (level by level as a contiguous range until the range
+    is one node, then along its path with the node carried in registers):
     ``O(p + log N)`` per step.
 
     On large curves the step is bound by memory latency (the next point is usually far away).
@@ -387,11 +388,12 @@ def _eh_loop(X, z, Wu, pat, upat, ulo, uhi, D, p, closed, tol, eps_abs, max_step
                 j >>= 1
             bz = -2.0
             bf = float(r)
-            while j > 1:
-                sb = j ^ 1
-                if T[sb, 0] > bz:
-                    bz = T[sb, 0]
-                    bf = T[sb, 1]
+            while j > 1:  # branch-free: a mispredicted branch here delays the prefetches
+                sv = T[j ^ 1, 0]
+                sf = T[j ^ 1, 1]
+                gt = sv > bz
+                bz = sv if gt else bz
+                bf = sf if gt else bf
                 j >>= 1
             bi = int(bf)
             q0 = bi - p if bi >= p else 0
@@ -524,16 +526,41 @@ def _eh_loop(X, z, Wu, pat, upat, ulo, uhi, D, p, closed, tol, eps_abs, max_step
                     zb = zk if gt else zb
                 T[P + b, 0] = zb
                 T[P + b, 1] = best
-            a = (P + blo) >> 1
-            bb = (P + bhi) >> 1
-            while a >= 1:
-                for j in range(a, bb + 1):
-                    c = 2 * j
-                    c += T[c + 1, 0] > T[c, 0]  # branch-free select, ties to the left
-                    T[j, 0] = T[c, 0]
-                    T[j, 1] = T[c, 1]
-                a >>= 1
-                bb >>= 1
+            # repair the ancestors: level by level while the range spans several nodes,
+            # then along the single path with the node's (value, index) carried in registers
+            # (reading it back from T would put a store-to-load round trip on every level)
+            if blo == bhi:
+                j = P + blo
+                cv = zb
+                cf = float(best)
+            else:
+                a = (P + blo) >> 1
+                bb = (P + bhi) >> 1
+                while a < bb:
+                    for j in range(a, bb + 1):
+                        c = 2 * j
+                        c += T[c + 1, 0] > T[c, 0]  # branch-free select, ties to the left
+                        T[j, 0] = T[c, 0]
+                        T[j, 1] = T[c, 1]
+                    a >>= 1
+                    bb >>= 1
+                j = a
+                c = 2 * j
+                c += T[c + 1, 0] > T[c, 0]
+                cv = T[c, 0]
+                cf = T[c, 1]
+                T[j, 0] = cv
+                T[j, 1] = cf
+            while j > 1:
+                sv = T[j ^ 1, 0]
+                sf = T[j ^ 1, 1]
+                # the same select as above: the right child wins only if strictly larger
+                take = not (cv > sv) if j & 1 else sv > cv
+                cv = sv if take else cv
+                cf = sf if take else cf
+                j >>= 1
+                T[j, 0] = cv
+                T[j, 1] = cf
         drop += zr
         if nh < hist.shape[0]:
             hist[nh, 0] = r
