@@ -263,3 +263,112 @@ def test_large_coordinates_keep_precision():
     np.testing.assert_allclose(np.asarray(b.curve.control_points) - 1e4,
                                a.curve.control_points, atol=1e-9)
     check_kkt(far, b, 0.02, 2, movable_mask(far, "g1"))
+
+
+# -- the ADMM warm start, the interior-point fallback -------------------------------------
+@pytest.mark.parametrize("dim,p", [(2, 3), (3, 3), (2, 4), (3, 2)])
+def test_admm_sweep_matches_dense_solve_and_projection(dim, p):
+    """One fused ADMM iteration (banded solve + relaxation + ball projection + dual update)
+    against numpy.linalg.solve on the dense matrix and the projection written out."""
+    from curvefair.fairing import _global_kernels as _k
+
+    rng = np.random.default_rng(10 * dim + p)
+    n = 40
+    M = np.zeros((n, n))
+    for i in range(n):
+        for o in range(1, p + 1):
+            if i + o < n:
+                M[i, i + o] = M[i + o, i] = rng.normal()
+    M += np.diag(np.full(n, 4.0 * p))
+    K = np.zeros((n, 2 * p + 1))
+    for i in range(n):
+        for o in range(-p, p + 1):
+            if 0 <= i + o < n:
+                K[i, p + o] = M[i, i + o]
+    rho, alpha = 0.7, 1.6
+    L = np.empty((n, p + 1))
+    F = np.empty((n, p + 1) if p == 3 else (1, 1))
+    assert _k.shift_cholesky(K, p, rho, L) == 0
+    if p == 3:
+        _k.admm_scale3(L, F)
+    g0 = rng.normal(size=(n, dim))
+    z = 0.1 * rng.normal(size=(n, dim))
+    u = 0.1 * rng.normal(size=(n, dim))
+    r2 = np.full(n, 0.05)
+    r2[[0, 7]] = 0.0  # fixed points: balls of radius 0
+    y = rho * (z - u) - g0
+    x = np.linalg.solve(M + rho * np.eye(n), y)
+    w = alpha * x + (1 - alpha) * z + u
+    q = np.linalg.norm(w, axis=1)
+    zn = w * np.where(q**2 > r2, np.sqrt(r2) / q, 1.0)[:, None]
+    un = w - zn
+    rr, dz = _k.admm_sweep(L, F, y, z0 := z.copy(), u, g0, rho, r2, alpha)
+    np.testing.assert_allclose(z0, zn, atol=1e-13)
+    np.testing.assert_allclose(u, un, atol=1e-13)
+    np.testing.assert_allclose(y, rho * (zn - un) - g0, atol=1e-12)
+    assert rr == pytest.approx(np.sum((x - zn) ** 2), rel=1e-12)
+    assert dz == pytest.approx(np.sum((zn - z) ** 2), rel=1e-12)
+
+
+@pytest.mark.parametrize("path", ["interior-point", "fallback"])
+def test_interior_point_path_kkt(monkeypatch, path):
+    """The interior point, used without the ADMM warm start (closed curves) and when the
+    active-set Newton does not converge from it, still meets the KKT conditions."""
+    import curvefair.fairing.global_fair as gf
+
+    if path == "interior-point":
+        monkeypatch.setattr(gf, "_ADMM_ITERS", 0)
+    else:  # one Newton step cannot finish from the warm start: the interior point takes over
+        monkeypatch.setattr(gf, "_ADMM_SSN_MAXIT", 1)
+    c = noisy(seed=12)
+    res = gf.global_fair(c, tol=0.02, clamp="g1")
+    assert res.stop_reason == "converged"
+    check_kkt(c, res, 0.02, 2, movable_mask(c, "g1"))
+    assert res.active.size > 0
+
+
+def test_larger_open_curve_kkt_and_feasibility():
+    """3000 control points (ADMM warm start, active-set Newton with reused factorisations):
+    stationarity with the returned multipliers against the sparse Gram matrix, complementarity,
+    the tolerance exactly, and no worse than the interior point alone."""
+    import curvefair.fairing.global_fair as gf
+
+    rng = np.random.default_rng(21)
+    x = np.arange(3000.0)
+    pts = np.c_[x, 20 * np.sin(x / 7) + 50 * np.sin(x / 31)] + 0.05 * rng.normal(size=(3000, 2))
+    c = interpolate_bspline(pts, param=x)
+    tol = 0.3
+    res = global_fair(c, tol=tol)
+    assert res.stop_reason == "converged"
+    G = energy_matrix(c, 2)
+    d = np.asarray(res.curve.control_points)
+    v = d - c.control_points
+    scale = np.abs(2 * (G @ np.asarray(c.control_points))).max()
+    assert np.abs(2 * (G @ d) + res.multipliers[:, None] * v).max() <= 1e-8 * scale
+    dist = np.linalg.norm(v, axis=1)
+    assert dist.max() <= tol
+    assert np.abs(res.multipliers * (dist - tol)).max() <= 1e-8 * scale * tol
+    assert res.multipliers.min() >= 0.0
+    ip = gf._ADMM_ITERS
+    try:
+        gf._ADMM_ITERS = 0
+        ref = global_fair(c, tol=tol)
+    finally:
+        gf._ADMM_ITERS = ip
+    assert res.energy_after <= ref.energy_after * (1 + 1e-10)
+    assert ref.energy_after <= res.energy_after * (1 + 1e-10)
+
+
+@pytest.mark.parametrize("flag", [True, False])
+def test_huge_page_setting_restored(flag):
+    from curvefair.fairing.global_fair import _np_ma
+
+    get = getattr(_np_ma, "_get_madvise_hugepage", None)
+    if get is None:
+        pytest.skip("numpy without the huge-page switch")
+    old = _np_ma._set_madvise_hugepage(flag)
+    try:
+        global_fair(noisy(n=30), tol=0.02)
+        assert bool(get()) is flag
+    finally:
+        _np_ma._set_madvise_hugepage(old)
