@@ -288,9 +288,7 @@ def test_admm_sweep_matches_dense_solve_and_projection(dim, p):
     rho, alpha = 0.7, 1.6
     L = np.empty((n, p + 1))
     F = np.empty((n, p + 1) if p == 3 else (1, 1))
-    assert _k.shift_cholesky(K, p, rho, L) == 0
-    if p == 3:
-        _k.admm_scale3(L, F)
+    assert _k.admm_factor(K, p, rho, L, F) == 0
     g0 = rng.normal(size=(n, dim))
     z = 0.1 * rng.normal(size=(n, dim))
     u = 0.1 * rng.normal(size=(n, dim))

@@ -875,36 +875,6 @@ def shift_cholesky(K, p, rho, L):  # type: ignore[no-untyped-def]
         for o in range(p + 1):
             L[i, o] = K[i, p + o] if i + o < n else 0.0
         L[i, 0] += rho
-    if p == 3:
-        for j in range(n):
-            d = L[j, 0]
-            if not d > 0.0:
-                return j + 1
-            d = np.sqrt(d)
-            inv = 1.0 / d
-            L[j, 0] = inv
-            if j + 3 < n:
-                l1 = L[j, 1] * inv
-                l2 = L[j, 2] * inv
-                l3 = L[j, 3] * inv
-                L[j, 1] = l1
-                L[j, 2] = l2
-                L[j, 3] = l3
-                L[j + 1, 0] -= l1 * l1
-                L[j + 1, 1] -= l2 * l1
-                L[j + 1, 2] -= l3 * l1
-                L[j + 2, 0] -= l2 * l2
-                L[j + 2, 1] -= l3 * l2
-                L[j + 3, 0] -= l3 * l3
-            else:
-                kmax = n - 1 - j
-                for k in range(1, kmax + 1):
-                    L[j, k] *= inv
-                for a in range(1, kmax + 1):
-                    la = L[j, a]
-                    for b in range(a, kmax + 1):
-                        L[j + a, b - a] -= L[j, b] * la
-        return 0
     info = _chol_cols(L, 0, n, n)
     for j in range(n):
         L[j, 0] = 1.0 / L[j, 0]
@@ -912,37 +882,78 @@ def shift_cholesky(K, p, rho, L):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def admm_scale3(L, F):  # type: ignore[no-untyped-def]
-    """For :func:`admm_sweep` with ``p = 3``: from the factor of :func:`shift_cholesky` (reciprocal
-    pivots ``r_j``), ``F[j, 0] = r_j``, ``F[j, k] = L[j - k, k] r_j`` (forward substitution)
-    and ``L[i, k] *= r_i`` (backward substitution), so that each substitution step is
-    ``x_j = r_j y_j - sum_k F[j, k] x_{j-k}`` (one multiply-add on the recurrence)."""
-    n = L.shape[0]
+def admm_factor(K, p, rho, L, F):  # type: ignore[no-untyped-def]
+    """Factor of ``K + rho I`` (open curve) for :func:`admm_sweep`. ``p = 3``: ``K + rho I = U D
+    U^T`` (``U`` unit lower) computed with the active window in registers (one division, one
+    multiply and one multiply-add on the pivot recurrence, no square root): ``L[i, k] =
+    U[i + k, i]`` (backward substitution), ``F[j, k] = U[j, j - k]`` (forward substitution) and
+    ``F[j, 0] = 1 / D_j``. Otherwise the band Cholesky of :func:`shift_cholesky` (``F``
+    unused). Returns 0 or ``j + 1`` for a non-positive pivot ``j``."""
+    n = K.shape[0]
+    if p != 3 or n < 4:
+        return shift_cholesky(K, p, rho, L)
+    for k in range(1, 4):
+        for j in range(k):
+            F[j, k] = 0.0
+    # pending (partially eliminated) entries: P00 = A'[j, j], P10 = A'[j+1, j], P20 = A'[j+2, j],
+    # P11 = A'[j+1, j+1], P21 = A'[j+2, j+1], P22 = A'[j+2, j+2]
+    P00 = K[0, 3] + rho
+    P10 = K[0, 4]
+    P20 = K[0, 5]
+    P11 = K[1, 3] + rho
+    P21 = K[1, 4]
+    P22 = K[2, 3] + rho
     for j in range(n):
-        r = L[j, 0]
+        d = P00
+        if not d > 0.0:
+            return j + 1
+        r = 1.0 / d
+        a1 = P10
+        a2 = P20
+        a3 = K[j, 6]
+        l1 = a1 * r
+        l2 = a2 * r
+        l3 = a3 * r
+        L[j, 0] = r
+        L[j, 1] = l1
+        L[j, 2] = l2
+        L[j, 3] = l3
         F[j, 0] = r
-        for k in range(1, 4):
-            F[j, k] = L[j - k, k] * r if j >= k else 0.0
-    for i in range(n):
-        r = L[i, 0]
-        for k in range(1, 4):
-            L[i, k] *= r
+        if j + 1 < n:
+            F[j + 1, 1] = l1
+        if j + 2 < n:
+            F[j + 2, 2] = l2
+        if j + 3 < n:
+            F[j + 3, 3] = l3
+            e31 = K[j + 1, 5]
+            e32 = K[j + 2, 4]
+            e33 = K[j + 3, 3] + rho
+        else:
+            e31 = 0.0
+            e32 = 0.0
+            e33 = 0.0
+        P00 = P11 - l1 * a1
+        P10 = P21 - l2 * a1
+        P20 = e31 - l3 * a1
+        P11 = P22 - l2 * a2
+        P21 = e32 - l3 * a2
+        P22 = e33 - l3 * a3
+    return 0
 
 
 @njit(cache=True)
 def admm_sweep(L, F, y, z, u, g0, rho, r2, alpha):  # type: ignore[no-untyped-def]
     """One over-relaxed ADMM iteration for ``min g0.x + x.K x / 2`` s.t. ``|z_i|^2 <= r2_i``,
     ``x = z`` (Boyd et al. 2011, sec. 3.4.3 / 5.1, scaled dual ``u``): on entry ``y`` holds
-    ``-g0 + rho (z - u)``; ``x = (K + rho I)^{-1} y`` (factor ``L`` of :func:`shift_cholesky`,
-    reciprocal pivots; ``p = 3``: scaled by :func:`admm_scale3` into ``L, F``; otherwise ``F`` is
-    unused), ``xh = alpha x + (1 - alpha) z``, ``z = P(xh + u)``, ``u += xh - z``; on exit ``y``
+    ``-g0 + rho (z - u)``; ``x = (K + rho I)^{-1} y`` (factor ``L, F`` of :func:`admm_factor`),
+    ``xh = alpha x + (1 - alpha) z``, ``z = P(xh + u)``, ``u += xh - z``; on exit ``y``
     holds the next right-hand side. The point updates are done inside the backward
     substitution (the last solved ``x_i`` kept in registers / a ring buffer), so every array is
     streamed at most twice per iteration. Returns the squared norms of the primal residual
     ``x - z`` and of the change of ``z``."""
     n, dim = y.shape
     kd = L.shape[1] - 1
-    if kd == 3:
+    if kd == 3 and n >= 4:
         return _admm_sweep3(L, F, y, z, u, g0, rho, r2, alpha)
     R = 8
     while R < kd + 1:
@@ -993,19 +1004,20 @@ def admm_sweep(L, F, y, z, u, g0, rho, r2, alpha):  # type: ignore[no-untyped-de
 
 @njit(cache=True)
 def _admm_sweep3(L, F, y, z, u, g0, rho, r2, alpha):  # type: ignore[no-untyped-def]
-    """:func:`admm_sweep` for cubics (``p = 3``; planar written out): substitutions with the last
-    three unknowns in registers, pre-scaled factors (one multiply-add on the recurrence, the
-    newest unknown subtracted last), branch-free projection."""
+    """:func:`admm_sweep` for cubics (``p = 3``, the ``U D U^T`` factor of :func:`admm_factor`;
+    planar written out): unit substitutions with the last three unknowns in registers (one
+    multiply-add on the recurrence, the newest unknown subtracted last), branch-free
+    projection."""
     n, dim = y.shape
     if dim != 2:
-        xs = np.zeros((n + 3, dim))  # x_{j-3} .. x_{j-1} at xs[j .. j + 2]
+        xs = np.zeros((n + 3, dim))  # v_{j-3} .. v_{j-1} at xs[j .. j + 2]
         for j in range(n):
             for a in range(dim):
-                xs[j + 3, a] = (F[j, 0] * y[j, a] - F[j, 3] * xs[j, a] - F[j, 2] * xs[j + 1, a]
+                xs[j + 3, a] = (y[j, a] - F[j, 3] * xs[j, a] - F[j, 2] * xs[j + 1, a]
                                 - F[j, 1] * xs[j + 2, a])
         for j in range(n):
             for a in range(dim):
-                y[j, a] = xs[j + 3, a]
+                y[j, a] = xs[j + 3, a] * F[j, 0]
         xb = np.zeros((n + 3, dim))  # x_{i+1} .. x_{i+3} at xb[i + 1 .. i + 3]
         rr = 0.0
         dz = 0.0
@@ -1013,7 +1025,7 @@ def _admm_sweep3(L, F, y, z, u, g0, rho, r2, alpha):  # type: ignore[no-untyped-
         for i in range(n - 1, -1, -1):
             q2 = 0.0
             for a in range(dim):
-                x = (L[i, 0] * y[i, a] - L[i, 3] * xb[i + 3, a] - L[i, 2] * xb[i + 2, a]
+                x = (y[i, a] - L[i, 3] * xb[i + 3, a] - L[i, 2] * xb[i + 2, a]
                      - L[i, 1] * xb[i + 1, a])
                 xb[i, a] = x
                 wa = alpha * x + (1.0 - alpha) * z[i, a] + u[i, a]
@@ -1038,13 +1050,14 @@ def _admm_sweep3(L, F, y, z, u, g0, rho, r2, alpha):  # type: ignore[no-untyped-
     b2 = 0.0
     b3 = 0.0
     for j in range(n):
-        ta = F[j, 0] * y[j, 0] - F[j, 3] * a3 - F[j, 2] * a2
-        tb = F[j, 0] * y[j, 1] - F[j, 3] * b3 - F[j, 2] * b2
+        ta = y[j, 0] - F[j, 3] * a3 - F[j, 2] * a2
+        tb = y[j, 1] - F[j, 3] * b3 - F[j, 2] * b2
         c1 = F[j, 1]
         va = ta - c1 * a1
         vb = tb - c1 * b1
-        y[j, 0] = va
-        y[j, 1] = vb
+        r = F[j, 0]
+        y[j, 0] = va * r
+        y[j, 1] = vb * r
         a3 = a2
         a2 = a1
         a1 = va
@@ -1061,9 +1074,8 @@ def _admm_sweep3(L, F, y, z, u, g0, rho, r2, alpha):  # type: ignore[no-untyped-
     b3 = 0.0
     beta = 1.0 - alpha
     for i in range(n - 1, -1, -1):
-        r = L[i, 0]
-        ta = r * y[i, 0] - L[i, 3] * a3 - L[i, 2] * a2
-        tb = r * y[i, 1] - L[i, 3] * b3 - L[i, 2] * b2
+        ta = y[i, 0] - L[i, 3] * a3 - L[i, 2] * a2
+        tb = y[i, 1] - L[i, 3] * b3 - L[i, 2] * b2
         l1 = L[i, 1]
         xa = ta - l1 * a1
         xb = tb - l1 * b1

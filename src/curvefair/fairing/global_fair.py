@@ -562,11 +562,7 @@ def _admm_start(K: FloatArray, p: int, g0: FloatArray, free: np.ndarray, tol: fl
     np.negative(g0, out=y)
 
     def factor(rho: float) -> bool:
-        if _k.shift_cholesky(K, p, rho, L):
-            return False
-        if p == 3:
-            _k.admm_scale3(L, F)
-        return True
+        return _k.admm_factor(K, p, rho, L, F) == 0
 
     if not factor(rho):
         return None
