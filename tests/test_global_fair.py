@@ -300,12 +300,18 @@ def test_admm_sweep_matches_dense_solve_and_projection(dim, p):
     q = np.linalg.norm(w, axis=1)
     zn = w * np.where(q**2 > r2, np.sqrt(r2) / q, 1.0)[:, None]
     un = w - zn
-    rr, dz = _k.admm_sweep(L, F, y, z0 := z.copy(), u, g0, rho, r2, alpha)
+    z0 = z.copy()
+    if p == 3:  # U D U^T factor, coordinate-major vectors
+        yt, zt, ut = (np.ascontiguousarray(a.T) for a in (y, z0, u))
+        _k.admm_sweep_t(L, F, yt, zt, ut, np.ascontiguousarray(g0.T), rho, r2, alpha)
+        y, z0, u = yt.T, zt.T, ut.T
+    else:
+        rr, dz = _k.admm_sweep(L, y, z0, u, g0, rho, r2, alpha)
+        assert rr == pytest.approx(np.sum((x - zn) ** 2), rel=1e-12)
+        assert dz == pytest.approx(np.sum((zn - z) ** 2), rel=1e-12)
     np.testing.assert_allclose(z0, zn, atol=1e-13)
     np.testing.assert_allclose(u, un, atol=1e-13)
     np.testing.assert_allclose(y, rho * (zn - un) - g0, atol=1e-12)
-    assert rr == pytest.approx(np.sum((x - zn) ** 2), rel=1e-12)
-    assert dz == pytest.approx(np.sum((zn - z) ** 2), rel=1e-12)
 
 
 @pytest.mark.parametrize("path", ["interior-point", "fallback"])

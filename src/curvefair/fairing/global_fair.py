@@ -538,8 +538,9 @@ def _admm_start(K: FloatArray, p: int, g0: FloatArray, free: np.ndarray, tol: fl
     the single ``n x n`` factor of ``K + rho I`` (the coordinates share it) and a projection
     onto the balls. ``rho`` starts at ``_ADMM_RHO0`` times the median diagonal of ``K`` and is
     reset every ``_ADMM_ADAPT`` iterations to the median curvature ``lambda_i / tol^2`` of the
-    projected points (the scale at which the splitting converges fastest; refactorised only
-    when that moves it by more than 30 %). The work arrays are carved from ``scratch`` (the
+    projected points (the scale at which the splitting converges fastest). Cubics keep the
+    vectors coordinate-major (:func:`._global_kernels.admm_sweep_t`). The work arrays are
+    carved from ``scratch`` (the
     Newton system's band storage, unused until then: its pages are then already mapped when
     the Newton iteration factorises) if it is large enough; the returned ``v`` may be a view
     of it. None if the factorisation fails."""
@@ -549,17 +550,22 @@ def _admm_start(K: FloatArray, p: int, g0: FloatArray, free: np.ndarray, tol: fl
     rho = _ADMM_RHO0 * float(np.median(K[free, p]))
     if not rho > 0.0:
         return None
-    shapes = [(n, p + 1), (n, p + 1) if p == 3 else (1, 1), (n, dim), (n, dim), (n, dim)]
+    cubic = p == 3 and n >= 4  # U D U^T factor, coordinate-major vectors (admm_sweep_t)
+    vec = (dim, n) if cubic else (n, dim)
+    shapes = [(n, p + 1), (n, p + 1) if cubic else (1, 1), vec, vec, vec, vec]
     sizes = [a * b for a, b in shapes]
     if scratch is not None and scratch.size >= sum(sizes):
         offs = np.cumsum([0] + sizes)[:-1]
-        L, F, z, u, y = (scratch[o:o + m].reshape(sh)
-                         for o, m, sh in zip(offs, sizes, shapes, strict=True))
+        L, F, z, u, y, g = (scratch[o:o + m].reshape(sh)
+                            for o, m, sh in zip(offs, sizes, shapes, strict=True))
         z[:] = 0.0
         u[:] = 0.0
     else:
-        L, F, z, u, y = (np.zeros(sh) for sh in shapes)
-    np.negative(g0, out=y)
+        L, F, z, u, y, g = (np.zeros(sh) for sh in shapes)
+    # (n, dim) views for the per-point bookkeeping
+    zp, up, yp, gp = (a.T for a in (z, u, y, g)) if cubic else (z, u, y, g)
+    gp[:] = g0
+    np.negative(gp, out=yp)
 
     def factor(rho: float) -> bool:
         return _k.admm_factor(K, p, rho, L, F) == 0
@@ -568,9 +574,12 @@ def _admm_start(K: FloatArray, p: int, g0: FloatArray, free: np.ndarray, tol: fl
         return None
     un = np.empty(n)
     for it in range(1, _ADMM_ITERS + 1):
-        _k.admm_sweep(L, F, y, z, u, g0, rho, r2, _ADMM_ALPHA)
+        if cubic:
+            _k.admm_sweep_t(L, F, y, z, u, g, rho, r2, _ADMM_ALPHA)
+        else:
+            _k.admm_sweep(L, y, z, u, g, rho, r2, _ADMM_ALPHA)
         if it % _ADMM_ADAPT == 0 and it < _ADMM_ITERS:
-            m = _k.admm_active_norms(u, free, un)
+            m = _k.admm_active_norms(up, free, un)
             if m:
                 new = float(np.median(un[:m])) * rho / tol
                 new = min(max(new, 0.1 * rho), 10.0 * rho)
@@ -578,13 +587,13 @@ def _admm_start(K: FloatArray, p: int, g0: FloatArray, free: np.ndarray, tol: fl
                     rho_old, rho = rho, new
                     if not factor(rho):
                         return None
-                    _k.admm_rescale(z, u, g0, rho_old / rho, rho, y)
+                    _k.admm_rescale(zp, up, gp, rho_old / rho, rho, yp)
     lam = np.empty(n)
-    sl, ss, m = _k.admm_multipliers(z, u, free, rho, t2, lam)
+    sl, ss, m = _k.admm_multipliers(zp, up, free, rho, t2, lam)
     kappa = (sl / m) / max(ss / m, 1e-3)
     if not kappa > 0.0:
         kappa = rho * t2
-    return z, lam, kappa
+    return zp, lam, kappa
 
 
 def _matvec(K: FloatArray, p: int, closed: bool, x: FloatArray) -> FloatArray:
