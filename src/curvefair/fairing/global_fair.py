@@ -376,7 +376,9 @@ def _global_fair(curve: BSplineCurve, tol: float | None, l: Any,  # noqa: E741
     closed = curve.closed
     W = None
     for k, v in w.items():
-        Wk = np.asarray(curve.gram_band(k)) * v
+        Wk = np.asarray(curve.gram_band(k))  # cached, read-only: scaled copies only if needed
+        if v != 1.0:
+            Wk = Wk * v
         W = Wk if W is None else W + Wk
     W = np.ascontiguousarray(W)
     d0 = np.array(curve.control_points)
@@ -536,7 +538,7 @@ def _admm_start(K: FloatArray, p: int, g0: FloatArray, free: np.ndarray, tol: fl
     """Approximate solution ``(v, lambda, kappa)`` of the ball-constrained QP (open curves)
     by over-relaxed ADMM (Boyd et al. 2011, sec. 5.1): every iteration is one banded solve with
     the single ``n x n`` factor of ``K + rho I`` (the coordinates share it) and a projection
-    onto the balls. ``rho`` starts at ``_ADMM_RHO0`` times the median diagonal of ``K`` and is
+    onto the balls. ``rho`` starts at ``_ADMM_RHO0`` times the mean diagonal of ``K`` and is
     reset every ``_ADMM_ADAPT`` iterations to the median curvature ``lambda_i / tol^2`` of the
     projected points (the scale at which the splitting converges fastest). Cubics keep the
     vectors coordinate-major (:func:`._global_kernels.admm_sweep_t`). The work arrays are
@@ -547,7 +549,7 @@ def _admm_start(K: FloatArray, p: int, g0: FloatArray, free: np.ndarray, tol: fl
     n, dim = g0.shape
     t2 = tol * tol
     r2 = np.where(free, t2, 0.0)
-    rho = _ADMM_RHO0 * float(np.median(K[free, p]))
+    rho = _ADMM_RHO0 * float(K[:, p].mean())
     if not rho > 0.0:
         return None
     cubic = p == 3 and n >= 4  # U D U^T factor, coordinate-major vectors (admm_sweep_t)
@@ -587,7 +589,7 @@ def _admm_start(K: FloatArray, p: int, g0: FloatArray, free: np.ndarray, tol: fl
                     rho_old, rho = rho, new
                     if not factor(rho):
                         return None
-                    _k.admm_rescale(zp, up, gp, rho_old / rho, rho, yp)
+                    _k.admm_rescale(z, u, g, rho_old / rho, rho, y)  # elementwise
     lam = np.empty(n)
     sl, ss, m = _k.admm_multipliers(zp, up, free, rho, t2, lam)
     kappa = (sl / m) / max(ss / m, 1e-3)
