@@ -10,9 +10,13 @@ some unknowns fixed (``fix[i, a]``: row and column replaced by the identity). ``
 with bandwidth ``kd = (p + 1) dim - 1`` (open curves) or cyclic-banded (closed curves).
 
 Storage: ``L[r, k] = M[r + k, r]`` (``k = 0 .. kd``; closed curves: row ``(r + k) mod N``), one
-row per unknown, factorised in place (right-looking band Cholesky). Closed curves are solved
-by bordering: the last ``kd`` unknowns are eliminated through a ``kd x kd`` Schur complement,
-``O(N kd^2)`` in all. Everything is ``O(N)`` time and memory.
+row per unknown, factorised in place: open curves ``U D U^T`` (:func:`assemble_ldl`, the
+planar cubic window in registers), closed curves band Cholesky, solved by bordering: the last
+``kd`` unknowns are eliminated through a ``kd x kd`` Schur complement, ``O(N kd^2)`` in all.
+Everything is ``O(N)`` time and memory.
+
+The ADMM warm start of open curves (:func:`admm_factor`, :func:`admm_sweep_t`) factorises the
+``n x n`` band ``K + rho I`` once for all coordinates.
 """
 
 from __future__ import annotations
@@ -261,27 +265,248 @@ def assemble(K, p, closed, B, Q, rot, fix, L):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def assemble_cholesky(K, p, B, Q, rot, fix, L):  # type: ignore[no-untyped-def]
-    """Assemble (open curves) and factorise in one pass: the columns of a point are written just
-    before the first elimination step that updates them, so ``L`` is streamed once.
-    Returns 0 or ``j + 1`` for a non-positive pivot ``j``."""
+def assemble_ldl(K, p, B, Q, rot, fix, L):  # type: ignore[no-untyped-def]
+    """Assemble (open curves) and factorise ``M = U D U^T`` (``U`` unit lower band) in one pass:
+    the columns of a batch of points are written just before the first elimination step that
+    needs them. On exit ``L[j, 0] = 1 / D_j`` and ``L[j, k] = U[j + k, j]`` (see
+    :func:`ldl_solve`). For ``kd = 7`` (planar cubics) the partially eliminated 7 x 7 window
+    is kept in registers (the band is read once and written once, no read-modify-write of
+    the trailing rows); otherwise right-looking in place. Returns 0 or ``j + 1`` for a
+    non-positive pivot ``j``."""
     n = K.shape[0]
     dim = B.shape[1]
     N = n * dim
     kd = L.shape[1] - 1
     nxt = 0
     j = 0
+    if kd == 7 and N > 16:
+        nxt = min(n, 256)
+        _assemble_range(K, p, False, B, Q, rot, fix, L, 0, nxt)
+        p00 = L[0, 0]
+        p10 = L[0, 1]
+        p11 = L[1, 0]
+        p20 = L[0, 2]
+        p21 = L[1, 1]
+        p22 = L[2, 0]
+        p30 = L[0, 3]
+        p31 = L[1, 2]
+        p32 = L[2, 1]
+        p33 = L[3, 0]
+        p40 = L[0, 4]
+        p41 = L[1, 3]
+        p42 = L[2, 2]
+        p43 = L[3, 1]
+        p44 = L[4, 0]
+        p50 = L[0, 5]
+        p51 = L[1, 4]
+        p52 = L[2, 3]
+        p53 = L[3, 2]
+        p54 = L[4, 1]
+        p55 = L[5, 0]
+        p60 = L[0, 6]
+        p61 = L[1, 5]
+        p62 = L[2, 4]
+        p63 = L[3, 3]
+        p64 = L[4, 2]
+        p65 = L[5, 1]
+        p66 = L[6, 0]
+        jend = N - 7
+        while j < jend:
+            if j + 7 >= nxt * dim and nxt < n:
+                stop = min(n, nxt + 256)
+                _assemble_range(K, p, False, B, Q, rot, fix, L, nxt, stop)
+                nxt = stop
+            d = p00
+            if not d > 0.0:
+                return j + 1
+            r = 1.0 / d
+            a1 = p10
+            a2 = p20
+            a3 = p30
+            a4 = p40
+            a5 = p50
+            a6 = p60
+            a7 = L[j, 7]
+            l1 = a1 * r
+            l2 = a2 * r
+            l3 = a3 * r
+            l4 = a4 * r
+            l5 = a5 * r
+            l6 = a6 * r
+            l7 = a7 * r
+            L[j, 0] = r
+            L[j, 1] = l1
+            L[j, 2] = l2
+            L[j, 3] = l3
+            L[j, 4] = l4
+            L[j, 5] = l5
+            L[j, 6] = l6
+            L[j, 7] = l7
+            p00 = p11 - l1 * a1
+            p10 = p21 - l2 * a1
+            p11 = p22 - l2 * a2
+            p20 = p31 - l3 * a1
+            p21 = p32 - l3 * a2
+            p22 = p33 - l3 * a3
+            p30 = p41 - l4 * a1
+            p31 = p42 - l4 * a2
+            p32 = p43 - l4 * a3
+            p33 = p44 - l4 * a4
+            p40 = p51 - l5 * a1
+            p41 = p52 - l5 * a2
+            p42 = p53 - l5 * a3
+            p43 = p54 - l5 * a4
+            p44 = p55 - l5 * a5
+            p50 = p61 - l6 * a1
+            p51 = p62 - l6 * a2
+            p52 = p63 - l6 * a3
+            p53 = p64 - l6 * a4
+            p54 = p65 - l6 * a5
+            p55 = p66 - l6 * a6
+            p60 = L[j + 1, 6] - l7 * a1
+            p61 = L[j + 2, 5] - l7 * a2
+            p62 = L[j + 3, 4] - l7 * a3
+            p63 = L[j + 4, 3] - l7 * a4
+            p64 = L[j + 5, 2] - l7 * a5
+            p65 = L[j + 6, 1] - l7 * a6
+            p66 = L[j + 7, 0] - l7 * a7
+            j += 1
+        # write the window back (right-looking storage) and finish in place
+        L[j + 0, 0] = p00
+        L[j + 0, 1] = p10
+        L[j + 1, 0] = p11
+        L[j + 0, 2] = p20
+        L[j + 1, 1] = p21
+        L[j + 2, 0] = p22
+        L[j + 0, 3] = p30
+        L[j + 1, 2] = p31
+        L[j + 2, 1] = p32
+        L[j + 3, 0] = p33
+        L[j + 0, 4] = p40
+        L[j + 1, 3] = p41
+        L[j + 2, 2] = p42
+        L[j + 3, 1] = p43
+        L[j + 4, 0] = p44
+        L[j + 0, 5] = p50
+        L[j + 1, 4] = p51
+        L[j + 2, 3] = p52
+        L[j + 3, 2] = p53
+        L[j + 4, 1] = p54
+        L[j + 5, 0] = p55
+        L[j + 0, 6] = p60
+        L[j + 1, 5] = p61
+        L[j + 2, 4] = p62
+        L[j + 3, 3] = p63
+        L[j + 4, 2] = p64
+        L[j + 5, 1] = p65
+        L[j + 6, 0] = p66
     while j < N:
-        stop = min(n, nxt + 256)
-        _assemble_range(K, p, False, B, Q, rot, fix, L, nxt, stop)
-        nxt = stop
+        if nxt < n:
+            stop = min(n, nxt + 256)
+            _assemble_range(K, p, False, B, Q, rot, fix, L, nxt, stop)
+            nxt = stop
         # columns whose updates reach only assembled rows
         j1 = N if nxt == n else max(j, nxt * dim - kd)
-        info = _chol_cols(L, j, j1, N)
+        info = _ldl_cols(L, j, j1, N)
         if info:
             return info
         j = j1
     return 0
+
+
+@njit(cache=True)
+def _ldl_cols(L, j0, j1, N):  # type: ignore[no-untyped-def]
+    """Elimination steps ``j0 .. j1 - 1`` of the band ``U D U^T`` factorisation of the first
+    ``N`` rows, right looking in place (see :func:`assemble_ldl`)."""
+    kd = L.shape[1] - 1
+    for j in range(j0, j1):
+        d = L[j, 0]
+        if not d > 0.0:
+            return j + 1
+        r = 1.0 / d
+        L[j, 0] = r
+        kmax = min(kd, N - 1 - j)
+        for a in range(1, kmax + 1):
+            aa = L[j, a]
+            if aa != 0.0:
+                la = aa * r
+                for b in range(a, kmax + 1):
+                    L[j + a, b - a] -= L[j, b] * la
+        for k in range(1, kmax + 1):
+            L[j, k] *= r
+    return 0
+
+
+@njit(cache=True)
+def ldl_solve(L, N, x):  # type: ignore[no-untyped-def]
+    """Solve ``U D U^T y = x`` in place (factor of :func:`assemble_ldl`), left looking: each
+    substitution step is one multiply-add on the recurrence (``kd = 7`` written out with the
+    last seven unknowns in registers)."""
+    kd = L.shape[1] - 1
+    if kd == 7 and N > 7:
+        x1 = 0.0
+        x2 = 0.0
+        x3 = 0.0
+        x4 = 0.0
+        x5 = 0.0
+        x6 = 0.0
+        x7 = 0.0
+        for j in range(N):
+            if j >= 7:
+                s = (x[j] - L[j - 7, 7] * x7 - L[j - 6, 6] * x6 - L[j - 5, 5] * x5
+                     - L[j - 4, 4] * x4 - L[j - 3, 3] * x3 - L[j - 2, 2] * x2)
+                v = s - L[j - 1, 1] * x1
+            else:
+                v = x[j]
+                for k in range(1, j + 1):
+                    v -= L[j - k, k] * x[j - k]
+            x[j] = v
+            x7 = x6
+            x6 = x5
+            x5 = x4
+            x4 = x3
+            x3 = x2
+            x2 = x1
+            x1 = v
+        for j in range(N):
+            x[j] *= L[j, 0]
+        x1 = 0.0
+        x2 = 0.0
+        x3 = 0.0
+        x4 = 0.0
+        x5 = 0.0
+        x6 = 0.0
+        x7 = 0.0
+        for i in range(N - 1, -1, -1):
+            if i + 7 < N:
+                s = (x[i] - L[i, 7] * x7 - L[i, 6] * x6 - L[i, 5] * x5 - L[i, 4] * x4
+                     - L[i, 3] * x3 - L[i, 2] * x2)
+                v = s - L[i, 1] * x1
+            else:
+                v = x[i]
+                for k in range(1, N - i):
+                    v -= L[i, k] * x[i + k]
+            x[i] = v
+            x7 = x6
+            x6 = x5
+            x5 = x4
+            x4 = x3
+            x3 = x2
+            x2 = x1
+            x1 = v
+        return
+    for j in range(N):
+        v = x[j]
+        for k in range(1, min(kd, j) + 1):
+            v -= L[j - k, k] * x[j - k]
+        x[j] = v
+    for j in range(N):
+        x[j] *= L[j, 0]
+    for i in range(N - 1, -1, -1):
+        v = x[i]
+        for k in range(1, min(kd, N - 1 - i) + 1):
+            v -= L[i, k] * x[i + k]
+        x[i] = v
 
 
 @njit(cache=True)

@@ -209,7 +209,7 @@ class _System:
             _k.assemble(self.K, self.p, True, B, self.Q, self.rot, self.fix, self.L)
             info = _k.cyclic_cholesky(self.L, self.Y, self.S)
         else:
-            info = _k.assemble_cholesky(self.K, self.p, B, self.Q, self.rot, self.fix, self.L)
+            info = _k.assemble_ldl(self.K, self.p, B, self.Q, self.rot, self.fix, self.L)
         return info == 0
 
     def solve(self, rhs: FloatArray, c: FloatArray | None = None,
@@ -232,7 +232,7 @@ class _System:
         elif self.closed:
             _k.cyclic_solve_full(self.L, self.Y, self.S, b)
         else:
-            _k.band_solve(self.L, self.N, b)
+            _k.ldl_solve(self.L, self.N, b)
         if self.anyrot:
             _k.post_solve(y, self.Q, self.rot, self.fix0)
         else:
