@@ -287,8 +287,7 @@ def test_admm_sweep_matches_dense_solve_and_projection(dim, p):
                 K[i, p + o] = M[i, i + o]
     rho, alpha = 0.7, 1.6
     L = np.empty((n, p + 1))
-    F = np.empty((n, p + 1) if p == 3 else (1, 1))
-    assert _k.admm_factor(K, p, rho, L, F) == 0
+    assert _k.admm_factor(K, p, rho, L) == 0
     g0 = rng.normal(size=(n, dim))
     z = 0.1 * rng.normal(size=(n, dim))
     u = 0.1 * rng.normal(size=(n, dim))
@@ -303,7 +302,7 @@ def test_admm_sweep_matches_dense_solve_and_projection(dim, p):
     z0 = z.copy()
     if p == 3:  # U D U^T factor, coordinate-major vectors
         yt, zt, ut = (np.ascontiguousarray(a.T) for a in (y, z0, u))
-        _k.admm_sweep_t(L, F, yt, zt, ut, np.ascontiguousarray(g0.T), rho, r2, alpha)
+        _k.admm_sweep_t(L, yt, zt, ut, np.ascontiguousarray(g0.T), rho, 0.05, r2 > 0, alpha)
         y, z0, u = yt.T, zt.T, ut.T
     else:
         rr, dz = _k.admm_sweep(L, y, z0, u, g0, rho, r2, alpha)

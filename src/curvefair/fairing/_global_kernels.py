@@ -1107,19 +1107,16 @@ def shift_cholesky(K, p, rho, L):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def admm_factor(K, p, rho, L, F):  # type: ignore[no-untyped-def]
-    """Factor of ``K + rho I`` (open curve) for :func:`admm_sweep`. ``p = 3``: ``K + rho I = U D
-    U^T`` (``U`` unit lower) computed with the active window in registers (one division, one
-    multiply and one multiply-add on the pivot recurrence, no square root): ``L[i, k] =
-    U[i + k, i]`` (backward substitution), ``F[j, k] = U[j, j - k]`` (forward substitution) and
-    ``F[j, 0] = 1 / D_j``. Otherwise the band Cholesky of :func:`shift_cholesky` (``F``
-    unused). Returns 0 or ``j + 1`` for a non-positive pivot ``j``."""
+def admm_factor(K, p, rho, L):  # type: ignore[no-untyped-def]
+    """Factor of ``K + rho I`` (open curve) for the ADMM sweeps. ``p = 3`` (for
+    :func:`admm_sweep_t`): ``K + rho I = U D U^T`` (``U`` unit lower) computed with the active
+    window in registers (one division, one multiply and one multiply-add on the pivot
+    recurrence, no square root), ``L[i, 0] = 1 / D_i``, ``L[i, k] = U[i + k, i]``. Otherwise
+    the band Cholesky of :func:`shift_cholesky` (for :func:`admm_sweep`). Returns 0 or
+    ``j + 1`` for a non-positive pivot ``j``."""
     n = K.shape[0]
     if p != 3 or n < 4:
         return shift_cholesky(K, p, rho, L)
-    for k in range(1, 4):
-        for j in range(k):
-            F[j, k] = 0.0
     # pending (partially eliminated) entries: P00 = A'[j, j], P10 = A'[j+1, j], P20 = A'[j+2, j],
     # P11 = A'[j+1, j+1], P21 = A'[j+2, j+1], P22 = A'[j+2, j+2]
     P00 = K[0, 3] + rho
@@ -1143,13 +1140,7 @@ def admm_factor(K, p, rho, L, F):  # type: ignore[no-untyped-def]
         L[j, 1] = l1
         L[j, 2] = l2
         L[j, 3] = l3
-        F[j, 0] = r
-        if j + 1 < n:
-            F[j + 1, 1] = l1
-        if j + 2 < n:
-            F[j + 2, 2] = l2
         if j + 3 < n:
-            F[j + 3, 3] = l3
             e31 = K[j + 1, 5]
             e32 = K[j + 2, 4]
             e33 = K[j + 3, 3] + rho
@@ -1226,13 +1217,15 @@ def admm_sweep(L, y, z, u, g0, rho, r2, alpha):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def admm_sweep_t(L, F, y, z, u, g0, rho, r2, alpha):  # type: ignore[no-untyped-def]
+def admm_sweep_t(L, y, z, u, g0, rho, t2, free, alpha):  # type: ignore[no-untyped-def]
     """:func:`admm_sweep` for cubics (``p = 3``, the ``U D U^T`` factor of :func:`admm_factor`)
-    on COORDINATE-MAJOR arrays ``y, z, u, g0`` of shape ``(dim, n)``: unit substitutions with
-    the last three unknowns in registers (one multiply-add on each recurrence, the newest
-    unknown subtracted last), then the relaxation / projection / dual update as a separate
-    loop over contiguous coordinates, which the compiler vectorises (about 40 % faster than
-    the same work interleaved with the backward substitution)."""
+    on COORDINATE-MAJOR arrays ``y, z, u, g0`` of shape ``(dim, n)``, balls of radius^2 ``t2``
+    at the ``free`` points (0 elsewhere): unit substitutions with the last three unknowns in
+    registers (one multiply-add on each recurrence, the newest unknown subtracted last; the
+    forward coefficients ``U[j, j - k] = L[j - k, k]`` read from the neighbouring rows), then
+    the relaxation / projection / dual update as a separate loop over contiguous coordinates,
+    which the compiler vectorises (about 40 % faster than the same work interleaved with the
+    backward substitution)."""
     dim, n = y.shape
     if dim == 2:
         a1 = 0.0
@@ -1242,12 +1235,14 @@ def admm_sweep_t(L, F, y, z, u, g0, rho, r2, alpha):  # type: ignore[no-untyped-
         b2 = 0.0
         b3 = 0.0
         for j in range(n):
-            ta = y[0, j] - F[j, 3] * a3 - F[j, 2] * a2
-            tb = y[1, j] - F[j, 3] * b3 - F[j, 2] * b2
-            c1 = F[j, 1]
-            va = ta - c1 * a1
-            vb = tb - c1 * b1
-            r = F[j, 0]
+            f3 = L[j - 3, 3] if j >= 3 else 0.0
+            f2 = L[j - 2, 2] if j >= 2 else 0.0
+            f1 = L[j - 1, 1] if j >= 1 else 0.0
+            ta = y[0, j] - f3 * a3 - f2 * a2
+            tb = y[1, j] - f3 * b3 - f2 * b2
+            va = ta - f1 * a1
+            vb = tb - f1 * b1
+            r = L[j, 0]
             y[0, j] = va * r
             y[1, j] = vb * r
             a3 = a2
@@ -1282,7 +1277,7 @@ def admm_sweep_t(L, F, y, z, u, g0, rho, r2, alpha):  # type: ignore[no-untyped-
             zb = z[1, i]
             wa = alpha * y[0, i] + beta * za + u[0, i]
             wb = alpha * y[1, i] + beta * zb + u[1, i]
-            ri = r2[i]
+            ri = t2 if free[i] else 0.0
             den = max(wa * wa + wb * wb, ri)
             f = np.sqrt(ri / den) if den > 0.0 else 1.0
             zna = wa * f
@@ -1301,8 +1296,14 @@ def admm_sweep_t(L, F, y, z, u, g0, rho, r2, alpha):  # type: ignore[no-untyped-
         v2 = 0.0
         v3 = 0.0
         for j in range(n):
-            v = y[a, j] - F[j, 3] * v3 - F[j, 2] * v2 - F[j, 1] * v1
-            y[a, j] = v * F[j, 0]
+            v = y[a, j]
+            if j >= 3:
+                v -= L[j - 3, 3] * v3
+            if j >= 2:
+                v -= L[j - 2, 2] * v2
+            if j >= 1:
+                v -= L[j - 1, 1] * v1
+            y[a, j] = v * L[j, 0]
             v3 = v2
             v2 = v1
             v1 = v
@@ -1322,7 +1323,7 @@ def admm_sweep_t(L, F, y, z, u, g0, rho, r2, alpha):  # type: ignore[no-untyped-
             wa = alpha * y[a, i] + beta * z[a, i] + u[a, i]
             y[a, i] = wa
             q2 += wa * wa
-        ri = r2[i]
+        ri = t2 if free[i] else 0.0
         den = max(q2, ri)
         f = np.sqrt(ri / den) if den > 0.0 else 1.0
         for a in range(dim):

@@ -548,36 +548,36 @@ def _admm_start(K: FloatArray, p: int, g0: FloatArray, free: np.ndarray, tol: fl
     of it. None if the factorisation fails."""
     n, dim = g0.shape
     t2 = tol * tol
-    r2 = np.where(free, t2, 0.0)
     rho = _ADMM_RHO0 * float(K[:, p].mean())
     if not rho > 0.0:
         return None
     cubic = p == 3 and n >= 4  # U D U^T factor, coordinate-major vectors (admm_sweep_t)
     vec = (dim, n) if cubic else (n, dim)
-    shapes = [(n, p + 1), (n, p + 1) if cubic else (1, 1), vec, vec, vec, vec]
+    shapes = [(n, p + 1), vec, vec, vec, vec]
     sizes = [a * b for a, b in shapes]
     if scratch is not None and scratch.size >= sum(sizes):
         offs = np.cumsum([0] + sizes)[:-1]
-        L, F, z, u, y, g = (scratch[o:o + m].reshape(sh)
-                            for o, m, sh in zip(offs, sizes, shapes, strict=True))
+        L, z, u, y, g = (scratch[o:o + m].reshape(sh)
+                         for o, m, sh in zip(offs, sizes, shapes, strict=True))
         z[:] = 0.0
         u[:] = 0.0
     else:
-        L, F, z, u, y, g = (np.zeros(sh) for sh in shapes)
+        L, z, u, y, g = (np.zeros(sh) for sh in shapes)
+    r2 = None if cubic else np.where(free, t2, 0.0)
     # (n, dim) views for the per-point bookkeeping
     zp, up, yp, gp = (a.T for a in (z, u, y, g)) if cubic else (z, u, y, g)
     gp[:] = g0
     np.negative(gp, out=yp)
 
     def factor(rho: float) -> bool:
-        return _k.admm_factor(K, p, rho, L, F) == 0
+        return _k.admm_factor(K, p, rho, L) == 0
 
     if not factor(rho):
         return None
     un = np.empty(n)
     for it in range(1, _ADMM_ITERS + 1):
         if cubic:
-            _k.admm_sweep_t(L, F, y, z, u, g, rho, r2, _ADMM_ALPHA)
+            _k.admm_sweep_t(L, y, z, u, g, rho, t2, free, _ADMM_ALPHA)
         else:
             _k.admm_sweep(L, y, z, u, g, rho, r2, _ADMM_ALPHA)
         if it % _ADMM_ADAPT == 0 and it < _ADMM_ITERS:
