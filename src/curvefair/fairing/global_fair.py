@@ -640,7 +640,7 @@ def _active_set_newton(system: _System, g0: FloatArray, free: np.ndarray, tol: f
         if stat <= 1e-10 and feas <= 1e-12 and fS <= 1e-12:
             return v, lam, it, True
         if it == maxit or feas > 1.0:  # feas > 1: a point went past sqrt(3) tol, diverging
-            break
+            return v, lam, it, False
         # in the fast (quadratic) phase with an unchanged active set the matrix has changed
         # only by the last, small step (frames, multipliers): reuse its factorisation (an
         # inexact Newton step; the next step refactorises unless it too reduced the residual
