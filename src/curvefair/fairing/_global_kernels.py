@@ -909,6 +909,13 @@ def post_solve(y, Q, rot, fix0):  # type: ignore[no-untyped-def]
         if fix0[i, 0]:
             for a in range(dim):
                 y[i, a] = 0.0
+        elif rot[i] and dim == 2:  # Q = [[q0, -q1], [q1, q0]]: only its first column is read
+            q0 = Q[i, 0, 0]
+            q1 = Q[i, 1, 0]
+            w0 = y[i, 0]
+            w1 = y[i, 1]
+            y[i, 0] = q0 * w0 - q1 * w1
+            y[i, 1] = q1 * w0 + q0 * w1
         elif rot[i]:
             w0 = y[i, 0]
             w1 = y[i, 1]
@@ -1475,8 +1482,10 @@ def ssn_eval_prep(g0, K, p, closed, v, lam, free, t2, kappa, delta, S, rd, f, rh
     (v != 0)`` (``f = (|v|^2 / t2 - 1) / 2``); ``lam`` clipped to ``max(lam, 0)`` on ``S`` and 0
     elsewhere; ``rd = g0 + K v + lam v / t2``; blocks ``B = (lam / t2 + delta) I``; at the
     active points the unit normals ``nrm``, the prescribed normal displacements ``c = -f t2 /
-    |v|`` (the linearised sphere), their frames ``Q`` (as :func:`set_frames`) and ``fix = fix0``
-    plus the normal axis. Returns ``(max |rd|, max f over free, max |f| over S, |S|)``."""
+    |v|`` (the linearised sphere), their frames ``Q`` (as :func:`set_frames`; planar: the first
+    column only, and only the diagonal of ``B``, whose other entries must be 0) and ``fix =
+    fix0`` plus the normal axis. Returns ``(max |rd|, max f over free, max |f| over S,
+    |S|)``."""
     n, dim = v.shape
     c23 = dim == 2 and p == 3
     rdm = 0.0
@@ -1548,19 +1557,21 @@ def ssn_eval_prep(g0, K, p, closed, v, lam, free, t2, kappa, delta, S, rd, f, rh
                 if abs(x) > rdm:
                     rdm = abs(x)
         iso = lam[i] / t2 + delta
-        for a in range(dim):
-            for b in range(dim):
-                B[i, a, b] = iso if a == b else 0.0
+        if dim == 2:  # off-diagonal entries stay 0 (B allocated zero)
+            B[i, 0, 0] = iso
+            B[i, 1, 1] = iso
+        else:
+            for a in range(dim):
+                for b in range(dim):
+                    B[i, a, b] = iso if a == b else 0.0
         if S[i]:
             for a in range(dim):
                 nrm[i, a] = v[i, a] / r
             c[i] = -fi * t2 / r
             fix[i, 0] = True
-            if dim == 2:
+            if dim == 2:  # first column only: the planar kernels build the rotation from it
                 Q[i, 0, 0] = nrm[i, 0]
                 Q[i, 1, 0] = nrm[i, 1]
-                Q[i, 0, 1] = -nrm[i, 1]
-                Q[i, 1, 1] = nrm[i, 0]
             else:
                 x0 = nrm[i, 0]
                 y0 = nrm[i, 1]

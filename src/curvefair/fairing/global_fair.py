@@ -192,6 +192,9 @@ class _System:
             self.rot[:] = rot
             _k.set_frames(nrm, rot, self.Q, self.fix, self.fix0)
         if self.dense:
+            if self.dim == 2:  # planar frames may hold their first column only
+                self.Q[:, 0, 1] = -self.Q[:, 1, 0]
+                self.Q[:, 1, 1] = self.Q[:, 0, 0]
             M = self.Kd + _blockdiag(B)
             Qf = _blockdiag(np.where(self.rot[:, None, None], self.Q,
                                      np.eye(self.dim)[None]))
@@ -623,7 +626,7 @@ def _active_set_newton(system: _System, g0: FloatArray, free: np.ndarray, tol: f
     rd = np.empty_like(v)
     f = np.empty(n)
     rho = np.empty(n)
-    B = np.empty((n, dim, dim))
+    B = np.zeros((n, dim, dim))  # ssn_eval_prep writes the diagonal (planar)
     nrm = np.empty_like(v)
     c = np.empty(n)
     dv = np.empty_like(v)
