@@ -23,9 +23,9 @@ changes at the data parameters (inflections; the smooth curve has about ``N / (7
 default is ``1e-4``), each against csaps at its own maximum deviation: the steps/fairness
 trade-off of the stopping rule; each ratio line says whether that run is as fair as csaps or
 fairer (both E2 and E3 ratios <= 1). At n = 1e6, sigma = 0.05, tol = 0.3 the largest such
-threshold among 3e-4, 5e-4, 7e-4, 1e-3 was 5e-4 (3.65M steps; E2 0.9990, E3 0.9640; 7e-4:
-E2 1.0001, E3 0.9941; 1e-3: E2 1.0012, E3 1.0352), so ``--eh-eps 5e-4`` is the labelled
-Eck-Hadenfeld run at csaps-level fairness. Each timed
+threshold among 3e-4, 5e-4, 6e-4, 7e-4, 1e-3 was 6e-4 (3.27M steps; E2 0.9996, E3 0.9795;
+7e-4: E2 1.0001, E3 0.9941; 1e-3: E2 1.0012, E3 1.0352), so ``--eh-eps 6e-4`` is the
+labelled Eck-Hadenfeld run at csaps-level fairness. Each timed
 Eck-Hadenfeld run starts from a fresh copy of the interpolant (Gram band not cached).
 ``--profile-csaps`` prints where one csaps call spends its time.
 

@@ -741,7 +741,7 @@ def eck_hadenfeld_fair(curve: BSplineCurve, *, l: int = 2, tol: float | None = N
         21 steps per control point at the default, 5 at ``3e-4 / n`` and 2.5 at
         ``1e-3 / n``, ending 1.2 % and 1.7 % higher in ``E_2``; against csaps' smoothing
         spline at the same maximum deviation it is fairer in both ``E_2`` and ``E_3`` up to
-        ``5e-4 / n`` (3.7 steps per control point) and slightly less fair in ``E_2`` from
+        ``6e-4 / n`` (3.3 steps per control point) and slightly less fair in ``E_2`` from
         ``7e-4 / n`` (ratio 1.0001; ``1e-3 / n``: 1.001, ``E_3`` 1.035). The default is kept.
     max_steps : int or None
         Step cap (default ``100 n``).
