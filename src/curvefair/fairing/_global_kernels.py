@@ -468,8 +468,6 @@ def ldl_solve(L, N, x):  # type: ignore[no-untyped-def]
             x3 = x2
             x2 = x1
             x1 = v
-        for j in range(N):
-            x[j] *= L[j, 0]
         x1 = 0.0
         x2 = 0.0
         x3 = 0.0
@@ -477,13 +475,13 @@ def ldl_solve(L, N, x):  # type: ignore[no-untyped-def]
         x5 = 0.0
         x6 = 0.0
         x7 = 0.0
-        for i in range(N - 1, -1, -1):
+        for i in range(N - 1, -1, -1):  # the D^-1 scaling folded in (same cache line)
             if i + 7 < N:
-                s = (x[i] - L[i, 7] * x7 - L[i, 6] * x6 - L[i, 5] * x5 - L[i, 4] * x4
-                     - L[i, 3] * x3 - L[i, 2] * x2)
+                s = (x[i] * L[i, 0] - L[i, 7] * x7 - L[i, 6] * x6 - L[i, 5] * x5
+                     - L[i, 4] * x4 - L[i, 3] * x3 - L[i, 2] * x2)
                 v = s - L[i, 1] * x1
             else:
-                v = x[i]
+                v = x[i] * L[i, 0]
                 for k in range(1, N - i):
                     v -= L[i, k] * x[i + k]
             x[i] = v
