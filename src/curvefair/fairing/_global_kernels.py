@@ -1586,10 +1586,7 @@ def ssn_eval_prep(g0, K, p, closed, v, lam, free, t2, kappa, delta, S, rd, f, rh
                 Q[i, 0, 2] = b_
                 Q[i, 1, 2] = sgn + y0 * y0 * a_
                 Q[i, 2, 2] = -y0
-        else:
-            for a in range(dim):
-                nrm[i, a] = 0.0
-            c[i] = 0.0
+        # (nrm, c and Q of inactive points are left as they are: never read)
     return rdm, fm, fsm, ns
 
 

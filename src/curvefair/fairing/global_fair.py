@@ -627,8 +627,8 @@ def _active_set_newton(system: _System, g0: FloatArray, free: np.ndarray, tol: f
     f = np.empty(n)
     rho = np.empty(n)
     B = np.zeros((n, dim, dim))  # ssn_eval_prep writes the diagonal (planar)
-    nrm = np.empty_like(v)
-    c = np.empty(n)
+    nrm = np.zeros_like(v)  # written at the active points only
+    c = np.zeros(n)
     dv = np.empty_like(v)
     S_fac = np.zeros(n, dtype=np.bool_)  # active set of the current factorisation
     have_fac = False
