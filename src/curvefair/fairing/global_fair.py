@@ -558,7 +558,12 @@ def _admm_start(K: FloatArray, p: int, g0: FloatArray, free: np.ndarray, tol: fl
     cubic = p == 3 and n >= 4  # U D U^T factor, coordinate-major vectors (admm_sweep_t)
     vec = (dim, n) if cubic else (n, dim)
     # cubics: float32 storage (a warm start; the sweep is memory-bound: 5.8 -> 4.8 ms at 1e6)
-    dt = np.float32 if cubic else np.float64
+    # when every stored quantity (factor entries and their reciprocals ~ diag K, vectors ~ tol,
+    # tol diag K, g0) is far inside its range (|K_ij| <= max diagonal)
+    kd = float(K[:, p].max())
+    gm = float(np.abs(g0).max())
+    safe = all(1e-25 < q < 1e25 for q in (kd, rho / _ADMM_RHO0, tol, kd * tol, gm or 1.0))
+    dt = np.float32 if cubic and safe else np.float64
     shapes = [(n, p + 1), vec, vec, vec, vec]
     sizes = [a * b for a, b in shapes]
     if scratch is not None:
