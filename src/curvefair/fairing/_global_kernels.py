@@ -1512,11 +1512,11 @@ def ssn_eval_prep(g0, K, p, closed, v, lam, free, t2, kappa, delta, S, rd, f, rh
                 ns += 1
                 if lam[i] < 0.0:
                     lam[i] = 0.0
-                if abs(fi) > fsm:
+                if not abs(fi) <= fsm:
                     fsm = abs(fi)
             else:
                 lam[i] = 0.0
-            if fi > fm:
+            if not fi <= fm:
                 fm = fi
             li = lam[i]
             interior = i >= p and i + p < n
@@ -1533,7 +1533,7 @@ def ssn_eval_prep(g0, K, p, closed, v, lam, free, t2, kappa, delta, S, rd, f, rh
                            + k4 * v[i + 1, a] + k5 * v[i + 2, a] + k6 * v[i + 3, a])
                     x = g0[i, a] + acc + li * (v[i, a] / t2)
                     rd[i, a] = x
-                    if abs(x) > rdm:
+                    if not abs(x) <= rdm:  # NaN propagates
                         rdm = abs(x)
             for a in range(dim):
                 if c23 and interior:
@@ -1552,7 +1552,7 @@ def ssn_eval_prep(g0, K, p, closed, v, lam, free, t2, kappa, delta, S, rd, f, rh
                         acc += K[i, p + o] * v[j, a]
                 x = g0[i, a] + acc + li * (v[i, a] / t2)
                 rd[i, a] = x
-                if abs(x) > rdm:
+                if not abs(x) <= rdm:  # NaN propagates
                     rdm = abs(x)
         iso = lam[i] / t2 + delta
         if dim == 2:  # off-diagonal entries stay 0 (B allocated zero)

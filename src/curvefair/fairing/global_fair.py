@@ -605,6 +605,8 @@ def _admm_start(K: FloatArray, p: int, g0: FloatArray, free: np.ndarray, tol: fl
                     _k.admm_rescale(z, u, g, rho_old / rho, rho, y)  # elementwise
     lam = np.empty(n)
     sl, ss, m = _k.admm_multipliers(zp, up, free, rho, t2, lam)
+    if not (np.isfinite(sl) and np.isfinite(ss) and np.isfinite(z).all()):
+        return None
     kappa = (sl / m) / max(ss / m, 1e-3)
     if not kappa > 0.0:
         kappa = rho * t2
