@@ -375,3 +375,19 @@ def test_huge_page_setting_restored(flag):
         assert bool(get()) is flag
     finally:
         _np_ma._set_madvise_hugepage(old)
+
+
+@pytest.mark.parametrize("scale", [1e-20, 1e20])
+def test_extreme_scales_stay_finite_and_feasible(scale):
+    """Far from unit scale (the Gram band ~ scale^-2) the warm start switches to float64
+    storage; the result is finite, converged, within tol and no worse than the input."""
+    rng = np.random.default_rng(0)
+    x = np.linspace(0, 8, 400)
+    c = interpolate_bspline(np.c_[x, np.sin(x) + 0.05 * rng.normal(size=400)] * scale)
+    tol = 0.02 * scale
+    res = global_fair(c, tol=tol)
+    assert res.stop_reason == "converged"
+    d = np.asarray(res.curve.control_points)
+    assert np.isfinite(d).all()
+    assert np.linalg.norm(d - c.control_points, axis=1).max() <= tol
+    assert res.energy_after <= res.energy_before
