@@ -379,8 +379,8 @@ def test_huge_page_setting_restored(flag):
 
 @pytest.mark.parametrize("scale", [1e-20, 1e20])
 def test_extreme_scales_stay_finite_and_feasible(scale):
-    """Far from unit scale (the Gram band ~ scale^-2) the warm start switches to float64
-    storage; the result is finite, converged, within tol and no worse than the input."""
+    """Far from unit scale (the Gram band ~ scale^-2; all storage is float64): the result is
+    finite, converged, within tol and no worse than the input."""
     rng = np.random.default_rng(0)
     x = np.linspace(0, 8, 400)
     c = interpolate_bspline(np.c_[x, np.sin(x) + 0.05 * rng.normal(size=400)] * scale)

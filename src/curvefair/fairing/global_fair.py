@@ -557,17 +557,8 @@ def _admm_start(K: FloatArray, p: int, g0: FloatArray, free: np.ndarray, tol: fl
         return None
     cubic = p == 3 and n >= 4  # U D U^T factor, coordinate-major vectors (admm_sweep_t)
     vec = (dim, n) if cubic else (n, dim)
-    # cubics: float32 storage (a warm start; the sweep is memory-bound: 5.8 -> 4.8 ms at 1e6)
-    # when every stored quantity (factor entries and their reciprocals ~ diag K, vectors ~ tol,
-    # tol diag K, g0) is far inside its range (|K_ij| <= max diagonal)
-    kd = float(K[:, p].max())
-    gm = float(np.abs(g0).max())
-    safe = all(1e-25 < q < 1e25 for q in (kd, rho / _ADMM_RHO0, tol, kd * tol, gm or 1.0))
-    dt = np.float32 if cubic and safe else np.float64
     shapes = [(n, p + 1), vec, vec, vec, vec]
     sizes = [a * b for a, b in shapes]
-    if scratch is not None:
-        scratch = scratch.view(dt)
     if scratch is not None and scratch.size >= sum(sizes):
         offs = np.cumsum([0] + sizes)[:-1]
         L, z, u, y, g = (scratch[o:o + m].reshape(sh)
@@ -575,7 +566,7 @@ def _admm_start(K: FloatArray, p: int, g0: FloatArray, free: np.ndarray, tol: fl
         z[:] = 0.0
         u[:] = 0.0
     else:
-        L, z, u, y, g = (np.zeros(sh, dtype=dt) for sh in shapes)
+        L, z, u, y, g = (np.zeros(sh) for sh in shapes)
     r2 = None if cubic else np.where(free, t2, 0.0)
     # (n, dim) views for the per-point bookkeeping
     zp, up, yp, gp = (a.T for a in (z, u, y, g)) if cubic else (z, u, y, g)
@@ -610,7 +601,7 @@ def _admm_start(K: FloatArray, p: int, g0: FloatArray, free: np.ndarray, tol: fl
     kappa = (sl / m) / max(ss / m, 1e-3)
     if not kappa > 0.0:
         kappa = rho * t2
-    return zp.astype(np.float64), lam, kappa
+    return zp, lam, kappa
 
 
 def _matvec(K: FloatArray, p: int, closed: bool, x: FloatArray) -> FloatArray:
