@@ -299,3 +299,42 @@ def test_open_cubic_interpolant_matches_scipy_natural(spacing):
         scale = np.abs(ref.c).max()
         np.testing.assert_allclose(c.control_points, ref.c, rtol=0, atol=1e-10 * scale)
         np.testing.assert_allclose(c(t), pts, rtol=0, atol=1e-10 * scale)
+
+
+@pytest.mark.parametrize("spacing", ["uniform", "uneven", "wild"])
+def test_natural_cubic_elimination_matches_pivoting_solve(spacing):
+    # the compiled elimination without pivoting against LAPACK gbsv (partial pivoting) on the
+    # same tridiagonal system, both coordinates, plus the interpolation conditions
+    from curvefair.curves.bspline import _natural_cubic_gbsv, _natural_cubic_kernel
+
+    rng = np.random.default_rng(7 + len(spacing))
+    m = 400
+    if spacing == "uniform":
+        u = np.arange(m, dtype=float)
+    elif spacing == "uneven":
+        u = np.cumsum(rng.uniform(0.05, 3.0, m))
+    else:
+        u = np.cumsum(np.r_[0.0, rng.choice([1e-4, 1.0, 1e3], m - 1)])
+    pts = np.cumsum(rng.normal(size=(m, 2)), axis=0)
+    T = np.empty(m + 6)
+    d = np.empty((m + 2, 2))
+    assert _natural_cubic_kernel(u, pts, T, d)
+    ref = _natural_cubic_gbsv(u, pts, T)
+    scale = np.abs(ref).max()
+    # the wild spacing makes the system ill-conditioned (control points ~1e7): both solves
+    # interpolate to ~1e-16 relative but differ by ~2e-10 relative
+    np.testing.assert_allclose(d[1:-1], ref, rtol=0, atol=1e-9 * scale)
+    np.testing.assert_array_equal(d[[0, -1]], pts[[0, -1]])
+    c = BSplineCurve(d, T, 3)
+    np.testing.assert_allclose(c(u), pts, rtol=0, atol=1e-13 * scale)
+    np.testing.assert_allclose(c(u[[0, -1]], 2), 0.0, atol=1e-8 * scale / (u[1] - u[0]) ** 2)
+
+
+def test_interpolate_bspline_coincident_points_with_given_params():
+    # the compiled coincident check raises as_points' message, also when params are given
+    pts = np.c_[np.arange(8.0), np.zeros(8)]
+    pts[5] = pts[4]
+    with pytest.raises(InputError, match="indices 4 and 5"):
+        interpolate_bspline(pts, param=np.arange(8.0))
+    pts[5, 1] = 1e-9  # a tiny but real step is accepted
+    interpolate_bspline(pts, param=np.arange(8.0))

@@ -318,6 +318,19 @@ class BSplineCurve(PiecewiseCurve):
         self._closed = closed
         self._gram_cache: dict[int, FloatArray] = {}
 
+    @classmethod
+    def _trusted(cls, control_points: FloatArray, knots: FloatArray, degree: int,
+                 closed: bool) -> "BSplineCurve":
+        """A curve from arrays the caller has built valid (float64 ``(n, dim)`` finite control
+        points it owns, a full valid knot vector): no checks, no copies (both made read-only)."""
+        out = cls.__new__(cls)
+        out._ctrl = readonly(control_points)
+        out._knots = readonly(knots)
+        out.degree = int(degree)
+        out._closed = bool(closed)
+        out._gram_cache = {}
+        return out
+
     # -- validation -------------------------------------------------------------------------
     @staticmethod
     def _check_open_knots(t: FloatArray, n: int, p: int) -> None:
@@ -650,7 +663,11 @@ def interpolate_bspline(points: ArrayLike, degree: int = 3, param: str | ArrayLi
         loop = np.vstack([pts, pts[:1]])
         spl = make_interp_spline(t, loop, k=p, bc_type="periodic", axis=0)
         return BSplineCurve.from_scipy(spl, closed=True)
-    pts = as_points(points, "points", min_points=p + 1)
+    # the coincident-points check of as_points in one compiled pass (numpy's temporaries cost
+    # ~0.03 s at 1e6 points); on a hit as_points itself raises its usual message
+    pts = as_points(points, "points", min_points=p + 1, allow_coincident=True)
+    if _first_coincident(pts) >= 0:
+        as_points(pts, "points", min_points=p + 1)
     t = as_params(param, pts.shape[0], "param") if not isinstance(param, str) \
         else parameterize(pts, param)
     if p == 3 and pts.shape[0] >= 4:
@@ -660,20 +677,111 @@ def interpolate_bspline(points: ArrayLike, degree: int = 3, param: str | ArrayLi
     return BSplineCurve.from_scipy(spl, closed=False)
 
 
+@njit(cache=True)
+def _natural_cubic_kernel(u, pts, T, d):  # type: ignore[no-untyped-def]
+    """Fill the clamped knot vector ``T`` (m + 6) and the control points ``d`` (m + 2, dim) of
+    the natural cubic interpolant (see :func:`_natural_cubic`): the tridiagonal system solved
+    for every coordinate at once by elimination without pivoting (Thomas). Returns False (and
+    leaves ``d`` partly written) when a pivot is tiny against its row, for the caller's
+    pivoting fallback; the interior rows are collocation rows of a totally positive matrix and
+    the end rows are diagonally dominant, so this does not happen for increasing ``u``."""
+    m = u.shape[0]
+    dim = pts.shape[1]
+    for i in range(3):
+        T[i] = u[0]
+        T[m + 3 + i] = u[m - 1]
+    for i in range(m):
+        T[i + 3] = u[i]
+    cp = np.empty(m)  # eliminated super-diagonal
+    rp = np.empty((m, dim))  # eliminated right-hand sides
+    # row 0: -(a0 + b0) x_0 + a0 x_1 = -b0 p_0
+    a0 = 1.0 / (u[2] - u[0])
+    b0 = 1.0 / (u[1] - u[0])
+    diag = -(a0 + b0)
+    cp[0] = a0 / diag
+    for a in range(dim):
+        rp[0, a] = -b0 * pts[0, a] / diag
+    for i in range(1, m - 1):  # data point i: x_{i-1}, x_i, x_{i+1} at the knot t_k, k = i + 3
+        k = i + 3
+        tk = T[k]
+        den = T[k + 1] - T[k - 1]
+        lo = (T[k + 1] - tk) ** 2 / (den * (T[k + 1] - T[k - 2]))
+        up = (tk - T[k - 1]) ** 2 / (den * (T[k + 2] - T[k - 1]))
+        piv = (1.0 - lo - up) - lo * cp[i - 1]
+        if not abs(piv) > 1e-12 * (abs(1.0 - lo - up) + abs(lo * cp[i - 1])):
+            return False
+        inv = 1.0 / piv
+        cp[i] = up * inv
+        for a in range(dim):
+            rp[i, a] = (pts[i, a] - lo * rp[i - 1, a]) * inv
+    # row m - 1: a1 x_{m-2} - (a1 + b1) x_{m-1} = -b1 p_{m-1}
+    a1 = 1.0 / (u[m - 1] - u[m - 3])
+    b1 = 1.0 / (u[m - 1] - u[m - 2])
+    piv = -(a1 + b1) - a1 * cp[m - 2]
+    if not abs(piv) > 1e-12 * (abs(a1 + b1) + abs(a1 * cp[m - 2])):
+        return False
+    for a in range(dim):
+        d[m, a] = (-b1 * pts[m - 1, a] - a1 * rp[m - 2, a]) / piv
+    for i in range(m - 2, -1, -1):
+        for a in range(dim):
+            d[i + 1, a] = rp[i, a] - cp[i] * d[i + 2, a]
+    for a in range(dim):
+        d[0, a] = pts[0, a]
+        d[m + 1, a] = pts[m - 1, a]
+    return True
+
+
+@njit(cache=True)
+def _first_coincident(pts):  # type: ignore[no-untyped-def]
+    """Index ``i`` of the first pair of consecutive points closer than ``as_points`` accepts
+    (every coordinate difference ``<= 4 eps max|pts|``), or -1; one pass, no temporaries."""
+    n, dim = pts.shape
+    scale = 0.0
+    for i in range(n):
+        for a in range(dim):
+            v = abs(pts[i, a])
+            if v > scale:
+                scale = v
+    thr = 4.0 * 2.220446049250313e-16 * max(scale, 2.2250738585072014e-308)
+    for i in range(n - 1):
+        same = True
+        for a in range(dim):
+            if abs(pts[i + 1, a] - pts[i, a]) > thr:
+                same = False
+                break
+        if same:
+            return i
+    return -1
+
+
 def _natural_cubic(u: FloatArray, pts: FloatArray) -> BSplineCurve:
     """Clamped cubic B-spline through ``pts`` at ``u`` (m >= 4) with ``r'' = 0`` at both ends:
-    the tridiagonal system of the interior control points, solved by LAPACK ``gbsv`` (the same
-    curve as ``make_interp_spline(u, pts, 3, bc_type="natural")``, in O(m) numpy).
+    the tridiagonal system of the interior control points, solved for all coordinates at once
+    by a compiled elimination (:func:`_natural_cubic_kernel`; LAPACK ``gbsv`` if a pivot were
+    tiny), the same curve as ``make_interp_spline(u, pts, 3, bc_type="natural")`` in O(m).
 
     At a simple knot ``t_k`` the cubic B-splines are ``N_{k-3}(t_k) = (t_{k+1} - t_k)^2 /
     ((t_{k+1} - t_{k-1}) (t_{k+1} - t_{k-2}))``, ``N_{k-1}(t_k) = (t_k - t_{k-1})^2 /
     ((t_{k+1} - t_{k-1}) (t_{k+2} - t_{k-1}))`` and ``N_{k-2} = 1 - N_{k-3} - N_{k-1}``; the
     natural end rows are ``(d_2 - d_1) / (u_2 - u_0) = (d_1 - d_0) / (u_1 - u_0)`` and its
     mirror image (Piegl & Tiller, The NURBS Book, eq. (3.9) for the second derivative)."""
+    m = u.shape[0]
+    u = np.ascontiguousarray(u, dtype=float)
+    pts = np.ascontiguousarray(pts, dtype=float)
+    T = np.empty(m + 6)
+    d = np.empty((m + 2, pts.shape[1]))
+    if not _natural_cubic_kernel(u, pts, T, d):
+        d[1:-1] = _natural_cubic_gbsv(u, pts, T)
+        d[0], d[-1] = pts[0], pts[-1]
+    return BSplineCurve._trusted(d, T, 3, False)
+
+
+def _natural_cubic_gbsv(u: FloatArray, pts: FloatArray, T: FloatArray) -> FloatArray:
+    """The interior control points of :func:`_natural_cubic` by LAPACK ``gbsv`` (partial
+    pivoting): the fallback of the compiled elimination."""
     from scipy.linalg import solve_banded
 
     m = u.shape[0]
-    T = np.concatenate([np.full(3, u[0]), u, np.full(3, u[-1])])  # full knot vector
     k = np.arange(4, m + 2)  # the interior data knots t_k = u_{k-3}, k = 4 .. m + 1
     tk = T[k]
     den = T[k + 1] - T[k - 1]
@@ -692,10 +800,7 @@ def _natural_cubic(u: FloatArray, pts: FloatArray) -> BSplineCurve:
     a1, b1 = 1.0 / (u[-1] - u[-3]), 1.0 / (u[-1] - u[-2])
     ab[2, m - 2], ab[1, m - 1] = a1, -(a1 + b1)
     rhs[m - 1] = -b1 * pts[-1]
-    d = np.empty((m + 2, pts.shape[1]))
-    d[0], d[-1] = pts[0], pts[-1]
-    d[1:-1] = solve_banded((1, 1), ab, rhs, check_finite=False)
-    return BSplineCurve(d, T, 3)
+    return solve_banded((1, 1), ab, rhs, check_finite=False)
 
 
 def fit_bspline(points: ArrayLike, n_ctrl: int, degree: int = 3,
