@@ -338,3 +338,31 @@ def test_loop_matches_slow_reference_mixed_knots(closed, tol):
                                                clamp="g1").curve, 2) if tol is None else None
         if z is not None:
             assert abs(z[idx[k]] - z[idx_ref[k]]) <= 1e-13 * z.max()
+
+
+@pytest.mark.parametrize("closed", [False, True])
+@pytest.mark.parametrize("p,dim", [(3, 2), (3, 3), (4, 2), (5, 3)])
+def test_fused_setup_is_bitwise_band_residual_and_energy(closed, p, dim):
+    # the loop's one-pass set-up must give exactly the values of the separate band kernels
+    # (the stopping threshold is relative to this energy), and the energy must match quadrature
+    from curvefair.curves.bspline import band_energy, band_residual
+    from curvefair.fairing.eck_hadenfeld import _aligned_empty, _setup_state
+
+    rng = np.random.default_rng(100 * p + dim + closed)
+    for n in (p + 2, 2 * p + 1, 40):
+        c = random_curve(rng, n=n, p=p, dim=dim, closed=closed)
+        W = np.ascontiguousarray(c.gram_band(2))
+        d = np.ascontiguousarray(c.control_points) * 1e3 + 5e5  # large coordinates
+        mask = rng.random(n) < 0.7
+        X = _aligned_empty((n, 3 * dim))
+        z = _aligned_empty((n,))
+        e = _setup_state(W, p, closed, d, mask, X, z)
+        g = np.empty_like(d)
+        band_residual(W, p, closed, d, g)
+        assert e == band_energy(W, p, closed, d)
+        np.testing.assert_array_equal(X[:, :dim], d)
+        np.testing.assert_array_equal(X[:, dim:2 * dim], g)
+        np.testing.assert_array_equal(X[:, 2 * dim:], d)
+        np.testing.assert_array_equal(z, np.where(mask, 0.0, -1.0))
+        shifted = c.replace(control_points=d - 5e5)
+        assert e == pytest.approx(quad_energy(shifted, 2), rel=1e-9)
