@@ -57,7 +57,7 @@ def aligned_copy(a: np.ndarray) -> np.ndarray:
 def run_loop(X, z, bp, tol: float, steps: int) -> int:
     Wu, pat, upat, ulo, uhi = bp
     return int(eh._eh_loop(X, z, Wu, pat, upat, ulo, uhi, 2, 3, False, tol, 0.0, steps,
-                           np.zeros((0, 3)))[0])
+                           np.zeros((0, 3)), eh._tree_buffer(X.shape[0]))[0])
 
 
 @njit(cache=True)

@@ -318,7 +318,7 @@ def test_natural_cubic_elimination_matches_pivoting_solve(spacing):
     pts = np.cumsum(rng.normal(size=(m, 2)), axis=0)
     T = np.empty(m + 6)
     d = np.empty((m + 2, 2))
-    assert _natural_cubic_kernel(u, pts, T, d)
+    assert _natural_cubic_kernel(u, pts, T, d, np.empty(m))
     ref = _natural_cubic_gbsv(u, pts, T)
     scale = np.abs(ref).max()
     # the wild spacing makes the system ill-conditioned (control points ~1e7): both solves

@@ -134,15 +134,16 @@ def _ders_kernel(knots, p, span, x, nder, local, out):  # type: ignore[no-untype
 
 
 @njit(cache=True)
-def _gram_kernel(knots, p, spans, l, xq, wq, n, closed):  # type: ignore[no-untyped-def]  # noqa: E741
-    """Banded Gram matrix ``W`` (n, 2p+1) of ``int N_i^(l) N_j^(l)`` (see ``gram_band``).
+def _gram_kernel(knots, p, spans, l, xq, wq, n, closed, W):  # type: ignore[no-untyped-def]  # noqa: E741
+    """Banded Gram matrix ``W`` (n, 2p+1) of ``int N_i^(l) N_j^(l)`` (see ``gram_band``),
+    accumulated into ``W`` (zeros on entry, allocated by numpy: huge pages, see
+    ``_natural_cubic_kernel``).
 
     One Gauss-Legendre rule per knot span, on local offsets ``x - knots[s]``; a span whose
     local knot pattern (``knots[s-p+1 .. s+p] - knots[s]``) equals the previous span's reuses
     its element matrix bitwise (uniform knots: a handful of evaluations in all).
     """
     nq = xq.shape[0]
-    W = np.zeros((n, 2 * p + 1))
     ndu = np.empty((p + 1, p + 1))
     left = np.empty(p + 1)
     right = np.empty(p + 1)
@@ -447,8 +448,9 @@ class BSplineCurve(PiecewiseCurve):
         """Indices ``s`` of the non-empty knot spans ``[knots[s], knots[s+1])`` of the domain."""
         p = self.degree
         t = self._knots
-        s = np.arange(p, t.shape[0] - p - 1)
-        s = s[t[s + 1] > t[s]]
+        K = t.shape[0]
+        s = np.flatnonzero(t[p + 1:K - p] > t[p:K - p - 1])  # slices: no index gathers
+        s += p
         readonly(s)
         return s
 
@@ -531,7 +533,7 @@ class BSplineCurve(PiecewiseCurve):
         xq, wq = _gauss(p - int(l) + 1)
         return _gram_kernel(np.ascontiguousarray(self._knots), p,
                             np.ascontiguousarray(self.spans, dtype=np.int64), int(l), xq, wq,
-                            self.n_ctrl, self._closed)
+                            self.n_ctrl, self._closed, np.zeros((self.n_ctrl, 2 * p + 1)))
 
     def gram_matrix(self, l: int) -> Any:  # noqa: E741
         """The Gram matrix of :meth:`gram_band` as a ``scipy.sparse`` CSR matrix ``(n, n)``."""
@@ -678,13 +680,17 @@ def interpolate_bspline(points: ArrayLike, degree: int = 3, param: str | ArrayLi
 
 
 @njit(cache=True)
-def _natural_cubic_kernel(u, pts, T, d):  # type: ignore[no-untyped-def]
+def _natural_cubic_kernel(u, pts, T, d, cp):  # type: ignore[no-untyped-def]
     """Fill the clamped knot vector ``T`` (m + 6) and the control points ``d`` (m + 2, dim) of
     the natural cubic interpolant (see :func:`_natural_cubic`): the tridiagonal system solved
     for every coordinate at once by elimination without pivoting (Thomas). Returns False (and
     leaves ``d`` partly written) when a pivot is tiny against its row, for the caller's
     pivoting fallback; the interior rows are collocation rows of a totally positive matrix and
-    the end rows are diagonally dominant, so this does not happen for increasing ``u``."""
+    the end rows are diagonally dominant, so this does not happen for increasing ``u``.
+
+    ``cp`` (m,) is work space. Every large array is allocated by the numpy caller: numpy asks
+    for transparent huge pages on large arrays, numba's allocator does not, and the first-touch
+    faults of 4 KiB pages cost ~25 ms per 50 MB."""
     m = u.shape[0]
     dim = pts.shape[1]
     for i in range(3):
@@ -692,8 +698,7 @@ def _natural_cubic_kernel(u, pts, T, d):  # type: ignore[no-untyped-def]
         T[m + 3 + i] = u[m - 1]
     for i in range(m):
         T[i + 3] = u[i]
-    cp = np.empty(m)  # eliminated super-diagonal
-    rp = np.empty((m, dim))  # eliminated right-hand sides
+    rp = d[1:]  # eliminated right-hand sides, rp[i] = d[i + 1] (overwritten in place)
     # row 0: -(a0 + b0) x_0 + a0 x_1 = -b0 p_0
     a0 = 1.0 / (u[2] - u[0])
     b0 = 1.0 / (u[1] - u[0])
@@ -770,7 +775,7 @@ def _natural_cubic(u: FloatArray, pts: FloatArray) -> BSplineCurve:
     pts = np.ascontiguousarray(pts, dtype=float)
     T = np.empty(m + 6)
     d = np.empty((m + 2, pts.shape[1]))
-    if not _natural_cubic_kernel(u, pts, T, d):
+    if not _natural_cubic_kernel(u, pts, T, d, np.empty(m)):
         d[1:-1] = _natural_cubic_gbsv(u, pts, T)
         d[0], d[-1] = pts[0], pts[-1]
     return BSplineCurve._trusted(d, T, 3, False)

@@ -291,7 +291,7 @@ _PREFETCH_LEVELS = 4  # tree nodes prefetched on the runner-up's path (from its 
 
 @njit(cache=True, error_model="numpy")
 def _eh_loop(X, z, Wu, pat, upat, ulo, uhi, D, p, closed, tol, eps_abs, max_steps,
-             hist):  # type: ignore[no-untyped-def]
+             hist, T):  # type: ignore[no-untyped-def]
     """Ranking-list loop, compiled; updates ``X`` and ``z`` in place.
 
     ``X[i] = (d_i, g_i, orig_i)``, ``D`` columns each (``X`` has ``3 D`` columns),
@@ -324,6 +324,9 @@ def _eh_loop(X, z, Wu, pat, upat, ulo, uhi, D, p, closed, tol, eps_abs, max_step
     shares the winner's subtree 3 levels down. Prefetches never change results.
 
     ``hist`` (shape (cap, 3)) receives (index, z, displacement) of the first ``cap`` steps.
+    ``T`` is the tree's storage, shape ``(>= 2 P, 2)`` (:func:`_tree_buffer`): allocated by
+    numpy, which asks for transparent huge pages on large arrays (numba's allocator does not,
+    and first-touch faults of 4 KiB pages cost ~25 ms per 50 MB), and 64-byte aligned.
     Returns (steps, total energy drop, stop code, number of history rows).
     """
     n = X.shape[0]
@@ -333,7 +336,6 @@ def _eh_loop(X, z, Wu, pat, upat, ulo, uhi, D, p, closed, tol, eps_abs, max_step
     P = 1
     while P < nb:
         P *= 4
-    T = np.empty((2 * P, 2))
     for j in range(2 * P):
         T[j, 0] = -1.0
         T[j, 1] = 0.0
@@ -722,6 +724,16 @@ def _setup_state(W, p, closed, d, mask, X, z):  # type: ignore[no-untyped-def]
     return e
 
 
+def _tree_buffer(n: int) -> FloatArray:
+    """Storage of :func:`_eh_loop`'s tournament tree for ``n`` control points: ``(2 P, 2)``,
+    ``P`` the smallest power of 4 ``>=`` the number of blocks, 64-byte aligned."""
+    nb = (int(n) + (1 << _BLOCK_SHIFT) - 1) >> _BLOCK_SHIFT
+    P = 1
+    while P < nb:
+        P *= 4
+    return _aligned_empty((2 * P, 2))
+
+
 def _aligned_empty(shape: tuple[int, ...]) -> FloatArray:
     """``np.empty(shape)`` starting on a 64-byte cache line (the ranking-list loop's blocks of
     8 ranking numbers are then exactly one line each)."""
@@ -847,7 +859,8 @@ def eck_hadenfeld_fair(curve: BSplineCurve, *, l: int = 2, tol: float | None = N
     hist = np.zeros((int(min(max(history_max, 0), max_steps)), 3))
     Wu, pat, upat, ulo, uhi = band_patterns(W)
     steps, drop, code, nh = _eh_loop(X, z, Wu, pat, upat, ulo, uhi, dim, curve.degree,
-                                     curve.closed, tolv, eps_abs, int(max_steps), hist)
+                                     curve.closed, tolv, eps_abs, int(max_steps), hist,
+                                     _tree_buffer(n))
     # the loop keeps every coordinate finite and the knots are the input's: no re-validation
     out = BSplineCurve._trusted(np.ascontiguousarray(X[:, :dim]), curve.knots, curve.degree,
                                 curve.closed)
