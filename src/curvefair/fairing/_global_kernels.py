@@ -1474,7 +1474,7 @@ def admm_multipliers(z, u, free, rho, t2, lam):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def ssn_eval_prep(g0, K, p, closed, v, lam, free, t2, kappa, delta, S, rd, f, rho,  # type: ignore[no-untyped-def]
+def ssn_eval_prep(g0, K, p, closed, v, lam, free, t2, kappa, delta, S, rd, rho,  # type: ignore[no-untyped-def]
                   B, nrm, c, Q, fix, fix0):
     """Semismooth Newton per-point work, one pass: active set ``S = free & (lam + kappa f > 0) &
     (v != 0)`` (``f = (|v|^2 / t2 - 1) / 2``); ``lam`` clipped to ``max(lam, 0)`` on ``S`` and 0
@@ -1482,8 +1482,8 @@ def ssn_eval_prep(g0, K, p, closed, v, lam, free, t2, kappa, delta, S, rd, f, rh
     active points the unit normals ``nrm``, the prescribed normal displacements ``c = -f t2 /
     |v|`` (the linearised sphere), their frames ``Q`` (as :func:`set_frames`; planar: the first
     column only, and only the diagonal of ``B``, whose other entries must be 0) and ``fix =
-    fix0`` plus the normal axis. Returns ``(max |rd|, max f over free, max |f| over S,
-    |S|)``."""
+    fix0`` plus the normal axis; ``rho = |v|``. Returns ``(max |rd|, max f over free, max |f|
+    over S, |S|)``."""
     n, dim = v.shape
     c23 = dim == 2 and p == 3
     rdm = 0.0
@@ -1497,7 +1497,6 @@ def ssn_eval_prep(g0, K, p, closed, v, lam, free, t2, kappa, delta, S, rd, f, rh
         r = np.sqrt(vv)
         fi = 0.5 * (vv / t2 - 1.0)
         rho[i] = r
-        f[i] = fi
         for a in range(dim):
             fix[i, a] = fix0[i, a]
         if not free[i]:

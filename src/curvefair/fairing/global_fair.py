@@ -438,12 +438,13 @@ def _solve_balls(system: _System, g0: FloatArray, free: np.ndarray, tol: float, 
     others): interior point, then active-set Newton (see :func:`global_fair`). Working with
     displacements keeps full relative precision whatever the coordinates. Returns
     ``(v, lambda, iterations, stop_reason)`` with ``g0 + K v + lambda v / tol^2 = 0`` at the
-    free points."""
+    free points (``g0`` is overwritten: 0 at the fixed points)."""
     n, dim = g0.shape
     K, p, closed = system.K, system.p, system.closed
     t2 = tol * tol
     m = int(free.sum())
-    g0 = np.ascontiguousarray(np.where(free[:, None], g0, 0.0))
+    g0 = np.ascontiguousarray(g0)  # (the caller's fresh residual: zeroed in place)
+    g0[~free] = 0.0
     gscale = float(np.abs(g0).max())
     if gscale == 0.0:  # already stationary: the input is optimal
         return np.zeros_like(g0), np.zeros(n), 0, "converged"
@@ -454,7 +455,7 @@ def _solve_balls(system: _System, g0: FloatArray, free: np.ndarray, tol: float, 
         start = _admm_start(K, p, g0, free, tol, system.L.reshape(-1))
         if start is not None:
             res = _active_set_newton(system, g0, free, tol, start[0], start[1], start[2],
-                                     gscale, min(_ADMM_SSN_MAXIT, max_steps - 1))
+                                     gscale, min(_ADMM_SSN_MAXIT, max_steps - 1), own=True)
             steps += res[2]
             if res[3]:
                 return res[0], res[1], steps, "converged"
@@ -614,22 +615,41 @@ def _matvec(K: FloatArray, p: int, closed: bool, x: FloatArray) -> FloatArray:
 
 
 def _active_set_newton(system: _System, g0: FloatArray, free: np.ndarray, tol: float,
-                       v: FloatArray, lam: FloatArray, kappa: float, gscale: float, maxit: int
-                       ) -> tuple[FloatArray, FloatArray, int, bool]:
-    """Semismooth Newton on the KKT system from ``(v, lam)`` (not modified); returns
-    ``(v, lam, iterations, converged)``."""
+                       v: FloatArray, lam: FloatArray, kappa: float, gscale: float, maxit: int,
+                       own: bool = False) -> tuple[FloatArray, FloatArray, int, bool]:
+    """Semismooth Newton on the KKT system from ``(v, lam)`` (not modified unless ``own``:
+    then ``lam`` is used in place); returns ``(v, lam, iterations, converged)``. The active
+    set is written straight into the system's frame flags."""
+    n, dim = v.shape
+    v = np.array(v, order="C")  # a copy (the ADMM start is a coordinate-major view)
+    if not own:
+        lam = lam.copy()
+    rd = np.empty_like(v)
+    rho = np.empty(n)
+    B = np.zeros((n, dim, dim))  # ssn_eval_prep writes the diagonal (planar)
+    nrm = np.zeros_like(v)  # written at the active points only
+    Q = system.Q
+    if dim == 2 and not system.dense:
+        # the planar kernels read (and the evaluation writes) only the first column of the
+        # frames, which is the normal: Q[i, :, 0] is nrm[i] (a view; no 32 MB array at 1e6)
+        Q = np.lib.stride_tricks.as_strided(nrm, shape=(n, 2, 2),
+                                            strides=(nrm.strides[0], nrm.strides[1], 0))
+    Q_saved, system.Q = system.Q, Q
+    try:
+        return _ssn_loop(system, g0, free, tol, v, lam, kappa, gscale, maxit, rd, rho, B, nrm)
+    finally:
+        system.Q = Q_saved
+
+
+def _ssn_loop(system: _System, g0: FloatArray, free: np.ndarray, tol: float, v: FloatArray,
+              lam: FloatArray, kappa: float, gscale: float, maxit: int, rd: FloatArray,
+              rho: FloatArray, B: FloatArray, nrm: FloatArray
+              ) -> tuple[FloatArray, FloatArray, int, bool]:
     n, dim = v.shape
     K, p, closed = system.K, system.p, system.closed
     t2 = tol * tol
     delta = 1e-14 * float(np.abs(K[:, p]).max())
-    v = v.copy()
-    lam = lam.copy()
-    S = system.rot  # the active set is written straight into the system's frame flags
-    rd = np.empty_like(v)
-    f = np.empty(n)
-    rho = np.empty(n)
-    B = np.zeros((n, dim, dim))  # ssn_eval_prep writes the diagonal (planar)
-    nrm = np.zeros_like(v)  # written at the active points only
+    S = system.rot
     c = np.zeros(n)
     dv = np.empty_like(v)
     S_fac = np.zeros(n, dtype=np.bool_)  # active set of the current factorisation
@@ -637,7 +657,7 @@ def _active_set_newton(system: _System, g0: FloatArray, free: np.ndarray, tol: f
     stat_prev = np.inf
     for it in range(maxit + 1):
         rdm, feas, fS, nS = _k.ssn_eval_prep(g0, K, p, closed, v, lam, free, t2, kappa, delta,
-                                             S, rd, f, rho, B, nrm, c, system.Q, system.fix,
+                                             S, rd, rho, B, nrm, c, system.Q, system.fix,
                                              system.fix0)
         stat = rdm / gscale
         if not np.isfinite(stat):
