@@ -152,14 +152,15 @@ def _gram_kernel(knots, p, spans, l, xq, wq, n, closed, W):  # type: ignore[no-u
     M = np.empty((p + 1, p + 1))
     prev = np.empty(2 * p)
     have = False
+    w2 = 2 * p + 1
+    Wf = W.reshape(-1)  # W[r, c] = Wf[r w2 + c]
     for m in range(spans.shape[0]):
         s = spans[m]
         ts = knots[s]
         same = have
         for k in range(2 * p):
             v = knots[s - p + 1 + k] - ts
-            if same and v != prev[k]:
-                same = False
+            same = same and v == prev[k]
             prev[k] = v
         if not same:
             h = knots[s + 1] - ts
@@ -172,12 +173,17 @@ def _gram_kernel(knots, p, spans, l, xq, wq, n, closed, W):  # type: ignore[no-u
                         acc += wq[q] * d[q, l, i] * d[q, l, j]
                     M[i, j] = acc * h
             have = True
-        for i in range(p + 1):
-            row = s - p + i
-            if closed:
-                row %= n
-            for j in range(p + 1):
-                W[row, p + j - i] += M[i, j]
+        if closed and s >= n:  # rows s - p .. s wrap past n - 1
+            for i in range(p + 1):
+                row = (s - p + i) % n
+                for j in range(p + 1):
+                    W[row, p + j - i] += M[i, j]
+        else:  # the same additions in the same order, flat indices
+            base = (s - p) * w2 + p
+            for i in range(p + 1):
+                b = base + i * (w2 - 1)
+                for j in range(p + 1):
+                    Wf[b + j] += M[i, j]
     return W
 
 
