@@ -418,14 +418,19 @@ def _global_fair(curve: BSplineCurve, tol: float | None, l: Any,  # noqa: E741
         return GlobalResult(out, E0, energy(x), lam, 1, "unconstrained",
                             np.zeros(0, dtype=np.int64))
 
-    v, lam_, steps, reason = _solve_balls(system, residual(K, d0), mask, tolv, gap, max_steps)
+    g0 = residual(K, d0)
+    v, lam_, steps, reason = _solve_balls(system, g0, mask, tolv, gap, max_steps)
     # strict feasibility in floating point, with a rounding margin (active points end on
     # their sphere): every fl(x_i - o_i) and the evaluated curve stay within tol
     margin = min(1e-9 * tolv, 1e-13 * tolv + 4.0 * np.finfo(float).eps * float(np.abs(d0).max()))
-    x = np.empty_like(d0)
+    # x in the (no longer needed) gradient's memory: pages already mapped
+    x = g0 if g0.flags.c_contiguous and not np.shares_memory(g0, v) else np.empty_like(d0)
     act = np.empty(n, dtype=np.bool_)
     _k.finish_points(d0, v, mask, tolv - margin, (1 - 1e-6) * tolv, x, act)
-    lam[mask] = E0 * lam_[mask] / (tolv * tolv)  # 2 (G d)_i + lam_i (d_i - o_i) = 0
+    # 2 (G d)_i + lam_i (d_i - o_i) = 0 (in place: no temporaries)
+    lam = np.multiply(lam_, E0, out=lam_ if lam_.flags.writeable else None)
+    lam /= tolv * tolv
+    lam[~mask] = 0.0
     out = curve.replace(control_points=x)
     active = np.flatnonzero(act)
     return GlobalResult(out, E0, energy(x), lam, steps, reason, active)
