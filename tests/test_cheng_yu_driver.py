@@ -100,7 +100,9 @@ def test_first_step_acts_on_the_top_ranked_bad_point():
     first, n_moved = int(res.history["index"][1]), int(res.history["n_moved"][1])
     acted = {first, first + 1} if n_moved == 2 else {first}
     assert ranked[0].index in acted or res.history["z"][1] < ranked[0].value
-    assert res.history["z"][1] in {b.value for b in ranked}
+    # the same ranking number computed by two routes: equal to rounding (exact equality held
+    # only by chance of the interpolant's last bits)
+    assert any(res.history["z"][1] == pytest.approx(b.value, rel=1e-12) for b in ranked)
     if n_moved == 2:  # step 4: the two best-ranked bad points are neighbours
         assert {ranked[0].index, ranked[1].index} == acted
 
