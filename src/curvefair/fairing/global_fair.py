@@ -116,6 +116,11 @@ def _small_pages() -> Iterator[None]:
                 put(_HUGE_DEPTH[1])
 
 
+
+def _absmax(a: FloatArray) -> float:
+    """``max |a|`` without an ``|a|`` temporary (NaN propagates)."""
+    return max(float(a.max()), -float(a.min())) if a.size else 0.0
+
 def _frames(nrm: FloatArray) -> FloatArray:
     """Orthonormal frames ``Q_i`` (shape (m, dim, dim)) whose first column is the unit vector
     ``nrm_i`` (2-D: the tangent is ``nrm`` turned by 90 degrees; 3-D: Duff et al. 2017,
@@ -422,7 +427,7 @@ def _global_fair(curve: BSplineCurve, tol: float | None, l: Any,  # noqa: E741
     v, lam_, steps, reason = _solve_balls(system, g0, mask, tolv, gap, max_steps)
     # strict feasibility in floating point, with a rounding margin (active points end on
     # their sphere): every fl(x_i - o_i) and the evaluated curve stay within tol
-    margin = min(1e-9 * tolv, 1e-13 * tolv + 4.0 * np.finfo(float).eps * float(np.abs(d0).max()))
+    margin = min(1e-9 * tolv, 1e-13 * tolv + 4.0 * np.finfo(float).eps * _absmax(d0))
     # x in the (no longer needed) gradient's memory: pages already mapped
     x = g0 if g0.flags.c_contiguous and not np.shares_memory(g0, v) else np.empty_like(d0)
     act = np.empty(n, dtype=np.bool_)
@@ -450,7 +455,7 @@ def _solve_balls(system: _System, g0: FloatArray, free: np.ndarray, tol: float, 
     m = int(free.sum())
     g0 = np.ascontiguousarray(g0)  # (the caller's fresh residual: zeroed in place)
     g0[~free] = 0.0
-    gscale = float(np.abs(g0).max())
+    gscale = _absmax(g0)
     if gscale == 0.0:  # already stationary: the input is optimal
         return np.zeros_like(g0), np.zeros(n), 0, "converged"
     eye = np.broadcast_to(np.eye(dim), (n, dim, dim))
@@ -654,7 +659,7 @@ def _ssn_loop(system: _System, g0: FloatArray, free: np.ndarray, tol: float, v: 
     n, dim = v.shape
     K, p, closed = system.K, system.p, system.closed
     t2 = tol * tol
-    delta = 1e-14 * float(np.abs(K[:, p]).max())
+    delta = 1e-14 * _absmax(K[:, p])
     S = system.rot
     c = np.zeros(n)
     dv = np.empty_like(v)
