@@ -37,6 +37,7 @@ Usage::
 from __future__ import annotations
 
 import argparse
+import importlib
 import time
 
 import numpy as np
@@ -44,6 +45,8 @@ import numpy as np
 from curvefair import BSplineCurve, interpolate_bspline
 from curvefair.fairing.eck_hadenfeld import eck_hadenfeld_fair
 from curvefair.fairing.global_fair import global_fair
+
+_gf = importlib.import_module("curvefair.fairing.global_fair")  # _gf._THREADS: threads used
 
 
 def data(n: int, sigma: float, seed: int) -> tuple[np.ndarray, np.ndarray]:
@@ -165,7 +168,7 @@ def main() -> None:
         t_gl = t_g + t_interp
         rows["curvefair global"] = (t_gl, bspline_metrics(gl.curve, t, pts),
                                     f"{gl.iterations} Newton iterations, {gl.stop_reason}; "
-                                    f"interp {t_interp:.2f}s")
+                                    f"interp {t_interp:.2f}s; threads {_gf._THREADS}")
 
     peers = {}
     for name in list(rows)[1:]:

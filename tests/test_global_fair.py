@@ -391,3 +391,68 @@ def test_extreme_scales_stay_finite_and_feasible(scale):
     assert np.isfinite(d).all()
     assert np.linalg.norm(d - c.control_points, axis=1).max() <= tol
     assert res.energy_after <= res.energy_before
+
+
+@pytest.mark.parametrize("closed", [False, True])
+def test_two_threads_give_bitwise_the_same_result(monkeypatch, closed):
+    """The Newton passes split into point ranges on two threads (forced here on a small curve)
+    give exactly the single-threaded result (planar: evaluation, right-hand side, back-rotation
+    and update in ranges; the ranges write disjoint points)."""
+    import importlib
+
+    gf = importlib.import_module("curvefair.fairing.global_fair")
+    rng = np.random.default_rng(3)
+    x = np.linspace(0, 12, 3000)
+    pts = np.c_[x, np.sin(x)] + 0.05 * rng.normal(size=(3000, 2))
+    if closed:
+        a = np.linspace(0, 2 * np.pi, 1500, endpoint=False)
+        pts = np.c_[np.cos(a), 0.6 * np.sin(a)] + 0.01 * rng.normal(size=(1500, 2))
+    c = interpolate_bspline(pts, closed=closed) if closed else interpolate_bspline(pts)
+    tol = 0.005 if closed else 0.05
+    monkeypatch.setattr(gf, "_PAR_MIN", 16)
+    calls = []
+    ranges = gf._ranges
+    monkeypatch.setattr(gf, "_ranges",
+                        lambda fn, lo, hi: calls.append(hi - lo) or ranges(fn, lo, hi))
+    out = {}
+    for th in (1, 2):
+        monkeypatch.setattr(gf, "_THREADS", th)
+        r = gf.global_fair(c, tol=tol)
+        assert r.stop_reason == "converged"
+        out[th] = (np.asarray(r.curve.control_points), r.multipliers, r.iterations)
+    assert calls  # the ranged passes ran
+    assert np.array_equal(out[1][0], out[2][0])
+    assert np.array_equal(out[1][1], out[2][1])
+    assert out[1][2] == out[2][2]
+
+
+def test_ranges_never_wait_for_a_busy_worker(monkeypatch):
+    """With the worker thread blocked, the calling thread does every chunk itself (in order,
+    no deadlock); an exception in a chunk is re-raised."""
+    import importlib
+    import threading
+
+    gf = importlib.import_module("curvefair.fairing.global_fair")
+    monkeypatch.setattr(gf, "_THREADS", 2)
+    monkeypatch.setattr(gf, "_PAR_MIN", 10)
+    gate = threading.Event()
+    gf._pool().submit(gate.wait, 30)  # occupies the single worker
+    try:
+        got = gf._ranges(lambda a, b: (a, b, threading.get_ident()), 5, 1005)
+        assert [g[:2] for g in got] == [(5 + (1000 * q) // gf._PAR_CHUNKS,
+                                         5 + (1000 * (q + 1)) // gf._PAR_CHUNKS)
+                                        for q in range(gf._PAR_CHUNKS)]
+        assert {g[2] for g in got} == {threading.get_ident()}
+    finally:
+        gate.set()
+    gate2 = threading.Event()
+    gf._pool().submit(gate2.wait, 30)
+    try:
+        with pytest.raises(ZeroDivisionError):
+            gf._ranges(lambda a, b: 1 // (a - 5), 5, 1005)
+    finally:
+        gate2.set()
+    # free worker: still the chunks in order, whichever thread ran them
+    got = gf._ranges(lambda a, b: (a, b), 0, 100)
+    assert got == [((100 * q) // gf._PAR_CHUNKS, (100 * (q + 1)) // gf._PAR_CHUNKS)
+                   for q in range(gf._PAR_CHUNKS)]

@@ -811,7 +811,7 @@ def prep_rhs(K, p, closed, B, Q, rot, fix, fix0, rhs, c, out, sgn=1.0):  # type:
     for the normal of a ``rot`` point, 0 at fixed points)."""
     n, dim = rhs.shape
     if dim == 2:
-        _prep_rhs2(K, p, closed, B, Q, rot, fix, fix0, rhs, c, out, sgn)
+        prep_rhs2_range(K, p, closed, B, Q, rot, fix, fix0, rhs, c, out, sgn, 0, rhs.shape[0])
         return
     anyrot = False
     for i in range(n):
@@ -855,12 +855,13 @@ def prep_rhs(K, p, closed, B, Q, rot, fix, fix0, rhs, c, out, sgn=1.0):  # type:
                 out[i, a] = c[i] if (rot[i] and a == 0 and not fix0[i, a]) else 0.0
 
 
-@njit(cache=True)
-def _prep_rhs2(K, p, closed, B, Q, rot, fix, fix0, rhs, c, out, sgn):  # type: ignore[no-untyped-def]
+@njit(cache=True, nogil=True)
+def prep_rhs2_range(K, p, closed, B, Q, rot, fix, fix0, rhs, c, out, sgn, i0, i1):  # type: ignore[no-untyped-def]
     """:func:`prep_rhs` for planar curves in one pass (selects instead of branches on the
-    frame flags of the neighbours)."""
+    frame flags of the neighbours), on the points ``i0 .. i1 - 1`` (each point is independent:
+    ranges may run concurrently)."""
     n = rhs.shape[0]
-    for i in range(n):
+    for i in range(i0, i1):
         w0 = sgn * rhs[i, 0]
         w1 = sgn * rhs[i, 1]
         interior = i >= p and i + p < n
@@ -902,8 +903,14 @@ def _prep_rhs2(K, p, closed, B, Q, rot, fix, fix0, rhs, c, out, sgn):  # type: i
 def post_solve(y, Q, rot, fix0):  # type: ignore[no-untyped-def]
     """Back to the original frame: ``y_i <- Q_i y_i`` at the ``rot`` points, 0 at fixed
     points."""
-    n, dim = y.shape
-    for i in range(n):
+    post_solve_range(y, Q, rot, fix0, 0, y.shape[0])
+
+
+@njit(cache=True, nogil=True)
+def post_solve_range(y, Q, rot, fix0, i0, i1):  # type: ignore[no-untyped-def]
+    """:func:`post_solve` on the points ``i0 .. i1 - 1``."""
+    dim = y.shape[1]
+    for i in range(i0, i1):
         if fix0[i, 0]:
             for a in range(dim):
                 y[i, a] = 0.0
@@ -1484,13 +1491,23 @@ def ssn_eval_prep(g0, K, p, closed, v, lam, free, t2, kappa, delta, S, rd, rho, 
     column only, and only the diagonal of ``B``, whose other entries must be 0) and ``fix =
     fix0`` plus the normal axis; ``rho = |v|``. Returns ``(max |rd|, max f over free, max |f|
     over S, |S|)``."""
+    return ssn_eval_range(g0, K, p, closed, v, lam, free, t2, kappa, delta, S, rd, rho, B,
+                          nrm, c, Q, fix, fix0, 0, v.shape[0])
+
+
+@njit(cache=True, nogil=True)
+def ssn_eval_range(g0, K, p, closed, v, lam, free, t2, kappa, delta, S, rd, rho,  # type: ignore[no-untyped-def]
+                   B, nrm, c, Q, fix, fix0, i0, i1):
+    """:func:`ssn_eval_prep` on the points ``i0 .. i1 - 1`` (reads ``v`` of their neighbours,
+    writes their own data only: ranges may run concurrently; the maxima and the count of
+    several ranges combine to those of their union)."""
     n, dim = v.shape
     c23 = dim == 2 and p == 3
     rdm = 0.0
     fm = -np.inf
     fsm = 0.0
     ns = 0
-    for i in range(n):
+    for i in range(i0, i1):
         vv = 0.0
         for a in range(dim):
             vv += v[i, a] * v[i, a]
@@ -1590,14 +1607,17 @@ def ssn_eval_prep(g0, K, p, closed, v, lam, free, t2, kappa, delta, S, rd, rho, 
 
 
 @njit(cache=True)
-def ssn_update_k(K, p, closed, v, dv, rd, lam, S, nrm, rho, t2, retract):  # type: ignore[no-untyped-def]
+def ssn_update_k(K, p, closed, v, dv, rd, lam, S, nrm, rho, t2, retract,  # type: ignore[no-untyped-def]
+                 edges_only=False):
     """Semismooth Newton update: the multipliers of the active points from the normal component
     of the stationarity equation (``K dv`` computed on the fly), then ``v += dv``; with
     ``retract`` the active points are put back on their sphere (the tangent-plane step
-    overshoots radially by ``|dv_t|^2 / (2 tol)``)."""
+    overshoots radially by ``|dv_t|^2 / (2 tol)``). ``edges_only`` (planar cubics, ``n > 6``):
+    the points ``3 .. n - 4`` are left to the caller (:func:`ssn_update23_range`)."""
     n, dim = v.shape
     if dim == 2 and p == 3 and n > 6:
-        _ssn_update23(K, closed, v, dv, rd, lam, S, nrm, rho, t2, retract, 3, n - 3)
+        if not edges_only:
+            ssn_update23_range(K, closed, v, dv, rd, lam, S, nrm, rho, t2, retract, 3, n - 3)
         lo = 3
         hi = n - 3
     else:
@@ -1639,11 +1659,12 @@ def ssn_update_k(K, p, closed, v, dv, rd, lam, S, nrm, rho, t2, retract):  # typ
                 v[i, a] *= f
 
 
-@njit(cache=True, error_model="numpy")
-def _ssn_update23(K, closed, v, dv, rd, lam, S, nrm, rho, t2, retract, i0, i1):  # type: ignore[no-untyped-def]
+@njit(cache=True, error_model="numpy", nogil=True)
+def ssn_update23_range(K, closed, v, dv, rd, lam, S, nrm, rho, t2, retract, i0, i1):  # type: ignore[no-untyped-def]
     """:func:`ssn_update_k` for planar cubics on the interior points ``i0 .. i1 - 1``: one
     pass, selects instead of branches (numpy error model: the unselected quotients of inactive
-    points may be inf)."""
+    points may be inf). Reads ``dv`` of the neighbours, writes the points' own ``v`` and
+    ``lam``: ranges may run concurrently."""
     tol = np.sqrt(t2)
     for i in range(i0, i1):
         si = S[i]
