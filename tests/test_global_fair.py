@@ -456,3 +456,23 @@ def test_ranges_never_wait_for_a_busy_worker(monkeypatch):
     got = gf._ranges(lambda a, b: (a, b), 0, 100)
     assert got == [((100 * q) // gf._PAR_CHUNKS, (100 * (q + 1)) // gf._PAR_CHUNKS)
                    for q in range(gf._PAR_CHUNKS)]
+
+
+def test_curvefair_threads_environment_variable():
+    """CURVEFAIR_THREADS=1 keeps global_fair on the calling thread; a bad value warns and
+    keeps the default (read at import: checked in fresh interpreters)."""
+    import os
+    import subprocess
+    import sys
+
+    code = "import curvefair.fairing.global_fair as g; print(g._THREADS)"
+
+    def threads(value):
+        env = dict(os.environ, CURVEFAIR_THREADS=value)
+        out = subprocess.run([sys.executable, "-W", "error::RuntimeWarning", "-c", code],
+                             capture_output=True, text=True, env=env)
+        return out.returncode, out.stdout.strip(), out.stderr
+
+    assert threads("1")[:2] == (0, "1")
+    rc, _, err = threads("many")
+    assert rc != 0 and "CURVEFAIR_THREADS must be 1 or 2" in err

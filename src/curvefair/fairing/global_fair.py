@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import os
 import threading
+import warnings
 from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import ThreadPoolExecutor
 from contextlib import contextmanager
@@ -133,7 +134,19 @@ def _cpu_count() -> int:
         return os.cpu_count() or 1
 
 
-_THREADS = min(2, _cpu_count())  # 1: everything on the calling thread
+def _thread_setting() -> int:
+    """Threads for the per-point passes: ``CURVEFAIR_THREADS`` (1 or 2; 1 keeps everything on
+    the calling thread), default 2 when the process may use 2 or more CPUs."""
+    env = os.environ.get("CURVEFAIR_THREADS", "").strip()
+    if env:
+        if env in ("1", "2"):
+            return min(int(env), max(_cpu_count(), 1))
+        warnings.warn(f"CURVEFAIR_THREADS must be 1 or 2, got {env!r}; using the default",
+                      RuntimeWarning, stacklevel=2)
+    return min(2, _cpu_count())
+
+
+_THREADS = _thread_setting()  # 1: everything on the calling thread
 _PAR_MIN = 100_000  # points: below, one range on the calling thread
 _PAR_CHUNKS = 16
 _POOL: list[ThreadPoolExecutor] = []
@@ -514,7 +527,8 @@ def global_fair(curve: BSplineCurve, *, tol: float | None = None, l: Any = 2,  #
     ranges write disjoint points, so the result is bitwise the same as on one thread, and the
     calling thread never waits for a chunk the worker has not started (at 1e6 points: 0.91 ->
     0.73-0.79 s with the second core free; with it busy in a spinning process 0-7 % slower
-    than one thread; ``_THREADS = 1`` switches it off). The convergence test is the same
+    than one thread; the environment variable ``CURVEFAIR_THREADS=1``, read at import, switches
+    it off). The convergence test is the same
     on every path (the warm start and reused factorisations change only the speed). Converged
     means: dual residual below ``1e-10`` of
     ``|grad F(o)|_inf``, every point within ``tol (1 + 1e-12)`` (then projected onto its ball),
