@@ -258,13 +258,13 @@ def _assemble_range(K, p, closed, B, Q, rot, fix, L, i0, i1):  # type: ignore[no
                         L[C, k] = blk[b, a]
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def assemble(K, p, closed, B, Q, rot, fix, L):  # type: ignore[no-untyped-def]
     """Fill ``L`` (shape (n dim, kd + 1)) with the lower band of ``M`` (see module docstring)."""
     _assemble_range(K, p, closed, B, Q, rot, fix, L, 0, K.shape[0])
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def assemble_ldl(K, p, B, Q, rot, fix, L):  # type: ignore[no-untyped-def]
     """Assemble (open curves) and factorise ``M = U D U^T`` (``U`` unit lower band) in one pass:
     the columns of a batch of points are written just before the first elimination step that
@@ -695,7 +695,7 @@ def _band_solve7(L, N, x):  # type: ignore[no-untyped-def]
 # ------------------------------------------------------------------------------------------
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def cyclic_cholesky(L, Y, S):  # type: ignore[no-untyped-def]
     """Factorise the cyclic band ``L`` (N > 3 kd): band Cholesky of the leading
     ``N - kd`` unknowns, ``Y = M_II^{-1} M_IB`` (shape (N - kd, kd)) and the Cholesky factor of

@@ -168,9 +168,21 @@ def _ranges(fn: Callable[[int, int], Any], lo: int, hi: int) -> list[Any]:
     claimed one at a time, and the calling thread waits only for chunks the worker has
     started: when the other core is busy (or the worker has not been scheduled yet) the
     calling thread simply does every chunk itself."""
+    return _ranges_start(fn, lo, hi)()
+
+
+def _ranges_start(fn: Callable[[int, int], Any], lo: int, hi: int
+                  ) -> Callable[[], list[Any]]:
+    """:func:`_ranges` in two halves: the worker thread starts on the chunks now, the
+    returned function (call it exactly once) does the chunks still unclaimed on the calling
+    thread, waits for those the worker has started and returns the results. Between the two
+    the calling thread may run other ``nogil`` compiled work that neither writes what ``fn``
+    reads nor touches what it writes (e.g. a factorisation while the right-hand side is
+    prepared). Single-threaded (or a short range): everything runs in the returned
+    function."""
     m = hi - lo
     if _THREADS < 2 or m < _PAR_MIN:
-        return [fn(lo, hi)]
+        return lambda: [fn(lo, hi)]
     k = _PAR_CHUNKS
     bounds = [lo + (m * q) // k for q in range(k + 1)]
     out: list[Any] = [None] * k
@@ -204,15 +216,19 @@ def _ranges(fn: Callable[[int, int], Any], lo: int, hi: int) -> list[Any]:
                             idle.set()
 
     _pool().submit(work, True)
-    work(False)
-    while True:
-        with lock:
-            if state["pending"] == 0:
-                break
-        idle.wait()
-    if state["error"] is not None:
-        raise state["error"]
-    return out
+
+    def finish() -> list[Any]:
+        work(False)
+        while True:
+            with lock:
+                if state["pending"] == 0:
+                    break
+            idle.wait()
+        if state["error"] is not None:
+            raise state["error"]
+        return out
+
+    return finish
 
 
 
@@ -387,12 +403,30 @@ class _System:
             info = _k.assemble_ldl(self.K, self.p, B, self.Q, self.rot, self.fix, self.L)
         return info == 0
 
+    def prep_start(self, B: FloatArray, nrot: int, rhs: FloatArray, c: FloatArray,
+                   out: FloatArray, sgn: float) -> Callable[[], list[Any]] | None:
+        """Start the planar right-hand side of :meth:`solve` (for the blocks ``B`` and the
+        frames, flags and ``nrot`` already written for the next :meth:`factor`) on the worker
+        thread, so that it runs while the calling thread factorises (the factorisation reads
+        the blocks and frames and writes only the band storage; the preparation writes only
+        ``out``). Call the returned function after :meth:`factor`, then
+        :meth:`solve` with ``prepped=True``. None: nothing started (prepare in :meth:`solve`)."""
+        if self.dense or self.dim != 2 or nrot <= 0 or _THREADS < 2 or self.n < _PAR_MIN:
+            return None
+        args = (self.K, self.p, self.closed, B, self.Q, self.rot, self.fix, self.fix0,
+                rhs, c, out, float(sgn))
+        return _ranges_start(lambda a, b: _k.prep_rhs2_range(*args, a, b), 0, self.n)
+
     def solve(self, rhs: FloatArray, c: FloatArray | None = None,
-              out: FloatArray | None = None, sgn: float = 1.0) -> FloatArray:
+              out: FloatArray | None = None, sgn: float = 1.0,
+              prepped: bool = False) -> FloatArray:
         """Displacement ``dx`` (n, dim): ``M dx = sgn rhs`` on the unfixed unknowns, ``dx = 0``
-        at fixed points, ``nrm_i . dx_i = c_i`` at the ``rot`` points."""
+        at fixed points, ``nrm_i . dx_i = c_i`` at the ``rot`` points. ``prepped``: ``out``
+        already holds the prepared right-hand side (:meth:`prep_start`)."""
         y = np.empty_like(rhs) if out is None else out
-        if self.anyrot and self.dim == 2:  # per point: in ranges (two threads)
+        if prepped:
+            assert out is not None and self.anyrot and self.dim == 2
+        elif self.anyrot and self.dim == 2:  # per point: in ranges (two threads)
             args = (self.K, self.p, self.closed, self.B, self.Q, self.rot, self.fix, self.fix0,
                     rhs, self.czero if c is None else c, y, float(sgn))
             _ranges(lambda a, b: _k.prep_rhs2_range(*args, a, b), 0, self.n)
@@ -871,12 +905,19 @@ def _ssn_loop(system: _System, g0: FloatArray, free: np.ndarray, tol: float, v: 
         # by _CHORD_RATE)
         chord = have_fac and stat <= _CHORD_RATE * stat_prev and np.array_equal(S, S_fac)
         stat_prev = stat
+        prepped = False
         if not chord:
-            if not system.factor(B, nrot=nS):
+            # the right-hand side prepared on the worker thread during the factorisation
+            fin = system.prep_start(B, nS, rd, c, dv, -1.0)
+            ok = system.factor(B, nrot=nS)
+            if fin is not None:
+                fin()
+                prepped = True
+            if not ok:
                 return v, lam, it, False
             S_fac[:] = S
             have_fac = True
-        system.solve(rd, c, out=dv, sgn=-1.0)
+        system.solve(rd, c, out=dv, sgn=-1.0, prepped=prepped)
         if dim == 2 and p == 3 and n > 6:  # interior points in ranges (two threads)
             _ranges(lambda a, b: _k.ssn_update23_range(K, closed, v, dv, rd, lam, S, nrm, rho,
                                                        t2, _RETRACT, a, b), 3, n - 3)
