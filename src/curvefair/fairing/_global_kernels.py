@@ -1118,7 +1118,7 @@ def shift_cholesky(K, p, rho, L):  # type: ignore[no-untyped-def]
     return info
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def admm_factor(K, p, rho, L):  # type: ignore[no-untyped-def]
     """Factor of ``K + rho I`` (open curve) for the ADMM sweeps. ``p = 3`` (for
     :func:`admm_sweep_t`): ``K + rho I = U D U^T`` (``U`` unit lower) computed with the active
@@ -1169,7 +1169,7 @@ def admm_factor(K, p, rho, L):  # type: ignore[no-untyped-def]
     return 0
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def admm_sweep(L, y, z, u, g0, rho, r2, alpha):  # type: ignore[no-untyped-def]
     """One over-relaxed ADMM iteration for ``min g0.x + x.K x / 2`` s.t. ``|z_i|^2 <= r2_i``,
     ``x = z`` (Boyd et al. 2011, sec. 3.4.3 / 5.1, scaled dual ``u``): on entry ``y`` holds
@@ -1228,7 +1228,7 @@ def admm_sweep(L, y, z, u, g0, rho, r2, alpha):  # type: ignore[no-untyped-def]
     return rr, dz
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def admm_sweep_t(L, y, z, u, g0, rho, t2, free, alpha):  # type: ignore[no-untyped-def]
     """:func:`admm_sweep` for cubics (``p = 3``, the ``U D U^T`` factor of :func:`admm_factor`)
     on COORDINATE-MAJOR arrays ``y, z, u, g0`` of shape ``(dim, n)``, balls of radius^2 ``t2``
