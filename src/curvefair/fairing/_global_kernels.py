@@ -1356,8 +1356,15 @@ def finish_points(d0, v, free, rmax, ract, x, act):  # type: ignore[no-untyped-d
     """``x = d0 + v`` with every free point pulled inside radius ``rmax`` so that the ROUNDED
     ``fl(x_i - d0_i)`` is within ``rmax`` too (fixed points: ``x = d0``); ``act[i]``: the final
     displacement is longer than ``ract``."""
-    n, dim = d0.shape
-    for i in range(n):
+    finish_points_range(d0, v, free, rmax, ract, x, act, 0, d0.shape[0])
+
+
+@njit(cache=True, nogil=True)
+def finish_points_range(d0, v, free, rmax, ract, x, act, i0, i1):  # type: ignore[no-untyped-def]
+    """:func:`finish_points` on the points ``i0 .. i1 - 1`` (independent: ranges may run
+    concurrently)."""
+    dim = d0.shape[1]
+    for i in range(i0, i1):
         if not free[i]:
             for a in range(dim):
                 x[i, a] = d0[i, a]

@@ -647,7 +647,8 @@ def _global_fair(curve: BSplineCurve, tol: float | None, l: Any,  # noqa: E741
     # x in the (no longer needed) gradient's memory: pages already mapped
     x = g0 if g0.flags.c_contiguous and not np.shares_memory(g0, v) else np.empty_like(d0)
     act = np.empty(n, dtype=np.bool_)
-    _k.finish_points(d0, v, mask, tolv - margin, (1 - 1e-6) * tolv, x, act)
+    rmax, ract = tolv - margin, (1 - 1e-6) * tolv
+    _ranges(lambda a, b: _k.finish_points_range(d0, v, mask, rmax, ract, x, act, a, b), 0, n)
     # 2 (G d)_i + lam_i (d_i - o_i) = 0 (in place: no temporaries)
     lam = np.multiply(lam_, E0, out=lam_ if lam_.flags.writeable else None)
     lam /= tolv * tolv
