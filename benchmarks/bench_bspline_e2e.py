@@ -122,6 +122,7 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--bisect", type=int, default=40, help="csaps bisection steps")
     ap.add_argument("--no-global", action="store_true")
+    ap.add_argument("--no-eh", action="store_true", help="skip the Eck-Hadenfeld rows")
     ap.add_argument("--eh-eps", type=float, nargs="*", default=[],
                     help="extra EH runs with eps = value / n (default rule: 1e-4)")
     ap.add_argument("--profile-csaps", action="store_true")
@@ -148,14 +149,16 @@ def main() -> None:
         return BSplineCurve(c.control_points, c.knots, c.degree)
     rows["input (interpolant)"] = (t_interp, bspline_metrics(c, t, pts), "")
 
-    t_fair, eh = best_of(lambda cc: eck_hadenfeld_fair(cc, l=2, tol=args.tol, clamp=(None, None),
-                                                       max_steps=200 * args.n), fresh_curve)
-    t_eh = t_fair + t_interp
-    rows["curvefair eck-hadenfeld"] = (t_eh, bspline_metrics(eh.curve, t, pts),
-                                       f"{eh.steps} steps ({eh.steps / t_fair / 1e6:.2f} M/s "
-                                       f"incl. set-up), {eh.stop_reason}; interp "
-                                       f"{t_interp:.2f}s")
-    for e in args.eh_eps:
+    if not args.no_eh:
+        t_fair, eh = best_of(lambda cc: eck_hadenfeld_fair(cc, l=2, tol=args.tol,
+                                                           clamp=(None, None),
+                                                           max_steps=200 * args.n), fresh_curve)
+        t_eh = t_fair + t_interp
+        rows["curvefair eck-hadenfeld"] = (t_eh, bspline_metrics(eh.curve, t, pts),
+                                           f"{eh.steps} steps ({eh.steps / t_fair / 1e6:.2f} "
+                                           f"M/s incl. set-up), {eh.stop_reason}; interp "
+                                           f"{t_interp:.2f}s")
+    for e in ([] if args.no_eh else args.eh_eps):
         t_f, r = best_of(lambda cc, e=e: eck_hadenfeld_fair(cc, l=2, tol=args.tol,
                                                             eps=e / c.n_ctrl,
                                                             max_steps=200 * args.n), fresh_curve)
