@@ -609,7 +609,7 @@ def _global_fair(curve: BSplineCurve, tol: float | None, l: Any,  # noqa: E741
             Wk = Wk * v
         W = Wk if W is None else W + Wk
     W = np.ascontiguousarray(W)
-    d0 = np.array(curve.control_points)
+    d0 = np.ascontiguousarray(curve.control_points, dtype=float)  # read only: no copy
     n, dim = d0.shape
 
     def residual(K: FloatArray, x: FloatArray) -> FloatArray:  # K x, difference form
