@@ -476,3 +476,56 @@ def test_curvefair_threads_environment_variable():
     assert threads("1")[:2] == (0, "1")
     rc, _, err = threads("many")
     assert rc != 0 and "CURVEFAIR_THREADS must be 1 or 2" in err
+
+
+@pytest.mark.parametrize("n", [9, 40, 777])
+def test_split_factorisation_is_the_fused_one(n):
+    """assemble_ldl_head (points 0 .. m-1 assembled on the way) + the other columns assembled
+    separately + assemble_ldl_tail give bitwise the factor of assemble_ldl (planar cubic,
+    random blocks, frames and fixed unknowns), and it solves the assembled system (dense
+    reference)."""
+    from curvefair.fairing import _global_kernels as k
+
+    rng = np.random.default_rng(n)
+    p = 3  # planar cubic: kd = 7
+    A = rng.normal(size=(n + 6, n))
+    G = A.T @ A / n + np.eye(n)  # SPD, then banded with its band rows
+    K = np.zeros((n, 2 * p + 1))
+    for o in range(-p, p + 1):
+        for i in range(n):
+            if 0 <= i + o < n:
+                K[i, p + o] = G[i, i + o]
+    # keep K symmetric positive definite: diagonal dominance
+    K[:, p] += np.abs(K).sum(axis=1)
+    B = np.zeros((n, 2, 2))
+    iso = 0.1 + rng.random(n)
+    B[:, 0, 0] = iso
+    B[:, 1, 1] = iso
+    nrm = rng.normal(size=(n, 2))
+    nrm /= np.linalg.norm(nrm, axis=1)[:, None]
+    Q = np.lib.stride_tricks.as_strided(nrm, shape=(n, 2, 2), strides=(16, 8, 0))
+    rot = rng.random(n) < 0.3
+    fix = np.zeros((n, 2), dtype=np.bool_)
+    fix[:, 0] = rot
+    fix[0] = True
+    L0 = np.full((2 * n, 8), np.nan)
+    assert k.assemble_ldl(K, p, B, Q, rot, fix, L0) == 0
+    for m in sorted({1, 4, n // 3, n // 2, n - 1}):
+        L = np.full((2 * n, 8), np.nan)
+        k._assemble_range(K, p, False, B, Q, rot, fix, L, m, n)
+        info, j = k.assemble_ldl_head(K, p, B, Q, rot, fix, L, m)
+        assert info == 0
+        assert k.assemble_ldl_tail(K, p, B, Q, rot, fix, L, j) == 0
+        assert np.array_equal(L, L0, equal_nan=True), m
+    # the factor solves the assembled matrix (independent dense solve of the same band)
+    Lb = np.zeros((2 * n, 8))
+    k.assemble(K, p, False, B, Q, rot, fix, Lb)
+    M = np.zeros((2 * n, 2 * n))
+    for jj in range(2 * n):
+        for kk in range(8):
+            if jj + kk < 2 * n:
+                M[jj + kk, jj] = M[jj, jj + kk] = Lb[jj, kk]
+    b = rng.normal(size=2 * n)
+    x = b.copy()
+    k.ldl_solve(L0, 2 * n, x)
+    assert np.allclose(M @ x, b, rtol=0, atol=1e-9 * np.abs(b).max() * np.abs(M).max())

@@ -88,7 +88,7 @@ def _assemble_range2(K, p, closed, B, Q, rot, fix, L, i0, i1):  # type: ignore[n
         L[C1, 2 * p + 1] = 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _assemble_range(K, p, closed, B, Q, rot, fix, L, i0, i1):  # type: ignore[no-untyped-def]
     """Write the lower-band entries of the columns of points ``i0 .. i1 - 1`` into ``L``."""
     if B.shape[1] == 2:
@@ -264,6 +264,134 @@ def assemble(K, p, closed, B, Q, rot, fix, L):  # type: ignore[no-untyped-def]
     _assemble_range(K, p, closed, B, Q, rot, fix, L, 0, K.shape[0])
 
 
+@njit(cache=True)
+def _ldl7(K, p, B, Q, rot, fix, L, j, jstop, nxt, nmax):  # type: ignore[no-untyped-def]
+    """Elimination steps ``j .. jstop - 1`` (``jstop <= N - 7``) of :func:`assemble_ldl` for
+    ``kd = 7``, with the 7 x 7 window loaded from (and written back to) the right-looking
+    storage at ``L[j:j + 7]``, the columns of points ``nxt .. nmax - 1`` assembled in batches
+    just before they are needed (points from ``nmax`` on must be assembled already: rows up to
+    ``jstop + 6`` are read). Returns ``(info, j, nxt)``."""
+    dim = B.shape[1]
+    p00 = L[j + 0, 0]
+    p10 = L[j + 0, 1]
+    p11 = L[j + 1, 0]
+    p20 = L[j + 0, 2]
+    p21 = L[j + 1, 1]
+    p22 = L[j + 2, 0]
+    p30 = L[j + 0, 3]
+    p31 = L[j + 1, 2]
+    p32 = L[j + 2, 1]
+    p33 = L[j + 3, 0]
+    p40 = L[j + 0, 4]
+    p41 = L[j + 1, 3]
+    p42 = L[j + 2, 2]
+    p43 = L[j + 3, 1]
+    p44 = L[j + 4, 0]
+    p50 = L[j + 0, 5]
+    p51 = L[j + 1, 4]
+    p52 = L[j + 2, 3]
+    p53 = L[j + 3, 2]
+    p54 = L[j + 4, 1]
+    p55 = L[j + 5, 0]
+    p60 = L[j + 0, 6]
+    p61 = L[j + 1, 5]
+    p62 = L[j + 2, 4]
+    p63 = L[j + 3, 3]
+    p64 = L[j + 4, 2]
+    p65 = L[j + 5, 1]
+    p66 = L[j + 6, 0]
+    while j < jstop:
+        if j + 7 >= nxt * dim and nxt < nmax:
+            stop = min(nmax, nxt + 256)
+            _assemble_range(K, p, False, B, Q, rot, fix, L, nxt, stop)
+            nxt = stop
+        d = p00
+        if not d > 0.0:
+            return j + 1, j, nxt
+        r = 1.0 / d
+        a1 = p10
+        a2 = p20
+        a3 = p30
+        a4 = p40
+        a5 = p50
+        a6 = p60
+        a7 = L[j, 7]
+        l1 = a1 * r
+        l2 = a2 * r
+        l3 = a3 * r
+        l4 = a4 * r
+        l5 = a5 * r
+        l6 = a6 * r
+        l7 = a7 * r
+        L[j, 0] = r
+        L[j, 1] = l1
+        L[j, 2] = l2
+        L[j, 3] = l3
+        L[j, 4] = l4
+        L[j, 5] = l5
+        L[j, 6] = l6
+        L[j, 7] = l7
+        p00 = p11 - l1 * a1
+        p10 = p21 - l2 * a1
+        p11 = p22 - l2 * a2
+        p20 = p31 - l3 * a1
+        p21 = p32 - l3 * a2
+        p22 = p33 - l3 * a3
+        p30 = p41 - l4 * a1
+        p31 = p42 - l4 * a2
+        p32 = p43 - l4 * a3
+        p33 = p44 - l4 * a4
+        p40 = p51 - l5 * a1
+        p41 = p52 - l5 * a2
+        p42 = p53 - l5 * a3
+        p43 = p54 - l5 * a4
+        p44 = p55 - l5 * a5
+        p50 = p61 - l6 * a1
+        p51 = p62 - l6 * a2
+        p52 = p63 - l6 * a3
+        p53 = p64 - l6 * a4
+        p54 = p65 - l6 * a5
+        p55 = p66 - l6 * a6
+        p60 = L[j + 1, 6] - l7 * a1
+        p61 = L[j + 2, 5] - l7 * a2
+        p62 = L[j + 3, 4] - l7 * a3
+        p63 = L[j + 4, 3] - l7 * a4
+        p64 = L[j + 5, 2] - l7 * a5
+        p65 = L[j + 6, 1] - l7 * a6
+        p66 = L[j + 7, 0] - l7 * a7
+        j += 1
+    # write the window back (right-looking storage) and finish in place
+    L[j + 0, 0] = p00
+    L[j + 0, 1] = p10
+    L[j + 1, 0] = p11
+    L[j + 0, 2] = p20
+    L[j + 1, 1] = p21
+    L[j + 2, 0] = p22
+    L[j + 0, 3] = p30
+    L[j + 1, 2] = p31
+    L[j + 2, 1] = p32
+    L[j + 3, 0] = p33
+    L[j + 0, 4] = p40
+    L[j + 1, 3] = p41
+    L[j + 2, 2] = p42
+    L[j + 3, 1] = p43
+    L[j + 4, 0] = p44
+    L[j + 0, 5] = p50
+    L[j + 1, 4] = p51
+    L[j + 2, 3] = p52
+    L[j + 3, 2] = p53
+    L[j + 4, 1] = p54
+    L[j + 5, 0] = p55
+    L[j + 0, 6] = p60
+    L[j + 1, 5] = p61
+    L[j + 2, 4] = p62
+    L[j + 3, 3] = p63
+    L[j + 4, 2] = p64
+    L[j + 5, 1] = p65
+    L[j + 6, 0] = p66
+    return 0, j, nxt
+
+
 @njit(cache=True, nogil=True)
 def assemble_ldl(K, p, B, Q, rot, fix, L):  # type: ignore[no-untyped-def]
     """Assemble (open curves) and factorise ``M = U D U^T`` (``U`` unit lower band) in one pass:
@@ -282,124 +410,9 @@ def assemble_ldl(K, p, B, Q, rot, fix, L):  # type: ignore[no-untyped-def]
     if kd == 7 and N > 16:
         nxt = min(n, 256)
         _assemble_range(K, p, False, B, Q, rot, fix, L, 0, nxt)
-        p00 = L[0, 0]
-        p10 = L[0, 1]
-        p11 = L[1, 0]
-        p20 = L[0, 2]
-        p21 = L[1, 1]
-        p22 = L[2, 0]
-        p30 = L[0, 3]
-        p31 = L[1, 2]
-        p32 = L[2, 1]
-        p33 = L[3, 0]
-        p40 = L[0, 4]
-        p41 = L[1, 3]
-        p42 = L[2, 2]
-        p43 = L[3, 1]
-        p44 = L[4, 0]
-        p50 = L[0, 5]
-        p51 = L[1, 4]
-        p52 = L[2, 3]
-        p53 = L[3, 2]
-        p54 = L[4, 1]
-        p55 = L[5, 0]
-        p60 = L[0, 6]
-        p61 = L[1, 5]
-        p62 = L[2, 4]
-        p63 = L[3, 3]
-        p64 = L[4, 2]
-        p65 = L[5, 1]
-        p66 = L[6, 0]
-        jend = N - 7
-        while j < jend:
-            if j + 7 >= nxt * dim and nxt < n:
-                stop = min(n, nxt + 256)
-                _assemble_range(K, p, False, B, Q, rot, fix, L, nxt, stop)
-                nxt = stop
-            d = p00
-            if not d > 0.0:
-                return j + 1
-            r = 1.0 / d
-            a1 = p10
-            a2 = p20
-            a3 = p30
-            a4 = p40
-            a5 = p50
-            a6 = p60
-            a7 = L[j, 7]
-            l1 = a1 * r
-            l2 = a2 * r
-            l3 = a3 * r
-            l4 = a4 * r
-            l5 = a5 * r
-            l6 = a6 * r
-            l7 = a7 * r
-            L[j, 0] = r
-            L[j, 1] = l1
-            L[j, 2] = l2
-            L[j, 3] = l3
-            L[j, 4] = l4
-            L[j, 5] = l5
-            L[j, 6] = l6
-            L[j, 7] = l7
-            p00 = p11 - l1 * a1
-            p10 = p21 - l2 * a1
-            p11 = p22 - l2 * a2
-            p20 = p31 - l3 * a1
-            p21 = p32 - l3 * a2
-            p22 = p33 - l3 * a3
-            p30 = p41 - l4 * a1
-            p31 = p42 - l4 * a2
-            p32 = p43 - l4 * a3
-            p33 = p44 - l4 * a4
-            p40 = p51 - l5 * a1
-            p41 = p52 - l5 * a2
-            p42 = p53 - l5 * a3
-            p43 = p54 - l5 * a4
-            p44 = p55 - l5 * a5
-            p50 = p61 - l6 * a1
-            p51 = p62 - l6 * a2
-            p52 = p63 - l6 * a3
-            p53 = p64 - l6 * a4
-            p54 = p65 - l6 * a5
-            p55 = p66 - l6 * a6
-            p60 = L[j + 1, 6] - l7 * a1
-            p61 = L[j + 2, 5] - l7 * a2
-            p62 = L[j + 3, 4] - l7 * a3
-            p63 = L[j + 4, 3] - l7 * a4
-            p64 = L[j + 5, 2] - l7 * a5
-            p65 = L[j + 6, 1] - l7 * a6
-            p66 = L[j + 7, 0] - l7 * a7
-            j += 1
-        # write the window back (right-looking storage) and finish in place
-        L[j + 0, 0] = p00
-        L[j + 0, 1] = p10
-        L[j + 1, 0] = p11
-        L[j + 0, 2] = p20
-        L[j + 1, 1] = p21
-        L[j + 2, 0] = p22
-        L[j + 0, 3] = p30
-        L[j + 1, 2] = p31
-        L[j + 2, 1] = p32
-        L[j + 3, 0] = p33
-        L[j + 0, 4] = p40
-        L[j + 1, 3] = p41
-        L[j + 2, 2] = p42
-        L[j + 3, 1] = p43
-        L[j + 4, 0] = p44
-        L[j + 0, 5] = p50
-        L[j + 1, 4] = p51
-        L[j + 2, 3] = p52
-        L[j + 3, 2] = p53
-        L[j + 4, 1] = p54
-        L[j + 5, 0] = p55
-        L[j + 0, 6] = p60
-        L[j + 1, 5] = p61
-        L[j + 2, 4] = p62
-        L[j + 3, 3] = p63
-        L[j + 4, 2] = p64
-        L[j + 5, 1] = p65
-        L[j + 6, 0] = p66
+        info, j, nxt = _ldl7(K, p, B, Q, rot, fix, L, 0, N - 7, nxt, n)
+        if info:
+            return info
     while j < N:
         if nxt < n:
             stop = min(n, nxt + 256)
@@ -412,6 +425,32 @@ def assemble_ldl(K, p, B, Q, rot, fix, L):  # type: ignore[no-untyped-def]
             return info
         j = j1
     return 0
+
+
+@njit(cache=True, nogil=True)
+def assemble_ldl_head(K, p, B, Q, rot, fix, L, nmax):  # type: ignore[no-untyped-def]
+    """First part of :func:`assemble_ldl` (``kd = 7``, ``N > 16``) while the columns of the
+    points ``nmax .. n - 1`` are assembled elsewhere (:func:`_assemble_range`, e.g. on another
+    thread): assembles points ``0 .. nmax - 1`` and eliminates the columns that read only
+    those. Returns ``(info, j)``: continue with :func:`assemble_ldl_tail` from ``j`` once
+    every column is assembled. The same operations as :func:`assemble_ldl` (bitwise)."""
+    dim = B.shape[1]
+    nxt = min(nmax, 256)
+    _assemble_range(K, p, False, B, Q, rot, fix, L, 0, nxt)
+    info, j, nxt = _ldl7(K, p, B, Q, rot, fix, L, 0, max(nmax * dim - 8, 0), nxt, nmax)
+    return info, j
+
+
+@njit(cache=True, nogil=True)
+def assemble_ldl_tail(K, p, B, Q, rot, fix, L, j):  # type: ignore[no-untyped-def]
+    """The rest of :func:`assemble_ldl` after :func:`assemble_ldl_head` (every column
+    assembled)."""
+    n = K.shape[0]
+    N = n * B.shape[1]
+    info, j, nxt = _ldl7(K, p, B, Q, rot, fix, L, j, N - 7, n, n)
+    if info:
+        return info
+    return _ldl_cols(L, j, N, N)
 
 
 @njit(cache=True)

@@ -149,6 +149,7 @@ def _thread_setting() -> int:
 _THREADS = _thread_setting()  # 1: everything on the calling thread
 _PAR_MIN = 100_000  # points: below, one range on the calling thread
 _PAR_CHUNKS = 16
+_ASM_SPLIT = 0.5  # open planar cubics: the worker assembles the columns from this fraction on
 _POOL: list[ThreadPoolExecutor] = []
 _POOL_LOCK = threading.Lock()
 
@@ -399,6 +400,17 @@ class _System:
         if self.closed:
             _k.assemble(self.K, self.p, True, B, self.Q, self.rot, self.fix, self.L)
             info = _k.cyclic_cholesky(self.L, self.Y, self.S)
+        elif self.kd == 7 and _THREADS >= 2 and self.n >= max(_PAR_MIN, 64):
+            # the columns of the last points assembled on the worker thread meanwhile (after
+            # any right-hand side queued before: prep_start); the same operations (bitwise)
+            args = (self.K, self.p, B, self.Q, self.rot, self.fix, self.L)
+            m = int(self.n * _ASM_SPLIT)
+            fin = _ranges_start(lambda a, b: _k._assemble_range(
+                self.K, self.p, False, B, self.Q, self.rot, self.fix, self.L, a, b), m, self.n)
+            info, j = _k.assemble_ldl_head(*args, m)
+            fin()
+            if info == 0:
+                info = _k.assemble_ldl_tail(*args, j)
         else:
             info = _k.assemble_ldl(self.K, self.p, B, self.Q, self.rot, self.fix, self.L)
         return info == 0
