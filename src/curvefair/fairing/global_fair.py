@@ -565,14 +565,16 @@ def global_fair(curve: BSplineCurve, *, tol: float | None = None, l: Any = 2,  #
     ``U D U^T`` (open curves) or band Cholesky bordered by a small Schur complement (closed
     curves, cyclic band): ``O(n)`` per iteration,
     typically 4-8 Newton iterations after the ADMM start, 10-20 with the interior point (1e6
-    planar cubic control points: about 0.8 s on one core, 0.72-0.79 s with a second core free).
+    planar cubic control points: about 0.7 s on one core, 0.53-0.61 s with a second core free).
     Planar curves split the per-point passes of every Newton iteration (evaluation,
     right-hand side, back-rotation, update) into point ranges shared by the calling thread and
     one worker thread (when the process may use 2 or more CPUs and the curve has at least
     100000 control points; the factorisation and the substitutions stay sequential, but the
     right-hand side of a refactorised step is prepared on the worker thread while the calling
-    thread factorises, the pages of the Newton work arrays are mapped on it during the ADMM
-    start, and the final pull-in onto the balls is split too); the
+    thread factorises, the worker then assembles the columns of the second half of the points
+    (open planar cubics) while the calling thread assembles and eliminates the first half,
+    the pages of the Newton work arrays are mapped on it during the ADMM start, and the final
+    pull-in onto the balls is split too); the
     ranges write disjoint points, so the result is bitwise the same as on one thread, and the
     calling thread never waits for a chunk the worker has not started (at 1e6 points: 0.91 ->
     0.73-0.79 s with the second core free; with it busy in a spinning process 0-7 % slower
