@@ -351,6 +351,7 @@ class _System:
         self.fix = self.fix0.copy()
         self.B = np.zeros((n, dim, dim))
         self.czero = np.zeros(n)
+        self.then: Any = None  # what factor()'s ``then`` returned
 
     @property
     def L(self) -> FloatArray:  # noqa: N802
@@ -361,13 +362,15 @@ class _System:
         return self._L
 
     def factor(self, B: FloatArray, rot: np.ndarray | None = None,
-               nrm: FloatArray | None = None, nrot: int | None = None) -> bool:
+               nrm: FloatArray | None = None, nrot: int | None = None,
+               then: Callable[[], Any] | None = None) -> bool:
         """Factorise for blocks ``B`` (n, dim, dim); points ``rot`` get the frame whose first
         axis is ``nrm`` and that axis fixed (a prescribed normal displacement). ``nrot``: the
         caller has already written ``self.rot``, ``self.Q`` and ``self.fix`` for ``nrot``
         such points (:func:`._global_kernels.ssn_eval_prep`). False if the matrix is not
         positive definite in floating point."""
         self.B = B
+        self.then = None
         if nrot is not None:
             self.anyrot = nrot > 0
         else:
@@ -397,16 +400,22 @@ class _System:
             except np.linalg.LinAlgError:
                 return False
             return True
+        split = (not self.closed and self.kd == 7 and _THREADS >= 2
+                 and self.n >= max(_PAR_MIN, 64))
+        if not split:
+            self.then = then() if then is not None else None
         if self.closed:
             _k.assemble(self.K, self.p, True, B, self.Q, self.rot, self.fix, self.L)
             info = _k.cyclic_cholesky(self.L, self.Y, self.S)
-        elif self.kd == 7 and _THREADS >= 2 and self.n >= max(_PAR_MIN, 64):
-            # the columns of the last points assembled on the worker thread meanwhile (after
-            # any right-hand side queued before: prep_start); the same operations (bitwise)
+        elif split:
+            # the columns of the last points assembled on the worker thread meanwhile, then
+            # (queued after them) ``then``, e.g. the right-hand side (prep_start); the same
+            # operations (bitwise)
             args = (self.K, self.p, B, self.Q, self.rot, self.fix, self.L)
             m = int(self.n * _ASM_SPLIT)
             fin = _ranges_start(lambda a, b: _k._assemble_range(
                 self.K, self.p, False, B, self.Q, self.rot, self.fix, self.L, a, b), m, self.n)
+            self.then = then() if then is not None else None
             info, j = _k.assemble_ldl_head(*args, m)
             fin()
             if info == 0:
@@ -958,8 +967,9 @@ def _ssn_loop(system: _System, g0: FloatArray, free: np.ndarray, tol: float, v: 
         prepped = False
         if not chord:
             # the right-hand side prepared on the worker thread during the factorisation
-            fin = system.prep_start(B, nS, rd, c, dv, -1.0)
-            ok = system.factor(B, nrot=nS)
+            ok = system.factor(B, nrot=nS,
+                               then=lambda nS=nS: system.prep_start(B, nS, rd, c, dv, -1.0))
+            fin, system.then = system.then, None
             if fin is not None:
                 fin()
                 prepped = True
