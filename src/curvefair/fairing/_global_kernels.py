@@ -1431,6 +1431,25 @@ def finish_points_range(d0, v, free, rmax, ract, x, act, i0, i1):  # type: ignor
         act[i] = dist > ract
 
 
+@njit(cache=True, inline="always")
+def _frame3(Q, i, x, y, z):  # type: ignore[no-untyped-def]
+    """``Q_i``: the orthonormal 3-D frame whose first column is the unit vector ``(x, y, z)``
+    (Duff et al. 2017, "Building an orthonormal basis, revisited"); inlined at numba IR level
+    (no call with an array argument in the loops)."""
+    sgn = 1.0 if z >= 0.0 else -1.0
+    a_ = -1.0 / (sgn + z)
+    b = x * y * a_
+    Q[i, 0, 0] = x
+    Q[i, 1, 0] = y
+    Q[i, 2, 0] = z
+    Q[i, 0, 1] = 1.0 + sgn * x * x * a_
+    Q[i, 1, 1] = sgn * b
+    Q[i, 2, 1] = -sgn * x
+    Q[i, 0, 2] = b
+    Q[i, 1, 2] = sgn + y * y * a_
+    Q[i, 2, 2] = -y
+
+
 @njit(cache=True)
 def set_frames(nrm, rot, Q, fix, fix0):  # type: ignore[no-untyped-def]
     """``fix = fix0`` plus the first axis of the ``rot`` points; ``Q_i`` the orthonormal frame
@@ -1450,21 +1469,7 @@ def set_frames(nrm, rot, Q, fix, fix0):  # type: ignore[no-untyped-def]
             Q[i, 0, 1] = -nrm[i, 1]
             Q[i, 1, 1] = nrm[i, 0]
         else:
-            x = nrm[i, 0]
-            y = nrm[i, 1]
-            z = nrm[i, 2]
-            sgn = 1.0 if z >= 0.0 else -1.0
-            a_ = -1.0 / (sgn + z)
-            b = x * y * a_
-            Q[i, 0, 0] = x
-            Q[i, 1, 0] = y
-            Q[i, 2, 0] = z
-            Q[i, 0, 1] = 1.0 + sgn * x * x * a_
-            Q[i, 1, 1] = sgn * b
-            Q[i, 2, 1] = -sgn * x
-            Q[i, 0, 2] = b
-            Q[i, 1, 2] = sgn + y * y * a_
-            Q[i, 2, 2] = -y
+            _frame3(Q, i, nrm[i, 0], nrm[i, 1], nrm[i, 2])
 
 
 @njit(cache=True)
@@ -1633,21 +1638,7 @@ def ssn_eval_range(g0, K, p, closed, v, lam, free, t2, kappa, delta, S, rd, rho,
                 Q[i, 0, 0] = nrm[i, 0]
                 Q[i, 1, 0] = nrm[i, 1]
             else:
-                x0 = nrm[i, 0]
-                y0 = nrm[i, 1]
-                z0 = nrm[i, 2]
-                sgn = 1.0 if z0 >= 0.0 else -1.0
-                a_ = -1.0 / (sgn + z0)
-                b_ = x0 * y0 * a_
-                Q[i, 0, 0] = x0
-                Q[i, 1, 0] = y0
-                Q[i, 2, 0] = z0
-                Q[i, 0, 1] = 1.0 + sgn * x0 * x0 * a_
-                Q[i, 1, 1] = sgn * b_
-                Q[i, 2, 1] = -sgn * x0
-                Q[i, 0, 2] = b_
-                Q[i, 1, 2] = sgn + y0 * y0 * a_
-                Q[i, 2, 2] = -y0
+                _frame3(Q, i, nrm[i, 0], nrm[i, 1], nrm[i, 2])
         # (nrm, c and Q of inactive points are left as they are: never read)
     return rdm, fm, fsm, ns
 
