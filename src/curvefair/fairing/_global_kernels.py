@@ -546,6 +546,27 @@ def ldl_solve(L, N, x):  # type: ignore[no-untyped-def]
         x[i] = v
 
 
+@njit(cache=True, inline="always")
+def _krow(K, p, closed, x, i, a, interior):  # type: ignore[no-untyped-def]
+    """``(K x)_{i, a}`` for points ``x`` (n, dim), ``K`` by its band rows ``K[i, p + o]``
+    (closed: indices mod n); ``interior`` (``p <= i < n - p``) skips the wrap tests. Inlined at
+    numba IR level: the same additions in the same order as a written-out loop."""
+    n = x.shape[0]
+    acc = 0.0
+    if interior:
+        for o in range(-p, p + 1):
+            acc += K[i, p + o] * x[i + o, a]
+    else:
+        for o in range(-p, p + 1):
+            j = i + o
+            if j < 0 or j >= n:
+                if not closed:
+                    continue
+                j = j + n if j < 0 else j - n
+            acc += K[i, p + o] * x[j, a]
+    return acc
+
+
 @njit(cache=True)
 def band_matvec(K, p, closed, x, out):  # type: ignore[no-untyped-def]
     """``out = kron(K, I) x`` for points ``x`` (n, dim); ``K`` given by its band rows
@@ -554,19 +575,7 @@ def band_matvec(K, p, closed, x, out):  # type: ignore[no-untyped-def]
     for i in range(n):
         interior = i >= p and i + p < n
         for a in range(dim):
-            acc = 0.0
-            if interior:
-                for o in range(-p, p + 1):
-                    acc += K[i, p + o] * x[i + o, a]
-            else:
-                for o in range(-p, p + 1):
-                    j = i + o
-                    if j < 0 or j >= n:
-                        if not closed:
-                            continue
-                        j %= n
-                    acc += K[i, p + o] * x[j, a]
-            out[i, a] = acc
+            out[i, a] = _krow(K, p, closed, x, i, a, interior)
 
 
 # ------------------------------------------------------------------------------------------
@@ -995,18 +1004,7 @@ def ip_eval(g0, K, p, closed, v, lam, free, t2, rd, s):  # type: ignore[no-untyp
         li = lam[i]
         interior = i >= p and i + p < n
         for a in range(dim):
-            acc = 0.0
-            if interior:
-                for o in range(-p, p + 1):
-                    acc += K[i, p + o] * v[i + o, a]
-            else:
-                for o in range(-p, p + 1):
-                    j = i + o
-                    if j < 0 or j >= n:
-                        if not closed:
-                            continue
-                        j = j + n if j < 0 else j - n
-                    acc += K[i, p + o] * v[j, a]
+            acc = _krow(K, p, closed, v, i, a, interior)
             va = v[i, a]
             r = g0[i, a] + acc + li * (va / t2)
             rd[i, a] = r
@@ -1605,18 +1603,7 @@ def ssn_eval_range(g0, K, p, closed, v, lam, free, t2, kappa, delta, S, rd, rho,
             for a in range(dim):
                 if c23 and interior:
                     break
-                acc = 0.0
-                if interior:
-                    for o in range(-p, p + 1):
-                        acc += K[i, p + o] * v[i + o, a]
-                else:
-                    for o in range(-p, p + 1):
-                        j = i + o
-                        if j < 0 or j >= n:
-                            if not closed:
-                                continue
-                            j = j + n if j < 0 else j - n
-                        acc += K[i, p + o] * v[j, a]
+                acc = _krow(K, p, closed, v, i, a, interior)
                 x = g0[i, a] + acc + li * (v[i, a] / t2)
                 rd[i, a] = x
                 if not abs(x) <= rdm:  # NaN propagates
@@ -1666,15 +1653,7 @@ def ssn_update_k(K, p, closed, v, dv, rd, lam, S, nrm, rho, t2, retract,  # type
         if lo <= i < hi:
             continue
         for a in range(dim):
-            acc = 0.0
-            for o in range(-p, p + 1):
-                j = i + o
-                if j < 0 or j >= n:
-                    if not closed:
-                        continue
-                    j = j + n if j < 0 else j - n
-                acc += K[i, p + o] * dv[j, a]
-            kdv[a] = acc
+            kdv[a] = _krow(K, p, closed, dv, i, a, False)
         if S[i]:
             acc = 0.0
             li = lam[i] / t2
