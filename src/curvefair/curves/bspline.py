@@ -187,6 +187,26 @@ def _gram_kernel(knots, p, spans, l, xq, wq, n, closed, W):  # type: ignore[no-u
     return W
 
 
+@njit(cache=True, inline="always")
+def residual_row(W, p, closed, x, i, a, interior):  # type: ignore[no-untyped-def]
+    """``(G x)_{i, a}`` in the difference form of :func:`band_residual`; ``interior``
+    (``p <= i < n - p``) skips the wrap tests. Inlined at numba IR level (no call with array
+    arguments in the callers' loops); the one place this sum is written."""
+    n = x.shape[0]
+    xi = x[i, a]
+    acc = 0.0
+    for o in range(-p, p + 1):
+        if o == 0:
+            continue
+        j = i + o
+        if not interior and (j < 0 or j >= n):
+            if not closed:
+                continue
+            j = j + n if j < 0 else j - n
+        acc += W[i, p + o] * (x[j, a] - xi)
+    return acc
+
+
 @njit(cache=True)
 def band_residual(W, p, closed, x, out):  # type: ignore[no-untyped-def]
     """``out = G x`` (per coordinate) for the Gram band ``W`` of :meth:`BSplineCurve.gram_band`,
@@ -200,18 +220,7 @@ def band_residual(W, p, closed, x, out):  # type: ignore[no-untyped-def]
     for i in range(n):
         interior = i >= p and i + p < n
         for a in range(dim):
-            xi = x[i, a]
-            acc = 0.0
-            for o in range(-p, p + 1):
-                if o == 0:
-                    continue
-                j = i + o
-                if not interior and (j < 0 or j >= n):
-                    if not closed:
-                        continue
-                    j = j + n if j < 0 else j - n
-                acc += W[i, p + o] * (x[j, a] - xi)
-            out[i, a] = acc
+            out[i, a] = residual_row(W, p, closed, x, i, a, interior)
 
 
 @njit(cache=True)

@@ -22,7 +22,7 @@ from numba import njit
 
 from .._typing import FloatArray
 from .._validate import as_nonnegative, as_step_count, check_finite
-from ..curves.bspline import BSplineCurve, band_energy, band_residual
+from ..curves.bspline import BSplineCurve, band_energy, band_residual, residual_row
 from ..errors import InputError
 from ._prefetch import prefetch
 
@@ -668,17 +668,7 @@ def _largest_free_z(W, p, closed, d, mask):  # type: ignore[no-untyped-def]
         interior = i >= p and i + p < n
         gg = 0.0
         for a in range(dim):
-            xi = d[i, a]
-            acc = 0.0
-            for o in range(-p, p + 1):
-                if o == 0:
-                    continue
-                j = i + o
-                if not interior and (j < 0 or j >= n):
-                    if not closed:
-                        continue
-                    j = j + n if j < 0 else j - n
-                acc += W[i, p + o] * (d[j, a] - xi)
+            acc = residual_row(W, p, closed, d, i, a, interior)
             gg += acc * acc
         v = gg / W[i, p]
         if first or v > best:
@@ -700,22 +690,7 @@ def _setup_state(W, p, closed, d, mask, X, z):  # type: ignore[no-untyped-def]
         interior = i >= p and i + p < n
         for a in range(dim):
             xi = d[i, a]
-            acc = 0.0
-            if interior:  # the same sums without the wrap tests
-                for o in range(-p, 0):
-                    acc += W[i, p + o] * (d[i + o, a] - xi)
-                for o in range(1, p + 1):
-                    acc += W[i, p + o] * (d[i + o, a] - xi)
-            else:
-                for o in range(-p, p + 1):
-                    if o == 0:
-                        continue
-                    j = i + o
-                    if j < 0 or j >= n:
-                        if not closed:
-                            continue
-                        j = j + n if j < 0 else j - n
-                    acc += W[i, p + o] * (d[j, a] - xi)
+            acc = residual_row(W, p, closed, d, i, a, interior)
             X[i, a] = xi
             X[i, dim + a] = acc
             X[i, 2 * dim + a] = xi
