@@ -476,6 +476,16 @@ def _loop_args(curve: BSplineCurve, kd: _KnotData, d: FloatArray, orig: FloatArr
 # the compiled loop
 # ------------------------------------------------------------------------------------------
 @njit(cache=True)
+def _pw_sum_long(v, m):  # type: ignore[no-untyped-def]
+    """numpy's pairwise summation above 128 values (recursive halves, multiples of 8)."""
+    if m <= 128:
+        return _pw_sum(v, m)
+    m2 = m // 2
+    m2 -= m2 % 8
+    return _pw_sum_long(v[:m2], m2) + _pw_sum_long(v[m2:], m - m2)
+
+
+@njit(cache=True, inline="always")
 def _pw_sum(v, m):  # type: ignore[no-untyped-def]
     """``v[:m].sum()`` in numpy's order (pairwise summation: sequential below 8 values, eight
     accumulators up to 128), so that the tracked sum is bitwise the vectorised one."""
@@ -484,31 +494,29 @@ def _pw_sum(v, m):  # type: ignore[no-untyped-def]
         for i in range(m):
             res += v[i]
         return res
-    if m <= 128:
-        r0, r1, r2, r3 = v[0], v[1], v[2], v[3]
-        r4, r5, r6, r7 = v[4], v[5], v[6], v[7]
-        i = 8
-        while i < m - (m % 8):
-            r0 += v[i]
-            r1 += v[i + 1]
-            r2 += v[i + 2]
-            r3 += v[i + 3]
-            r4 += v[i + 4]
-            r5 += v[i + 5]
-            r6 += v[i + 6]
-            r7 += v[i + 7]
-            i += 8
-        res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
-        while i < m:
-            res += v[i]
-            i += 1
-        return res
-    m2 = m // 2
-    m2 -= m2 % 8
-    return _pw_sum(v[:m2], m2) + _pw_sum(v[m2:], m - m2)
+    if m > 128:
+        return _pw_sum_long(v, m)
+    r0, r1, r2, r3 = v[0], v[1], v[2], v[3]
+    r4, r5, r6, r7 = v[4], v[5], v[6], v[7]
+    i = 8
+    while i < m - (m % 8):
+        r0 += v[i]
+        r1 += v[i + 1]
+        r2 += v[i + 2]
+        r3 += v[i + 3]
+        r4 += v[i + 4]
+        r5 += v[i + 5]
+        r6 += v[i + 6]
+        r7 += v[i + 7]
+        i += 8
+    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    while i < m:
+        res += v[i]
+        i += 1
+    return res
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _knot_measure(d, k, p, ctrl, C, right, left2):  # type: ignore[no-untyped-def]
     """:meth:`_KnotData.jumps` / :func:`sapidis_measure` at one knot, same operation order."""
     dim = d.shape[1]
@@ -579,7 +587,7 @@ def _knot_measure(d, k, p, ctrl, C, right, left2):  # type: ignore[no-untyped-de
     return v / speed ** e
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _ls_moves(d, k, p, ctrl, alphas, new, Q, A, f):  # type: ignore[no-untyped-def]
     """Least-squares removal (seed 004 eqs. (8.24)-(8.30)) at knot ``k``: the ``p`` new control
     points of basis functions ``j-p .. j-1`` into ``new``; ``Q`` (p+2, dim), ``A`` (p, p-1),
