@@ -336,7 +336,8 @@ def test_no_knots_and_zero_steps():
 
 
 def test_local_measure_equals_vectorised_one():
-    # the loop's scalar measure at every knot against _KnotData.jumps (numpy), all degrees/dims
+    # the loop's scalar measure at every knot, and _KnotData.jumps (bitwise), against the
+    # session-2 numpy measure (einsum + sapidis_measure), all degrees/dims
     from curvefair.fairing.knot_removal import _knot_measure
 
     rng = np.random.default_rng(9)
@@ -350,6 +351,9 @@ def test_local_measure_equals_vectorised_one():
                     np.testing.assert_array_equal(getattr(kd, name), getattr(old, name))
                 d = np.array(c.control_points)
                 ref = old.jumps(d)
+                np.testing.assert_array_equal(kd.jumps(d), ref)  # the vectorised measure
+                sub = np.array([0, 3, 2, 2, kd.js.size - 1])
+                np.testing.assert_array_equal(kd.jumps(d, sub), old.jumps(d, sub))
                 got = np.array([_knot_measure(d, k, p, kd.ctrl, kd.c, kd.right, kd.left2)
                                 for k in range(kd.js.size)])
                 np.testing.assert_allclose(got, ref, rtol=4e-16 * 8, atol=0)
@@ -363,7 +367,8 @@ def test_local_measure_equals_vectorised_one():
         kd = _KnotData(c)
         r2 = np.einsum("ma,mad->md", kd.right[:, 1, :], d[kd.ctrl[:, 1:]])
         assert np.any(np.abs(r2).max(axis=1) < 1e-12)  # the straight piece is there
-        ref = kd.jumps(d)
+        ref = _RefKnotData(c).jumps(d)
+        np.testing.assert_array_equal(kd.jumps(d), ref)
         got = np.array([_knot_measure(d, k, p, kd.ctrl, kd.c, kd.right, kd.left2)
                         for k in range(kd.js.size)])
         np.testing.assert_allclose(got, ref, rtol=4e-16 * 8, atol=0)

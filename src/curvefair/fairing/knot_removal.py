@@ -219,17 +219,20 @@ class _KnotData:
         self.c = c  # (k, p+2)
         self.right = np.ascontiguousarray(right[:, 1:3, :])  # r', r'' (right limits)
         self.left2 = np.ascontiguousarray(left[:, 2, :])  # r'' (left limit)
-        self.ctrl = curve.control_index(js[:, None] + np.arange(-p - 1, 1)[None, :])  # (k, p+2)
+        self.ctrl = np.ascontiguousarray(  # (k, p+2)
+            curve.control_index(js[:, None] + np.arange(-p - 1, 1)[None, :]), dtype=np.int64)
 
     def jumps(self, d: FloatArray, k: np.ndarray | slice = slice(None)) -> FloatArray:
-        """Sapidis-Farin measure at knots ``js[k]``."""
+        """Sapidis-Farin measure at knots ``js[k]``: :func:`sapidis_measure` of the one-sided
+        derivatives, bitwise (a compiled pass per knot for everything but the final
+        ``speed ** (p + 1)``, which numpy evaluates as in :func:`sapidis_measure`)."""
         p = self.p
-        Q = d[self.ctrl[k]]  # (m, p+2, dim)
-        J = np.einsum("ma,mad->md", self.c[k], Q)
-        r1 = np.einsum("ma,mad->md", self.right[k][:, 0, :], Q[:, 1:, :])
-        r2 = np.einsum("ma,mad->md", self.right[k][:, 1, :], Q[:, 1:, :])
-        l2 = np.einsum("ma,mad->md", self.left2[k], Q[:, :-1, :])
-        return sapidis_measure(r1, r2, l2, J, p)
+        ks = np.ascontiguousarray(np.arange(self.js.size)[k], dtype=np.int64)
+        num = np.empty(ks.size)
+        speed = np.empty(ks.size)
+        _measure_parts_all(np.ascontiguousarray(d, dtype=np.float64), ks, p, self.ctrl, self.c,
+                           self.right, self.left2, num, speed)
+        return num / speed ** (3 if p == 2 else p + 1)
 
 
 def _cross(a: FloatArray, b: FloatArray) -> FloatArray:
@@ -518,7 +521,16 @@ def _pw_sum(v, m):  # type: ignore[no-untyped-def]
 
 @njit(cache=True, inline="always")
 def _knot_measure(d, k, p, ctrl, C, right, left2):  # type: ignore[no-untyped-def]
-    """:meth:`_KnotData.jumps` / :func:`sapidis_measure` at one knot, same operation order."""
+    """:meth:`_KnotData.jumps` / :func:`sapidis_measure` at one knot, same operation order
+    (the scalar ``pow`` may differ from numpy's vectorised one in the last bit)."""
+    num, speed = _measure_parts(d, k, p, ctrl, C, right, left2)
+    return num / speed ** (3.0 if p == 2 else float(p + 1))
+
+
+@njit(cache=True, inline="always")
+def _measure_parts(d, k, p, ctrl, C, right, left2):  # type: ignore[no-untyped-def]
+    """Numerator and ``|r'|`` (``inf`` if zero) of the measure at knot ``k``: the measure is
+    ``num / speed ** (p + 1)`` (``p = 2``: ``** 3``); numpy's operation order."""
     dim = d.shape[1]
     J0 = J1 = J2 = 0.0
     a0 = a1 = a2 = 0.0  # r'
@@ -559,7 +571,7 @@ def _knot_measure(d, k, p, ctrl, C, right, left2):  # type: ignore[no-untyped-de
         speed = np.inf
     if p == 2:
         if dim == 2:
-            return abs((a0 * b1 - a1 * b0) - (a0 * l1 - a1 * l0)) / speed ** 3.0
+            return abs((a0 * b1 - a1 * b0) - (a0 * l1 - a1 * l0)), speed
         x0 = a1 * b2 - a2 * b1
         x1 = a2 * b0 - a0 * b2
         x2 = a0 * b1 - a1 * b0
@@ -568,10 +580,9 @@ def _knot_measure(d, k, p, ctrl, C, right, left2):  # type: ignore[no-untyped-de
         x1 = a2 * l0 - a0 * l2
         x2 = a0 * l1 - a1 * l0
         kl = np.sqrt(x0 * x0 + x1 * x1 + x2 * x2)
-        return abs(kr - kl) / speed ** 3.0
-    e = float(p + 1)
+        return abs(kr - kl), speed
     if dim == 2:
-        return abs(a0 * J1 - a1 * J0) / speed ** e
+        return abs(a0 * J1 - a1 * J0), speed
     c0 = a1 * J2 - a2 * J1
     c1 = a2 * J0 - a0 * J2
     c2 = a0 * J1 - a1 * J0
@@ -584,7 +595,13 @@ def _knot_measure(d, k, p, ctrl, C, right, left2):  # type: ignore[no-untyped-de
         v = abs(x0 * c0 + x1 * c1 + x2 * c2) / nb
     else:
         v = np.sqrt(c0 * c0 + c1 * c1 + c2 * c2)
-    return v / speed ** e
+    return v, speed
+
+
+@njit(cache=True)
+def _measure_parts_all(d, ks, p, ctrl, C, right, left2, num, speed):  # type: ignore[no-untyped-def]
+    for u in range(ks.shape[0]):
+        num[u], speed[u] = _measure_parts(d, ks[u], p, ctrl, C, right, left2)
 
 
 @njit(cache=True, inline="always")
