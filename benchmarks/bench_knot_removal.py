@@ -101,6 +101,7 @@ def main() -> None:
     print(f"{'n':>8} {'variant':>13} {'steps':>7} {'new e2e s':>10} {'loop s':>9} "
           f"{'us/step':>8} {'M steps/s':>9} | {'old e2e s':>9} {'us/step':>8} {'ratio':>7} "
           f"{'same':>8}")
+    per_step: dict[str, list[tuple[int, float]]] = {v: [] for v in kr.VARIANTS}
     for n in args.sizes:
         c = make_curve(n, args.degree, args.rel)
         for v in kr.VARIANTS:
@@ -109,6 +110,7 @@ def main() -> None:
             t_loop, steps = loop_only(c, v, args.repeat)
             assert steps == res.steps
             us_new = 1e6 * t_loop / max(steps, 1)
+            per_step[v].append((n, us_new))
             line = (f"{n:>8} {v:>13} {steps:>7} {t_e2e:>10.4f} {t_loop:>9.5f} {us_new:>8.3f} "
                     f"{steps / t_loop / 1e6:>9.2f} |")
             if n <= args.old_max:
@@ -128,6 +130,11 @@ def main() -> None:
             else:
                 line += f" {'-':>9} {'-':>8} {'-':>7} {'-':>8}"
             print(line, flush=True)
+    for v, rows in per_step.items():
+        (n0, u0), (n1, u1) = min(rows), max(rows)
+        if n1 > n0:
+            print(f"{v}: us/step at n = {n1} / at n = {n0}: {u1 / u0:.2f} "
+                  f"(log2 n ratio {np.log2(n1) / np.log2(n0):.2f}, n ratio {n1 / n0:.0f})")
 
 
 if __name__ == "__main__":
