@@ -262,7 +262,7 @@ def test_compiled_loop_matches_python_reference(p, dim, closed, variant):
 def test_cases_cover_every_stop_reason_and_blocking():
     # the random cases above must exercise every branch of the loop: run a sample and check
     rng = np.random.default_rng(77)
-    reasons, n_blocked, onepoint_bitwise = set(), 0, 0
+    reasons, n_blocked = set(), 0
     for trial in range(60):
         p = int(rng.integers(2, 6))
         dim = int(rng.integers(2, 4))
@@ -276,9 +276,6 @@ def test_cases_cover_every_stop_reason_and_blocking():
         assert_same(got, ref)
         reasons.add(ref.stop_reason)
         n_blocked += len(ref.blocked)
-        if variant == "one-point":
-            onepoint_bitwise += bool(np.array_equal(got.curve.control_points,
-                                                    ref.curve.control_points))
     assert reasons >= {"eps", "no_decrease", "tolerance", "max_steps"}
     assert n_blocked > 0
 
@@ -351,9 +348,12 @@ def test_local_measure_equals_vectorised_one():
                     np.testing.assert_array_equal(getattr(kd, name), getattr(old, name))
                 d = np.array(c.control_points)
                 ref = old.jumps(d)
-                np.testing.assert_array_equal(kd.jumps(d), ref)  # the vectorised measure
+                # the vectorised measure: bitwise equal on the development machine, but the
+                # einsum reference's summation order may depend on the CPU's SIMD width
+                np.testing.assert_allclose(kd.jumps(d), ref, rtol=1e-14, atol=0)
                 sub = np.array([0, 3, 2, 2, kd.js.size - 1])
-                np.testing.assert_array_equal(kd.jumps(d, sub), old.jumps(d, sub))
+                np.testing.assert_allclose(kd.jumps(d, sub), old.jumps(d, sub), rtol=1e-14,
+                                           atol=0)
                 got = np.array([_knot_measure(d, k, p, kd.ctrl, kd.c, kd.right, kd.left2)
                                 for k in range(kd.js.size)])
                 np.testing.assert_allclose(got, ref, rtol=4e-16 * 8, atol=0)
