@@ -172,7 +172,11 @@ def reference_knot_removal_fair(curve, *, variant="one-point", tol=None, eps=Non
         hist.append((j, zk, float(np.sqrt(np.sum((new - old) ** 2, axis=1)).max())))
     out = curve.replace(control_points=d)
     h = np.array(hist, dtype=float).reshape(-1, 3)
-    return KRResult(out, steps, reason, sum0, float(kd.jumps(d).sum()), h, blocked, total)
+    # session 3: an eps stop with a blocked knot still above the threshold is a tolerance stop
+    zend = kd.jumps(d)
+    if reason == "eps" and any(zend[int(pos[j])] > eps_abs for j in blocked):
+        reason = "tolerance"
+    return KRResult(out, steps, reason, sum0, float(zend.sum()), h, blocked, total)
 
 
 # ------------------------------------------------------------------------------------------

@@ -315,7 +315,8 @@ class KRResult:
     steps : int
     stop_reason : str
         ``"eps"``, ``"no_decrease"`` (the last removal did not lower ``sum z``; it was undone),
-        ``"tolerance"`` (every knot left is blocked by the tolerance or protected points),
+        ``"tolerance"`` (every knot whose ``z`` is above the threshold is blocked by the
+        tolerance or by fixed points),
         ``"max_steps"``, ``"no_knots"``.
     sum_before, sum_after : float
         ``sum_j z_j`` of the input and of the result.
@@ -420,6 +421,12 @@ def knot_removal_fair(curve: BSplineCurve, *, variant: Variant = "one-point",
     eps_abs = epsv * float(z.max()) if eps_relative else epsv
     out, steps, reason, total, hist, blocked = _run_loop(curve, kd, d, orig, mask, variant,
                                                          tolv, eps_abs, max_steps, on_tol, z)
+    if reason == "eps" and blocked:
+        # every knot still worth removing is blocked: the tolerance stopped the loop (as in
+        # eck_hadenfeld_fair); the unblocked ones left are the removed knots, z ~ 0
+        pos = np.searchsorted(js, np.asarray(blocked, dtype=np.int64))
+        if float(kd.jumps(d, pos).max()) > eps_abs:
+            reason = "tolerance"
     return KRResult(out, steps, reason, sum0, float(kd.jumps(d).sum()), hist, blocked, total)
 
 
