@@ -200,7 +200,7 @@ def test_band_system_matches_dense_solve(closed, dim, p, n):
     nrm /= np.linalg.norm(nrm, axis=1)[:, None]
     c = rng.normal(size=n)
     rhs = rng.normal(size=(n, dim))
-    sysm = _System(np.ascontiguousarray(K), p, dim, closed, fixed)
+    sysm = _System(np.ascontiguousarray(K), 1.0, p, dim, closed, fixed)
     assert sysm.factor(Bl, rot=rot, nrm=nrm)
     dx = sysm.solve(rhs.copy(), c)
     # dense reference: unknowns dx; equations: fixed points dx = 0, rot points n.dx = c and
@@ -287,7 +287,7 @@ def test_admm_sweep_matches_dense_solve_and_projection(dim, p):
                 K[i, p + o] = M[i, i + o]
     rho, alpha = 0.7, 1.6
     L = np.empty((n, p + 1))
-    assert _k.admm_factor(K, p, rho, L) == 0
+    assert _k.admm_factor(K, 1.0, p, rho, L) == 0
     g0 = rng.normal(size=(n, dim))
     z = 0.1 * rng.normal(size=(n, dim))
     u = 0.1 * rng.normal(size=(n, dim))
@@ -509,17 +509,17 @@ def test_split_factorisation_is_the_fused_one(n):
     fix[:, 0] = rot
     fix[0] = True
     L0 = np.full((2 * n, 8), np.nan)
-    assert k.assemble_ldl(K, p, B, Q, rot, fix, L0) == 0
+    assert k.assemble_ldl(K, 1.0, p, B, Q, rot, fix, L0) == 0
     for m in sorted({1, 4, n // 3, n // 2, n - 1}):
         L = np.full((2 * n, 8), np.nan)
-        k._assemble_range(K, p, False, B, Q, rot, fix, L, m, n)
-        info, j = k.assemble_ldl_head(K, p, B, Q, rot, fix, L, m)
+        k._assemble_range(K, 1.0, p, False, B, Q, rot, fix, L, m, n)
+        info, j = k.assemble_ldl_head(K, 1.0, p, B, Q, rot, fix, L, m)
         assert info == 0
-        assert k.assemble_ldl_tail(K, p, B, Q, rot, fix, L, j) == 0
+        assert k.assemble_ldl_tail(K, 1.0, p, B, Q, rot, fix, L, j) == 0
         assert np.array_equal(L, L0, equal_nan=True), m
     # the factor solves the assembled matrix (independent dense solve of the same band)
     Lb = np.zeros((2 * n, 8))
-    k.assemble(K, p, False, B, Q, rot, fix, Lb)
+    k.assemble(K, 1.0, p, False, B, Q, rot, fix, Lb)
     M = np.zeros((2 * n, 2 * n))
     for jj in range(2 * n):
         for kk in range(8):
@@ -529,3 +529,149 @@ def test_split_factorisation_is_the_fused_one(n):
     x = b.copy()
     k.ldl_solve(L0, 2 * n, x)
     assert np.allclose(M @ x, b, rtol=0, atol=1e-9 * np.abs(b).max() * np.abs(M).max())
+
+
+# -- session 3: the damped Newton step from the ADMM start, the scaled band, the IP slacks ----
+def _noisy_line(n, dim, sigma, seed):
+    rng = np.random.default_rng(seed)
+    x = np.arange(float(n))
+    pts = np.c_[x, np.zeros((n, dim - 1))] + sigma * rng.normal(size=(n, dim))
+    return interpolate_bspline(pts, param=x)
+
+
+def _record_newton(monkeypatch, gf):
+    """Record ``(iterations, converged)`` of every active-set Newton call."""
+    calls = []
+    orig = gf._active_set_newton
+
+    def wrapped(*a, **k):
+        out = orig(*a, **k)
+        calls.append((out[2], out[3]))
+        return out
+
+    monkeypatch.setattr(gf, "_active_set_newton", wrapped)
+    return calls
+
+
+def test_damped_newton_needed_and_optimal_small(monkeypatch):
+    """A noisy straight line (80 points, 35 end up active): the plain Newton step from the
+    ADMM start diverges (the interior point has to take over); with the damped step the Newton
+    iteration converges from the ADMM start. The result is checked against SLSQP on the same
+    problem (energy, points) and the KKT conditions with the from-scratch Gram matrix."""
+    import curvefair.fairing.global_fair as gf
+
+    c = _noisy_line(80, 2, 0.05, 1)
+    tol = 0.15
+    monkeypatch.setattr(gf, "_DAMP_MIN_POINTS", 5)  # (the default needs 100 active points)
+    calls = _record_newton(monkeypatch, gf)
+    monkeypatch.setattr(gf, "_STEP_MAX", np.inf)  # no safeguard
+    plain = gf.global_fair(c, tol=tol)
+    assert plain.stop_reason == "converged"
+    assert calls[0][1] is False  # diverged from the ADMM start
+    calls.clear()
+    monkeypatch.setattr(gf, "_STEP_MAX", 1.0)
+    res = gf.global_fair(c, tol=tol)
+    assert res.stop_reason == "converged"
+    assert len(calls) == 1 and calls[0][1] is True  # no interior point needed
+    mask = np.ones(c.n_ctrl, dtype=bool)
+    check_kkt(c, res, tol, 2, mask)
+    assert res.active.size >= 20
+    # SLSQP from the original points (analytic gradients)
+    G = dense_gram(c, 2)
+    d0 = np.asarray(c.control_points)
+
+    def energy(x):
+        d = x.reshape(-1, 2)
+        return float(np.sum(d * (G @ d)))
+
+    def grad(x):
+        return (2 * G @ x.reshape(-1, 2)).ravel()
+
+    def cons(x):
+        return tol**2 - np.sum((x.reshape(-1, 2) - d0) ** 2, axis=1)
+
+    def cons_jac(x):
+        dd = -2 * (x.reshape(-1, 2) - d0)
+        J = np.zeros((d0.shape[0], d0.size))
+        idx = np.arange(d0.shape[0])
+        J[idx, 2 * idx] = dd[:, 0]
+        J[idx, 2 * idx + 1] = dd[:, 1]
+        return J
+
+    opt = minimize(energy, d0.ravel(), jac=grad, method="SLSQP",
+                   constraints=[{"type": "ineq", "fun": cons, "jac": cons_jac}],
+                   options={"ftol": 1e-15, "maxiter": 2000})
+    assert cons(opt.x).min() >= -1e-9
+    assert res.energy_after <= opt.fun * (1 + 1e-9)
+    assert opt.fun <= res.energy_after * (1 + 1e-6)
+    np.testing.assert_allclose(np.asarray(res.curve.control_points).ravel(), opt.x,
+                               atol=1e-3 * tol)
+    # and the same optimum as the interior-point route
+    assert abs(res.energy_after - plain.energy_after) <= 1e-10 * res.energy_after
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_damped_newton_large_sparse_kkt_and_tolerance(monkeypatch, dim):
+    """5e4 points of a noisy line (about 19 % (2-D) / 35 % (3-D) active at the end): the
+    Newton iteration converges from the ADMM start (before: a diverging first step, then the
+    interior point; 3-D: a division by zero in it). KKT conditions against the sparse Gram
+    matrix, the tolerance by dense sampling of both curves at equal parameters, and the same
+    energy as the interior point alone."""
+    import curvefair.fairing.global_fair as gf
+
+    c = _noisy_line(50_000, dim, 0.05, 0)
+    tol = 0.2
+    calls = _record_newton(monkeypatch, gf)
+    res = gf.global_fair(c, tol=tol)
+    assert res.stop_reason == "converged"
+    assert calls[0][1] is True
+    G = energy_matrix(c, 2)
+    d = np.asarray(res.curve.control_points)
+    v = d - c.control_points
+    scale = np.abs(2 * (G @ np.asarray(c.control_points))).max()
+    assert np.abs(2 * (G @ d) + res.multipliers[:, None] * v).max() <= 1e-8 * scale
+    dist = np.linalg.norm(v, axis=1)
+    assert dist.max() <= tol
+    assert np.abs(res.multipliers * (dist - tol)).max() <= 1e-8 * scale * tol
+    assert res.multipliers.min() >= 0.0
+    t = np.asarray(c.knots)
+    u = np.linspace(t[c.degree], t[-c.degree - 1], 400_000)
+    assert np.linalg.norm(res.curve(u) - c(u), axis=1).max() <= tol * (1 + 1e-12)
+    monkeypatch.setattr(gf, "_ADMM_ITERS", 0)  # the interior point (slack floor) alone
+    ref = gf.global_fair(c, tol=tol)
+    assert ref.stop_reason == "converged"
+    assert abs(res.energy_after - ref.energy_after) <= 1e-10 * res.energy_after
+
+
+def test_scaled_band_is_the_scaled_copy():
+    """The kernels read ``K[i, j] * ks``: factorising and solving with ``(K, ks)`` gives bitwise
+    the result of the explicitly scaled copy ``(K * ks, 1)`` (planar and 3-D, open and closed,
+    with frames and fixed points)."""
+    import curvefair.fairing._global_kernels as k
+    from curvefair.fairing.global_fair import _System
+
+    rng = np.random.default_rng(5)
+    for dim, closed in [(2, False), (3, False), (2, True), (3, True)]:
+        n, p = 40, 3
+        c = noisy(n=n, closed=closed, dim=dim, seed=3)
+        W = np.ascontiguousarray(c.gram_band(2))
+        ks = 2.0 / 3.7  # not a power of two
+        fixed = np.zeros(c.n_ctrl, bool)
+        fixed[[0, 5]] = True
+        m = c.n_ctrl
+        rot = (rng.random(m) < 0.4) & ~fixed
+        nrm = rng.normal(size=(m, dim))
+        nrm /= np.linalg.norm(nrm, axis=1)[:, None]
+        B = np.zeros((m, dim, dim))
+        B[:, range(dim), range(dim)] = rng.random((m, 1))
+        rhs = rng.normal(size=(m, dim))
+        cc = rng.normal(size=m)
+        out = []
+        for K, s in [(W * ks, 1.0), (W, ks)]:
+            sysm = _System(K, s, p, dim, closed, fixed)
+            assert sysm.factor(B, rot=rot, nrm=nrm)
+            out.append(sysm.solve(rhs.copy(), cc))
+            x = np.empty((m, dim))
+            k.band_matvec(K, s, p, closed, rhs, x)
+            out.append(x)
+        assert np.array_equal(out[0], out[2]) and np.array_equal(out[1], out[3])

@@ -17,6 +17,11 @@ Everything is ``O(N)`` time and memory.
 
 The ADMM warm start of open curves (:func:`admm_factor`, :func:`admm_sweep_t`) factorises the
 ``n x n`` band ``K + rho I`` once for all coordinates.
+
+Every kernel takes ``K`` as the pair ``(K, ks)``: the band rows of the UNSCALED energy matrix
+(the curve's cached Gram band, read only) and the scale ``ks = 2 / E0``; each entry is read as
+``K[i, j] * ks``, the same rounded value as an entry of the scaled copy ``K * ks`` (so the
+results are bitwise those of a scaled copy, without its ``n (2p + 1)`` doubles).
 """
 
 from __future__ import annotations
@@ -30,7 +35,7 @@ from numba import njit
 
 
 @njit(cache=True)
-def _assemble_range2(K, p, closed, B, Q, rot, fix, L, i0, i1):  # type: ignore[no-untyped-def]
+def _assemble_range2(K, ks, p, closed, B, Q, rot, fix, L, i0, i1):  # type: ignore[no-untyped-def]
     """:func:`_assemble_range` for planar curves, branch-light: the frame of point ``i`` is the
     rotation with first column ``q_i`` (``(1, 0)`` without frame), so the block
     ``M[(j, .), (i, .)] = K_ij Q_j^T Q_i = K_ij [[C, -S], [S, C]]`` with ``C = q_j . q_i``,
@@ -58,7 +63,7 @@ def _assemble_range2(K, p, closed, B, Q, rot, fix, L, i0, i1):  # type: ignore[n
             b00 = qi0 * c00 + qi1 * c10
             b10 = -qi1 * c00 + qi0 * c10
             b11 = -qi1 * c01 + qi0 * c11
-        kk = K[i, p]
+        kk = (K[i, p] * ks)
         L[C0, 0] = (kk + b00) * wi0 + (1.0 - wi0)
         L[C0, 1] = b10 * wi0 * wi1
         L[C1, 0] = (kk + b11) * wi1 + (1.0 - wi1)
@@ -78,7 +83,7 @@ def _assemble_range2(K, p, closed, B, Q, rot, fix, L, i0, i1):  # type: ignore[n
             qj1 = Q[j, 1, 0] if rj else 0.0
             wj0 = 0.0 if fix[j, 0] else 1.0
             wj1 = 0.0 if fix[j, 1] else 1.0
-            kk = K[i, p + o]
+            kk = (K[i, p + o] * ks)
             cc = kk * (qj0 * qi0 + qj1 * qi1)
             sn = kk * (qj0 * qi1 - qj1 * qi0)
             L[C0, k] = cc * (wi0 * wj0)
@@ -89,10 +94,10 @@ def _assemble_range2(K, p, closed, B, Q, rot, fix, L, i0, i1):  # type: ignore[n
 
 
 @njit(cache=True, nogil=True)
-def _assemble_range(K, p, closed, B, Q, rot, fix, L, i0, i1):  # type: ignore[no-untyped-def]
+def _assemble_range(K, ks, p, closed, B, Q, rot, fix, L, i0, i1):  # type: ignore[no-untyped-def]
     """Write the lower-band entries of the columns of points ``i0 .. i1 - 1`` into ``L``."""
     if B.shape[1] == 2:
-        _assemble_range2(K, p, closed, B, Q, rot, fix, L, i0, i1)
+        _assemble_range2(K, ks, p, closed, B, Q, rot, fix, L, i0, i1)
         return
     n = K.shape[0]
     dim = B.shape[1]
@@ -125,7 +130,7 @@ def _assemble_range(K, p, closed, B, Q, rot, fix, L, i0, i1):  # type: ignore[no
                 for o in range(p + 1):
                     if i + o >= n and not closed:
                         break
-                    L[C, o * dim] = K[i, p + o]
+                    L[C, o * dim] = (K[i, p + o] * ks)
                 for b in range(a, dim):
                     L[C, b - a] += B[i, b, a]
             continue
@@ -141,7 +146,7 @@ def _assemble_range(K, p, closed, B, Q, rot, fix, L, i0, i1):  # type: ignore[no
                         break
                     j -= n
                 rj = rot[j]
-                kk = K[i, p + o]
+                kk = (K[i, p + o] * ks)
                 if ri and rj:
                     t00 = Q[j, 0, 0] * Q[i, 0, 0] + Q[j, 1, 0] * Q[i, 1, 0]
                     t01 = Q[j, 0, 0] * Q[i, 0, 1] + Q[j, 1, 0] * Q[i, 1, 1]
@@ -209,7 +214,7 @@ def _assemble_range(K, p, closed, B, Q, rot, fix, L, i0, i1):  # type: ignore[no
                     break
                 j -= n
             rj = rot[j]
-            kk = K[i, p + o]
+            kk = (K[i, p + o] * ks)
             # blk[b, a] = M[(j, b), (i, a)]
             if not ri and not rj:
                 for b in range(dim):
@@ -259,13 +264,13 @@ def _assemble_range(K, p, closed, B, Q, rot, fix, L, i0, i1):  # type: ignore[no
 
 
 @njit(cache=True, nogil=True)
-def assemble(K, p, closed, B, Q, rot, fix, L):  # type: ignore[no-untyped-def]
+def assemble(K, ks, p, closed, B, Q, rot, fix, L):  # type: ignore[no-untyped-def]
     """Fill ``L`` (shape (n dim, kd + 1)) with the lower band of ``M`` (see module docstring)."""
-    _assemble_range(K, p, closed, B, Q, rot, fix, L, 0, K.shape[0])
+    _assemble_range(K, ks, p, closed, B, Q, rot, fix, L, 0, K.shape[0])
 
 
 @njit(cache=True)
-def _ldl7(K, p, B, Q, rot, fix, L, j, jstop, nxt, nmax):  # type: ignore[no-untyped-def]
+def _ldl7(K, ks, p, B, Q, rot, fix, L, j, jstop, nxt, nmax):  # type: ignore[no-untyped-def]
     """Elimination steps ``j .. jstop - 1`` (``jstop <= N - 7``) of :func:`assemble_ldl` for
     ``kd = 7``, with the 7 x 7 window loaded from (and written back to) the right-looking
     storage at ``L[j:j + 7]``, the columns of points ``nxt .. nmax - 1`` assembled in batches
@@ -303,7 +308,7 @@ def _ldl7(K, p, B, Q, rot, fix, L, j, jstop, nxt, nmax):  # type: ignore[no-unty
     while j < jstop:
         if j + 7 >= nxt * dim and nxt < nmax:
             stop = min(nmax, nxt + 256)
-            _assemble_range(K, p, False, B, Q, rot, fix, L, nxt, stop)
+            _assemble_range(K, ks, p, False, B, Q, rot, fix, L, nxt, stop)
             nxt = stop
         d = p00
         if not d > 0.0:
@@ -393,7 +398,7 @@ def _ldl7(K, p, B, Q, rot, fix, L, j, jstop, nxt, nmax):  # type: ignore[no-unty
 
 
 @njit(cache=True, nogil=True)
-def assemble_ldl(K, p, B, Q, rot, fix, L):  # type: ignore[no-untyped-def]
+def assemble_ldl(K, ks, p, B, Q, rot, fix, L):  # type: ignore[no-untyped-def]
     """Assemble (open curves) and factorise ``M = U D U^T`` (``U`` unit lower band) in one pass:
     the columns of a batch of points are written just before the first elimination step that
     needs them. On exit ``L[j, 0] = 1 / D_j`` and ``L[j, k] = U[j + k, j]`` (see
@@ -409,14 +414,14 @@ def assemble_ldl(K, p, B, Q, rot, fix, L):  # type: ignore[no-untyped-def]
     j = 0
     if kd == 7 and N > 16:
         nxt = min(n, 256)
-        _assemble_range(K, p, False, B, Q, rot, fix, L, 0, nxt)
-        info, j, nxt = _ldl7(K, p, B, Q, rot, fix, L, 0, N - 7, nxt, n)
+        _assemble_range(K, ks, p, False, B, Q, rot, fix, L, 0, nxt)
+        info, j, nxt = _ldl7(K, ks, p, B, Q, rot, fix, L, 0, N - 7, nxt, n)
         if info:
             return info
     while j < N:
         if nxt < n:
             stop = min(n, nxt + 256)
-            _assemble_range(K, p, False, B, Q, rot, fix, L, nxt, stop)
+            _assemble_range(K, ks, p, False, B, Q, rot, fix, L, nxt, stop)
             nxt = stop
         # columns whose updates reach only assembled rows
         j1 = N if nxt == n else max(j, nxt * dim - kd)
@@ -428,7 +433,7 @@ def assemble_ldl(K, p, B, Q, rot, fix, L):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, nogil=True)
-def assemble_ldl_head(K, p, B, Q, rot, fix, L, nmax):  # type: ignore[no-untyped-def]
+def assemble_ldl_head(K, ks, p, B, Q, rot, fix, L, nmax):  # type: ignore[no-untyped-def]
     """First part of :func:`assemble_ldl` (``kd = 7``, ``N > 16``) while the columns of the
     points ``nmax .. n - 1`` are assembled elsewhere (:func:`_assemble_range`, e.g. on another
     thread): assembles points ``0 .. nmax - 1`` and eliminates the columns that read only
@@ -436,18 +441,18 @@ def assemble_ldl_head(K, p, B, Q, rot, fix, L, nmax):  # type: ignore[no-untyped
     every column is assembled. The same operations as :func:`assemble_ldl` (bitwise)."""
     dim = B.shape[1]
     nxt = min(nmax, 256)
-    _assemble_range(K, p, False, B, Q, rot, fix, L, 0, nxt)
-    info, j, nxt = _ldl7(K, p, B, Q, rot, fix, L, 0, max(nmax * dim - 8, 0), nxt, nmax)
+    _assemble_range(K, ks, p, False, B, Q, rot, fix, L, 0, nxt)
+    info, j, nxt = _ldl7(K, ks, p, B, Q, rot, fix, L, 0, max(nmax * dim - 8, 0), nxt, nmax)
     return info, j
 
 
 @njit(cache=True, nogil=True)
-def assemble_ldl_tail(K, p, B, Q, rot, fix, L, j):  # type: ignore[no-untyped-def]
+def assemble_ldl_tail(K, ks, p, B, Q, rot, fix, L, j):  # type: ignore[no-untyped-def]
     """The rest of :func:`assemble_ldl` after :func:`assemble_ldl_head` (every column
     assembled)."""
     n = K.shape[0]
     N = n * B.shape[1]
-    info, j, nxt = _ldl7(K, p, B, Q, rot, fix, L, j, N - 7, n, n)
+    info, j, nxt = _ldl7(K, ks, p, B, Q, rot, fix, L, j, N - 7, n, n)
     if info:
         return info
     return _ldl_cols(L, j, N, N)
@@ -547,15 +552,15 @@ def ldl_solve(L, N, x):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, inline="always")
-def _krow(K, p, closed, x, i, a, interior):  # type: ignore[no-untyped-def]
-    """``(K x)_{i, a}`` for points ``x`` (n, dim), ``K`` by its band rows ``K[i, p + o]``
+def _krow(K, ks, p, closed, x, i, a, interior):  # type: ignore[no-untyped-def]
+    """``(K x)_{i, a}`` for points ``x`` (n, dim), ``K`` by its band rows ``K[i, p + o] * ks``
     (closed: indices mod n); ``interior`` (``p <= i < n - p``) skips the wrap tests. Inlined at
     numba IR level: the same additions in the same order as a written-out loop."""
     n = x.shape[0]
     acc = 0.0
     if interior:
         for o in range(-p, p + 1):
-            acc += K[i, p + o] * x[i + o, a]
+            acc += (K[i, p + o] * ks) * x[i + o, a]
     else:
         for o in range(-p, p + 1):
             j = i + o
@@ -563,19 +568,42 @@ def _krow(K, p, closed, x, i, a, interior):  # type: ignore[no-untyped-def]
                 if not closed:
                     continue
                 j = j + n if j < 0 else j - n
-            acc += K[i, p + o] * x[j, a]
+            acc += (K[i, p + o] * ks) * x[j, a]
     return acc
 
 
 @njit(cache=True)
-def band_matvec(K, p, closed, x, out):  # type: ignore[no-untyped-def]
-    """``out = kron(K, I) x`` for points ``x`` (n, dim); ``K`` given by its band rows
-    ``K[i, p + o] = K_{i, i+o}`` (symmetric; closed: indices mod n)."""
+def band_residual_scaled(W, ks, p, closed, x, out):  # type: ignore[no-untyped-def]
+    """``out = (W ks) x`` per coordinate in the difference form of
+    :func:`curvefair.curves.bspline.band_residual` (``sum_{o != 0} (W[i, p + o] ks) (x_{i+o} -
+    x_i)``, the same operations on the entries of the scaled band)."""
     n, dim = x.shape
     for i in range(n):
         interior = i >= p and i + p < n
         for a in range(dim):
-            out[i, a] = _krow(K, p, closed, x, i, a, interior)
+            xi = x[i, a]
+            acc = 0.0
+            for o in range(-p, p + 1):
+                if o == 0:
+                    continue
+                j = i + o
+                if not interior and (j < 0 or j >= n):
+                    if not closed:
+                        continue
+                    j = j + n if j < 0 else j - n
+                acc += (W[i, p + o] * ks) * (x[j, a] - xi)
+            out[i, a] = acc
+
+
+@njit(cache=True)
+def band_matvec(K, ks, p, closed, x, out):  # type: ignore[no-untyped-def]
+    """``out = kron(K ks, I) x`` for points ``x`` (n, dim); ``K ks`` given by its band rows
+    ``K[i, p + o] * ks = (K ks)_{i, i+o}`` (symmetric; closed: indices mod n)."""
+    n, dim = x.shape
+    for i in range(n):
+        interior = i >= p and i + p < n
+        for a in range(dim):
+            out[i, a] = _krow(K, ks, p, closed, x, i, a, interior)
 
 
 # ------------------------------------------------------------------------------------------
@@ -853,13 +881,13 @@ def cyclic_solve_full(L, Y, S, x):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def prep_rhs(K, p, closed, B, Q, rot, fix, fix0, rhs, c, out, sgn=1.0):  # type: ignore[no-untyped-def]
-    """``out = Q^T (sgn rhs - (kron(K, I) + B) z)`` with ``z_i = c_i Q_i[:, 0]`` at the ``rot``
+def prep_rhs(K, ks, p, closed, B, Q, rot, fix, fix0, rhs, c, out, sgn=1.0):  # type: ignore[no-untyped-def]
+    """``out = Q^T (sgn rhs - (kron(K ks, I) + B) z)`` with ``z_i = c_i Q_i[:, 0]`` at the ``rot``
     points (their prescribed normal displacement), fixed unknowns set to their values (``c_i``
     for the normal of a ``rot`` point, 0 at fixed points)."""
     n, dim = rhs.shape
     if dim == 2:
-        prep_rhs2_range(K, p, closed, B, Q, rot, fix, fix0, rhs, c, out, sgn, 0, rhs.shape[0])
+        prep_rhs2_range(K, ks, p, closed, B, Q, rot, fix, fix0, rhs, c, out, sgn, 0, rhs.shape[0])
         return
     anyrot = False
     for i in range(n):
@@ -878,7 +906,7 @@ def prep_rhs(K, p, closed, B, Q, rot, fix, fix0, rhs, c, out, sgn=1.0):  # type:
                         continue
                     j %= n
                 if rot[j]:
-                    kc = K[i, p + o] * c[j]
+                    kc = (K[i, p + o] * ks) * c[j]
                     for a in range(dim):
                         out[i, a] -= kc * Q[j, a, 0]
             if rot[i]:
@@ -904,7 +932,7 @@ def prep_rhs(K, p, closed, B, Q, rot, fix, fix0, rhs, c, out, sgn=1.0):  # type:
 
 
 @njit(cache=True, nogil=True)
-def prep_rhs2_range(K, p, closed, B, Q, rot, fix, fix0, rhs, c, out, sgn, i0, i1):  # type: ignore[no-untyped-def]
+def prep_rhs2_range(K, ks, p, closed, B, Q, rot, fix, fix0, rhs, c, out, sgn, i0, i1):  # type: ignore[no-untyped-def]
     """:func:`prep_rhs` for planar curves in one pass (selects instead of branches on the
     frame flags of the neighbours), on the points ``i0 .. i1 - 1`` (each point is independent:
     ranges may run concurrently)."""
@@ -921,7 +949,7 @@ def prep_rhs2_range(K, p, closed, B, Q, rot, fix, fix0, rhs, c, out, sgn, i0, i1
                         continue
                     j = j + n if j < 0 else j - n
             rj = rot[j]
-            kc = K[i, p + o] * (c[j] if rj else 0.0)
+            kc = (K[i, p + o] * ks) * (c[j] if rj else 0.0)
             w0 -= kc * (Q[j, 0, 0] if rj else 0.0)
             w1 -= kc * (Q[j, 1, 0] if rj else 0.0)
         if rot[i]:
@@ -956,8 +984,11 @@ def post_solve(y, Q, rot, fix0):  # type: ignore[no-untyped-def]
 
 @njit(cache=True, nogil=True)
 def post_solve_range(y, Q, rot, fix0, i0, i1):  # type: ignore[no-untyped-def]
-    """:func:`post_solve` on the points ``i0 .. i1 - 1``."""
+    """:func:`post_solve` on the points ``i0 .. i1 - 1``; returns ``max |y_i|^2`` over the
+    ``rot`` points and over the others (the norm before the rotation, which keeps it)."""
     dim = y.shape[1]
+    m2 = 0.0
+    r2 = 0.0
     for i in range(i0, i1):
         if fix0[i, 0]:
             for a in range(dim):
@@ -969,6 +1000,7 @@ def post_solve_range(y, Q, rot, fix0, i0, i1):  # type: ignore[no-untyped-def]
             w1 = y[i, 1]
             y[i, 0] = q0 * w0 - q1 * w1
             y[i, 1] = q1 * w0 + q0 * w1
+            r2 = max(r2, w0 * w0 + w1 * w1)
         elif rot[i]:
             w0 = y[i, 0]
             w1 = y[i, 1]
@@ -978,6 +1010,26 @@ def post_solve_range(y, Q, rot, fix0, i0, i1):  # type: ignore[no-untyped-def]
                 if dim == 3:
                     t += Q[i, a, 2] * w2
                 y[i, a] = t
+            r2 = max(r2, w0 * w0 + w1 * w1 + w2 * w2)
+        else:
+            yy = 0.0
+            for a in range(dim):
+                yy += y[i, a] * y[i, a]
+            m2 = max(m2, yy)
+    return r2, m2
+
+
+@njit(cache=True)
+def max_point_norm2(y):  # type: ignore[no-untyped-def]
+    """``max_i |y_i|^2`` (NaN propagates)."""
+    m2 = 0.0
+    for i in range(y.shape[0]):
+        yy = 0.0
+        for a in range(y.shape[1]):
+            yy += y[i, a] * y[i, a]
+        if not yy <= m2:
+            m2 = yy
+    return m2
 
 
 # ------------------------------------------------------------------------------------------
@@ -986,10 +1038,11 @@ def post_solve_range(y, Q, rot, fix0, i0, i1):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def ip_eval(g0, K, p, closed, v, lam, free, t2, rd, s):  # type: ignore[no-untyped-def]
-    """Dual residual ``rd = g0 + K v + lam v / t2`` and slacks ``s = -f`` at the free points
-    (0 and 1 elsewhere); returns ``(max |rd|, min s, sum lam s)``. (Helpers inlined by hand:
-    numba's inlined helpers made this loop five times slower.)"""
+def ip_eval(g0, K, ks, p, closed, v, lam, free, t2, rd, s):  # type: ignore[no-untyped-def]
+    """Dual residual ``rd = g0 + K v + lam v / t2`` and slacks ``s = -f`` (at least ``1e-16``:
+    a point that rounding puts on its sphere) at the free points (0 and 1 elsewhere); returns
+    ``(max |rd|, min s, sum lam s)``. (Helpers inlined by hand: numba's inlined helpers made
+    this loop five times slower.)"""
     n, dim = v.shape
     rdm = 0.0
     smin = np.inf
@@ -1004,7 +1057,7 @@ def ip_eval(g0, K, p, closed, v, lam, free, t2, rd, s):  # type: ignore[no-untyp
         li = lam[i]
         interior = i >= p and i + p < n
         for a in range(dim):
-            acc = _krow(K, p, closed, v, i, a, interior)
+            acc = _krow(K, ks, p, closed, v, i, a, interior)
             va = v[i, a]
             r = g0[i, a] + acc + li * (va / t2)
             rd[i, a] = r
@@ -1013,6 +1066,8 @@ def ip_eval(g0, K, p, closed, v, lam, free, t2, rd, s):  # type: ignore[no-untyp
                 rdm = ar
             vv += va * va
         si = -0.5 * (vv / t2 - 1.0)
+        if si < 1e-16:  # (on the sphere by rounding: s = 0 would divide by zero; NaN stays)
+            si = 1e-16
         s[i] = si
         if si < smin:
             smin = si
@@ -1140,14 +1195,14 @@ def second_order(dv, free, t2, out):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def shift_cholesky(K, p, rho, L):  # type: ignore[no-untyped-def]
+def shift_cholesky(K, ks, p, rho, L):  # type: ignore[no-untyped-def]
     """Band Cholesky of ``K + rho I`` (open curve, ``L`` shape (n, p + 1), ``L[r, k] =
     M[r + k, r]``), with the RECIPROCAL pivots stored in ``L[:, 0]`` (for
     :func:`admm_sweep`). Returns 0 or ``j + 1`` for a non-positive pivot ``j``."""
     n = K.shape[0]
     for i in range(n):
         for o in range(p + 1):
-            L[i, o] = K[i, p + o] if i + o < n else 0.0
+            L[i, o] = (K[i, p + o] * ks) if i + o < n else 0.0
         L[i, 0] += rho
     info = _chol_cols(L, 0, n, n)
     for j in range(n):
@@ -1156,7 +1211,7 @@ def shift_cholesky(K, p, rho, L):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, nogil=True)
-def admm_factor(K, p, rho, L):  # type: ignore[no-untyped-def]
+def admm_factor(K, ks, p, rho, L):  # type: ignore[no-untyped-def]
     """Factor of ``K + rho I`` (open curve) for the ADMM sweeps. ``p = 3`` (for
     :func:`admm_sweep_t`): ``K + rho I = U D U^T`` (``U`` unit lower) computed with the active
     window in registers (one division, one multiply and one multiply-add on the pivot
@@ -1165,15 +1220,15 @@ def admm_factor(K, p, rho, L):  # type: ignore[no-untyped-def]
     ``j + 1`` for a non-positive pivot ``j``."""
     n = K.shape[0]
     if p != 3 or n < 4:
-        return shift_cholesky(K, p, rho, L)
+        return shift_cholesky(K, ks, p, rho, L)
     # pending (partially eliminated) entries: P00 = A'[j, j], P10 = A'[j+1, j], P20 = A'[j+2, j],
     # P11 = A'[j+1, j+1], P21 = A'[j+2, j+1], P22 = A'[j+2, j+2]
-    P00 = K[0, 3] + rho
-    P10 = K[0, 4]
-    P20 = K[0, 5]
-    P11 = K[1, 3] + rho
-    P21 = K[1, 4]
-    P22 = K[2, 3] + rho
+    P00 = (K[0, 3] * ks) + rho
+    P10 = (K[0, 4] * ks)
+    P20 = (K[0, 5] * ks)
+    P11 = (K[1, 3] * ks) + rho
+    P21 = (K[1, 4] * ks)
+    P22 = (K[2, 3] * ks) + rho
     for j in range(n):
         d = P00
         if not d > 0.0:
@@ -1181,7 +1236,7 @@ def admm_factor(K, p, rho, L):  # type: ignore[no-untyped-def]
         r = 1.0 / d
         a1 = P10
         a2 = P20
-        a3 = K[j, 6]
+        a3 = (K[j, 6] * ks)
         l1 = a1 * r
         l2 = a2 * r
         l3 = a3 * r
@@ -1190,9 +1245,9 @@ def admm_factor(K, p, rho, L):  # type: ignore[no-untyped-def]
         L[j, 2] = l2
         L[j, 3] = l3
         if j + 3 < n:
-            e31 = K[j + 1, 5]
-            e32 = K[j + 2, 4]
-            e33 = K[j + 3, 3] + rho
+            e31 = (K[j + 1, 5] * ks)
+            e32 = (K[j + 2, 4] * ks)
+            e33 = (K[j + 3, 3] * ks) + rho
         else:
             e31 = 0.0
             e32 = 0.0
@@ -1530,7 +1585,7 @@ def admm_multipliers(z, u, free, rho, t2, lam):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def ssn_eval_prep(g0, K, p, closed, v, lam, free, t2, kappa, delta, S, rd, rho,  # type: ignore[no-untyped-def]
+def ssn_eval_prep(g0, K, ks, p, closed, v, lam, free, t2, kappa, delta, S, rd,  # type: ignore[no-untyped-def]
                   B, nrm, c, Q, fix, fix0):
     """Semismooth Newton per-point work, one pass: active set ``S = free & (lam + kappa f > 0) &
     (v != 0)`` (``f = (|v|^2 / t2 - 1) / 2``); ``lam`` clipped to ``max(lam, 0)`` on ``S`` and 0
@@ -1538,14 +1593,14 @@ def ssn_eval_prep(g0, K, p, closed, v, lam, free, t2, kappa, delta, S, rd, rho, 
     active points the unit normals ``nrm``, the prescribed normal displacements ``c = -f t2 /
     |v|`` (the linearised sphere), their frames ``Q`` (as :func:`set_frames`; planar: the first
     column only, and only the diagonal of ``B``, whose other entries must be 0) and ``fix =
-    fix0`` plus the normal axis; ``rho = |v|``. Returns ``(max |rd|, max f over free, max |f|
+    fix0`` plus the normal axis. Returns ``(max |rd|, max f over free, max |f|
     over S, |S|)``."""
-    return ssn_eval_range(g0, K, p, closed, v, lam, free, t2, kappa, delta, S, rd, rho, B,
+    return ssn_eval_range(g0, K, ks, p, closed, v, lam, free, t2, kappa, delta, S, rd, B,
                           nrm, c, Q, fix, fix0, 0, v.shape[0])
 
 
 @njit(cache=True, nogil=True)
-def ssn_eval_range(g0, K, p, closed, v, lam, free, t2, kappa, delta, S, rd, rho,  # type: ignore[no-untyped-def]
+def ssn_eval_range(g0, K, ks, p, closed, v, lam, free, t2, kappa, delta, S, rd,  # type: ignore[no-untyped-def]
                    B, nrm, c, Q, fix, fix0, i0, i1):
     """:func:`ssn_eval_prep` on the points ``i0 .. i1 - 1`` (reads ``v`` of their neighbours,
     writes their own data only: ranges may run concurrently; the maxima and the count of
@@ -1562,7 +1617,6 @@ def ssn_eval_range(g0, K, p, closed, v, lam, free, t2, kappa, delta, S, rd, rho,
             vv += v[i, a] * v[i, a]
         r = np.sqrt(vv)
         fi = 0.5 * (vv / t2 - 1.0)
-        rho[i] = r
         for a in range(dim):
             fix[i, a] = fix0[i, a]
         if not free[i]:
@@ -1586,13 +1640,13 @@ def ssn_eval_range(g0, K, p, closed, v, lam, free, t2, kappa, delta, S, rd, rho,
             li = lam[i]
             interior = i >= p and i + p < n
             if c23 and interior:
-                k0 = K[i, 0]
-                k1 = K[i, 1]
-                k2 = K[i, 2]
-                k3 = K[i, 3]
-                k4 = K[i, 4]
-                k5 = K[i, 5]
-                k6 = K[i, 6]
+                k0 = (K[i, 0] * ks)
+                k1 = (K[i, 1] * ks)
+                k2 = (K[i, 2] * ks)
+                k3 = (K[i, 3] * ks)
+                k4 = (K[i, 4] * ks)
+                k5 = (K[i, 5] * ks)
+                k6 = (K[i, 6] * ks)
                 for a in range(2):
                     acc = (k0 * v[i - 3, a] + k1 * v[i - 2, a] + k2 * v[i - 1, a] + k3 * v[i, a]
                            + k4 * v[i + 1, a] + k5 * v[i + 2, a] + k6 * v[i + 3, a])
@@ -1603,7 +1657,7 @@ def ssn_eval_range(g0, K, p, closed, v, lam, free, t2, kappa, delta, S, rd, rho,
             for a in range(dim):
                 if c23 and interior:
                     break
-                acc = _krow(K, p, closed, v, i, a, interior)
+                acc = _krow(K, ks, p, closed, v, i, a, interior)
                 x = g0[i, a] + acc + li * (v[i, a] / t2)
                 rd[i, a] = x
                 if not abs(x) <= rdm:  # NaN propagates
@@ -1631,7 +1685,7 @@ def ssn_eval_range(g0, K, p, closed, v, lam, free, t2, kappa, delta, S, rd, rho,
 
 
 @njit(cache=True)
-def ssn_update_k(K, p, closed, v, dv, rd, lam, S, nrm, rho, t2, retract,  # type: ignore[no-untyped-def]
+def ssn_update_k(K, ks, p, closed, v, dv, rd, lam, S, nrm, t2, retract,  # type: ignore[no-untyped-def]
                  edges_only=False):
     """Semismooth Newton update: the multipliers of the active points from the normal component
     of the stationarity equation (``K dv`` computed on the fly), then ``v += dv``; with
@@ -1641,7 +1695,7 @@ def ssn_update_k(K, p, closed, v, dv, rd, lam, S, nrm, rho, t2, retract,  # type
     n, dim = v.shape
     if dim == 2 and p == 3 and n > 6:
         if not edges_only:
-            ssn_update23_range(K, closed, v, dv, rd, lam, S, nrm, rho, t2, retract, 3, n - 3)
+            ssn_update23_range(K, ks, closed, v, dv, rd, lam, S, nrm, t2, retract, 3, n - 3)
         lo = 3
         hi = n - 3
     else:
@@ -1653,13 +1707,15 @@ def ssn_update_k(K, p, closed, v, dv, rd, lam, S, nrm, rho, t2, retract,  # type
         if lo <= i < hi:
             continue
         for a in range(dim):
-            kdv[a] = _krow(K, p, closed, dv, i, a, False)
+            kdv[a] = _krow(K, ks, p, closed, dv, i, a, False)
         if S[i]:
             acc = 0.0
             li = lam[i] / t2
+            vv = 0.0
             for a in range(dim):
                 acc += nrm[i, a] * (rd[i, a] + kdv[a] + li * dv[i, a])
-            lam[i] = lam[i] - acc * t2 / rho[i]
+                vv += v[i, a] * v[i, a]
+            lam[i] = lam[i] - acc * t2 / np.sqrt(vv)  # |v_i| as in the evaluation
         else:
             lam[i] = 0.0
     for i in range(n):
@@ -1676,7 +1732,7 @@ def ssn_update_k(K, p, closed, v, dv, rd, lam, S, nrm, rho, t2, retract,  # type
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
-def ssn_update23_range(K, closed, v, dv, rd, lam, S, nrm, rho, t2, retract, i0, i1):  # type: ignore[no-untyped-def]
+def ssn_update23_range(K, ks, closed, v, dv, rd, lam, S, nrm, t2, retract, i0, i1):  # type: ignore[no-untyped-def]
     """:func:`ssn_update_k` for planar cubics on the interior points ``i0 .. i1 - 1``: one
     pass, selects instead of branches (numpy error model: the unselected quotients of inactive
     points may be inf). Reads ``dv`` of the neighbours, writes the points' own ``v`` and
@@ -1686,12 +1742,19 @@ def ssn_update23_range(K, closed, v, dv, rd, lam, S, nrm, rho, t2, retract, i0, 
         si = S[i]
         li = lam[i] / t2
         acc = 0.0
+        k0 = K[i, 0] * ks
+        k1 = K[i, 1] * ks
+        k2 = K[i, 2] * ks
+        k3 = K[i, 3] * ks
+        k4 = K[i, 4] * ks
+        k5 = K[i, 5] * ks
+        k6 = K[i, 6] * ks
         for a in range(2):
-            kd = (K[i, 0] * dv[i - 3, a] + K[i, 1] * dv[i - 2, a] + K[i, 2] * dv[i - 1, a]
-                  + K[i, 3] * dv[i, a] + K[i, 4] * dv[i + 1, a] + K[i, 5] * dv[i + 2, a]
-                  + K[i, 6] * dv[i + 3, a])
+            kd = (k0 * dv[i - 3, a] + k1 * dv[i - 2, a] + k2 * dv[i - 1, a] + k3 * dv[i, a]
+                  + k4 * dv[i + 1, a] + k5 * dv[i + 2, a] + k6 * dv[i + 3, a])
             acc += nrm[i, a] * (rd[i, a] + kd + li * dv[i, a])
-        lnew = lam[i] - acc * t2 / rho[i]
+        r = np.sqrt(v[i, 0] * v[i, 0] + v[i, 1] * v[i, 1])  # |v_i| as in the evaluation
+        lnew = lam[i] - acc * t2 / r
         lam[i] = lnew if si else 0.0
         x0 = v[i, 0] + dv[i, 0]
         x1 = v[i, 1] + dv[i, 1]
