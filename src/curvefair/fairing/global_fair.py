@@ -9,17 +9,17 @@ This is the problem every local method of :func:`curvefair.fair` on B-splines wo
 control point at a time (Eck & Hadenfeld's ranking list is block Gauss-Seidel on it), solved
 here for all points at once: it is never worse than any of them at the same tolerance.
 
-Solver (see :func:`global_fair`): open curves start with a few dozen ADMM iterations that
-share ONE ``n x n`` band factorisation (the Gram matrix is the same for every coordinate), then
-an active-set (semismooth) Newton iteration that converges quadratically once the active balls
+Solver (see :func:`global_fair`): curves start with a few dozen ADMM iterations that share
+ONE ``n x n`` band factorisation (the Gram matrix is the same for every coordinate), then an
+active-set (semismooth) Newton iteration that converges quadratically once the active balls
 are known (a damped, Levenberg-Marquardt step while its steps are too long, see
-:func:`global_fair`); closed curves (and any Newton failure) use a Mehrotra predictor-corrector
-interior point with strictly feasible iterates, finished by the same Newton iteration. Each Newton
-iteration factorises one symmetric block-banded matrix (bandwidth ``(degree + 1) dim - 1``,
-coordinates interleaved) by a compiled band Cholesky (closed curves: the cyclic band bordered
-by a small Schur complement), see :mod:`._global_kernels`: ``O(n)`` time and memory per
-iteration; typically 4-8 Newton iterations after the warm start (10-20 with the interior
-point).
+:func:`global_fair`); tiny closed curves (and any Newton failure) use a Mehrotra
+predictor-corrector interior point with strictly feasible iterates, finished by the same Newton
+iteration. Each Newton iteration factorises one symmetric block-banded matrix (bandwidth
+``(degree + 1) dim - 1``, coordinates interleaved) by a compiled band Cholesky (closed curves:
+the cyclic band bordered by a small Schur complement), see :mod:`._global_kernels`: ``O(n)``
+time and memory per iteration; typically 4-8 Newton iterations after the warm start (10-20
+with the interior point).
 """
 
 from __future__ import annotations
@@ -560,13 +560,14 @@ def global_fair(curve: BSplineCurve, *, tol: float | None = None, l: Any = 2,  #
     matrix of :meth:`BSplineCurve.gram_band`), solved on ``F = E(d)/E(o)`` with the constraints
     ``f_i = (|d_i - o_i|^2 / tol^2 - 1) / 2 <= 0``:
 
-    0. open curves: warm start by over-relaxed ADMM (Boyd et al., *Distributed Optimization
+    0. warm start by over-relaxed ADMM (Boyd et al., *Distributed Optimization
        and Statistical Learning via ADMM*, 2011, sec. 3.4.3 / 5.1; ``alpha = 1.6``) on the
        splitting ``x = z``, ``z`` in the balls: 20 iterations, each one banded solve with the
-       single ``n x n`` factor of ``2G/E(o) + rho I`` (shared by the coordinates) and a
-       projection, ``rho`` reset after 10 iterations to the median ``lambda_i / tol^2`` of the
-       projected points; then step 3 directly (at most 15 iterations, 30 once damped; if it
-       does not converge, steps 1-3 follow from scratch). From this start a Newton step that
+       single ``n x n`` factor of ``2G/E(o) + rho I`` (shared by the coordinates; closed
+       curves: the cyclic band, bordered, except tiny ones) and a projection, ``rho`` reset
+       after 10 iterations to the median ``lambda_i / tol^2`` of the projected points; then
+       step 3 directly (at most 15 iterations, 30 once damped; if it does not converge,
+       steps 1-3 follow from scratch). From this start a Newton step that
        moves an inactive point further than ``tol`` (an active one further than ``2 tol``)
        is rejected and solved again with a Levenberg-Marquardt term ``mu I`` added to the
        blocks (``mu`` starts at the median ``lambda_i / tol^2`` of the active points, x10 per
@@ -726,11 +727,14 @@ def _solve_balls(system: _System, g0: FloatArray, free: np.ndarray, tol: float, 
         return np.zeros_like(g0), np.zeros(n), 0, "converged"
     eye = np.broadcast_to(np.eye(dim), (n, dim, dim))
     steps = 1
-    if _ADMM_ITERS > 0 and not closed and n > 2 * p + 2 and max_steps > 1:
+    if _ADMM_ITERS > 0 and n > 2 * p + 2 and max_steps > 1 and not system.dense:
         # 0. ADMM warm start (one n x n band factorisation), then the active-set Newton; the
         # Newton work arrays' pages mapped on the worker thread during the ADMM iterations
         work = _ssn_work(n, dim, prefault=_THREADS >= 2 and n >= _PAR_MIN)
-        start = _admm_start(K, ks, p, g0, free, tol, system.L.reshape(-1))
+        if closed:
+            start = _admm_start_closed(K, ks, p, g0, free, tol)
+        else:
+            start = _admm_start(K, ks, p, g0, free, tol, system.L.reshape(-1))
         if start is not None:
             maxit = min(_ADMM_SSN_MAXIT, max_steps - 1)
             res = _active_set_newton(system, g0, free, tol, start[0], start[1], start[2],
@@ -902,6 +906,64 @@ def _admm_start(K: FloatArray, ks: float, p: int, g0: FloatArray, free: np.ndarr
     if not kappa > 0.0:
         kappa = rho * t2
     return zp, lam, kappa
+
+
+def _admm_start_closed(K: FloatArray, ks: float, p: int, g0: FloatArray, free: np.ndarray,
+                       tol: float) -> tuple[FloatArray, FloatArray, float] | None:
+    """:func:`_admm_start` for closed curves: the same over-relaxed ADMM iteration (the same
+    ``rho`` rule), with the cyclic band ``K + rho I`` factorised once per ``rho`` by the
+    bordered band Cholesky of :class:`_System` (one unknown per point, shared by the
+    coordinates); the point updates vectorised. None if the factorisation fails."""
+    n, dim = g0.shape
+    t2 = tol * tol
+    rho = _ADMM_RHO0 * float((K[:, p] * ks).mean())
+    if not rho > 0.0:
+        return None
+    sysA = _System(K, ks, p, 1, True, np.zeros(n, dtype=np.bool_))
+    if sysA.dense:
+        return None
+
+    def factor(rho: float) -> bool:
+        return sysA.factor(np.full((n, 1, 1), rho))
+
+    if not factor(rho):
+        return None
+    r2 = np.where(free, t2, 0.0)
+    z = np.zeros((n, dim))
+    u = np.zeros((n, dim))
+    x = np.empty((n, dim))
+    col = np.empty((n, 1))
+    un = np.empty(n)
+    a1 = 1.0 - _ADMM_ALPHA
+    for it in range(1, _ADMM_ITERS + 1):
+        y = rho * (z - u) - g0
+        for a in range(dim):  # x = (K + rho I)^{-1} y, per coordinate
+            col[:, 0] = y[:, a]
+            x[:, a] = sysA.solve(col, out=col)[:, 0]
+        w = _ADMM_ALPHA * x + a1 * z + u  # over-relaxed x, plus u
+        q2 = np.einsum("ij,ij->i", w, w)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            f = np.where(q2 > r2, np.sqrt(r2 / q2), 1.0)
+        np.multiply(w, f[:, None], out=z)  # projection onto the balls
+        np.subtract(w, z, out=u)
+        if it % _ADMM_ADAPT == 0 and it < _ADMM_ITERS:
+            m = _k.admm_active_norms(u, free, un)
+            if m:
+                new = float(np.median(un[:m])) * rho / tol
+                new = min(max(new, 0.1 * rho), 10.0 * rho)
+                if new != rho:
+                    u *= rho / new
+                    rho = new
+                    if not factor(rho):
+                        return None
+    lam = np.empty(n)
+    sl, ss, m = _k.admm_multipliers(z, u, free, rho, t2, lam)
+    if not (np.isfinite(sl) and np.isfinite(ss) and np.isfinite(z).all()) or m == 0:
+        return None
+    kappa = (sl / m) / max(ss / m, 1e-3)
+    if not kappa > 0.0:
+        kappa = rho * t2
+    return z, lam, kappa
 
 
 def _copy_into(out: FloatArray, a: FloatArray) -> FloatArray:
