@@ -595,7 +595,7 @@ def global_fair(curve: BSplineCurve, *, tol: float | None = None, l: Any = 2,  #
     ``U D U^T`` (open curves) or band Cholesky bordered by a small Schur complement (closed
     curves, cyclic band): ``O(n)`` per iteration,
     typically 4-8 Newton iterations after the ADMM start, 10-20 with the interior point (1e6
-    planar cubic control points: about 0.7 s on one core, 0.53-0.61 s with a second core free).
+    planar cubic control points: 0.77-0.84 s on one core, 0.56-0.63 s with a second core free).
     Planar curves split the per-point passes of every Newton iteration (evaluation,
     right-hand side, back-rotation, update) into point ranges shared by the calling thread and
     one worker thread (when the process may use 2 or more CPUs and the curve has at least
