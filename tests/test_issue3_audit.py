@@ -469,15 +469,32 @@ def test_global_max_steps_zero_through_fair_is_refused_or_a_no_op_for_the_local_
         np.testing.assert_array_equal(r.curve.control_points, c.control_points)
 
 
-@pytest.mark.xfail(strict=True, reason="issue 3 audit: fair(method='global', max_steps=0) "
-                   "still runs one Newton iteration and moves the control points "
-                   "(global_fair._driver uses max(max_steps, 1); global_fair(max_steps=0) "
-                   "does the same); every other method takes 0 steps and returns the input")
 def test_global_max_steps_zero_is_a_no_op():
+    # issue 3 audit: fair(method='global', max_steps=0) used to run one Newton iteration
+    # (the start) and move the control points; like every other method it now takes 0 steps
+    from curvefair.fairing.global_fair import global_fair
+
     c = noisy_open(23, n=20)
     r = cf.fair(c, "global", tol=0.02, max_steps=0)
     assert r.report["steps"] == 0
     np.testing.assert_array_equal(r.curve.control_points, c.control_points)
+    assert r.report["stop_reason"] == "max_steps"
+    assert r.report["n_moved"] == 0 and r.report["max_deviation"] == 0.0
+    assert r.report["energy_after"] == r.report["energy_before"]
+    for tol in (0.02, None):  # constrained and unconstrained, called directly
+        g = global_fair(c, tol=tol, max_steps=0)
+        assert (g.iterations, g.stop_reason) == (0, "max_steps")
+        np.testing.assert_array_equal(g.curve.control_points, c.control_points)
+        assert g.energy_after == g.energy_before and g.active.size == 0
+        assert not g.multipliers.any()
+
+
+@pytest.mark.parametrize("bad", [-1, 1.5, True, "3"])
+def test_global_max_steps_is_validated(bad):
+    from curvefair.fairing.global_fair import global_fair
+
+    with pytest.raises(cf.InputError, match="max_steps"):
+        global_fair(noisy_open(23, n=20), tol=0.02, max_steps=bad)
 
 
 # ------------------------------------------------------------------------------------------

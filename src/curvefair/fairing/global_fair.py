@@ -37,6 +37,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .._typing import FloatArray
+from .._validate import as_nonnegative, as_step_count
 from ..curves.bspline import BSplineCurve, band_energy
 from ..errors import InputError
 from . import _global_kernels as _k
@@ -512,7 +513,8 @@ class GlobalResult:
         point.
     iterations : int
         Newton iterations (active set and interior point, including the steps that reuse a
-        factorisation; the start counts as 1; 1 for an unconstrained solve).
+        factorisation; the start counts as 1; 1 for an unconstrained solve; 0 with
+        ``max_steps=0``).
     stop_reason : str
         ``"converged"`` (duality gap below ``gap``), ``"unconstrained"``, ``"max_steps"``,
         ``"numerical"`` (rounding stopped it early), ``"no_movable_point"``, ``"zero_energy"``.
@@ -531,7 +533,7 @@ class GlobalResult:
 
 def global_fair(curve: BSplineCurve, *, tol: float | None = None, l: Any = 2,  # noqa: E741
                 clamp: Any = (None, None), protect: Iterable[int] = (), gap: float = 1e-13,
-                max_steps: int = 500) -> GlobalResult:
+                max_steps: int | None = 500) -> GlobalResult:
     """Minimise the fairness energy over all free control points within ``tol``.
 
     Parameters
@@ -547,8 +549,11 @@ def global_fair(curve: BSplineCurve, *, tol: float | None = None, l: Any = 2,  #
     gap : float
         Interior-point stopping threshold on the total complementarity
         ``sum_i lambda_i s_i`` (in units of ``E(input)``).
-    max_steps : int
-        Cap on the Newton iterations (interior point and active set together).
+    max_steps : int >= 0 or None
+        Cap on the Newton iterations (interior point and active set together; the start
+        counts as 1); ``None``: 500. ``0`` makes no iteration: the input is returned unchanged
+        with ``iterations = 0`` and ``stop_reason = "max_steps"`` (as the other methods; a
+        curve without free points or with zero energy or ``tol = 0`` keeps its own reason).
 
     Returns
     -------
@@ -635,13 +640,13 @@ def global_fair(curve: BSplineCurve, *, tol: float | None = None, l: Any = 2,  #
 
 
 def _global_fair(curve: BSplineCurve, tol: float | None, l: Any,  # noqa: E741
-                 clamp: Any, protect: Iterable[int], gap: float, max_steps: int) -> GlobalResult:
+                 clamp: Any, protect: Iterable[int], gap: float,
+                 max_steps: int | None) -> GlobalResult:
     curve = check_bspline(curve)
     w = _weights(l, curve.degree)
-    if tol is not None:
-        tolv = float(tol)
-        if not (np.isfinite(tolv) and tolv >= 0):
-            raise InputError(f"tol must be a finite number >= 0 or None, got {tol!r}")
+    if tol is not None:  # (None: unconstrained; none_means only words the message "... or None")
+        tolv = as_nonnegative(tol, "tol", none_means=np.inf)
+    max_steps = as_step_count(max_steps, default=500)
     mask = movable_mask(curve, clamp, protect)
     p = curve.degree
     closed = curve.closed
@@ -672,6 +677,8 @@ def _global_fair(curve: BSplineCurve, tol: float | None, l: Any,  # noqa: E741
     if E0 <= 0.0 or (tol is not None and tolv == 0.0):
         return GlobalResult(curve, E0, E0, lam, 0, "zero_energy" if E0 <= 0 else "converged",
                             np.zeros(0, dtype=np.int64))
+    if max_steps == 0:  # no iteration (not even the start or the unconstrained solve)
+        return GlobalResult(curve, E0, E0, lam, 0, "max_steps", np.zeros(0, dtype=np.int64))
     # F = E / E0: grad F = kron(K, I) d with K = W ks, never formed: every kernel reads the
     # entries of W times ks (the same rounded values as a scaled copy, without its 56 MB at
     # 1e6 planar cubic points)
@@ -1140,8 +1147,9 @@ def _driver(curve: BSplineCurve, *, tol: float | None, eps: float | None, max_st
     from .fair import DriverOutput, FairingHistory
 
     gap = 1e-13 if eps is None else max(float(eps), 1e-16)
+    max_steps = 500 if max_steps is None else max_steps  # 0: no iteration, the input returned
     res = global_fair(curve, tol=tol, l=l, clamp=clamp, protect=protect, gap=gap,
-                      max_steps=500 if max_steps is None else max(int(max_steps), 1))
+                      max_steps=max_steps)
     p0 = np.asarray(curve.control_points)
     p1 = np.asarray(res.curve.control_points)
     moved = np.flatnonzero(np.any(p0 != p1, axis=1))
@@ -1149,7 +1157,7 @@ def _driver(curve: BSplineCurve, *, tol: float | None, eps: float | None, max_st
     hist = FairingHistory.from_arrays(moved, np.zeros(moved.size), disp)
     return DriverOutput(
         curve=res.curve, steps=res.iterations, stop_reason=res.stop_reason, history=hist,
-        eps=gap, max_steps=500 if max_steps is None else max_steps,
+        eps=gap, max_steps=max_steps,
         extra={"l": l if isinstance(l, (int, np.integer)) else str(l),
                "energy_l_before": res.energy_before, "energy_l_after": res.energy_after,
                "n_active": int(res.active.size),
