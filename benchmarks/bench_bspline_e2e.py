@@ -123,6 +123,9 @@ def main() -> None:
     ap.add_argument("--bisect", type=int, default=40, help="csaps bisection steps")
     ap.add_argument("--no-global", action="store_true")
     ap.add_argument("--no-eh", action="store_true", help="skip the Eck-Hadenfeld rows")
+    ap.add_argument("--schedules", nargs="+", default=["ranking", "sweep"],
+                    choices=["ranking", "sweep"],
+                    help="Eck-Hadenfeld schedules to run (each at the default eps and --eh-eps)")
     ap.add_argument("--eh-eps", type=float, nargs="*", default=[],
                     help="extra EH runs with eps = value / n (default rule: 1e-4)")
     ap.add_argument("--profile-csaps", action="store_true")
@@ -131,7 +134,9 @@ def main() -> None:
     args = ap.parse_args()
     t, pts = data(args.n, args.sigma, args.seed)
     # warm up the compiled code outside the timing
-    eck_hadenfeld_fair(interpolate_bspline(pts[:200], param=t[:200]), tol=args.tol)
+    for sched in args.schedules:
+        eck_hadenfeld_fair(interpolate_bspline(pts[:200], param=t[:200]), tol=args.tol,
+                           schedule=sched)
 
     def best_of(fn, fresh=lambda: None):  # (best time, result of the last run)
         best = np.inf
@@ -149,22 +154,17 @@ def main() -> None:
         return BSplineCurve(c.control_points, c.knots, c.degree)
     rows["input (interpolant)"] = (t_interp, bspline_metrics(c, t, pts), "")
 
-    if not args.no_eh:
-        t_fair, eh = best_of(lambda cc: eck_hadenfeld_fair(cc, l=2, tol=args.tol,
-                                                           clamp=(None, None),
-                                                           max_steps=200 * args.n), fresh_curve)
-        t_eh = t_fair + t_interp
-        rows["curvefair eck-hadenfeld"] = (t_eh, bspline_metrics(eh.curve, t, pts),
-                                           f"{eh.steps} steps ({eh.steps / t_fair / 1e6:.2f} "
-                                           f"M/s incl. set-up), {eh.stop_reason}; interp "
-                                           f"{t_interp:.2f}s")
-    for e in ([] if args.no_eh else args.eh_eps):
-        t_f, r = best_of(lambda cc, e=e: eck_hadenfeld_fair(cc, l=2, tol=args.tol,
-                                                            eps=e / c.n_ctrl,
-                                                            max_steps=200 * args.n), fresh_curve)
-        rows[f"curvefair eck-hadenfeld eps={e:g}/n"] = (
-            t_f + t_interp, bspline_metrics(r.curve, t, pts),
-            f"{r.steps} steps ({r.steps / t_f / 1e6:.2f} M/s incl. set-up), {r.stop_reason}")
+    for sched in ([] if args.no_eh else args.schedules):
+        label = "curvefair eck-hadenfeld" + ("" if sched == "ranking" else f" {sched}")
+        for e in [None, *args.eh_eps]:
+            eps = None if e is None else e / c.n_ctrl
+            t_f, r = best_of(lambda cc, eps=eps, sched=sched: eck_hadenfeld_fair(
+                cc, l=2, tol=args.tol, eps=eps, clamp=(None, None), max_steps=200 * args.n,
+                schedule=sched), fresh_curve)
+            rows[label + ("" if e is None else f" eps={e:g}/n")] = (
+                t_f + t_interp, bspline_metrics(r.curve, t, pts),
+                f"{r.steps} steps ({r.steps / t_f / 1e6:.2f} M/s incl. set-up), "
+                f"{r.stop_reason}; interp {t_interp:.2f}s")
     if not args.no_global:
         global_fair(interpolate_bspline(pts[:200], param=t[:200]), tol=args.tol)  # warm-up
         t_g, gl = best_of(lambda cc: global_fair(cc, tol=args.tol, l=2), fresh_curve)

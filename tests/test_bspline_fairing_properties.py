@@ -1,4 +1,5 @@
-"""Hypothesis properties of the B-spline fairing methods (eck-hadenfeld, knot-removal, global).
+"""Hypothesis properties of the B-spline fairing methods (eck-hadenfeld with both schedules,
+knot-removal, global).
 
 Energy never increases (minimisers), the tolerance is never broken (dense sampling of the curve
 distance to the input, at equal parameter), clamped ends keep position / tangent / curvature to
@@ -18,7 +19,7 @@ from curvefair.fairing.eck_hadenfeld import eck_hadenfeld_fair
 from curvefair.fairing.global_fair import energy_matrix, global_fair
 from curvefair.fairing.knot_removal import knot_removal_fair
 
-METHODS = ["eh2", "eh3", "kr1", "krls", "global"]
+METHODS = ["eh2", "eh3", "ehs", "kr1", "krls", "global"]
 CLAMPS = {"g0": 1, "g1": 2, "g2": 3}
 
 
@@ -50,6 +51,9 @@ def run(method, curve, tol, clamp):
     if method in ("eh2", "eh3"):
         return eck_hadenfeld_fair(curve, l=int(method[2]), tol=tol, clamp=clamp, eps=1e-10,
                                   max_steps=3000).curve
+    if method == "ehs":
+        return eck_hadenfeld_fair(curve, l=2, tol=tol, clamp=clamp, eps=1e-10, max_steps=3000,
+                                  schedule="sweep").curve
     if method in ("kr1", "krls"):
         return knot_removal_fair(curve, tol=tol, clamp=clamp,
                                  variant="one-point" if method == "kr1" else "least-squares").curve
