@@ -272,6 +272,9 @@ def test_methods_listing_matches_registry():
     ["fair", "ex1.csv", "-o", "nofolder/o.csv"],
     ["plot", "ex1.csv", "-o", "f.gif"],
     ["fair", "ex1.csv", "--bogus"],
+    ["fair", "ex1.csv", "-o", "o.csv", "-O", "noequals"],
+    ["fair", "ex1.csv", "-o", "o.csv", "--option", "=3"],
+    ["fair", "ex1.csv", "-o", "o.csv", "-O", "tol=0.1"],
 ])
 def test_usage_errors_exit_2(tmp_path: Path, ex1: Path, args, monkeypatch):
     monkeypatch.chdir(tmp_path)
@@ -289,3 +292,73 @@ def test_protect_indices_follow_file_order(tmp_path: Path, ex1: Path, monkeypatc
     p0 = np.loadtxt(ex1, delimiter=",", skiprows=2)
     np.testing.assert_array_equal(np.asarray(rec.points)[3], p0[3])  # protected P4 stays
     assert np.max(np.abs(np.asarray(rec.points) - p0)) > 1e-3  # others moved
+
+
+# --- method options: -O KEY=VALUE -------------------------------------------------------------
+def _bspline_file(tmp_path: Path) -> Path:
+    x = np.linspace(0, 10, 12)
+    y = np.sin(x / 2)
+    y[5] += 0.4
+    write_curves(tmp_path / "b.json", [interpolate_bspline(np.c_[x, y])])
+    return tmp_path / "b.json"
+
+
+def test_method_options_reach_fair_and_unknown_ones_fail(tmp_path: Path):
+    before = _bspline_file(tmp_path).read_bytes()
+    runs = cli_many([["fair", "b.json", "-o", "sweep.json", "-m", "eck-hadenfeld",
+                      "-O", "schedule=sweep", "--option", "l=3", "--report", "r.json"],
+                     ["fair", "b.json", "-o", "bogus.json", "-m", "eck-hadenfeld",
+                      "-O", "bogus=1"],
+                     ["fair", "b.json", "-o", "bad.json", "-O", "schedule=zigzag"]], tmp_path)
+    assert runs[0].returncode == 0, runs[0].stderr
+    rep = json.loads((tmp_path / "r.json").read_text())
+    r = rep["curves"][0]["report"]
+    assert r["method"] == "eck-hadenfeld"
+    assert r["schedule"] == "sweep" and r["l"] == 3  # "3" parsed as an int
+    assert rep["options"]["method_options"] == {"schedule": "sweep", "l": 3}
+    assert_user_error(runs[1], 1, "bogus", "eck-hadenfeld", "schedule")
+    assert_user_error(runs[2], 1, "schedule", "zigzag")
+    assert not (tmp_path / "bogus.json").exists()  # the only curve failed: nothing written
+    assert not (tmp_path / "bad.json").exists()
+    assert (tmp_path / "b.json").read_bytes() == before
+
+
+def test_option_noequals_is_a_usage_error_naming_option(tmp_path: Path, ex1: Path,
+                                                        monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    r = CliRunner().invoke(main, ["fair", "ex1.csv", "-o", "o.csv", "-O", "noequals"])
+    assert r.exit_code == 2, r.output
+    assert "--option" in r.output and "noequals" in r.output
+    assert not (tmp_path / "o.csv").exists()
+
+
+def test_option_values_are_typed():
+    from curvefair.cli import _parse_method_options
+
+    got = _parse_method_options(["a=3", "b=0.25", "c=1e-3", "d=true", "e=False", "f=sweep",
+                                 "g=", "h=x=y", "a=-4"])
+    assert got == {"a": -4, "b": 0.25, "c": 1e-3, "d": True, "e": False, "f": "sweep",
+                   "g": "", "h": "x=y"}
+    assert type(got["a"]) is int and type(got["d"]) is bool
+
+
+def test_methods_lists_options_with_defaults():
+    from curvefair.fairing.fair import method_options
+
+    r = CliRunner().invoke(main, ["methods"])
+    assert r.exit_code == 0
+    assert "schedule" in r.output and "schedule=ranking" in r.output
+    assert "variant=one-point" in r.output
+    r = CliRunner().invoke(main, ["methods", "--json"])
+    rows = {x["name"]: x for x in json.loads(r.output)}
+    assert rows["eck-hadenfeld"]["options"]["schedule"] == "ranking"
+    for name, row in rows.items():
+        assert list(row["options"]) == list(method_options(name))
+
+
+def test_fair_help_documents_option():
+    r = CliRunner().invoke(main, ["fair", "--help"])
+    assert r.exit_code == 0
+    assert "-O, --option KEY=VALUE" in r.output
+    r = CliRunner().invoke(main, ["--help"])
+    assert "-O schedule=sweep" in r.output

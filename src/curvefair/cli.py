@@ -12,7 +12,9 @@ equal to input without ``--in-place``, nonexistent input file).
 from __future__ import annotations
 
 import contextlib
+import inspect
 import json
+import math
 import os
 import sys
 import time
@@ -40,6 +42,7 @@ Examples:
   curvefair fair profile.csv -o profile_faired.csv --tol 0.05 --plot before_after.png
   curvefair fair part.dxf -o part_faired.dxf --method knot-removal --tol 0.01 --report r.json
   curvefair fair foil.dat --in-place --tol 1e-4 --clamp g2
+  curvefair fair part.dxf -o part_faired.dxf -m eck-hadenfeld -O schedule=sweep -O l=3
   curvefair analyze profile.csv
   curvefair analyze part.dxf --json > analysis.json
   curvefair plot profile.csv --compare profile_faired.csv -o compare.svg
@@ -139,6 +142,47 @@ def _parse_protect(value: str | None) -> list[int]:
     return out
 
 
+def _parse_value(text: str) -> Any:
+    """``-O`` values: an int literal, else a float, else true/false, else the string itself."""
+    try:
+        return int(text)
+    except ValueError:
+        pass
+    try:
+        return float(text)
+    except ValueError:
+        pass
+    low = text.strip().lower()
+    if low in ("true", "false"):
+        return low == "true"
+    return text
+
+
+def _parse_method_options(items: Sequence[str]) -> dict[str, Any]:
+    """``("schedule=sweep", "l=3")`` -> ``{"schedule": "sweep", "l": 3}`` (the last wins)."""
+    out: dict[str, Any] = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        key = key.strip()
+        if not sep or not key:
+            raise click.BadParameter(f"{item!r} is not KEY=VALUE (e.g. -O schedule=sweep)",
+                                     param_hint="'-O' / '--option'")
+        if key in _fair_arguments():
+            flag = "the IN argument" if key == "curve" else "--" + key.replace("_", "-")
+            raise click.BadParameter(f"{key!r} is not a method option; use {flag}",
+                                     param_hint="'-O' / '--option'")
+        out[key] = _parse_value(value)
+    return out
+
+
+def _fair_arguments() -> set[str]:
+    """The named parameters of :func:`curvefair.fair` (they have their own flags)."""
+    from . import fair
+
+    return {p.name for p in inspect.signature(fair).parameters.values()
+            if p.kind is not p.VAR_KEYWORD}
+
+
 def _read(path: str, corner_angle: float | None) -> list[Any]:
     from . import read_curves
 
@@ -188,12 +232,36 @@ def main() -> None:
 # ------------------------------------------------------------------------------------------
 # methods
 # ------------------------------------------------------------------------------------------
-def _method_rows() -> list[dict[str, Any]]:
-    from .fairing import METHODS
+def _option_default(v: Any) -> Any:
+    """An option's default as JSON (None for "no default"; other objects as their repr)."""
+    if v is inspect.Parameter.empty:
+        return None
+    if v is None or isinstance(v, (bool, int, str)):
+        return v
+    if isinstance(v, float):
+        return v if math.isfinite(v) else repr(v)
+    return repr(v)
 
+
+def _option_text(name: str, v: Any) -> str:
+    """``name=default`` as it would be typed after ``-O``."""
+    if v is inspect.Parameter.empty:
+        return f"{name} (required)"
+    if isinstance(v, bool):
+        return f"{name}={'true' if v else 'false'}"
+    return f"{name}={v}"
+
+
+def _method_rows(raw_defaults: bool = False) -> list[dict[str, Any]]:
+    from .fairing import METHODS
+    from .fairing.fair import method_options
+
+    conv = (lambda v: v) if raw_defaults else _option_default
     return [{"name": s.name, "curve_types": [t.__name__ for t in s.curve_types],
              "default": bool(s.default), "modes": list(s.modes), "summary": s.summary,
-             "source": s.source} for s in METHODS.values()]
+             "source": s.source,
+             "options": {k: conv(v) for k, v in method_options(s.name).items()}}
+            for s in METHODS.values()]
 
 
 def _default_methods_text() -> str:
@@ -208,11 +276,12 @@ def _default_methods_text() -> str:
 @main.command("methods")
 @click.option("--json", "as_json", is_flag=True, help="Machine-readable output.")
 def methods_cmd(as_json: bool) -> None:
-    """List the fairing methods: curve types, one line each and the source paper."""
-    rows = _method_rows()
+    """List the fairing methods: curve types, one line each, the source paper, and the
+    method's options with their defaults (pass them to 'curvefair fair' as -O KEY=VALUE)."""
     if as_json:
-        click.echo(json.dumps(rows, indent=2))
+        click.echo(json.dumps(_method_rows(), indent=2))
         return
+    rows = _method_rows(raw_defaults=True)
     from rich.table import Table
 
     table = Table(show_lines=True, title="curvefair fairing methods (* = default for its type)")
@@ -220,9 +289,11 @@ def methods_cmd(as_json: bool) -> None:
     table.add_column("curves")
     table.add_column("what it does")
     table.add_column("source")
+    table.add_column("options (-O KEY=VALUE), defaults")
     for r in rows:
+        opts = "\n".join(_option_text(k, v) for k, v in r["options"].items()) or "-"
         table.add_row(r["name"] + (" *" if r["default"] else ""), ", ".join(r["curve_types"]),
-                      r["summary"], r["source"])
+                      r["summary"], r["source"], opts)
     _console().print(table)
 
 
@@ -482,6 +553,12 @@ def _summary_table(rows: list[dict[str, Any]]) -> Any:
               show_default=True,
               help="Hermite methods: re-interpolate after each step, or keep the step's "
                    "derivatives.")
+@click.option("-O", "--option", "method_option", metavar="KEY=VALUE", multiple=True,
+              help="A method option, repeatable (e.g. -m eck-hadenfeld -O schedule=sweep "
+                   "-O l=3). VALUE is read as an integer, else a number, else true/false, "
+                   "else text; a repeated KEY: the last wins. 'curvefair methods' lists each "
+                   "method's options and defaults; a KEY the method does not take fails the "
+                   "curve.")
 @click.option("--decimals", type=click.IntRange(min=0), metavar="N",
               help="Text formats: write every number with N decimals [default: the input "
                    "file's precision].")
@@ -493,7 +570,8 @@ def _summary_table(rows: list[dict[str, Any]]) -> Any:
 @_quiet_option
 def fair_cmd(infile: str, out: str | None, in_place: bool, method: str | None,
              tol: float | None, eps: float | None, max_steps: int | None, clamp: str,
-             protect: str | None, mode: str, decimals: int | None, report: str | None,
+             protect: str | None, mode: str, method_option: tuple[str, ...],
+             decimals: int | None, report: str | None,
              history: bool,
              plot_path: str | None, corner_angle: float, no_corners: bool,
              quiet: bool) -> None:
@@ -517,6 +595,7 @@ def fair_cmd(infile: str, out: str | None, in_place: bool, method: str | None,
             raise click.UsageError(f"OUT {out!r} is the input file; pass --in-place to replace "
                                    "it")
     user_protect = _parse_protect(protect)
+    options = _parse_method_options(method_option)
     if plot_path is not None:
         _check_figure_path(plot_path, "--plot")
     for p, opt in ((report, "--report"), (plot_path, "--plot"), (out, "-o/--output")):
@@ -547,7 +626,8 @@ def fair_cmd(infile: str, out: str | None, in_place: bool, method: str | None,
                                    "kind": rec.kind}
             try:
                 res = fair(rec.curve, method, tol=tol, eps=eps, max_steps=max_steps,
-                           clamp=clamp, protect=_local_protect(rec, user_protect), mode=mode)
+                           clamp=clamp, protect=_local_protect(rec, user_protect), mode=mode,
+                           **options)
             except CurvefairError as exc:
                 row.update(status="failed", error=str(exc))
                 faired.append(rec)
@@ -579,6 +659,8 @@ def fair_cmd(infile: str, out: str | None, in_place: bool, method: str | None,
                 "output": os.path.abspath(out), "format": out_fmt,
                 "options": {"method": method, "tol": tol, "eps": eps, "max_steps": max_steps,
                             "clamp": clamp, "protect": user_protect, "mode": mode,
+                            "method_options": {k: _option_default(v)
+                                               for k, v in options.items()},
                             "corner_angle": _corner(corner_angle, no_corners)},
                 "n_curves": len(rows), "n_failed": len(failures), "output_written": wrote_out,
                 "time_s": time.perf_counter() - t0, "curves": rows})

@@ -8,6 +8,8 @@ points moved and how far, the largest deviation of the curve).
 
 from __future__ import annotations
 
+import functools
+import inspect
 import math
 import time
 from collections.abc import Callable, Iterable
@@ -28,6 +30,7 @@ __all__ = [
     "METHODS",
     "register_method",
     "available_methods",
+    "method_options",
     "fair",
     "CLAMPS",
     "MODES",
@@ -206,6 +209,84 @@ def available_methods(curve: object = None) -> list[str]:
             and (s.accepts is None or s.accepts(curve))]
 
 
+# arguments of every driver that fair() passes itself: not "options" of a method
+_STANDARD_ARGS = frozenset({"tol", "eps", "max_steps", "clamp", "protect", "mode"})
+
+
+def _driver_options(spec: MethodSpec) -> tuple[dict[str, Any], bool]:
+    """The driver's own keyword options ``{name: default}`` and whether it takes ``**kwargs``.
+
+    The first positional parameter (the curve), the arguments :func:`fair` passes itself
+    (:data:`_STANDARD_ARGS`) and keywords bound by a :func:`functools.partial` driver are not
+    options. A driver whose signature cannot be read is taken to accept anything.
+    """
+    try:
+        sig = inspect.signature(spec.driver)
+    except (TypeError, ValueError):
+        return {}, True
+    bound = (set(spec.driver.keywords) if isinstance(spec.driver, functools.partial)
+             else set())
+    opts: dict[str, Any] = {}
+    var_kw = False
+    for k, p in enumerate(sig.parameters.values()):
+        if p.kind is p.VAR_KEYWORD:
+            var_kw = True
+            continue
+        if p.kind not in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY):
+            continue
+        if k == 0 and p.kind is p.POSITIONAL_OR_KEYWORD:
+            continue  # the curve
+        if p.name in _STANDARD_ARGS or p.name in bound:
+            continue
+        opts[p.name] = p.default
+    return opts, var_kw
+
+
+def _method_spec(name: object) -> MethodSpec:
+    if not isinstance(name, str) or name not in METHODS:
+        raise InputError(f"unknown method {name!r}; valid methods are: "
+                         + ", ".join(repr(m) for m in METHODS))
+    return METHODS[name]
+
+
+def method_options(name: str) -> dict[str, Any]:
+    """The options ``fair(curve, name, **options)`` accepts, each with its default.
+
+    Options are the method driver's keyword parameters other than ``tol``, ``eps``,
+    ``max_steps``, ``clamp``, ``protect`` and ``mode`` (which :func:`fair` takes itself), in
+    the driver's order; an option without a default maps to :data:`inspect.Parameter.empty`.
+    A driver that also takes ``**kwargs`` (the Hermite methods) may accept or check further
+    names itself; only its named options are listed.
+
+    Raises
+    ------
+    InputError
+        Unknown method name.
+
+    Examples
+    --------
+    >>> from curvefair.fairing.fair import method_options
+    >>> method_options("eck-hadenfeld")["schedule"]
+    'ranking'
+    """
+    return dict(_driver_options(_method_spec(name))[0])
+
+
+def _check_options(spec: MethodSpec, options: dict[str, Any]) -> None:
+    """Refuse option names the method's driver does not take (InputError naming them)."""
+    known, var_kw = _driver_options(spec)
+    if var_kw:
+        return
+    unknown = sorted(k for k in options if k not in known)
+    if not unknown:
+        return
+    names = ", ".join(repr(k) for k in unknown)
+    what = f"no option {names}" if len(unknown) == 1 else f"no options {names}"
+    valid = ("its options are: " + ", ".join(sorted(known)) if known
+             else "it takes no options")
+    raise InputError(f"method {spec.name!r} has {what}; {valid}")
+
+
 # ----------------------------------------------------------------------------------------------
 # helpers
 # ----------------------------------------------------------------------------------------------
@@ -361,7 +442,9 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
         For the Hermite methods: ``"spline"`` re-interpolates after every step (the papers'
         examples), ``"hermite"`` keeps the step's own derivatives.
     **options
-        Passed to the method's driver.
+        Passed to the method's driver; :func:`method_options` lists each method's options and
+        their defaults (e.g. ``schedule="sweep"`` for ``"eck-hadenfeld"``). An unknown name
+        raises :class:`InputError` before any work is done.
 
     Returns
     -------
@@ -371,7 +454,7 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
     Raises
     ------
     InputError
-        Unknown method/mode/clamp, ``tol <= 0``, ``eps < 0``, negative ``max_steps``, protect
+        Unknown method/mode/clamp/option, ``tol <= 0``, ``eps < 0``, negative ``max_steps``, protect
         index out of range, a curve the method does not handle, too few points.
 
     Notes
@@ -403,10 +486,7 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
     if method is None:
         spec = _default_method(curve)
     else:
-        if not isinstance(method, str) or method not in METHODS:
-            raise InputError(f"unknown method {method!r}; valid methods are: "
-                             + ", ".join(repr(m) for m in METHODS))
-        spec = METHODS[method]
+        spec = _method_spec(method)
     if not isinstance(curve, spec.curve_types):
         raise InputError(
             f"method {spec.name!r} needs a {' or '.join(t.__name__ for t in spec.curve_types)}, "
@@ -426,6 +506,7 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
     if mode not in spec.modes:
         raise InputError(f"method {spec.name!r} supports mode "
                          + " or ".join(repr(m) for m in spec.modes) + f", got {mode!r}")
+    _check_options(spec, options)
     kwargs = dict(options)
     if spec.modes != ("spline",):
         kwargs["mode"] = mode
