@@ -85,30 +85,32 @@ def main() -> None:
     ap.add_argument("--eps", type=float, nargs="+", default=[1e-4, 3e-4, 6e-4, 1e-3])
     ap.add_argument("--bisect", type=int, default=20)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--schedules", nargs="+", default=["ranking"], choices=["ranking", "sweep"],
+                    help="Eck-Hadenfeld schedules (each against csaps and its own smallest eps)")
     args = ap.parse_args()
     eps = sorted(args.eps)
-    print("family n sigma tol eps*n steps/n stop E2/csaps E3/csaps E2/E2min E3/E3min "
-          "infl(csaps)", flush=True)
+    print("family n sigma tol schedule eps*n steps/n stop E2/csaps E3/csaps E2/E2min E3/E3min "
+          "infl(csaps) maxdev", flush=True)
     for fam in args.families:
         for n in args.sizes:
             for sigma in args.sigma:
                 t, pts = family(fam, n, sigma, args.seed)
                 c = interpolate_bspline(pts, param=t)
-                for tol in args.tol:
+                for tol, sched in ((a, b) for a in args.tol for b in args.schedules):
                     ref = None
                     for e in eps:
                         r = eck_hadenfeld_fair(c, l=2, tol=tol, eps=e / c.n_ctrl,
-                                               max_steps=500 * n)
+                                               max_steps=500 * n, schedule=sched)
                         m = bspline_metrics(r.curve, t, pts)
                         p = csaps_matching(t, pts, m["max_dev"], args.bisect)
                         mc = csaps_metrics(csaps_fit(t, pts, p), t, pts)
                         if ref is None:
                             ref = m
-                        print(f"{fam} {n} {sigma:g} {tol:g} {e:g} {r.steps / n:.2f} "
+                        print(f"{fam} {n} {sigma:g} {tol:g} {sched} {e:g} {r.steps / n:.2f} "
                               f"{r.stop_reason} {m['E2'] / mc['E2']:.4f} "
                               f"{m['E3'] / mc['E3']:.4f} {m['E2'] / ref['E2']:.4f} "
                               f"{m['E3'] / ref['E3']:.4f} {m['inflections']}"
-                              f"({mc['inflections']})", flush=True)
+                              f"({mc['inflections']}) {m['max_dev']:.4g}", flush=True)
 
 
 if __name__ == "__main__":

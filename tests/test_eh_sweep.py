@@ -243,3 +243,13 @@ def test_tolerance_holds_as_computed_at_large_coordinates(schedule, offset, dim)
     u = np.linspace(*c.domain, 20001)
     slack = 8 * np.finfo(float).eps * np.abs(pts).max()
     assert np.linalg.norm(res.curve(u) - c(u), axis=1).max() <= tol + slack
+
+
+def test_option_checks():
+    c = random_curve(np.random.default_rng(8), 20, 3, 2, False)
+    for kw in ({"history_max": "x"}, {"history_max": -1}, {"eps_relative": "yes"},
+               {"schedule": "Ranking "}):
+        with pytest.raises(InputError, match=next(iter(kw))):
+            eck_hadenfeld_fair(c, **kw)
+    from curvefair.fairing import method_options
+    assert method_options("eck-hadenfeld")["schedule"] == "ranking"

@@ -60,9 +60,9 @@ BASELINE = "interpolant"  # natural cubic interpolating spline of the input: "be
 
 
 # option variants worth showing besides each method's defaults: ``l=3`` (the third-derivative
-# energy) for the two methods that take it
+# energy) for the two methods that take it, and Eck-Hadenfeld's sweep schedule
 VARIANTS: dict[str, list[tuple[str, dict[str, Any]]]] = {
-    "eck-hadenfeld": [("l3+eps0", {"l": 3, "eps": 0.0})],
+    "eck-hadenfeld": [("l3+eps0", {"l": 3, "eps": 0.0}), ("sweep", {"schedule": "sweep"})],
     "global": [("l3", {"l": 3})],
 }
 

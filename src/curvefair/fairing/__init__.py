@@ -16,6 +16,7 @@ from .fair import (
     MethodSpec,
     available_methods,
     fair,
+    method_options,
     register_method,
 )
 
@@ -28,6 +29,7 @@ __all__ = [
     "METHODS",
     "register_method",
     "available_methods",
+    "method_options",
 ]
 
 METHOD_MODULES = [

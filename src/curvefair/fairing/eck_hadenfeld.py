@@ -21,7 +21,7 @@ import numpy as np
 from numba import njit
 
 from .._typing import FloatArray
-from .._validate import as_nonnegative, as_step_count, check_finite
+from .._validate import as_nonnegative, as_step_count, check_finite, choice
 from ..curves.bspline import BSplineCurve, band_energy, band_residual, residual_row
 from ..errors import InputError
 from ._prefetch import prefetch
@@ -67,11 +67,10 @@ SCHEDULES = ("ranking", "sweep")
 
 
 def check_schedule(schedule: object) -> str:
-    key = schedule.lower() if isinstance(schedule, str) else schedule
-    if key not in SCHEDULES:
-        raise InputError(f"schedule must be one of {', '.join(map(repr, SCHEDULES))}, "
-                         f"got {schedule!r}")
-    return str(key)
+    """``"ranking"`` or ``"sweep"`` (any case)."""
+    if isinstance(schedule, str) and schedule.lower() in SCHEDULES:
+        return schedule.lower()
+    return choice(schedule, SCHEDULES, "schedule")
 
 
 CLAMP_POINTS = {None: 0, "none": 0, "free": 0, "g0": 1, "g1": 2, "g2": 3}
@@ -1010,6 +1009,9 @@ def eck_hadenfeld_fair(curve: BSplineCurve, *, l: int = 2, tol: float | None = N
     tolv = as_nonnegative(tol, "tol", none_means=np.inf)
     epsv = (default_eps(n) if eps_relative else 0.0) if eps is None else as_nonnegative(eps, "eps")
     max_steps = as_step_count(max_steps, default=100 * n)
+    history_max = as_step_count(history_max, "history_max", default=1_000_000)
+    if not isinstance(eps_relative, (bool, np.bool_)):
+        raise InputError(f"eps_relative must be True or False, got {eps_relative!r}")
     sched = check_schedule(schedule)
     mask = movable_mask(curve, clamp, protect)
     W = np.ascontiguousarray(curve.gram_band(lv))
@@ -1019,7 +1021,7 @@ def eck_hadenfeld_fair(curve: BSplineCurve, *, l: int = 2, tol: float | None = N
     z = _aligned_empty((n,))
     e0 = float(_setup_state(W, curve.degree, curve.closed, d, mask, X, z))
     eps_abs = epsv * e0 if eps_relative else epsv
-    hist = np.zeros((int(min(max(history_max, 0), max_steps)), 3))
+    hist = np.zeros((int(min(history_max, max_steps)), 3))
     Wu, pat, upat, ulo, uhi = band_patterns(W)
     if sched == "ranking":
         steps, drop, code, nh = _eh_loop(X, z, Wu, pat, upat, ulo, uhi, dim, curve.degree,
