@@ -302,6 +302,28 @@ def _candidate(g0, g1, g2, d0, d1, d2, o0, o1, o2, gii, igii, tol):  # type: ign
     return gii * (s0 * s0 + s1 * s1 + s2 * s2), s0, s1, s2
 
 
+@njit(cache=True, inline="always")
+def _move_residuals(X, Wu, pr, r, e0, e1, e2, D, p, closed):  # type: ignore[no-untyped-def]
+    """After ``d_r`` moved by ``e``: ``(G d)_i += G_ir e`` over the band of ``r`` (cyclic for
+    closed curves), ``G``'s row ``r`` being ``Wu[pr]``. Inlined at numba IR level into both
+    loops (no call with array arguments in them); the one place this update is written."""
+    n = X.shape[0]
+    for c in range(2 * p + 1):
+        i = r + c - p
+        if closed:
+            if i < 0:
+                i += n
+            elif i >= n:
+                i -= n
+        elif i < 0 or i >= n:
+            continue
+        w = Wu[pr, c]
+        X[i, D] += w * e0
+        X[i, D + 1] += w * e1
+        if D == 3:
+            X[i, 5] += w * e2
+
+
 _BLOCK_SHIFT = 3  # 8 control points (one 64-byte line of z) per leaf of the tournament tree
 _SPECULATE_BYTES = 1 << 22  # prefetch the runner-up's data when the state exceeds ~4 MB
 _RUNNER_UP_TOP = 256  # the runner-up is sought among the siblings of the nodes below 256
@@ -459,20 +481,7 @@ def _eh_loop(X, z, Wu, pat, upat, ulo, uhi, D, p, closed, tol, eps_abs, max_step
                                         Wu[pr, 2 * p + 1], tol)
         X[r, 0] += e0
         X[r, 1] += e1
-        for c in range(2 * p + 1):
-            i = r + c - p
-            if closed:
-                if i < 0:
-                    i += n
-                elif i >= n:
-                    i -= n
-            elif i < 0 or i >= n:
-                continue
-            w = Wu[pr, c]
-            X[i, D] += w * e0
-            X[i, D + 1] += w * e1
-            if D == 3:
-                X[i, 5] += w * e2
+        _move_residuals(X, Wu, pr, r, e0, e1, e2, D, p, closed)
         # the changed ranking numbers: one or two contiguous ranges
         lo1 = r - p
         hi1 = r + p
@@ -712,20 +721,7 @@ def _eh_sweep(X, z, Wu, pat, upat, ulo, uhi, D, p, closed, tol, eps_abs, max_ste
         X[r, 1] += e1
         if D == 3:
             X[r, 2] += e2
-        for c in range(2 * p + 1):
-            i = r + c - p
-            if closed:
-                if i < 0:
-                    i += n
-                elif i >= n:
-                    i -= n
-            elif i < 0 or i >= n:
-                continue
-            w = Wu[pr, c]
-            X[i, D] += w * e0
-            X[i, D + 1] += w * e1
-            if D == 3:
-                X[i, 5] += w * e2
+        _move_residuals(X, Wu, pr, r, e0, e1, e2, D, p, closed)
         # every point whose (G d)_i changed: queue it when its drop may reach the threshold
         if wrap_all:
             lo = 0
