@@ -5,7 +5,10 @@ One step moves one control point ``d_r`` to the minimiser of the energy
 (seed 003, eqs. (12)-(16)). The automatic method (:func:`eck_hadenfeld_fair`, registered as
 ``"eck-hadenfeld"`` in :func:`curvefair.fair`) is the ranking list described in ERRATA: always fair
 the control point whose move lowers the energy most, recompute only the ``2p + 1`` neighbours,
-keep every control point within ``tol`` of its ORIGINAL position.
+keep every control point within ``tol`` of its ORIGINAL position. ``schedule="sweep"`` takes the
+same steps in Gauss-Seidel order instead (every point above the threshold in turn, then the
+neighbours of the moved ones), with the same stopping test: faster on large curves and, on
+noisy data, as fair or fairer at the same threshold.
 
 Indices are 0-based (the paper writes ``d_0 .. d_n`` with order ``k = p + 1``; its ``2k - 1``
 neighbours are our ``2p + 1``).
@@ -303,6 +306,43 @@ def _candidate(g0, g1, g2, d0, d1, d2, o0, o1, o2, gii, igii, tol):  # type: ign
 
 
 @njit(cache=True, inline="always")
+def _candidate2(g0, g1, d0, d1, o0, o1, gii, igii, tol):  # type: ignore[no-untyped-def]
+    """:func:`_candidate` for a planar point, branch-free: the free and the clamped move are
+    both computed and one is selected (a mispredicted branch on whether the ball is reached
+    costs more than the extra arithmetic); the same operations in the same order, so the same
+    values bitwise (also the zero move below rounding). Returns ``(z, e0, e1)``."""
+    s0 = -g0 * igii
+    s1 = -g1 * igii
+    a0 = abs(d0)
+    a1 = abs(d1)
+    m = a0 if a0 > a1 else a1
+    floor = 4e-16 * (m + (tol if tol < np.inf else 0.0))
+    floor *= floor
+    ss = s0 * s0 + s1 * s1
+    rad = tol - 2e-15 * (m + 2.0 * tol)
+    rad = rad if rad > 0.0 else 0.0
+    v0 = d0 + s0 - o0
+    v1 = d1 + s1 - o1
+    vv = v0 * v0 + v1 * v1
+    f = rad / np.sqrt(vv)  # inf/nan when not clamped: not selected below
+    c0 = o0 + v0 * f - d0
+    c1 = o1 + v1 * f - d1
+    ee = c0 * c0 + c1 * c1
+    zc = gii * (2.0 * (c0 * s0 + c1 * s1) - ee)
+    zc = zc if zc > 0.0 else 0.0
+    zc = 0.0 if ee <= floor else zc
+    clamped = tol < np.inf and vv > rad * rad
+    z = zc if clamped else gii * ss
+    z = 0.0 if ss <= floor else z
+    nomove = ss <= floor or (clamped and ee <= floor)  # _candidate returns zeros then
+    e0 = c0 if clamped else s0
+    e1 = c1 if clamped else s1
+    e0 = 0.0 if nomove else e0
+    e1 = 0.0 if nomove else e1
+    return z, e0, e1
+
+
+@njit(cache=True, inline="always")
 def _move_residuals(X, Wu, pr, r, e0, e1, e2, D, p, closed):  # type: ignore[no-untyped-def]
     """After ``d_r`` moved by ``e``: ``(G d)_i += G_ir e`` over the band of ``r`` (cyclic for
     closed curves), ``G``'s row ``r`` being ``Wu[pr]``. Inlined at numba IR level into both
@@ -476,9 +516,9 @@ def _eh_loop(X, z, Wu, pat, upat, ulo, uhi, D, p, closed, tol, eps_abs, max_step
                                         Wu[pr, 2 * p + 1], tol)
             X[r, 2] += e2
         else:
-            zz, e0, e1, e2 = _candidate(X[r, 2], X[r, 3], 0.0, X[r, 0], X[r, 1], 0.0,
-                                        X[r, 4], X[r, 5], 0.0, Wu[pr, p],
-                                        Wu[pr, 2 * p + 1], tol)
+            zz, e0, e1 = _candidate2(X[r, 2], X[r, 3], X[r, 0], X[r, 1], X[r, 4], X[r, 5],
+                                     Wu[pr, p], Wu[pr, 2 * p + 1], tol)
+            e2 = 0.0
         X[r, 0] += e0
         X[r, 1] += e1
         _move_residuals(X, Wu, pr, r, e0, e1, e2, D, p, closed)
@@ -712,9 +752,9 @@ def _eh_sweep(X, z, Wu, pat, upat, ulo, uhi, D, p, closed, tol, eps_abs, max_ste
                                         X[r, 6], X[r, 7], X[r, 8], Wu[pr, p],
                                         Wu[pr, 2 * p + 1], tol)
         else:
-            zz, e0, e1, e2 = _candidate(X[r, 2], X[r, 3], 0.0, X[r, 0], X[r, 1], 0.0,
-                                        X[r, 4], X[r, 5], 0.0, Wu[pr, p],
-                                        Wu[pr, 2 * p + 1], tol)
+            zz, e0, e1 = _candidate2(X[r, 2], X[r, 3], X[r, 0], X[r, 1], X[r, 4], X[r, 5],
+                                     Wu[pr, p], Wu[pr, 2 * p + 1], tol)
+            e2 = 0.0
         if zz <= 0.0 or zz < thr:
             continue
         X[r, 0] += e0
