@@ -1126,7 +1126,8 @@ def _register() -> None:
         curve_types=(BSplineCurve,),
         driver=_driver,
         summary="Eck & Hadenfeld ranking list: move the control point whose energy-minimising "
-                "position lowers E_l (l=2|3) most, within tol of the original",
+                "position lowers E_l (l=2|3) most, within tol of the original "
+                "(schedule=sweep: the same steps in Gauss-Seidel order)",
         source="Eck & Hadenfeld, Local energy fairing of B-spline curves, eqs. (12)-(16); "
                "ranking list as in ERRATA",
         default=True,
