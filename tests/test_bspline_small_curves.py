@@ -10,6 +10,7 @@ import sys
 import pytest
 
 CASES = {
+    "closed-minimal": "cf.BSplineCurve([[0,0],[1,0],[1,1],[0,1]], [0,1,2,3,4], 3, closed=True)",
     "single-span": "cf.BSplineCurve([[0,0],[1,1],[2,1],[3,0]], [0,0,0,0,1,1,1,1], 3)",
     "two-span": "cf.BSplineCurve([[0,0],[1,1],[2,1],[3,0],[4,1]], [0,0,0,0,.5,1,1,1,1], 3)",
     "quartic-3d": "cf.BSplineCurve(np.c_[np.arange(5.), np.sin(np.arange(5.)), np.cos(np.arange(5.))],"
@@ -17,14 +18,17 @@ CASES = {
 }
 
 
-@pytest.mark.parametrize("method", ["eck-hadenfeld", "knot-removal", "cheng-yu", "global"])
+@pytest.mark.parametrize("method", ["eck-hadenfeld", "eck-hadenfeld/sweep", "knot-removal",
+                                    "cheng-yu", "global"])
 @pytest.mark.parametrize("case", sorted(CASES))
 def test_small_bspline_all_methods(method, case):
+    name, _, sched = method.partition("/")
+    opts = f", schedule={sched!r}" if sched else ""
     code = f"""
 import numpy as np, curvefair as cf
 c = {CASES[case]}
 try:
-    r = cf.fair(c, {method!r}, tol=0.1)
+    r = cf.fair(c, {name!r}, tol=0.1{opts})
 except cf.CurvefairError as exc:   # a documented refusal is fine, a crash is not
     print("refused:", exc)
 else:
