@@ -343,6 +343,18 @@ def _candidate2(g0, g1, d0, d1, o0, o1, gii, igii, tol):  # type: ignore[no-unty
 
 
 @njit(cache=True, inline="always")
+def _record(hist, nh, r, z, e0, e1, e2):  # type: ignore[no-untyped-def]
+    """Write step ``(index, z, displacement)`` into row ``nh`` of ``hist`` while it has room;
+    returns the new row count. Inlined into both loops."""
+    if nh < hist.shape[0]:
+        hist[nh, 0] = r
+        hist[nh, 1] = z
+        hist[nh, 2] = np.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+        nh += 1
+    return nh
+
+
+@njit(cache=True, inline="always")
 def _move_residuals(X, Wu, pr, r, e0, e1, e2, D, p, closed):  # type: ignore[no-untyped-def]
     """After ``d_r`` moved by ``e``: ``(G d)_i += G_ir e`` over the band of ``r`` (cyclic for
     closed curves), ``G``'s row ``r`` being ``Wu[pr]``. Inlined at numba IR level into both
@@ -432,7 +444,6 @@ def _eh_loop(X, z, Wu, pat, upat, ulo, uhi, D, p, closed, tol, eps_abs, max_step
     for j in range(2 * P):
         T[j, 0] = -1.0
         T[j, 1] = 0.0
-    tolf = tol if tol < np.inf else 0.0
     tol2 = tol * tol
     any_movable = False
     for i in range(n):
@@ -575,34 +586,8 @@ def _eh_loop(X, z, Wu, pat, upat, ulo, uhi, D, p, closed, tol, eps_abs, max_step
             else:
                 for i in range(lo, hi + 1):
                     pi = upat if inside else pat[i]
-                    gii = Wu[pi, p]
-                    igii = Wu[pi, 2 * p + 1]
-                    d0 = X[i, 0]
-                    d1 = X[i, 1]
-                    s0 = -X[i, 2] * igii
-                    s1 = -X[i, 3] * igii
-                    o0 = X[i, 4]
-                    o1 = X[i, 5]
-                    a0 = abs(d0)
-                    a1 = abs(d1)
-                    m = a0 if a0 > a1 else a1
-                    floor = 4e-16 * (m + tolf)
-                    floor *= floor
-                    ss = s0 * s0 + s1 * s1
-                    v0 = d0 + s0 - o0
-                    v1 = d1 + s1 - o1
-                    vv = v0 * v0 + v1 * v1
-                    rad = tol - 2e-15 * (m + 2.0 * tol)  # as in _candidate
-                    rad = rad if rad > 0.0 else 0.0
-                    f = rad / np.sqrt(vv)  # inf/nan when not clamped: not selected below
-                    e0_ = o0 + v0 * f - d0
-                    e1_ = o1 + v1 * f - d1
-                    ee = e0_ * e0_ + e1_ * e1_
-                    zc = gii * (2.0 * (e0_ * s0 + e1_ * s1) - ee)
-                    zc = zc if zc > 0.0 else 0.0
-                    zc = 0.0 if ee <= floor else zc
-                    zn = zc if vv > rad * rad else gii * ss
-                    zn = 0.0 if ss <= floor else zn
+                    zn = _candidate2(X[i, 2], X[i, 3], X[i, 0], X[i, 1], X[i, 4], X[i, 5],
+                                     Wu[pi, p], Wu[pi, 2 * p + 1], tol)[0]
                     zo = z[i]
                     z[i] = zo if zo < 0.0 else zn
             blo = lo >> _BLOCK_SHIFT
@@ -671,11 +656,7 @@ def _eh_loop(X, z, Wu, pat, upat, ulo, uhi, D, p, closed, tol, eps_abs, max_step
                 T[j, 0] = cv
                 T[j, 1] = cf
         drop += zr
-        if nh < hist.shape[0]:
-            hist[nh, 0] = r
-            hist[nh, 1] = zr
-            hist[nh, 2] = np.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
-            nh += 1
+        nh = _record(hist, nh, r, zr, e0, e1, e2)
         steps += 1
     return steps, drop, code, nh
 
@@ -794,11 +775,7 @@ def _eh_sweep(X, z, Wu, pat, upat, ulo, uhi, D, p, closed, tol, eps_abs, max_ste
                 flags[i] = 1
                 cnt += 1
         drop += zz
-        if nh < hist.shape[0]:
-            hist[nh, 0] = r
-            hist[nh, 1] = zz
-            hist[nh, 2] = np.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
-            nh += 1
+        nh = _record(hist, nh, r, zz, e0, e1, e2)
         steps += 1
     return steps, drop, code, nh
 
