@@ -343,6 +343,20 @@ def _candidate2(g0, g1, d0, d1, o0, o1, gii, igii, tol):  # type: ignore[no-unty
 
 
 @njit(cache=True, inline="always")
+def _point_candidate(X, i, Wu, pi, p, D, tol):  # type: ignore[no-untyped-def]
+    """``(z, e0, e1, e2)`` of control point ``i`` from the loop state ``X = [d | G d | orig]``
+    (``D`` columns each) and its band row ``Wu[pi]``: :func:`_candidate` in 3-D, the
+    branch-free :func:`_candidate2` in the plane (same values). Inlined; the one place the
+    state's columns are unpacked for a candidate."""
+    if D == 3:
+        return _candidate(X[i, 3], X[i, 4], X[i, 5], X[i, 0], X[i, 1], X[i, 2],
+                          X[i, 6], X[i, 7], X[i, 8], Wu[pi, p], Wu[pi, 2 * p + 1], tol)
+    z, e0, e1 = _candidate2(X[i, 2], X[i, 3], X[i, 0], X[i, 1], X[i, 4], X[i, 5],
+                            Wu[pi, p], Wu[pi, 2 * p + 1], tol)
+    return z, e0, e1, 0.0
+
+
+@njit(cache=True, inline="always")
 def _record(hist, nh, r, z, e0, e1, e2):  # type: ignore[no-untyped-def]
     """Write step ``(index, z, displacement)`` into row ``nh`` of ``hist`` while it has room;
     returns the new row count. Inlined into both loops."""
@@ -450,14 +464,7 @@ def _eh_loop(X, z, Wu, pat, upat, ulo, uhi, D, p, closed, tol, eps_abs, max_step
         if z[i] >= 0.0:
             any_movable = True
             pi = upat if ulo <= i < uhi else pat[i]
-            if D == 3:
-                z[i] = _candidate(X[i, 3], X[i, 4], X[i, 5], X[i, 0], X[i, 1], X[i, 2],
-                                  X[i, 6], X[i, 7], X[i, 8], Wu[pi, p],
-                                  Wu[pi, 2 * p + 1], tol)[0]
-            else:
-                z[i] = _candidate(X[i, 2], X[i, 3], 0.0, X[i, 0], X[i, 1], 0.0,
-                                  X[i, 4], X[i, 5], 0.0, Wu[pi, p],
-                                  Wu[pi, 2 * p + 1], tol)[0]
+            z[i] = _point_candidate(X, i, Wu, pi, p, D, tol)[0]
     if not any_movable:
         return 0, 0.0, 2, 0
     for b in range(nb):
@@ -521,17 +528,11 @@ def _eh_loop(X, z, Wu, pat, upat, ulo, uhi, D, p, closed, tol, eps_abs, max_step
                 prefetch(T, 2 * j)
                 j >>= 2
         pr = upat if ulo <= r < uhi else pat[r]
-        if D == 3:
-            zz, e0, e1, e2 = _candidate(X[r, 3], X[r, 4], X[r, 5], X[r, 0], X[r, 1], X[r, 2],
-                                        X[r, 6], X[r, 7], X[r, 8], Wu[pr, p],
-                                        Wu[pr, 2 * p + 1], tol)
-            X[r, 2] += e2
-        else:
-            zz, e0, e1 = _candidate2(X[r, 2], X[r, 3], X[r, 0], X[r, 1], X[r, 4], X[r, 5],
-                                     Wu[pr, p], Wu[pr, 2 * p + 1], tol)
-            e2 = 0.0
+        zz, e0, e1, e2 = _point_candidate(X, r, Wu, pr, p, D, tol)
         X[r, 0] += e0
         X[r, 1] += e1
+        if D == 3:
+            X[r, 2] += e2
         _move_residuals(X, Wu, pr, r, e0, e1, e2, D, p, closed)
         # the changed ranking numbers: one or two contiguous ranges
         lo1 = r - p
@@ -564,9 +565,7 @@ def _eh_loop(X, z, Wu, pat, upat, ulo, uhi, D, p, closed, tol, eps_abs, max_step
                     if z[i] < 0.0:
                         continue
                     pi = upat if inside else pat[i]
-                    z[i] = _candidate(X[i, 3], X[i, 4], X[i, 5], X[i, 0], X[i, 1], X[i, 2],
-                                      X[i, 6], X[i, 7], X[i, 8], Wu[pi, p],
-                                      Wu[pi, 2 * p + 1], tol)[0]
+                    z[i] = _point_candidate(X, i, Wu, pi, p, D, tol)[0]
             elif tol2 == np.inf:
                 for i in range(lo, hi + 1):
                     pi = upat if inside else pat[i]
@@ -586,8 +585,7 @@ def _eh_loop(X, z, Wu, pat, upat, ulo, uhi, D, p, closed, tol, eps_abs, max_step
             else:
                 for i in range(lo, hi + 1):
                     pi = upat if inside else pat[i]
-                    zn = _candidate2(X[i, 2], X[i, 3], X[i, 0], X[i, 1], X[i, 4], X[i, 5],
-                                     Wu[pi, p], Wu[pi, 2 * p + 1], tol)[0]
+                    zn = _point_candidate(X, i, Wu, pi, p, D, tol)[0]
                     zo = z[i]
                     z[i] = zo if zo < 0.0 else zn
             blo = lo >> _BLOCK_SHIFT
@@ -697,12 +695,7 @@ def _eh_sweep(X, z, Wu, pat, upat, ulo, uhi, D, p, closed, tol, eps_abs, max_ste
         flags[i] = 0
         any_movable = True
         pi = upat if ulo <= i < uhi else pat[i]
-        if D == 3:
-            zi = _candidate(X[i, 3], X[i, 4], X[i, 5], X[i, 0], X[i, 1], X[i, 2],
-                            X[i, 6], X[i, 7], X[i, 8], Wu[pi, p], Wu[pi, 2 * p + 1], tol)[0]
-        else:
-            zi = _candidate(X[i, 2], X[i, 3], 0.0, X[i, 0], X[i, 1], 0.0,
-                            X[i, 4], X[i, 5], 0.0, Wu[pi, p], Wu[pi, 2 * p + 1], tol)[0]
+        zi = _point_candidate(X, i, Wu, pi, p, D, tol)[0]
         if zi > 0.0 and zi >= thr:
             Q[tail] = i
             tail += 1
@@ -728,14 +721,7 @@ def _eh_sweep(X, z, Wu, pat, upat, ulo, uhi, D, p, closed, tol, eps_abs, max_ste
         cnt -= 1
         flags[r] = 0
         pr = upat if ulo <= r < uhi else pat[r]
-        if D == 3:
-            zz, e0, e1, e2 = _candidate(X[r, 3], X[r, 4], X[r, 5], X[r, 0], X[r, 1], X[r, 2],
-                                        X[r, 6], X[r, 7], X[r, 8], Wu[pr, p],
-                                        Wu[pr, 2 * p + 1], tol)
-        else:
-            zz, e0, e1 = _candidate2(X[r, 2], X[r, 3], X[r, 0], X[r, 1], X[r, 4], X[r, 5],
-                                     Wu[pr, p], Wu[pr, 2 * p + 1], tol)
-            e2 = 0.0
+        zz, e0, e1, e2 = _point_candidate(X, r, Wu, pr, p, D, tol)
         if zz <= 0.0 or zz < thr:
             continue
         X[r, 0] += e0
