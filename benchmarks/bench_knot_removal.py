@@ -69,7 +69,8 @@ def loop_only(curve, variant: str, repeat: int) -> tuple[float, int]:
     z0 = kd.jumps(d0)
     mask = movable_mask(curve)
     args0 = kr._loop_args(curve, kd, d0.copy(), d0.copy(), mask, variant, np.inf, 0.0,
-                          10 * kd.js.size, "skip", z0.copy())
+                          10 * kd.js.size, "skip", z0.copy(),
+                          kr.ROUNDING_FLOOR * float(z0.max()))
     mutable = (0, 20, 21, 22, 23)  # d, z, rank, tv, ti
     ts, steps = [], 0
     for _ in range(repeat):

@@ -12,9 +12,14 @@ in scalar code, so the comparison is between two independent computations of the
 What is compared, on many random cases (degrees 2..5, 2-D/3-D, open/closed, non-uniform knots,
 with/without tol, clamp/protect, both variants, both on_tol values, eps settings, max_steps):
 the step sequence (knot indices), the blocked knots, the stop reason, steps, exactly; the
-control points, the history and the tracked sum to 1e-12 relative (one-point: the points are
-in practice bitwise equal; z differs by an ulp where numpy's vectorised ``pow`` (SVML) and the
-scalar ``pow`` differ, least squares by the rounding of QR vs SVD).
+control points, the history and the tracked sum to 1e-12 relative (the reference's ``einsum``
+and BLAS ``c @ d`` may sum in another order than the compiled loop, depending on the CPU's SIMD
+width; least squares differs by the rounding of QR vs SVD).
+
+Rounding-level ties: the loop's documented tie rule (``ROUNDING_FLOOR``: a jump below the floor
+is zero, a step must lower the sum by more than the floor) is applied by the reference too, and
+no case puts a tolerance exactly on a move (the tolerance of the long runs is taken between two
+moves, not on one), so no comparison here hinges on the last bit of a sum.
 """
 
 from __future__ import annotations
@@ -28,6 +33,7 @@ from curvefair.curves.bspline import basis_derivatives
 from curvefair.errors import InputError
 from curvefair.fairing.eck_hadenfeld import check_bspline, movable_mask
 from curvefair.fairing.knot_removal import (
+    ROUNDING_FLOOR,
     VARIANTS,
     KRResult,
     _KnotData,
@@ -112,6 +118,7 @@ def reference_knot_removal_fair(curve, *, variant="one-point", tol=None, eps=Non
     sum0 = float(z.sum())
     epsv = (1e-6 if eps_relative else 0.0) if eps is None else as_nonnegative(eps, "eps")
     eps_abs = epsv * float(z.max()) if eps_relative else epsv
+    floor = ROUNDING_FLOOR * float(z.max())  # the documented tie rule (session 5)
     p = curve.degree
     n = curve.n_ctrl
     pos = np.full(len(curve.knots), -1, dtype=np.int64)
@@ -137,7 +144,7 @@ def reference_knot_removal_fair(curve, *, variant="one-point", tol=None, eps=Non
         if zk < 0:  # every knot blocked
             reason = "tolerance"
             break
-        if zk <= eps_abs or zk == 0.0:
+        if zk <= eps_abs or zk <= floor:
             reason = "eps"
             break
         j = int(js[k])
@@ -158,7 +165,7 @@ def reference_knot_removal_fair(curve, *, variant="one-point", tol=None, eps=Non
         tk = touched_knots(np.asarray(idx, dtype=np.int64))
         znew = kd.jumps(d, tk)
         new_total = total - float(z[tk].sum()) + float(znew.sum())
-        if new_total >= total:
+        if new_total >= total - floor:
             d[idx] = old
             reason = "no_decrease"
             break
@@ -294,6 +301,17 @@ def noisy_circle(rng, n, p, dim, closed, rel=0.01):
     return interpolate_bspline(pts, degree=p, closed=closed)
 
 
+def tol_between_moves(moves):
+    """A tolerance near the median move but halfway between two moves that differ by more than
+    1e-9 relative, so that no move's ``|new - orig| <= tol`` is decided by rounding."""
+    m = np.unique(np.asarray(moves, dtype=float))
+    i = m.size // 2
+    while i + 1 < m.size and m[i + 1] - m[i] <= 1e-9 * m[i + 1]:
+        i += 1
+    assert i + 1 < m.size
+    return float(0.5 * (m[i] + m[i + 1]))
+
+
 @pytest.mark.parametrize("variant", VARIANTS)
 @pytest.mark.parametrize(("p", "dim", "closed"), [(3, 2, False), (3, 3, True), (2, 2, True),
                                                    (5, 3, False), (4, 2, False)])
@@ -305,7 +323,7 @@ def test_long_run_matches_reference(variant, p, dim, closed):
     ref = reference_knot_removal_fair(c, variant=variant, **free)
     assert ref.steps > 20
     assert_same(knot_removal_fair(c, variant=variant, **free), ref)
-    tol = float(np.median(ref.history[:, 2]))  # about half the free moves break it
+    tol = tol_between_moves(ref.history[:, 2])  # about half the free moves break it
     for kw in ({"tol": tol, "clamp": None if closed else "g2", "eps": 0.0, "protect": [7, 100]},
                {"tol": tol, "on_tol": "stop"}, {"tol": tol, "max_steps": 15}):
         ref = reference_knot_removal_fair(c, variant=variant, **kw)

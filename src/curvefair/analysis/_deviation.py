@@ -6,8 +6,8 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numba import njit
 
+from .._jit import njit
 from .._typing import FloatArray
 from ..curves.piecewise import PiecewiseCurve
 from ..errors import InputError

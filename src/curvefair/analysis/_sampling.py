@@ -23,8 +23,8 @@ from functools import lru_cache
 from math import comb
 
 import numpy as np
-from numba import njit
 
+from .._jit import njit
 from .._typing import FloatArray
 from ._core import CROSS_RTOL, SPEED_RTOL, derivs_at, falling, frenet
 

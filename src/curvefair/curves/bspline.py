@@ -23,11 +23,11 @@ from functools import cached_property
 from typing import Any
 
 import numpy as np
-from numba import njit
 from scipy.interpolate import BSpline, make_interp_spline, make_lsq_spline
 from scipy.sparse import csr_matrix
 from scipy.sparse.linalg import spsolve
 
+from .._jit import njit
 from .._typing import ArrayLike, FloatArray
 from .._validate import _as_float, as_params, as_points, check_finite
 from ..errors import InputError

@@ -27,7 +27,8 @@ results are bitwise those of a scaled copy, without its ``n (2p + 1)`` doubles).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from .._jit import njit
 
 # ------------------------------------------------------------------------------------------
 # assembly

@@ -24,8 +24,8 @@ below machine precision relative to the change itself.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from .._jit import njit
 from ..curves.hermite import cubic_hermite_coefficients, quintic_hermite_coefficients
 from .ranking import tt_build, tt_top, tt_update, tt_update_range
 

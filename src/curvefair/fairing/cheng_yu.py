@@ -18,8 +18,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from numba import njit
 
+from .._jit import njit
 from .._typing import FloatArray
 from .._validate import as_nonnegative, as_step_count
 from ..analysis.discrete import (

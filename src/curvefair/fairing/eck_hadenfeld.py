@@ -21,8 +21,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from numba import njit
 
+from .._jit import njit
 from .._typing import FloatArray
 from .._validate import as_nonnegative, as_step_count, check_finite, choice
 from ..curves.bspline import BSplineCurve, band_energy, band_residual, residual_row

@@ -17,8 +17,8 @@ from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
-from numba import njit
 
+from .._jit import njit
 from .._typing import FloatArray
 from .._validate import as_nonnegative, as_step_count
 from ..curves.bspline import BSplineCurve, basis_derivatives
@@ -224,15 +224,24 @@ class _KnotData:
 
     def jumps(self, d: FloatArray, k: np.ndarray | slice = slice(None)) -> FloatArray:
         """Sapidis-Farin measure at knots ``js[k]``: :func:`sapidis_measure` of the one-sided
-        derivatives, bitwise (a compiled pass per knot for everything but the final
-        ``speed ** (p + 1)``, which numpy evaluates as in :func:`sapidis_measure`)."""
-        p = self.p
+        derivatives, computed per knot by the same compiled scalar code as the loop's local
+        updates (:func:`_knot_measure`), so the initial ranking and the updated one agree
+        bitwise and neither depends on the CPU's SIMD width."""
         ks = np.ascontiguousarray(np.arange(self.js.size)[k], dtype=np.int64)
-        num = np.empty(ks.size)
-        speed = np.empty(ks.size)
-        _measure_parts_all(np.ascontiguousarray(d, dtype=np.float64), ks, p, self.ctrl, self.c,
-                           self.right, self.left2, num, speed)
-        return num / speed ** (3 if p == 2 else p + 1)
+        out = np.empty(ks.size)
+        _measure_all(np.ascontiguousarray(d, dtype=np.float64), ks, self.p, self.ctrl, self.c,
+                     self.right, self.left2, out)
+        return out
+
+
+def _speed_power(speed: FloatArray, k: int) -> FloatArray:
+    """``speed ** k`` for a whole ``k >= 1`` as ``k - 1`` multiplications in turn (the order of
+    :func:`_ipow`): exactly rounded at each step, so it is the same on every CPU, unlike a
+    vectorised ``pow``."""
+    out = speed
+    for _ in range(k - 1):
+        out = out * speed
+    return out
 
 
 def _cross(a: FloatArray, b: FloatArray) -> FloatArray:
@@ -256,20 +265,20 @@ def sapidis_measure(r1: FloatArray, r2_right: FloatArray, r2_left: FloatArray,
     if p == 2:
         r2r = r2_right
         if r1.shape[-1] == 2:
-            return np.abs(_cross(r1, r2r) - _cross(r1, r2_left)) / speed**3
+            return np.abs(_cross(r1, r2r) - _cross(r1, r2_left)) / _speed_power(speed, 3)
         kr = np.linalg.norm(np.cross(r1, r2r), axis=-1)
         kl = np.linalg.norm(np.cross(r1, r2_left), axis=-1)
-        return np.abs(kr - kl) / speed**3
+        return np.abs(kr - kl) / _speed_power(speed, 3)
     cj = _cross(r1, J)
     if r1.shape[-1] == 2:
-        return np.abs(cj) / speed ** (p + 1)
+        return np.abs(cj) / _speed_power(speed, p + 1)
     b = np.cross(r1, r2_right)
     nb = np.linalg.norm(b, axis=-1)
     scale = np.linalg.norm(r1, axis=-1) * np.linalg.norm(r2_right, axis=-1)
     ok = nb > 1e-12 * scale
     proj = np.abs(np.sum(b * cj, axis=-1)) / np.where(ok, nb, 1.0)
     full = np.linalg.norm(cj, axis=-1)
-    return np.where(ok, proj, full) / speed ** (p + 1)
+    return np.where(ok, proj, full) / _speed_power(speed, p + 1)
 
 
 def knot_jumps(curve: BSplineCurve) -> tuple[np.ndarray, FloatArray]:
@@ -379,14 +388,19 @@ def knot_removal_fair(curve: BSplineCurve, *, variant: Variant = "one-point",
     moved control point, and stop when ``sum z_j`` stops decreasing (the last step is undone),
     at the step cap, or at the tolerance.
 
+    Ties and rounding (the same choices on every CPU): every ``z_j`` is computed by one compiled
+    scalar routine in a fixed operation order, with ``|r'|^(p+1)`` as repeated multiplication
+    (no vectorised ``pow``, no reassociation), so the ranking does not depend on the CPU's SIMD
+    width. Equal ``z`` go to the smaller knot index. A ``z`` at or below :data:`ROUNDING_FLOOR`
+    times the largest initial ``z`` is rounding noise and counts as zero (an ``eps`` stop, also
+    when ``eps = 0``), and a step has to lower ``sum z_j`` by more than that floor, else the loop
+    stops with ``no_decrease``: the loop never acts on a difference that rounding alone made.
+
     The loop is compiled (numba): the per-knot data that depends only on the knots (jump
     coefficients, one-sided basis derivative rows, Boehm's ratios) is set up vectorised, then
     each step costs the removal moves (one point, or a ``p x (p-1)`` least-squares solve), the
     measure at the ``<= 2p + 1`` touched knots and ``O(log N)`` updates of an indexed tournament
-    tree (:mod:`~curvefair.fairing.ranking`). It makes the same steps as the Python loop it
-    replaced (session 2): one-point control points bitwise equal, least squares to rounding
-    (QR instead of LAPACK's SVD), ``z`` and ``sum_tracked`` to an ulp where numpy's vectorised
-    ``pow`` rounds differently from the scalar one.
+    tree (:mod:`~curvefair.fairing.ranking`).
 
     Examples
     --------
@@ -419,8 +433,10 @@ def knot_removal_fair(curve: BSplineCurve, *, variant: Variant = "one-point",
     sum0 = float(z.sum())
     epsv = (1e-6 if eps_relative else 0.0) if eps is None else as_nonnegative(eps, "eps")
     eps_abs = epsv * float(z.max()) if eps_relative else epsv
+    floor = ROUNDING_FLOOR * float(z.max())
     out, steps, reason, total, hist, blocked = _run_loop(curve, kd, d, orig, mask, variant,
-                                                         tolv, eps_abs, max_steps, on_tol, z)
+                                                         tolv, eps_abs, max_steps, on_tol, z,
+                                                         floor)
     if reason == "eps" and blocked:
         # every knot still worth removing is blocked: the tolerance stopped the loop (as in
         # eck_hadenfeld_fair); the unblocked ones left are the removed knots, z ~ 0
@@ -432,14 +448,21 @@ def knot_removal_fair(curve: BSplineCurve, *, variant: Variant = "one-point",
 
 _REASONS = ("max_steps", "tolerance", "eps", "no_decrease")
 
+#: Relative rounding floor of the Sapidis-Farin loop: a jump at or below ``ROUNDING_FLOOR``
+#: times the largest initial jump counts as zero (the loop stops there as at ``eps``), and a step
+#: must lower the tracked sum by more than that much (else ``no_decrease``). ``2**-40`` is about
+#: 4000 ulps: far above the rounding of the jumps, far below any jump that shows in a curvature plot.
+ROUNDING_FLOOR = 2.0 ** -40
+
 
 def _run_loop(curve: BSplineCurve, kd: _KnotData, d: FloatArray, orig: FloatArray,
               mask: np.ndarray, variant: str, tolv: float, eps_abs: float, max_steps: int,
-              on_tol: str, z: FloatArray) -> tuple[BSplineCurve, int, str, float, FloatArray,
-                                                   list[int]]:
+              on_tol: str, z: FloatArray, floor: float = 0.0
+              ) -> tuple[BSplineCurve, int, str, float, FloatArray, list[int]]:
     """Run the compiled loop on the set-up of :func:`_loop_args`; ``d`` is updated in place."""
     steps, code, total, hist, blocked, nb = _kr_loop(
-        *_loop_args(curve, kd, d, orig, mask, variant, tolv, eps_abs, max_steps, on_tol, z))
+        *_loop_args(curve, kd, d, orig, mask, variant, tolv, eps_abs, max_steps, on_tol, z,
+                    floor))
     out = curve.replace(control_points=d)
     return (out, int(steps), _REASONS[code], float(total), hist[:steps].copy(),
             [int(j) for j in blocked[:nb]])
@@ -447,9 +470,10 @@ def _run_loop(curve: BSplineCurve, kd: _KnotData, d: FloatArray, orig: FloatArra
 
 def _loop_args(curve: BSplineCurve, kd: _KnotData, d: FloatArray, orig: FloatArray,
                mask: np.ndarray, variant: str, tolv: float, eps_abs: float, max_steps: int,
-               on_tol: str, z: FloatArray) -> tuple[Any, ...]:
+               on_tol: str, z: FloatArray, floor: float = 0.0) -> tuple[Any, ...]:
     """Arguments of :func:`_kr_loop`: the per-knot data (vectorised, depends on the knots only),
-    the ranking tree over ``z`` and the state (``d``, ``z`` are used in place)."""
+    the ranking tree over ``z`` and the state (``d``, ``z`` are used in place); ``floor`` is the
+    absolute rounding floor (:data:`ROUNDING_FLOOR` times the largest initial jump)."""
     p = curve.degree
     n = curve.n_ctrl
     js = kd.js
@@ -479,7 +503,7 @@ def _loop_args(curve: BSplineCurve, kd: _KnotData, d: FloatArray, orig: FloatArr
     return (d, orig, mask, float(tolv), p, n, bool(curve.closed), js, pos, C,
             np.ascontiguousarray(kd.right), np.ascontiguousarray(kd.left2), ctrl, a1, denom,
             alphas, variant == "least-squares", float(eps_abs), int(max_steps), on_tol == "stop",
-            z, rank, tv, ti, float(z.sum()), cap)
+            z, rank, tv, ti, float(z.sum()), cap, float(floor))
 
 
 # ------------------------------------------------------------------------------------------
@@ -527,11 +551,20 @@ def _pw_sum(v, m):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, inline="always")
+def _ipow(x, k):  # type: ignore[no-untyped-def]
+    """``x ** k`` for a whole ``k >= 1`` as ``k - 1`` multiplications in turn (no ``pow``: the
+    same bits on every CPU; :func:`_speed_power` is its numpy twin)."""
+    out = x
+    for _ in range(k - 1):
+        out = out * x
+    return out
+
+
+@njit(cache=True, inline="always")
 def _knot_measure(d, k, p, ctrl, C, right, left2):  # type: ignore[no-untyped-def]
-    """:meth:`_KnotData.jumps` / :func:`sapidis_measure` at one knot, same operation order
-    (the scalar ``pow`` may differ from numpy's vectorised one in the last bit)."""
+    """:meth:`_KnotData.jumps` / :func:`sapidis_measure` at one knot, same operation order."""
     num, speed = _measure_parts(d, k, p, ctrl, C, right, left2)
-    return num / speed ** (3.0 if p == 2 else float(p + 1))
+    return num / _ipow(speed, 3 if p == 2 else p + 1)
 
 
 @njit(cache=True, inline="always")
@@ -606,9 +639,9 @@ def _measure_parts(d, k, p, ctrl, C, right, left2):  # type: ignore[no-untyped-d
 
 
 @njit(cache=True)
-def _measure_parts_all(d, ks, p, ctrl, C, right, left2, num, speed):  # type: ignore[no-untyped-def]
+def _measure_all(d, ks, p, ctrl, C, right, left2, out):  # type: ignore[no-untyped-def]
     for u in range(ks.shape[0]):
-        num[u], speed[u] = _measure_parts(d, ks[u], p, ctrl, C, right, left2)
+        out[u] = _knot_measure(d, ks[u], p, ctrl, C, right, left2)
 
 
 @njit(cache=True, inline="always")
@@ -684,7 +717,7 @@ def _ls_moves(d, k, p, ctrl, alphas, new, Q, A, f):  # type: ignore[no-untyped-d
 @njit(cache=True)
 def _kr_loop(d, orig, mask, tol, p, n, closed, js, pos, C, right, left2, ctrl, a1, denom,
              alphas, lsq, eps_abs, max_steps, stop_on_tol, z, rank, tv, ti, total,
-             cap):  # type: ignore[no-untyped-def]
+             cap, floor):  # type: ignore[no-untyped-def]
     """The Sapidis-Farin loop (see :func:`knot_removal_fair`); returns ``(steps, reason code,
     tracked sum, history, blocked knots, number blocked)``. ``d``, ``z``, ``rank`` and the tree
     are updated in place. Per step: the removal moves (one point, or a ``p x (p-1)`` least
@@ -713,7 +746,7 @@ def _kr_loop(d, orig, mask, tol, p, n, closed, js, pos, C, right, left2, ctrl, a
         if zk < 0:  # every knot blocked
             code = 1
             break
-        if zk <= eps_abs or zk == 0.0:
+        if zk <= eps_abs or zk <= floor:
             code = 2
             break
         j = js[k]
@@ -797,7 +830,7 @@ def _kr_loop(d, orig, mask, tol, p, n, closed, js, pos, C, right, left2, ctrl, a
             zold[u] = z[kk]
             znew[u] = _knot_measure(d, kk, p, ctrl, C, right, left2)
         new_total = total - _pw_sum(zold, m) + _pw_sum(znew, m)
-        if new_total >= total:
+        if new_total >= total - floor:
             for r in range(nm - 1, -1, -1):
                 q = idx[r]
                 for e in range(dim):

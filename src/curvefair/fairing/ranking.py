@@ -34,7 +34,8 @@ Examples
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from .._jit import njit
 
 __all__ = ["tt_build", "tt_update", "tt_top", "tt_value", "tt_update_range"]
 

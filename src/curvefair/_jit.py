@@ -1,0 +1,217 @@
+"""Where curvefair's compiled kernels are decorated: ``njit`` with a cache that cannot go stale.
+
+numba's own on-disk cache keys a kernel on the source file that defines it. A kernel that
+inlines or calls a function from another file (``residual_row`` from ``curves/bspline.py``
+inside the Eck-Hadenfeld loop, say) is not invalidated when that callee changes, and a module
+constant frozen into the machine code is not either: the old machine code keeps running. Here
+every curvefair kernel is cached under a directory named by a hash of *all* of the package's
+Python sources together with the numba, llvmlite and Python versions and the compile options
+that change the machine code (``NUMBA_BOUNDSCHECK``, ``NUMBA_OPT``, ``NUMBA_DEBUGINFO``). Any
+edit to any module, or another compile setting, selects a new, empty directory: a stale kernel
+cannot be loaded. (numba keys each entry on the CPU name and features itself, so
+``NUMBA_CPU_NAME=generic`` and the host CPU share a directory without mixing.)
+
+Where the cache lives, first that is writable:
+
+1. ``$CURVEFAIR_CACHE_DIR`` (an empty value, or ``0``/``off``/``none``, turns caching off);
+2. ``__pycache__/curvefair-jit-<key>`` inside the installed package (a source checkout);
+3. the user cache, ``$XDG_CACHE_HOME/curvefair`` or ``~/.cache/curvefair``;
+4. ``<tempdir>/curvefair-<uid>``;
+5. nowhere: kernels are compiled in every process (a read-only system install whose user has
+   no writable home still imports and runs).
+
+When a new directory is made, the older ``curvefair-jit-*`` ones beside it are removed: at once
+inside the package, after 14 days unused in a shared cache (which may serve several installs).
+The first compilation into a new cache directory prints one line to stderr saying so
+(set ``CURVEFAIR_QUIET=1`` to silence it).
+
+The locator plugs into numba's documented-by-example cache machinery
+(``numba.core.caching.CacheImpl._locator_classes``), placed first so that it answers for
+curvefair's own files only; every other numba user in the process is unaffected.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import os
+import shutil
+import sys
+import tempfile
+import time
+from collections.abc import Callable
+from typing import Any
+
+import llvmlite
+import numba
+from numba import config as _nb_config
+from numba import njit as _numba_njit
+from numba.core import caching as _caching
+
+__all__ = ["njit", "cache_dir", "cache_key"]
+
+_PKG_DIR = os.path.dirname(os.path.abspath(__file__))
+_PREFIX = "curvefair-jit-"
+_OFF = {"", "0", "off", "none", "false", "no"}
+
+
+def _source_hash() -> str:
+    """sha256 over every ``.py`` file of the package (relative path and bytes, sorted) and the
+    versions and options that change compiled code."""
+    h = hashlib.sha256()
+    files = []
+    for root, dirs, names in os.walk(_PKG_DIR):
+        dirs[:] = sorted(d for d in dirs if d != "__pycache__")
+        files.extend(os.path.join(root, n) for n in names if n.endswith(".py"))
+    for path in sorted(files):
+        h.update(os.path.relpath(path, _PKG_DIR).replace(os.sep, "/").encode())
+        h.update(b"\0")
+        with open(path, "rb") as f:
+            h.update(f.read())
+        h.update(b"\0")
+    h.update(repr((numba.__version__, llvmlite.__version__, sys.version, sys.platform,
+                   int(_nb_config.BOUNDSCHECK or 0), int(_nb_config.OPT),
+                   int(_nb_config.DEBUGINFO_DEFAULT or 0))).encode())
+    return h.hexdigest()[:20]
+
+
+def _writable_dir(path: str) -> bool:
+    try:
+        os.makedirs(path, exist_ok=True)
+        tempfile.TemporaryFile(dir=path).close()
+    except OSError:
+        return False
+    return True
+
+
+def _prune_siblings(parent: str, keep: str, older_than: float) -> None:
+    """Remove the other ``curvefair-jit-*`` folders of ``parent`` not used for ``older_than``
+    seconds (0: all of them)."""
+    try:
+        names = os.listdir(parent)
+    except OSError:
+        return
+    now = time.time()
+    for name in names:
+        path = os.path.join(parent, name)
+        if not name.startswith(_PREFIX) or name == keep:
+            continue
+        try:
+            if now - os.stat(path).st_mtime < older_than:
+                continue
+        except OSError:
+            continue
+        shutil.rmtree(path, ignore_errors=True)
+
+
+_SHARED_KEEP = 14 * 86400.0  # a shared cache folder keeps other versions' kernels for 14 days
+
+
+def _choose_cache_dir(key: str) -> str | None:
+    """The first usable folder of the list in the module docstring, made if need be; the
+    package's own ``__pycache__`` serves one source tree, so its older folders go at once, while
+    a shared one (user cache, temp, ``$CURVEFAIR_CACHE_DIR``) may serve several installs."""
+    name = _PREFIX + key
+    env = os.environ.get("CURVEFAIR_CACHE_DIR")
+    if env is not None:
+        if env.strip().lower() in _OFF:
+            return None
+        parents = [(env, _SHARED_KEEP)]
+    else:
+        xdg = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+        uid = os.getuid() if hasattr(os, "getuid") else "user"
+        parents = [(os.path.join(_PKG_DIR, "__pycache__"), 0.0),
+                   (os.path.join(xdg, "curvefair"), _SHARED_KEEP),
+                   (os.path.join(tempfile.gettempdir(), f"curvefair-{uid}"), _SHARED_KEEP)]
+    for parent, keep in parents:
+        path = os.path.join(parent, name)
+        existed = os.path.isdir(path)
+        if _writable_dir(path):
+            if existed:
+                with contextlib.suppress(OSError):
+                    os.utime(path)  # in use: not pruned by another install
+            else:
+                _prune_siblings(parent, name, keep)
+            return path
+    return None
+
+
+_KEY = _source_hash()
+_CACHE_DIR = _choose_cache_dir(_KEY)
+_noticed = False
+
+
+def cache_key() -> str:
+    """The hash that names the kernel cache (changes with any source edit or compile option)."""
+    return _KEY
+
+
+def cache_dir() -> str | None:
+    """The directory compiled kernels are cached in, or ``None`` when caching is off."""
+    return _CACHE_DIR
+
+
+def _notice_first_compile(path: str) -> None:
+    """One stderr line, once per new cache directory (a marker file records that it was said)."""
+    global _noticed
+    if _noticed:
+        return
+    _noticed = True
+    if os.environ.get("CURVEFAIR_QUIET", "").strip().lower() not in _OFF:
+        return
+    try:
+        fd = os.open(os.path.join(path, ".notice"), os.O_CREAT | os.O_EXCL | os.O_WRONLY)
+    except OSError:
+        return  # said before (or the directory went away): stay quiet
+    os.close(fd)
+    sys.stderr.write("curvefair: compiling its numerical kernels for this machine "
+                     f"(once, about 20-60 s; cached in {path})\n")
+
+
+class _CurvefairCacheLocator(_caching._CacheLocator):
+    """numba cache locator for curvefair's own source files: one directory per :func:`cache_key`,
+    whose key is also the source stamp."""
+
+    def __init__(self, py_func: Callable[..., Any], py_file: str) -> None:
+        self._py_file = py_file
+        self._lineno = py_func.__code__.co_firstlineno
+        rel = os.path.relpath(os.path.dirname(os.path.abspath(py_file)), _PKG_DIR)
+        sub = "pkg" if rel == "." else rel.replace(os.sep, "_")
+        assert _CACHE_DIR is not None
+        self._path = os.path.join(_CACHE_DIR, sub)
+
+    def ensure_cache_path(self) -> None:  # called before every save
+        super().ensure_cache_path()
+        _notice_first_compile(_CACHE_DIR or self._path)
+
+    def get_cache_path(self) -> str:
+        return self._path
+
+    def get_source_stamp(self) -> str:
+        return _KEY
+
+    def get_disambiguator(self) -> str:
+        return str(self._lineno)
+
+    @classmethod
+    def from_function(cls, py_func: Callable[..., Any], py_file: str) -> Any:
+        if _CACHE_DIR is None:
+            return None
+        path = os.path.abspath(py_file)
+        if os.path.commonpath([path, _PKG_DIR]) != _PKG_DIR:
+            return None  # not curvefair's: numba's own locators answer
+        return cls(py_func, py_file)
+
+
+# numba >= 0.61 calls the implementation class ``CacheImpl``, earlier ones ``_CacheImpl``
+_IMPL = getattr(_caching, "CacheImpl", None) or _caching._CacheImpl
+if _CurvefairCacheLocator not in _IMPL._locator_classes:
+    _IMPL._locator_classes.insert(0, _CurvefairCacheLocator)
+
+
+def njit(*args: Any, **kwargs: Any) -> Any:
+    """``numba.njit`` for curvefair kernels: ``cache=True`` goes to the keyed cache above, or is
+    dropped when no cache directory is writable (the kernel is then compiled per process)."""
+    if kwargs.get("cache") and _CACHE_DIR is None:
+        kwargs["cache"] = False
+    return _numba_njit(*args, **kwargs)

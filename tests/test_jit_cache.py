@@ -1,0 +1,155 @@
+"""The compiled-kernel cache (``curvefair._jit``) cannot go stale and never stops an import.
+
+Each case copies the package into a temporary folder, adds two small modules (a kernel in one file
+that calls a jitted callee and reads a constant from another), and runs them in fresh
+interpreters with their own cache folder: numba's own cache would keep running the old machine
+code after the callee changed (it keys a kernel on its own file only).
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import curvefair
+
+PKG = Path(curvefair.__file__).resolve().parent
+
+CALLER = '''
+from ._jit import njit
+from ._probe_callee import SCALE, callee
+
+
+@njit(cache=True)
+def kernel(x):
+    s = 0.0
+    for i in range(4):
+        s += callee(x + i)
+    return s * SCALE
+'''
+
+CALLEE = '''
+from ._jit import njit
+
+SCALE = {scale}
+
+
+@njit(cache=True, inline="always")
+def callee(x):
+    return {factor} * x
+'''
+
+RUN = '''
+import sys, json
+from curvefair import _jit
+from curvefair._probe_caller import kernel
+v = kernel(1.0)
+print(json.dumps({"value": v, "hits": sum(kernel.stats.cache_hits.values()),
+                  "misses": sum(kernel.stats.cache_misses.values()), "dir": _jit.cache_dir()}))
+'''
+
+
+def _copy_package(tmp: Path) -> Path:
+    root = tmp / "site"
+    shutil.copytree(PKG, root / "curvefair", ignore=shutil.ignore_patterns("__pycache__"))
+    (root / "curvefair" / "_probe_caller.py").write_text(CALLER)
+    (root / "curvefair" / "_probe_callee.py").write_text(CALLEE.format(scale=1.0, factor=2.0))
+    return root
+
+
+def _run(root: Path, env_extra: dict[str, str], code: str = RUN) -> tuple[dict, str]:
+    import json
+
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("CURVEFAIR_", "NUMBA_"))}
+    env.update({"PYTHONPATH": str(root), "PYTHONDONTWRITEBYTECODE": "1"}, **env_extra)
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env,
+                          cwd=root, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    return json.loads(proc.stdout.strip().splitlines()[-1]), proc.stderr
+
+
+def test_callee_edit_in_another_file_invalidates_the_cache(tmp_path):
+    root = _copy_package(tmp_path)
+    env: dict[str, str] = {}  # the default place: the package's own __pycache__
+    first, err = _run(root, env)
+    assert first["dir"].startswith(str(root / "curvefair" / "__pycache__" / "curvefair-jit-"))
+    assert first["value"] == 2.0 * (1 + 2 + 3 + 4)  # 2 * sum(x + i), i = 0..3
+    assert first["misses"] == 1 and first["hits"] == 0
+    assert "compiling" in err  # the one-line notice, into a new cache folder
+    second, err = _run(root, env)
+    assert second == {**first, "hits": 1, "misses": 0}  # loaded from the cache ...
+    assert "compiling" not in err  # ... and said only once
+    # edit the callee's file only (its caller's file is unchanged): the old machine code must
+    # not be loaded
+    (root / "curvefair" / "_probe_callee.py").write_text(CALLEE.format(scale=1.0, factor=3.0))
+    third, _ = _run(root, env)
+    assert third["value"] == 3.0 * 10
+    assert third["dir"] != first["dir"]  # another source hash, another folder
+    # a constant frozen into the kernel, defined in the other file, likewise
+    (root / "curvefair" / "_probe_callee.py").write_text(CALLEE.format(scale=0.5, factor=3.0))
+    fourth, _ = _run(root, env)
+    assert fourth["value"] == 0.5 * 3.0 * 10
+    # the folders of the superseded sources are pruned when a new one is made
+    cache = root / "curvefair" / "__pycache__"
+    assert sorted(p.name for p in cache.iterdir()) == [Path(fourth["dir"]).name]
+
+
+def test_shared_cache_folder_keeps_other_versions(tmp_path):
+    # $CURVEFAIR_CACHE_DIR (like ~/.cache) may serve several installs: editing one does not
+    # throw away the other's kernels, and each finds its own again
+    root = _copy_package(tmp_path)
+    env = {"CURVEFAIR_CACHE_DIR": str(tmp_path / "cache")}
+    a, _ = _run(root, env)
+    (root / "curvefair" / "_probe_callee.py").write_text(CALLEE.format(scale=1.0, factor=3.0))
+    b, _ = _run(root, env)
+    assert b["value"] == 30.0 and b["dir"] != a["dir"]
+    (root / "curvefair" / "_probe_callee.py").write_text(CALLEE.format(scale=1.0, factor=2.0))
+    again, _ = _run(root, env)
+    assert again == {**a, "hits": 1, "misses": 0}
+
+
+def test_bounds_checking_gets_its_own_cache(tmp_path):
+    # NUMBA_BOUNDSCHECK changes the machine code but not numba's own cache key
+    root = _copy_package(tmp_path)
+    env = {"CURVEFAIR_CACHE_DIR": str(tmp_path / "cache")}
+    plain, _ = _run(root, env)
+    checked, _ = _run(root, {**env, "NUMBA_BOUNDSCHECK": "1"})
+    assert checked["dir"] != plain["dir"] and checked["misses"] == 1
+
+
+def test_imports_and_runs_with_no_writable_cache(tmp_path):
+    # a system install: the package's __pycache__, the user cache and the temp folder all
+    # unusable (a regular file stands where a folder would have to be made: even root cannot
+    # write there), and the explicit switch off
+    root = _copy_package(tmp_path)
+    blocker = tmp_path / "not-a-dir"
+    blocker.write_text("")
+    (root / "curvefair" / "__pycache__").write_text("")
+    # with no cache at all, a kernel of the package itself (compiled in the process) as well
+    full = RUN.replace("v = kernel(1.0)", "v = kernel(1.0)\nimport numpy as np\n"
+                       "import curvefair\n"
+                       "from curvefair.fairing.ranking import tt_build, tt_top\n"
+                       "assert tt_top(*tt_build(np.array([3.0, 7.0, 1.0]))) == (1, 7.0)")
+    for env, code in (({"XDG_CACHE_HOME": str(blocker), "HOME": str(blocker / "home"),
+                        "TMPDIR": str(tmp_path)}, RUN),  # only the temp folder is left
+                      ({"CURVEFAIR_CACHE_DIR": "off"}, RUN),
+                      ({"CURVEFAIR_CACHE_DIR": str(blocker / "cache")}, full)):  # unusable
+        out, err = _run(root, env, code)
+        assert out["value"] == 20.0
+        assert "cannot cache" not in err
+        if "TMPDIR" in env:
+            assert out["dir"].startswith(str(tmp_path / f"curvefair-{os.getuid()}"))
+        else:
+            assert out["dir"] is None and out["hits"] == 0
+
+
+@pytest.mark.parametrize("name", ["CURVEFAIR_QUIET"])
+def test_notice_can_be_silenced(tmp_path, name):
+    root = _copy_package(tmp_path)
+    _, err = _run(root, {"CURVEFAIR_CACHE_DIR": str(tmp_path / "cache"), name: "1"})
+    assert "compiling" not in err
