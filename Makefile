@@ -4,7 +4,7 @@ VENV   ?= .venv
 PY     := $(VENV)/bin/python
 PIP    := $(VENV)/bin/pip
 
-.PHONY: demo test bench bench-quality clean venv
+.PHONY: demo test bench bench-quality clean venv venv-test
 
 $(VENV)/.stamp-base: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -21,6 +21,8 @@ $(VENV)/.stamp-bench: pyproject.toml $(VENV)/.stamp-test
 	touch $@
 
 venv: $(VENV)/.stamp-base
+
+venv-test: $(VENV)/.stamp-test
 
 ## demo: fair the bundled example curve, print a before/after summary, write demo_out/report.json
 demo: $(VENV)/.stamp-base
