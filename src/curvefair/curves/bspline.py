@@ -134,6 +134,46 @@ def _ders_kernel(knots, p, span, x, nder, local, out):  # type: ignore[no-untype
 
 
 @njit(cache=True)
+def _power_form_kernel(knots, p, spans, ctrl, closed, out):  # type: ignore[no-untyped-def]
+    """``out[m, k, :] = sum_a N_{s-p+a}^(k)(t_s) d_{s-p+a} / k!`` for ``s = spans[m]`` (control
+    indices mod ``n`` for a closed curve): the piecewise power form of the B-spline. A span
+    whose local knot pattern equals the previous span's reuses its basis derivatives."""
+    n = ctrl.shape[0]
+    dim = ctrl.shape[1]
+    ndu = np.empty((p + 1, p + 1))
+    left = np.empty(p + 1)
+    right = np.empty(p + 1)
+    a = np.empty((2, p + 1))
+    d = np.empty((1, p + 1, p + 1))
+    fact = np.empty(p + 1)
+    fact[0] = 1.0
+    for k in range(1, p + 1):
+        fact[k] = fact[k - 1] * k
+    prev = np.empty(2 * p)
+    have = False
+    for m in range(spans.shape[0]):
+        s = spans[m]
+        ts = knots[s]
+        same = have  # the basis derivatives depend on the local knot pattern only
+        for k in range(2 * p):
+            v = knots[s - p + 1 + k] - ts
+            same = same and v == prev[k]
+            prev[k] = v
+        if not same:  # (local offsets: a repeated pattern gives bitwise the same values)
+            _ders_one(knots, p, s, 0.0, ts, p, ndu, left, right, a, d, 0)
+            have = True
+        for k in range(p + 1):
+            for e in range(dim):
+                acc = 0.0
+                for b in range(p + 1):
+                    i = s - p + b
+                    if closed:
+                        i = i % n
+                    acc += d[0, k, b] * ctrl[i, e]
+                out[m, k, e] = acc / fact[k]
+
+
+@njit(cache=True)
 def _gram_kernel(knots, p, spans, l, xq, wq, n, closed, W):  # type: ignore[no-untyped-def]  # noqa: E741
     """Banded Gram matrix ``W`` (n, 2p+1) of ``int N_i^(l) N_j^(l)`` (see ``gram_band``),
     accumulated into ``W`` (zeros on entry, allocated by numpy: huge pages, see
@@ -494,14 +534,14 @@ class BSplineCurve(PiecewiseCurve):
 
     # -- piecewise form ---------------------------------------------------------------------
     def _make_piecewise(self) -> PiecewisePolynomial:
+        """Power form per knot span: ``c[m, k] = sum_a N_{s-p+a}^(k)(t_s) d_{s-p+a} / k!``
+        (Taylor coefficients at the span's left knot), one compiled pass over the spans."""
         p = self.degree
         t = self._knots
-        s = self.spans
-        ders = basis_derivatives(t, p, s, t[s], p)  # (m, p+1, p+1)
-        idx = self.control_index(s[:, None] - p + np.arange(p + 1)[None, :])  # (m, p+1)
-        local = self._ctrl[idx]  # (m, p+1, dim)
-        fact = np.cumprod(np.r_[1.0, np.arange(1, p + 1, dtype=float)])
-        coeffs = np.einsum("mka,mad->mkd", ders, local) / fact[None, :, None]
+        s = np.ascontiguousarray(self.spans, dtype=np.int64)
+        coeffs = np.empty((s.size, p + 1, self._ctrl.shape[1]))
+        _power_form_kernel(np.ascontiguousarray(t), p, s, np.ascontiguousarray(self._ctrl),
+                           self._closed, coeffs)
         breaks = np.append(t[s], t[s[-1] + 1])
         return PiecewisePolynomial(breaks, coeffs)
 
