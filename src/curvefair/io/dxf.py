@@ -147,16 +147,13 @@ def _closed_knots(knots: FloatArray, p: int) -> FloatArray:
     """The periodic knot vector of a clamped closed spline (closed flag, first control point
     repeated last): the clamped curve on ``[a, b]`` with interior knots ``I`` is exactly the
     periodic spline with the distinct control points ``d_0 .. d_{N-2}`` and the full knots
-    ``[I[-1] - T, a (p times), I, b (p times), I[:p] + T]``, ``T = b - a``: a seam knot of
+    ``[I[-1] - T, a (p times), I, b (p times), ([I, b (p times)])[:p] + T]``, ``T = b - a``: a seam knot of
     multiplicity ``p`` (C0, like the clamped ends), every span's knots ``t_{j-p+1} ..
     t_{j+p}`` the same as the clamped vector's on ``[a, b]`` (Piegl & Tiller, section 2.2)."""
     a, b = float(knots[p]), float(knots[-p - 1])
     interior = np.asarray(knots[p + 1: -p - 1], dtype=float)
     T = b - a
-    head = np.resize(interior, p) if interior.shape[0] < p else interior[:p]
-    if interior.shape[0] < p:   # short interior: wrap as many periods as needed
-        head = np.array([interior[i % interior.shape[0]] + T * (i // interior.shape[0])
-                         for i in range(p)])
+    head = np.r_[interior, np.full(p, b)][:p]     # t_{N+p+j} = t_{p+1+j} + T
     return np.r_[interior[-1] - T, np.full(p, a), interior, np.full(p, b), head + T]
 
 

@@ -902,6 +902,9 @@ def _patch_iges(text: str, patches: list[_Patch]) -> str:
         cands.append((d, f, raw, knots, m, c0))
     new_blocks = dict(blocks)
     done: set[int] = set()
+    first = sec["P"][0] if sec["P"] else " " * 80
+    zpad = first[73:80].startswith("0") or first[65:72].startswith("0")   # "0000003P0000012"
+    seq = "{:07d}" if zpad else "{:7d}"
     for pa in patches:
         hits = [(c, s) for c in cands
                 if (s := _match(c[2], c[3], c[4], pa.old_local, pa.old_knots, pa.p)) is not None]
@@ -933,30 +936,36 @@ def _patch_iges(text: str, patches: list[_Patch]) -> str:
         if not same_layout or nk[pa.new_p] != knots[m] or nk[-pa.new_p - 1] != knots[-m - 1]:
             tail = [_num(nk[pa.new_p]), _num(nk[-pa.new_p - 1])] + tail[2:]
         nf += tail
-        new_blocks[d] = _iges_block(nf, pd, rd, d)
+        new_blocks[d] = _iges_block(nf, pd, rd, d, zpad)
     # renumber the parameter section and the directory entries' pointers and counts
     out_p: list[str] = []
     start: dict[int, int] = {}
     for d in order:
         start[d] = len(out_p) + 1
         for ln in new_blocks[d]:
-            out_p.append(ln[:73] + f"{len(out_p) + 1:7d}")
+            out_p.append(ln[:73] + seq.format(len(out_p) + 1))
     new_de = []
     for j in range(0, len(de), 2):
         a, b = de[j], de[j + 1]
         d = j + 1
         if d in start and int(a[8:16]) != start[d]:
-            a = a[:8] + f"{start[d]:8d}" + a[16:]
+            a = a[:8] + _pad(start[d], a[8:16]) + a[16:]
         if d in start and int(b[24:32]) != len(new_blocks[d]):
-            b = b[:24] + f"{len(new_blocks[d]):8d}" + b[32:]
+            b = b[:24] + _pad(len(new_blocks[d]), b[24:32]) + b[32:]
         new_de += [a, b]
     t = sec["T"][0]
     if int(t[25:32]) != len(out_p):
-        t = t[:24] + f"P{len(out_p):7d}" + t[32:]
+        t = t[:24] + "P" + _pad(len(out_p), t[25:32]) + t[32:]
     return nl.join(sec["S"] + sec["G"] + new_de + out_p + [t]) + nl
 
 
-def _iges_block(fields: list[str], pd: str, rd: str, d: int) -> list[str]:
+def _pad(v: int, like: str) -> str:
+    """``v`` in a fixed field as wide as ``like``, zero-padded if ``like`` is."""
+    w = len(like)
+    return f"{v:0{w}d}" if like.startswith("0") else f"{v:{w}d}"
+
+
+def _iges_block(fields: list[str], pd: str, rd: str, d: int, zpad: bool) -> list[str]:
     toks = [f + pd for f in fields[:-1]] + [fields[-1] + rd]
     rows, cur = [], ""
     for tk in toks:
@@ -965,4 +974,5 @@ def _iges_block(fields: list[str], pd: str, rd: str, d: int) -> list[str]:
             cur = ""
         cur += tk
     rows.append(cur)
-    return [f"{r:<64s} {d:7d}P{0:7d}" for r in rows]
+    de = f"{d:07d}" if zpad else f"{d:7d}"
+    return [f"{r:<64s} {de}P{0:07d}" for r in rows]
