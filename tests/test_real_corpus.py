@@ -149,8 +149,11 @@ def test_dxf_round_trip(tmp_path, src):
             continue
         f = b.entitydb.get(h)
         assert f is not None and f.dxftype() == e.dxftype(), h
-        if e.dxftype() in ("SPLINE", "LWPOLYLINE", "POLYLINE", "HATCH"):
-            assert _attrs(f) == _attrs(e), h
+        if e.dxftype() == "DICTIONARYVAR" and " @ " in str(e.dxf.get("value", "")):
+            continue                                  # ezdxf's save time stamp (EZDXF_META)
+        assert _attrs(f) == _attrs(e), h
+        if e.dxftype() in ("SPLINE", "LWPOLYLINE", "POLYLINE"):
+            np.testing.assert_array_equal(_dxf_geom(f), _dxf_geom(e))
     # tolerance on disk, against the input's raw arrays
     for h in touched:
         g0, g1 = _dxf_geom(a.entitydb[h]), _dxf_geom(b.entitydb[h])
@@ -210,6 +213,41 @@ def test_dxf_hatch_that_cannot_follow_loses_the_association(tmp_path):
     assert h.dxf.associative == 0 and all(not p.source_boundary_objects for p in h.paths)
     assert "570" not in (b.entitydb["24A"].reactors.get() if b.entitydb["24A"].reactors
                          else [])
+
+
+def test_dxf_closed_spline_is_read_closed_and_written_closed(tmp_path):
+    """trimesh spline.DXF, SPLINE 7A: closed flag, clamped knots, first control point repeated
+    last, tangent-continuous at the seam (2e-8 rad): read as one closed curve, the same curve
+    as scipy's clamped BSpline of the entity's arrays; written back in the clamped layout with
+    the closed flag."""
+    from scipy.interpolate import BSpline
+
+    src = REAL / "trimesh" / "spline.DXF"
+    recs = {r.source["handle"]: r for r in _read(src)}
+    r = recs["7A"]
+    assert r.curve.closed and r.source["spline_layout"] == "clamped_closed"
+    e = ezdxf.readfile(src).entitydb["7A"]
+    raw = np.array([tuple(v) for v in e.control_points])[:, :2]
+    u = np.linspace(*r.curve.domain, 400)
+    ref = BSpline(np.array(e.knots), raw, e.dxf.degree)(u)
+    np.testing.assert_allclose(r.curve(u), ref, rtol=0, atol=1e-12)
+    faired, _, tol = _fair_all([r])
+    out = tmp_path / "o.dxf"
+    _write(out, faired, src)
+    f = ezdxf.readfile(out).entitydb["7A"]
+    assert f.closed and f.dxf.flags == e.dxf.flags and list(f.knots) == list(e.knots)
+    back = np.array([tuple(v) for v in f.control_points])[:, :2]
+    np.testing.assert_array_equal(back[0], back[-1])
+    assert float(np.linalg.norm(back - raw, axis=1).max()) <= tol
+
+
+@pytest.mark.xfail(strict=True, reason="geom-smooth: the seam of a closed spline (a knot of "
+                   "multiplicity degree) turns from G1 into a 4 degree kink")
+def test_dxf_closed_spline_seam_stays_g1():
+    src = REAL / "trimesh" / "spline.DXF"
+    r = next(r for r in _read(src) if r.source["handle"] == "7A")
+    faired, _, _ = _fair_all([r])
+    assert _g1_breaks(faired[0].curve, r.curve) <= 1e-7
 
 
 @pytest.mark.parametrize("src,why", [
@@ -275,17 +313,20 @@ def _g1_breaks(curve, rec_curve):
     t = np.asarray(curve.knots)
     lo, hi = curve.domain
     worst = 0.0
-    for k in np.unique(t[(t > lo) & (t < hi)]):
-        if np.count_nonzero(t == k) < p:
-            continue
-        e = 1e-9 * (hi - lo)
+    e = 1e-9 * (hi - lo)
+    joins = [(k - e, k + e) for k in np.unique(t[(t > lo) & (t < hi)])
+             if np.count_nonzero(t == k) >= p]
+    if curve.closed:                               # the seam of a closed curve
+        joins.append((hi - e, lo + e))
 
-        def angle(c):
-            d0, d1 = c(np.array([k - e]), 1)[0], c(np.array([k + e]), 1)[0]
-            cosv = np.dot(d0, d1) / np.linalg.norm(d0) / np.linalg.norm(d1)
-            return float(np.arccos(np.clip(cosv, -1, 1)))
-        if angle(rec_curve) < 1e-6:
-            worst = max(worst, angle(curve))
+    def angle(c, u0, u1):
+        d0, d1 = c(np.array([u0]), 1)[0], c(np.array([u1]), 1)[0]
+        cosv = np.dot(d0, d1) / np.linalg.norm(d0) / np.linalg.norm(d1)
+        return float(np.arccos(np.clip(cosv, -1, 1)))
+
+    for u0, u1 in joins:
+        if angle(rec_curve, u0, u1) < 1e-6:
+            worst = max(worst, angle(curve, u0, u1))
     return worst
 
 
