@@ -24,7 +24,8 @@ unsupported. Coordinates are the entity's own (OCS for 2-D polylines); a curve w
 all have the same z is 2-D and keeps that z (``source["z"]``).
 
 ``source`` keys: ``handle``, ``dxftype``, ``layer``, ``layout``, ``z`` (None for 3-D), and
-``spline_layout`` (``"clamped"``, ``"clamped_closed"``, ``"periodic"``, ``"periodic_short"``) or the point-list keys.
+``spline_layout`` (``"clamped"``, ``"clamped_closed"``, ``"periodic"``,
+``"periodic_short"``) or the point-list keys.
 
 Write
 -----
@@ -147,8 +148,8 @@ def _closed_knots(knots: FloatArray, p: int) -> FloatArray:
     """The periodic knot vector of a clamped closed spline (closed flag, first control point
     repeated last): the clamped curve on ``[a, b]`` with interior knots ``I`` is exactly the
     periodic spline with the distinct control points ``d_0 .. d_{N-2}`` and the full knots
-    ``[I[-1] - T, a (p times), I, b (p times), ([I, b (p times)])[:p] + T]``, ``T = b - a``: a seam knot of
-    multiplicity ``p`` (C0, like the clamped ends), every span's knots ``t_{j-p+1} ..
+    ``[I[-1] - T, a (p times), I, b (p times), ([I, b (p times)])[:p] + T]``, ``T = b - a``:
+    a seam knot of multiplicity ``p`` (C0, like the clamped ends), every span's knots ``t_{j-p+1} ..
     t_{j+p}`` the same as the clamped vector's on ``[a, b]`` (Piegl & Tiller, section 2.2)."""
     a, b = float(knots[p]), float(knots[-p - 1])
     interior = np.asarray(knots[p + 1: -p - 1], dtype=float)
@@ -430,7 +431,7 @@ def _follow_hatches(doc: Any, before: dict[str, tuple[FloatArray, FloatArray | N
                 if hasattr(e, "reactors") and e.reactors is not None and \
                         h.dxf.handle in e.reactors.get():
                     e.discard_reactor_handle(h.dxf.handle)
-            warnings.warn(f"{os.fspath(template)}: HATCH {h.dxf.handle} was associative to a "  # type: ignore[arg-type]
+            warnings.warn(f"{template}: HATCH {h.dxf.handle} was associative to a "
                           "faired curve whose new shape its boundary path cannot take; the "
                           "association is removed and the hatch keeps its old boundary",
                           UserWarning, stacklevel=4)

@@ -296,13 +296,13 @@ def _compound_of(records: Sequence[CurveRecord]) -> Any:
     return comp
 
 
-def _write_new(path: object, fmt: str, records: Sequence[CurveRecord]) -> None:
+def _write_new(path: str | os.PathLike[str], fmt: str, records: Sequence[CurveRecord]) -> None:
     from OCP.IFSelect import IFSelect_ReturnStatus
     from OCP.IGESControl import IGESControl_Writer
     from OCP.STEPControl import STEPControl_StepModelType, STEPControl_Writer
 
     comp = _compound_of(records)
-    with atomic_path(path) as tmp, _quiet():  # type: ignore[arg-type]
+    with atomic_path(path) as tmp, _quiet():
         if fmt == "iges":
             w = IGESControl_Writer("MM", 0)
             w.AddShape(comp)
@@ -313,7 +313,7 @@ def _write_new(path: object, fmt: str, records: Sequence[CurveRecord]) -> None:
             sw.Transfer(comp, STEPControl_StepModelType.STEPControl_AsIs)
             ok = sw.Write(os.fspath(tmp)) == IFSelect_ReturnStatus.IFSelect_RetDone
         if not ok:
-            raise InputError(f"write_curves: OCC could not write {os.fspath(path)!r}")  # type: ignore[arg-type]
+            raise InputError(f"write_curves: OCC could not write {os.fspath(path)!r}")
 
 
 def _same_curve(a: BSplineCurve, b: BSplineCurve) -> bool:
