@@ -309,16 +309,20 @@ def test_real_libdxfrw_file(tmp_path):
     doc = ezdxf.readfile(src)
     for r in recs:
         e = doc.entitydb[r.source["handle"]]
-        assert e.closed and r.source["spline_layout"] == "clamped"
-        assert r.curve.n_ctrl == len(e.control_points) and r.source["layer"] == "Layer 1"
+        # a closed flag with the first control point repeated last: a closed curve (the
+        # repeated point stored once), the same curve as the clamped one of the file
+        assert e.closed and r.source["spline_layout"] == "clamped_closed" and r.curve.closed
+        assert r.curve.n_ctrl == len(e.control_points) - 1 and r.source["layer"] == "Layer 1"
         u = np.linspace(*r.curve.domain, 80)
         # reference: scipy's BSpline on the entity's raw arrays (ezdxf's construction tool
         # rounds the 12-digit knots of this file to 7 digits, off by ~5e-6 here)
         ref = BSpline(np.array(e.knots), np.array([tuple(v) for v in e.control_points]), 3)(u)
         np.testing.assert_allclose(r.curve(u), ref[:, :2], atol=1e-9)
         np.testing.assert_allclose(r.curve(u), _ezdxf_points(e, u)[:, :2], atol=1e-4)
-        # geometrically closed: first and last control points coincide
-        np.testing.assert_array_equal(r.curve.control_points[0], r.curve.control_points[-1])
+        # the file's control points, the repeated one once
+        raw = np.array([tuple(v) for v in e.control_points])[:, :2]
+        np.testing.assert_array_equal(r.curve.control_points, raw[:-1])
+        np.testing.assert_array_equal(raw[0], raw[-1])
     c = recs[1].curve
     cp = np.array(c.control_points)
     cp[3] += [0.5, -0.25]
@@ -334,7 +338,12 @@ def test_real_libdxfrw_file(tmp_path):
     e48 = b.entitydb["48"]
     assert e48.dxf.flags == 11 and e48.dxf.color == 250 and list(e48.knots) == \
         list(doc.entitydb["48"].knots)
-    np.testing.assert_array_equal(np.array([tuple(v) for v in e48.control_points])[:, :2], cp)
+    back = np.array([tuple(v) for v in e48.control_points])[:, :2]
+    np.testing.assert_array_equal(back, np.r_[cp, cp[:1]])     # written back closed, clamped
+    # and the faired-by-hand curve is what the file now holds (scipy on the raw arrays)
+    u = np.linspace(*c.domain, 200)
+    moved = c.replace(control_points=cp)
+    np.testing.assert_allclose(BSpline(np.array(e48.knots), back, 3)(u), moved(u), atol=1e-12)
 
 
 def test_missing_ezdxf_names_the_extra(tmp_path, monkeypatch):

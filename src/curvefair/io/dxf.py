@@ -8,8 +8,10 @@ space layouts (block definitions are not read: editing them would change every i
 ``SPLINE`` with control points -> ``kind="bspline"``, a :class:`~curvefair.BSplineCurve` with
 the entity's degree, knots and control points:
 
-- clamped knot vector: an open curve (the DXF *closed* flag, set on splines whose first and
-  last control points coincide, is kept as it is);
+- clamped knot vector: an open curve; with the DXF *closed* flag and the first control point
+  repeated last (what libdxfrw and LibreCAD write for closed splines) a closed curve whose
+  seam knot has multiplicity ``degree`` (the same curve exactly; ``spline_layout``
+  ``"clamped_closed"``), written back in the file's clamped layout;
 - periodic layout (closed flag, the first ``degree`` control points repeated at the end,
   ``n + 2 degree + 1`` knots -- what ezdxf's ``set_closed`` and most CAD programs write, or
   ``n + 1`` knots as in AutoCAD's documentation): a closed curve;
@@ -22,7 +24,8 @@ unsupported. Coordinates are the entity's own (OCS for 2-D polylines); a curve w
 all have the same z is 2-D and keeps that z (``source["z"]``).
 
 ``source`` keys: ``handle``, ``dxftype``, ``layer``, ``layout``, ``z`` (None for 3-D), and
-``spline_layout`` (``"clamped"``, ``"periodic"``, ``"periodic_short"``) or the point-list keys.
+``spline_layout`` (``"clamped"``, ``"clamped_closed"``, ``"periodic"``,
+``"periodic_short"``) or the point-list keys.
 
 Write
 -----
@@ -116,7 +119,11 @@ def _spline_record(e: Any, base: dict[str, Any], path: object, corner_angle: flo
     N = cps.shape[0]
     pts, z = planar(cps)
     try:
-        if knots.shape[0] == N + p + 1 and is_clamped(knots, p):
+        if closed_flag and knots.shape[0] == N + p + 1 and is_clamped(knots, p) and \
+                N - p - 1 >= 1 and np.array_equal(cps[0], cps[-1]):
+            curve = BSplineCurve(pts[: N - 1], _closed_knots(knots, p), p, closed=True)
+            layout = "clamped_closed"
+        elif knots.shape[0] == N + p + 1 and is_clamped(knots, p):
             curve = BSplineCurve(pts, knots, p, closed=False)
             layout = "clamped"
         elif closed_flag and knots.shape[0] == N + p + 1 and N > 2 * p and \
@@ -135,6 +142,20 @@ def _spline_record(e: Any, base: dict[str, Any], path: object, corner_angle: flo
         raise FileFormatError(f"SPLINE {base['handle']}: {exc}", path) from None
     src = dict(base, z=z, spline_layout=layout, had_fit_points=bool(fits.shape[0]))
     return [CurveRecord(curve, base["name"], "bspline", src)]
+
+
+def _closed_knots(knots: FloatArray, p: int) -> FloatArray:
+    """The periodic knot vector of a clamped closed spline (closed flag, first control point
+    repeated last): the clamped curve on ``[a, b]`` with interior knots ``I`` is exactly the
+    periodic spline with the distinct control points ``d_0 .. d_{N-2}`` and the full knots
+    ``[I[-1] - T, a (p times), I, b (p times), ([I, b (p times)])[:p] + T]``, ``T = b - a``:
+    a seam knot of multiplicity ``p`` (C0, like the clamped ends), every span's knots ``t_{j-p+1} ..
+    t_{j+p}`` the same as the clamped vector's on ``[a, b]`` (Piegl & Tiller, section 2.2)."""
+    a, b = float(knots[p]), float(knots[-p - 1])
+    interior = np.asarray(knots[p + 1: -p - 1], dtype=float)
+    T = b - a
+    head = np.r_[interior, np.full(p, b)][:p]     # t_{N+p+j} = t_{p+1+j} + T
+    return np.r_[interior[-1] - T, np.full(p, a), interior, np.full(p, b), head + T]
 
 
 def _polyline_record(e: Any, base: dict[str, Any], path: object,
@@ -231,7 +252,15 @@ def _set_spline(e: Any, rec: CurveRecord) -> None:
         raise InputError(f"write_curves: SPLINE {rec.source['handle']} was "
                          f"{'closed' if layout != 'clamped' else 'open'}; the curve is not")
     p = curve.degree
-    if layout == "periodic_short":
+    if layout == "clamped_closed":
+        t, n = curve.knots, curve.n_ctrl
+        if not (np.all(t[1:p + 1] == t[p]) and np.all(t[n + 1:n + p + 1] == t[p + n])):
+            raise InputError(f"write_curves: SPLINE {rec.source['handle']} is a clamped closed "
+                             "spline; the curve no longer has a seam knot of multiplicity "
+                             f"{p} and cannot be written in that layout")
+        cps = np.r_[curve.control_points, curve.control_points[:1]]
+        knots = np.r_[np.full(p + 1, t[p]), t[p + 1:n + 1], np.full(p + 1, t[p + n])]
+    elif layout == "periodic_short":
         cps = curve.control_points
         knots = curve.knots[p: p + curve.n_ctrl + 1]
     else:
@@ -321,15 +350,23 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
     ours = [r for r in records if template is not None and r.format == FORMAT
             and r.path is not None and os.path.abspath(r.path) == os.path.abspath(template)]
     others = [r for r in records if not any(r is o for o in ours)]
+    before: dict[str, tuple[FloatArray, FloatArray | None]] = {}
     for handle, recs in _group(ours).items():
         e = doc.entitydb.get(handle)
         if e is None or e.dxftype() != recs[0].source["dxftype"]:
             raise InputError(f"write_curves: the template has no {recs[0].source['dxftype']} "
                              f"with handle {handle}")
+        old = _outline(e)
         if recs[0].kind == "bspline":
             _set_spline(e, recs[0])
         else:
             _set_points(e, recs)
+        new_geom = _outline(e)
+        if old is not None and new_geom is not None and not (
+                np.array_equal(old[0], new_geom[0]) and _eq(old[1], new_geom[1])):
+            before[handle] = old
+    if before:
+        _follow_hatches(doc, before, template)
     # records from another DXF file that were split into pieces: join them again
     for _key, recs in _group_foreign(others).items():
         if len(recs) > 1 or "indices" in recs[0].source:
@@ -342,6 +379,119 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
             _add_new(msp, recs[0], recs[0].source.get("z"))
     with atomic_path(path, suffix=".dxf") as tmp:
         doc.saveas(os.fspath(tmp))
+
+
+def _eq(a: FloatArray | None, b: FloatArray | None) -> bool:
+    return (a is None and b is None) or (a is not None and b is not None
+                                         and np.array_equal(a, b))
+
+
+def _outline(e: Any) -> tuple[FloatArray, FloatArray | None] | None:
+    """(2-D points, knots) an associative hatch boundary copies from a source entity: the
+    control points (or fit points) and knots of a SPLINE, the vertices of a polyline."""
+    t = e.dxftype()
+    if t == "SPLINE":
+        cps = np.asarray([tuple(v) for v in e.control_points], dtype=float).reshape(-1, 3)
+        if cps.shape[0] == 0:
+            cps = np.asarray([tuple(v) for v in e.fit_points], dtype=float).reshape(-1, 3)
+        return cps[:, :2], np.asarray(e.knots, dtype=float)
+    if t == "LWPOLYLINE":
+        return np.asarray(e.get_points("xy"), dtype=float).reshape(-1, 2), None
+    if t == "POLYLINE":
+        return np.asarray([tuple(v.dxf.location)[:2] for v in e.vertices],
+                          dtype=float).reshape(-1, 2), None
+    return None
+
+
+def _follow_hatches(doc: Any, before: dict[str, tuple[FloatArray, FloatArray | None]],
+                    template: object) -> None:
+    """Associative HATCHes whose boundary comes from a faired entity (DXF group 330 source
+    boundary objects): the boundary is moved with it -- a polyline path copied from its one
+    source polyline, an edge path's line ends at the old vertices moved to the new ones and a
+    spline edge equal to the old spline replaced by the new one. A boundary that cannot be
+    matched that way keeps its old geometry and loses the association (flag 0, no source
+    objects), with a warning: an associative hatch that no longer follows its boundary would
+    be re-computed by the CAD program at an unknown moment."""
+    for h in doc.entitydb.values():
+        if h.dxftype() != "HATCH" or not h.dxf.get("associative", 0) or h.is_alive is False:
+            continue
+        hit = False
+        ok = True
+        for path in h.paths:
+            src = [s for s in path.source_boundary_objects if s in before]
+            if not src:
+                continue
+            hit = True
+            ok = _move_path(doc, path, src, before) and ok
+        if hit and not ok:
+            h.dxf.associative = 0
+            for path in h.paths:
+                path.source_boundary_objects = []
+            for e in doc.entitydb.values():
+                if hasattr(e, "reactors") and e.reactors is not None and \
+                        h.dxf.handle in e.reactors.get():
+                    e.discard_reactor_handle(h.dxf.handle)
+            warnings.warn(f"{template}: HATCH {h.dxf.handle} was associative to a "
+                          "faired curve whose new shape its boundary path cannot take; the "
+                          "association is removed and the hatch keeps its old boundary",
+                          UserWarning, stacklevel=4)
+
+
+def _move_path(doc: Any, path: Any, src: list[str],
+               before: dict[str, tuple[FloatArray, FloatArray | None]]) -> bool:
+    kind = type(path).__name__
+    if kind == "PolylinePath":
+        if len(path.source_boundary_objects) != 1:
+            return False
+        e = doc.entitydb.get(src[0])
+        if e is None or e.dxftype() != "LWPOLYLINE":
+            return False
+        old = np.asarray([v[:2] for v in path.vertices], dtype=float)
+        if old.shape != before[src[0]][0].shape or not np.array_equal(old, before[src[0]][0]):
+            return False
+        bulges = [v[2] if len(v) > 2 else 0.0 for v in path.vertices]
+        new = _outline(e)[0]  # type: ignore[index]
+        path.set_vertices([(float(x), float(y), b) for (x, y), b in
+                           zip(new, bulges, strict=True)], is_closed=path.is_closed)
+        return True
+    if kind != "EdgePath":
+        return False
+    moved: dict[tuple[float, float], tuple[float, float]] = {}
+    splines = []
+    for hd in src:
+        e = doc.entitydb.get(hd)
+        new = _outline(e) if e is not None else None
+        if new is None:
+            return False
+        if e.dxftype() == "SPLINE":
+            splines.append((before[hd], e))
+        else:
+            for a, b in zip(before[hd][0], new[0], strict=True):
+                moved[(float(a[0]), float(a[1]))] = (float(b[0]), float(b[1]))
+    done_splines = 0
+    for ed in path.edges:
+        name = type(ed).__name__
+        if name == "LineEdge":
+            for attr in ("start", "end"):
+                q = tuple(map(float, getattr(ed, attr)))
+                if q in moved:
+                    setattr(ed, attr, moved[q])
+        elif name == "SplineEdge":
+            cps = np.asarray([tuple(v)[:2] for v in ed.control_points], dtype=float)
+            for (old_cps, old_knots), e in splines:
+                if cps.shape == old_cps.shape and np.array_equal(cps, old_cps) and \
+                        np.array_equal(np.asarray(ed.knot_values, dtype=float), old_knots):
+                    ed.control_points = [tuple(v)[:2] for v in e.control_points]
+                    ed.knot_values = [float(k) for k in e.knots]
+                    ed.degree = int(e.dxf.degree)
+                    done_splines += 1
+                    break
+    if done_splines != len(splines):
+        return False
+    # every moved vertex must now be where its polyline has it
+    ends = {tuple(map(float, getattr(ed, a))) for ed in path.edges
+            if type(ed).__name__ == "LineEdge" for a in ("start", "end")}
+    return all(v in ends or k == v for k, v in moved.items()) or not moved
 
 
 def _group_foreign(records: Sequence[CurveRecord]) -> dict[Any, list[CurveRecord]]:

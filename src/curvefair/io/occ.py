@@ -15,31 +15,53 @@ other analytic curves are left alone; rational or trimmed B-splines are unsuppor
 
 Write
 -----
-A new file through OCC's IGES writer (curves as entity 126, millimetres) or STEP writer
-(``AsIs``: B-spline curves as ``b_spline_curve_with_knots`` in a geometric set). With
-``template=`` the template's shape is read and its free edges that the records came from are
-replaced by the faired curves (``BRepTools_ReShape``); the rest of the shape (faces, solids,
-other edges) is written back geometrically unchanged, but OCC writes the file anew: entity
-numbering, names, colours and layers of the original are not kept. STEP stores 12 significant
-digits, so a read -> write -> read round trip agrees to about 1e-12 relative, not bit for bit.
+Without a template: a new file through OCC's IGES writer (curves as entity 126, millimetres)
+or STEP writer (``AsIs``: B-spline curves as ``b_spline_curve_with_knots`` in a geometric set).
+
+With ``template=`` (the file the records were read from) the template's own text is edited,
+never re-translated by OCC, so entity numbering, product structure, names, colours, styles
+and layers stay as they were:
+
+- no curve changed: the template's bytes are copied unchanged;
+- STEP: each faired edge is matched to the one ``B_SPLINE_CURVE_WITH_KNOTS`` instance whose
+  degree, knots and control points are the edge's curve as OCC read it (control points times
+  the file's length unit, before the edge's location); the ``CARTESIAN_POINT`` instances of
+  the poles that moved get the new coordinates (a point shared with another instance, e.g. a
+  vertex, is left alone and the curve gets a new point), knots only if they changed;
+- IGES: the same match against the free entities 126 (not those under a trimmed surface 144,
+  a bounded surface 143 or a BRep edge list 504); its parameter data is rewritten and the
+  parameter section renumbered (directory pointers, line counts, terminate section);
+- numbers are written as the shortest text that reads back to the same float64.
+
+The written file is then read again with OCC and checked: the same number of solids, shells,
+faces, wires, edges and vertices, every free edge that was not faired where it was, every
+faired one on its faired curve (1e-9 of the model's size). Where no unique match exists
+(OCC built the edge from another entity, e.g. the 2-D curve of a curve on a surface 142, or
+converted it; periodic curves; an IGES transformation matrix; curves from other files to add)
+or the check fails, nothing is written and :class:`~curvefair.FileFormatError` (or
+:class:`~curvefair.InputError` for foreign curves) says why.
 """
 
 from __future__ import annotations
 
 import contextlib
 import os
+import re
+import shutil
 import warnings
 from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 
+from .._typing import FloatArray
 from ..curves.bspline import BSplineCurve
 from ..errors import CurvefairError, FileFormatError, InputError
 from ._common import (
     CurveRecord,
     Unsupported,
     atomic_path,
+    atomic_write,
     bspline_of,
     is_clamped,
     joined_points,
@@ -253,39 +275,15 @@ def _edge(curve: BSplineCurve, z: float | None) -> Any:
     return mk.Edge()
 
 
-def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
-          template: str | None = None, **_: Any) -> None:
-    """Write an IGES or STEP file; see the module docstring."""
-    fmt = _fmt_of(path)
-    _occ(f"writing {fmt.upper()} files")
+def _compound_of(records: Sequence[CurveRecord]) -> Any:
     from OCP.BRep import BRep_Builder
-    from OCP.BRepTools import BRepTools_ReShape
-    from OCP.IFSelect import IFSelect_ReturnStatus
-    from OCP.IGESControl import IGESControl_Writer
-    from OCP.STEPControl import STEPControl_StepModelType, STEPControl_Writer
     from OCP.TopoDS import TopoDS_Compound
 
     builder = BRep_Builder()
     comp = TopoDS_Compound()
     builder.MakeCompound(comp)
-    ours: list[CurveRecord] = []
-    if template is not None:
-        tfmt = _fmt_of(template)
-        shape = _read_shape(template, tfmt, f"writing {fmt.upper()} files")
-        edges = _free_edges(shape)
-        ours = [r for r in records if r.format == tfmt and r.path is not None
-                and os.path.abspath(r.path) == os.path.abspath(template)]
-        reshape = BRepTools_ReShape()
-        for r in ours:
-            k = int(r.source["edge"])
-            if not 0 <= k < len(edges):
-                raise InputError(f"write_curves: the template has no free edge {k}")
-            reshape.Replace(edges[k], _edge(bspline_of(r.curve, "write_curves"),
-                                            r.source.get("z")))
-        builder.Add(comp, reshape.Apply(shape))
-    others = [r for r in records if not any(r is o for o in ours)]
     groups: dict[Any, list[CurveRecord]] = {}
-    for i, r in enumerate(others):
+    for i, r in enumerate(records):
         key = (r.path, r.format, r.source.get("handle"), r.source.get("id"),
                r.source.get("element")) if "indices" in r.source else ("single", i)
         groups.setdefault(key, []).append(r)
@@ -295,6 +293,15 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
             pts = joined_points(recs, "write_curves")
             rec = rec.with_curve(points_curve(pts, bool(rec.source.get("closed"))))
         builder.Add(comp, _edge(bspline_of(rec.curve, "write_curves"), rec.source.get("z")))
+    return comp
+
+
+def _write_new(path: str | os.PathLike[str], fmt: str, records: Sequence[CurveRecord]) -> None:
+    from OCP.IFSelect import IFSelect_ReturnStatus
+    from OCP.IGESControl import IGESControl_Writer
+    from OCP.STEPControl import STEPControl_StepModelType, STEPControl_Writer
+
+    comp = _compound_of(records)
     with atomic_path(path) as tmp, _quiet():
         if fmt == "iges":
             w = IGESControl_Writer("MM", 0)
@@ -307,3 +314,665 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
             ok = sw.Write(os.fspath(tmp)) == IFSelect_ReturnStatus.IFSelect_RetDone
         if not ok:
             raise InputError(f"write_curves: OCC could not write {os.fspath(path)!r}")
+
+
+def _same_curve(a: BSplineCurve, b: BSplineCurve) -> bool:
+    return (a.degree == b.degree and a.closed == b.closed
+            and np.array_equal(a.knots, b.knots)
+            and np.array_equal(np.asarray(a.control_points), np.asarray(b.control_points)))
+
+
+def _edge_samples(edge: Any, m: int = 33) -> FloatArray:
+    from OCP.BRepAdaptor import BRepAdaptor_Curve
+
+    ad = BRepAdaptor_Curve(edge)
+    u = np.linspace(ad.FirstParameter(), ad.LastParameter(), m)
+    return np.array([(ad.Value(t).X(), ad.Value(t).Y(), ad.Value(t).Z()) for t in u])
+
+
+def _census(shape: Any) -> dict[str, int]:
+    """Distinct solids, shells, faces, wires, edges and vertices of a shape."""
+    from OCP.TopAbs import TopAbs_ShapeEnum
+    from OCP.TopExp import TopExp_Explorer
+
+    out = {}
+    for name in ("SOLID", "SHELL", "FACE", "WIRE", "EDGE", "VERTEX"):
+        seen = _ShapeSet()
+        ex = TopExp_Explorer(shape, getattr(TopAbs_ShapeEnum, f"TopAbs_{name}"))
+        n = 0
+        while ex.More():
+            n += seen.add(ex.Current())
+            ex.Next()
+        out[name.lower()] = n
+    return out
+
+
+def _verify(written: object, fmt: str, shape: Any, edges: list[Any],
+            patches: list[_Patch]) -> None:
+    """Re-read the patched file with OCC: the same topology, every edge that was not faired
+    where it was (1e-9 of the model's size), every faired one on its faired curve."""
+    back = _read_shape(written, fmt, "checking the written file")
+    if _census(back) != _census(shape):
+        raise _Refuse(f"OCC reads the patched file with {_census(back)} instead of "
+                      f"{_census(shape)}")
+    bedges = _free_edges(back)
+    if len(bedges) != len(edges):
+        raise _Refuse(f"OCC reads {len(bedges)} free edges in the patched file, not "
+                      f"{len(edges)}")
+    want = {pa.k: pa for pa in patches}
+    ref = [_edge_samples(e) for e in edges]
+    size = max(max(float(np.abs(r).max()) for r in ref), 1.0)
+    for k, (e, r) in enumerate(zip(bedges, ref, strict=True)):
+        got = _edge_samples(e)
+        if k in want:
+            c = bspline_of(want[k].rec.curve, "write_curves")
+            u = np.linspace(*c.domain, got.shape[0])
+            exp = c(u)
+            exp = np.c_[exp, np.full(exp.shape[0], want[k].rec.source.get("z") or 0.0)] \
+                if exp.shape[1] == 2 else exp
+        else:
+            exp = r
+        err = float(np.abs(got - exp).max())
+        if not err <= 1e-9 * size:
+            raise _Refuse(f"edge {k} of the patched file is {err:.3g} from "
+                          f"{'the faired curve' if k in want else 'the original'}")
+
+
+def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
+          template: str | None = None, **_: Any) -> None:
+    """Write an IGES or STEP file; see the module docstring."""
+    fmt = _fmt_of(path)
+    _occ(f"writing {fmt.upper()} files")
+    if template is None:
+        _write_new(path, fmt, records)
+        return
+    tfmt = _fmt_of(template)
+    ours = [r for r in records if r.format == tfmt and r.path is not None
+            and os.path.abspath(r.path) == os.path.abspath(template)]
+    others = [r for r in records if not any(r is o for o in ours)]
+    if tfmt != fmt or others:
+        why = (f"the template is {tfmt.upper()}" if tfmt != fmt else
+               f"{len(others)} curve(s) do not come from {os.fspath(template)!r}")
+        raise InputError(f"write_curves: {fmt.upper()} write-back edits the template's own "
+                         f"curves only and {why}; write them to a new file (no template)")
+    shape = _read_shape(template, tfmt, f"writing {fmt.upper()} files")
+    edges = _free_edges(shape)
+    patches = []
+    for r in ours:
+        k = int(r.source["edge"])
+        if not 0 <= k < len(edges):
+            raise InputError(f"write_curves: the template has no free edge {k}")
+        try:
+            orig, _z = _bspline_of_edge(edges[k])
+        except (LookupError, Unsupported, CurvefairError):
+            raise InputError(f"write_curves: free edge {k} of the template is not a "
+                             "B-spline curve curvefair reads") from None
+        new = bspline_of(r.curve, "write_curves")
+        if _same_curve(new, orig):
+            continue
+        try:
+            patches.append(_Patch(k, edges[k], r, orig))
+        except _Refuse as exc:
+            raise _refused(template, fmt, str(exc)) from None
+    if not patches:                     # nothing changed: the template's bytes as they are
+        with atomic_path(path) as tmp:
+            shutil.copyfile(os.fspath(template), tmp)
+        return
+    with open(os.fspath(template), "rb") as fh:
+        raw = fh.read()
+    try:
+        text = raw.decode("latin-1")
+        out = _patch_step(text, patches) if fmt == "step" else _patch_iges(text, patches)
+        with atomic_path(path) as tmp:
+            with open(tmp, "wb") as fh:
+                fh.write(out.encode("latin-1"))
+            _verify(tmp, fmt, shape, edges, patches)
+    except _Refuse as exc:
+        raise _refused(template, fmt, str(exc)) from None
+
+
+def _refused(template: object, fmt: str, why: str) -> FileFormatError:
+    return FileFormatError(f"cannot write the faired curves back into this {fmt.upper()} file "
+                           f"without losing or changing what was not faired ({why}); nothing "
+                           "was written. Write the curves to a new file (no template) to get "
+                           "them without the rest of the model", template)
+
+
+# ------------------------------------------------------------------------------------------
+# write-back into the template's own text (STEP Part 21 / IGES fixed format)
+# ------------------------------------------------------------------------------------------
+def _num(v: float, exp: str = "E") -> str:
+    """A real as the shortest text that reads back to the same float64, with a decimal point
+    (STEP and IGES reals need one: ``1.``, ``1.5E-05``)."""
+    s = repr(float(v))
+    mant, _, ex = s.partition("e")
+    if "." not in mant:
+        mant += "."
+    return mant + (exp + ex if ex else "")
+
+
+def _orig_curve(edge: Any) -> tuple[Any, Any, Any]:
+    """(local Geom_BSplineCurve, edge location gp_Trsf, local curve) of a free edge."""
+    from OCP.BRep import BRep_Tool
+    from OCP.GeomAdaptor import GeomAdaptor_Curve
+    from OCP.GeomAbs import GeomAbs_CurveType
+    from OCP.TopLoc import TopLoc_Location
+
+    loc = TopLoc_Location()
+    c = BRep_Tool.Curve_s(edge, loc, 0.0, 0.0)
+    ad = GeomAdaptor_Curve(c)
+    if ad.GetType() != GeomAbs_CurveType.GeomAbs_BSplineCurve:
+        raise LookupError("not a B-spline")
+    return ad.BSpline(), loc.Transformation()
+
+
+def _local_poles(bs: Any) -> tuple[FloatArray, FloatArray, int]:
+    n = bs.NbPoles()
+    xyz = np.array([(bs.Pole(i).X(), bs.Pole(i).Y(), bs.Pole(i).Z()) for i in range(1, n + 1)])
+    ks = bs.KnotSequence()
+    flat = np.array([ks.Value(i) for i in range(ks.Lower(), ks.Upper() + 1)], dtype=float)
+    return xyz, flat, int(bs.Degree())
+
+
+def _apply(trsf: Any, xyz: FloatArray, inverse: bool = False) -> FloatArray:
+    from OCP.gp import gp_XYZ
+
+    t = trsf.Inverted() if inverse else trsf
+    out = np.empty_like(xyz)
+    for i, q in enumerate(xyz):
+        v = gp_XYZ(float(q[0]), float(q[1]), float(q[2]))
+        t.Transforms(v)
+        out[i] = (v.X(), v.Y(), v.Z())
+    return out
+
+
+def _new_poles(curve: BSplineCurve, z: float | None) -> tuple[FloatArray, FloatArray, int]:
+    """Global 3-D poles, full knot vector and degree of a record's curve as OCC holds it."""
+    g = _geom(curve, z)
+    return _local_poles(g)
+
+
+def _match(raw: FloatArray, raw_knots: FloatArray, degree: int, poles: FloatArray,
+           knots: FloatArray, p: int) -> float | None:
+    """Scale s with ``poles == s * raw`` (the file's length unit in OCC's millimetres) if the
+    raw entity is this curve (same degree, knots, poles to 1e-9 of the curve's size)."""
+    if degree != p or raw.shape != poles.shape or raw_knots.shape != knots.shape:
+        return None
+    span = max(abs(knots[-1] - knots[0]), 1e-300)
+    size = max(float(np.abs(poles).max()), 1e-300)
+    den = float(np.sum(raw * raw))
+    if den == 0.0:
+        return None
+    s = float(np.sum(raw * poles)) / den
+    if not s > 0:
+        return None
+    if np.max(np.abs(raw * s - poles)) > 1e-9 * size:
+        return None
+    # OCC keeps the file's knots as they are (possibly scaled: compare normalised)
+    a = (raw_knots - raw_knots[0]) / max(raw_knots[-1] - raw_knots[0], 1e-300)
+    b = (knots - knots[0]) / span
+    if np.max(np.abs(a - b)) > 1e-9:
+        return None
+    return s
+
+
+class _Patch:
+    """One faired edge to write into the template's text."""
+
+    def __init__(self, k: int, edge: Any, rec: CurveRecord, orig: BSplineCurve) -> None:
+        self.k = k
+        self.rec = rec
+        bs, self.trsf = _orig_curve(edge)
+        self.old_local, self.old_knots, self.p = _local_poles(bs)
+        curve = bspline_of(rec.curve, "write_curves")
+        # poles the fairing did not move keep their text exactly
+        a, b = np.asarray(curve.control_points), np.asarray(orig.control_points)
+        self.kept = np.all(a == b, axis=1) if a.shape == b.shape and \
+            np.array_equal(curve.knots, orig.knots) else np.zeros(a.shape[0], dtype=bool)
+        new_glob, self.new_knots, self.new_p = _new_poles(curve, rec.source.get("z"))
+        self.new_local = _apply(self.trsf, new_glob, inverse=True)
+        if curve.closed or bs.IsPeriodic():
+            raise _Refuse(f"edge {k} is a periodic curve")
+
+    def raw_poles(self, scale: float) -> FloatArray:
+        return self.new_local / scale
+
+    def raw_knots(self, old_raw: FloatArray) -> FloatArray:
+        """The new knots in the file's own parameterisation (OCC keeps it; an affine map)."""
+        if np.array_equal(self.new_knots, self.old_knots):
+            return old_raw
+        a = (old_raw[-1] - old_raw[0]) / (self.old_knots[-1] - self.old_knots[0])
+        return old_raw[0] + (self.new_knots - self.old_knots[0]) * a
+
+
+class _Refuse(Exception):
+    """The faired curves cannot be written into the template's text without loss."""
+
+
+def _mults(flat: FloatArray) -> tuple[list[float], list[int]]:
+    knots, mults = [], []
+    for v in flat:
+        if knots and v == knots[-1]:
+            mults[-1] += 1
+        else:
+            knots.append(float(v))
+            mults.append(1)
+    return knots, mults
+
+
+# ---- STEP -------------------------------------------------------------------------------
+def _step_instances(text: str) -> list[tuple[int, int, int, str]]:
+    """(id, start, end, body) of every ``#id = ...;`` instance of the DATA section; ``end`` is
+    the index after the ``;``. Strings ('...', '' inside) and comments are skipped."""
+    out = []
+    m = re.search(r"^\s*DATA\s*(?:\([^;]*\))?\s*;", text, re.M)
+    if m is None:
+        raise _Refuse("no DATA section")
+    i, n = m.end(), len(text)
+    head = re.compile(r"\s*#(\d+)\s*=\s*")
+    while i < n:
+        h = head.match(text, i)
+        if h is None:
+            rest = text[i:].lstrip()
+            if rest.startswith("ENDSEC") or rest.startswith("/*"):
+                if rest.startswith("/*"):
+                    j = text.index("*/", i) + 2
+                    i = j
+                    continue
+                break
+            raise _Refuse(f"cannot parse the DATA section near character {i}")
+        j = h.end()
+        start = i + (len(text[i:h.end()]) - len(text[i:h.end()].lstrip()))
+        while j < n:
+            c = text[j]
+            if c == "'":
+                j += 1
+                while j < n:
+                    if text[j] == "'":
+                        if j + 1 < n and text[j + 1] == "'":
+                            j += 2
+                            continue
+                        break
+                    j += 1
+            elif c == "/" and text.startswith("/*", j):
+                j = text.index("*/", j) + 1
+            elif c == ";":
+                break
+            j += 1
+        out.append((int(h.group(1)), start, j + 1, text[h.end():j]))
+        i = j + 1
+    return out
+
+
+def _step_parse(body: str) -> tuple[str, list[Any]]:
+    """``NAME(args)`` -> (NAME, args); args nested lists of atom strings."""
+    m = re.match(r"\s*([A-Z_][A-Z0-9_]*)\s*\(", body)
+    if m is None:
+        raise ValueError("not a simple instance")
+    pos = m.end()
+
+    def items(i: int) -> tuple[list[Any], int]:
+        out: list[Any] = []
+        cur = ""
+        while i < len(body):
+            c = body[i]
+            if c == "'":
+                j = i + 1
+                while True:
+                    j = body.index("'", j)
+                    if body.startswith("''", j):
+                        j += 2
+                        continue
+                    break
+                cur += body[i:j + 1]
+                i = j + 1
+                continue
+            if c == "(":
+                sub, i = items(i + 1)
+                out.append((cur.strip(), sub) if cur.strip() else sub)
+                cur = ""
+                continue
+            if c == ")":
+                if cur.strip():
+                    out.append(cur.strip())
+                return out, i + 1
+            if c == ",":
+                if cur.strip():
+                    out.append(cur.strip())
+                cur = ""
+                i += 1
+                continue
+            cur += c
+            i += 1
+        raise ValueError("unbalanced parentheses")
+
+    args, end = items(pos)
+    if body[end:].strip():
+        raise ValueError("trailing text")
+    return m.group(1), args
+
+
+def _strip_strings(body: str) -> str:
+    return re.sub(r"'(?:[^']|'')*'", "''", body)
+
+
+def _patch_step(text: str, patches: list[_Patch]) -> str:
+    inst = _step_instances(text)
+    by_id = {i: (s, e, b) for i, s, e, b in inst}
+    refs: dict[int, int] = {}
+    for _, _, _, b in inst:
+        for r in re.findall(r"#(\d+)", _strip_strings(b)):
+            refs[int(r)] = refs.get(int(r), 0) + 1
+    points: dict[int, FloatArray] = {}
+    names: dict[int, str] = {}
+
+    def point(pid: int) -> FloatArray:
+        if pid not in points:
+            name, args = _step_parse(by_id[pid][2])
+            if name != "CARTESIAN_POINT":
+                raise ValueError(name)
+            points[pid] = np.array([float(v) for v in args[1]], dtype=float)
+            names[pid] = args[0] if isinstance(args[0], str) else "''"
+        return points[pid]
+
+    cands = []
+    for i, _, _, b in inst:
+        if not b.lstrip().startswith("B_SPLINE_CURVE_WITH_KNOTS"):
+            continue
+        try:
+            _, args = _step_parse(b)
+            pids = [int(a[1:]) for a in args[2]]
+            raw = np.array([point(q) for q in pids])
+            if raw.shape[1] != 3:
+                continue
+            mults = [int(v) for v in args[6]]
+            kv = [float(v) for v in args[7]]
+        except (ValueError, KeyError, IndexError, TypeError):
+            continue
+        flat = np.repeat(kv, mults)
+        cands.append((i, args, pids, raw, flat, int(args[1])))
+    next_id = max(by_id) + 1
+    edits: dict[int, str] = {}
+    new_lines: list[str] = []
+    for pa in patches:
+        hits = [(c, s) for c in cands
+                if (s := _match(c[3], c[4], c[5], pa.old_local, pa.old_knots, pa.p)) is not None]
+        if len(hits) != 1:
+            raise _Refuse(f"edge {pa.k}: {'no' if not hits else len(hits)} "
+                          "B_SPLINE_CURVE_WITH_KNOTS instance(s) hold its curve as OCC read "
+                          "it")
+        (cid, args, pids, raw, flat, _), scale = hits[0]
+        if cid in edits:
+            raise _Refuse(f"edge {pa.k}: its curve #{cid} is shared with another faired edge")
+        new = pa.raw_poles(scale)
+        nknots = pa.raw_knots(flat)
+        new_ids: list[str] = []
+        for j, q in enumerate(new):
+            if j < len(pids) and (pa.kept[j] or np.array_equal(q, raw[j])):
+                new_ids.append(f"#{pids[j]}")
+                continue
+            label = names.get(pids[j], "''") if j < len(pids) else "''"
+            body = f"CARTESIAN_POINT({label},(" + ",".join(_num(v) for v in q) + "))"
+            if j < len(pids) and refs.get(pids[j], 0) == 1 and pids[j] not in edits:
+                edits[pids[j]] = body
+                new_ids.append(f"#{pids[j]}")
+            else:
+                new_lines.append(f"#{next_id}={body};")
+                new_ids.append(f"#{next_id}")
+                next_id += 1
+        for q in pids[len(new):]:
+            if refs.get(q, 0) == 1:
+                edits[q] = ""               # an unshared pole no longer used: removed
+        a = list(args)
+        a[1] = str(pa.new_p)
+        a[2] = new_ids
+        if not np.array_equal(nknots, flat):
+            kk, mm = _mults(nknots)
+            a[6] = [str(v) for v in mm]
+            a[7] = [_num(v) for v in kk]
+        if a != list(args):
+            edits[cid] = "B_SPLINE_CURVE_WITH_KNOTS(" + _step_join(a) + ")"
+    out = []
+    last = 0
+    for i, s, e, b in inst:
+        if i in edits:
+            out.append(text[last:s])
+            if edits[i]:
+                out.append(text[s:e - 1 - len(b)] + edits[i] + ";")  # the same "#id = "
+            elif text[e:e + 1] == "\n":
+                e += 1
+            last = e
+    out.append(text[last:])
+    result = "".join(out)
+    if new_lines:
+        at = _step_data_end(result)
+        result = result[:at] + "\n".join(new_lines) + "\n" + result[at:]
+    return result
+
+
+def _step_data_end(text: str) -> int:
+    m = re.search(r"^\s*DATA\s*(?:\([^;]*\))?\s*;", text, re.M)
+    e = re.compile(r"^\s*ENDSEC\s*;", re.M).search(text, m.end() if m else 0)
+    if m is None or e is None:
+        raise _Refuse("no end of the DATA section")
+    return e.start() + (len(e.group(0)) - len(e.group(0).lstrip()))
+
+
+def _step_join(items: list[Any]) -> str:
+    parts = []
+    for it in items:
+        if isinstance(it, tuple):
+            parts.append(f"{it[0]}({_step_join(it[1])})")
+        elif isinstance(it, list):
+            parts.append(f"({_step_join(it)})")
+        else:
+            parts.append(it)
+    return ",".join(parts)
+
+
+# ---- IGES -------------------------------------------------------------------------------
+def _iges_sections(text: str) -> tuple[list[str], str]:
+    lines = text.splitlines()
+    nl = "\r\n" if "\r\n" in text[:200] else "\n"
+    for k, ln in enumerate(lines):
+        if len(ln) < 73 or ln[72] not in "SGDPT":
+            if ln.strip() == "" and k == len(lines) - 1:
+                continue
+            raise _Refuse(f"line {k + 1} is not an 80-column IGES record")
+    return lines, nl
+
+
+def _iges_delims(glines: list[str]) -> tuple[str, str]:
+    g = "".join(ln[:72] for ln in glines)
+    delims = []
+    i = 0
+    for default in (",", ";"):
+        if g.startswith("1H", i):
+            delims.append(g[i + 2])
+            i += 3
+            if len(delims) == 1:
+                # the field after the parameter delimiter is separated by it
+                i += 1
+        else:
+            delims.append(default)
+            i += 1
+    return delims[0], delims[1]
+
+
+def _iges_fields(data: str, pd: str, rd: str) -> list[str]:
+    """Parameter data of one entity split at the delimiters (126 holds no strings)."""
+    data = data.split(rd, 1)[0]
+    return [f.strip() for f in data.split(pd)]
+
+
+def _iges_real(s: str) -> float:
+    return float(s.replace("D", "E").replace("d", "e")) if s else 0.0
+
+
+def _patch_iges(text: str, patches: list[_Patch]) -> str:
+    lines, nl = _iges_sections(text)
+    sec = {c: [ln for ln in lines if len(ln) >= 73 and ln[72] == c] for c in "SGDPT"}
+    pd, rd = _iges_delims(sec["G"])
+    de = sec["D"]
+    if len(de) % 2:
+        raise _Refuse("odd number of directory entry lines")
+    blocks: dict[int, list[str]] = {}
+    order: list[int] = []
+    for ln in sec["P"]:
+        d = int(ln[65:72])
+        if d not in blocks:
+            order.append(d)
+            blocks[d] = []
+        blocks[d].append(ln)
+    ents = {}
+    for j in range(0, len(de), 2):
+        a, b = de[j], de[j + 1]
+        dnum = j + 1
+        ents[dnum] = (int(a[0:8]), a[48:56].strip(), b)
+    # 126 entities that bound a face (144 -> 142 -> 102 -> 126) are not free edges
+    in_face: set[int] = set()
+
+    def params(d: int) -> list[str]:
+        return _iges_fields("".join(ln[:64] for ln in blocks.get(d, [])), pd, rd)
+
+    def mark(d: int, depth: int = 0) -> None:
+        if d not in ents or depth > 8:
+            return
+        t = ents[d][0]
+        f = params(d)
+        if t == 126:
+            in_face.add(d)
+        elif t == 102:
+            for q in f[2:2 + int(f[1])]:
+                mark(int(q), depth + 1)
+        elif t == 142:
+            for q in f[3:5]:
+                if q and int(q):
+                    mark(int(q), depth + 1)
+        elif t == 144:
+            n2 = int(f[3])
+            for q in [f[4]] + f[5:5 + n2]:
+                if q and int(q):
+                    mark(int(q), depth + 1)
+        elif t == 141:
+            n = int(f[4])
+            i = 5
+            for _ in range(n):
+                mark(int(f[i]), depth + 1)
+                k = int(f[i + 2])
+                i += 3 + k
+
+    for d, (t, _, _) in ents.items():
+        if t in (144, 143):
+            try:
+                if t == 144:
+                    mark(d)
+                else:
+                    f = params(d)
+                    for q in f[4:4 + int(f[3])]:
+                        mark(int(q))
+            except (ValueError, IndexError):
+                raise _Refuse(f"cannot follow the face entity at DE {d}") from None
+        if t == 504:                    # edge list of BRep faces: N, then (CURV, SVP, SV, EVP, EV)
+            try:
+                f = params(d)
+                for q in range(int(f[1])):
+                    mark(int(f[2 + 5 * q]))
+            except (ValueError, IndexError):
+                raise _Refuse(f"cannot follow the edge list at DE {d}") from None
+    cands = []
+    for d, (t, tm, _) in ents.items():
+        if t != 126 or d in in_face:
+            continue
+        try:
+            f = params(d)
+            k, m = int(f[1]), int(f[2])
+            nk = k + m + 2
+            base = 7
+            knots = np.array([_iges_real(v) for v in f[base:base + nk]])
+            w = np.array([_iges_real(v) for v in f[base + nk:base + nk + k + 1]])
+            c0 = base + nk + k + 1
+            raw = np.array([_iges_real(v) for v in f[c0:c0 + 3 * (k + 1)]]).reshape(-1, 3)
+        except (ValueError, IndexError):
+            continue
+        if tm not in ("", "0"):
+            continue                    # a transformation matrix: not matched (refused below)
+        if not np.all(w == w[0]):
+            continue
+        cands.append((d, f, raw, knots, m, c0))
+    new_blocks = dict(blocks)
+    done: set[int] = set()
+    first = sec["P"][0] if sec["P"] else " " * 80
+    zpad = first[73:80].startswith("0") or first[65:72].startswith("0")   # "0000003P0000012"
+    seq = "{:07d}" if zpad else "{:7d}"
+    for pa in patches:
+        hits = [(c, s) for c in cands
+                if (s := _match(c[2], c[3], c[4], pa.old_local, pa.old_knots, pa.p)) is not None]
+        if len(hits) != 1:
+            raise _Refuse(f"edge {pa.k}: {'no' if not hits else len(hits)} free 126 "
+                          "entities hold its curve as OCC read it; OCC may have built the "
+                          "edge from another entity, e.g. a curve on a surface (142)")
+        (d, f, raw, knots, m, c0), scale = hits[0]
+        if d in done:
+            raise _Refuse(f"edge {pa.k}: entity {d} is shared with another faired edge")
+        done.add(d)
+        new = pa.raw_poles(scale)
+        nk = pa.raw_knots(knots)
+        kk = new.shape[0] - 1
+        same_layout = nk.shape == knots.shape and kk == raw.shape[0] - 1
+        nf = f[:1] + [str(kk), str(pa.new_p)] + f[3:7]
+        if same_layout:
+            nf += [ov if v == o else _num(v) for v, o, ov in
+                   zip(nk, knots, f[7:7 + len(knots)], strict=True)]
+            nf += f[7 + len(knots):c0]
+        else:
+            nf += [_num(v) for v in nk] + ["1."] * (kk + 1)
+        for j, q in enumerate(new):
+            for c in range(3):
+                idx = c0 + 3 * j + c
+                same = same_layout and (bool(pa.kept[j]) or q[c] == raw[j, c])
+                nf.append(f[idx] if same else _num(q[c]))
+        tail = f[c0 + 3 * raw.shape[0]:]
+        if not same_layout or nk[pa.new_p] != knots[m] or nk[-pa.new_p - 1] != knots[-m - 1]:
+            tail = [_num(nk[pa.new_p]), _num(nk[-pa.new_p - 1])] + tail[2:]
+        nf += tail
+        new_blocks[d] = _iges_block(nf, pd, rd, d, zpad)
+    # renumber the parameter section and the directory entries' pointers and counts
+    out_p: list[str] = []
+    start: dict[int, int] = {}
+    for d in order:
+        start[d] = len(out_p) + 1
+        for ln in new_blocks[d]:
+            out_p.append(ln[:73] + seq.format(len(out_p) + 1))
+    new_de = []
+    for j in range(0, len(de), 2):
+        a, b = de[j], de[j + 1]
+        d = j + 1
+        if d in start and int(a[8:16]) != start[d]:
+            a = a[:8] + _pad(start[d], a[8:16]) + a[16:]
+        if d in start and int(b[24:32]) != len(new_blocks[d]):
+            b = b[:24] + _pad(len(new_blocks[d]), b[24:32]) + b[32:]
+        new_de += [a, b]
+    t = sec["T"][0]
+    if int(t[25:32]) != len(out_p):
+        t = t[:24] + "P" + _pad(len(out_p), t[25:32]) + t[32:]
+    return nl.join(sec["S"] + sec["G"] + new_de + out_p + [t]) + nl
+
+
+def _pad(v: int, like: str) -> str:
+    """``v`` in a fixed field as wide as ``like``, zero-padded if ``like`` is."""
+    w = len(like)
+    return f"{v:0{w}d}" if like.startswith("0") else f"{v:{w}d}"
+
+
+def _iges_block(fields: list[str], pd: str, rd: str, d: int, zpad: bool) -> list[str]:
+    toks = [f + pd for f in fields[:-1]] + [fields[-1] + rd]
+    rows, cur = [], ""
+    for tk in toks:
+        if len(cur) + len(tk) > 64:
+            rows.append(cur)
+            cur = ""
+        cur += tk
+    rows.append(cur)
+    de = f"{d:07d}" if zpad else f"{d:7d}"
+    return [f"{r:<64s} {de}P{0:07d}" for r in rows]

@@ -42,6 +42,7 @@ the caller's process is never exposed to the file. Cost: one extra process start
 from __future__ import annotations
 
 import os
+import shutil
 import subprocess
 import sys
 import warnings
@@ -315,6 +316,22 @@ def _add_new(rh: Any, model: Any, rec: CurveRecord) -> None:
     model.Objects.Add(geom, attr)
 
 
+def _geometry_key(g: Any) -> tuple[Any, ...]:
+    """Control points (x, y, z, w) and knots, or polyline vertices, of a curve object."""
+    if hasattr(g, "Knots") and hasattr(g, "Points"):
+        pts = g.Points
+        return (int(g.Degree), np.array([(pts[i].X, pts[i].Y, pts[i].Z, pts[i].W)
+                                         for i in range(len(pts))]), np.array(list(g.Knots)))
+    if hasattr(g, "PointCount"):
+        return (np.array([_p3(g.Point(k)) for k in range(g.PointCount)]),)
+    return (id(g),)
+
+
+def _same_key(a: tuple[Any, ...], b: tuple[Any, ...]) -> bool:
+    return len(a) == len(b) and all(
+        np.array_equal(x, y) if isinstance(x, np.ndarray) else x == y for x, y in zip(a, b))
+
+
 def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
           template: str | None = None, **_: Any) -> None:
     """Write a Rhino model; see the module docstring."""
@@ -332,6 +349,7 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
     groups: dict[str, list[CurveRecord]] = {}
     for r in ours:
         groups.setdefault(r.source["id"], []).append(r)
+    changed = False
     for ident, recs in groups.items():
         obj = None
         for k in range(len(model.Objects)):
@@ -339,11 +357,26 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
                 obj = model.Objects[k]
                 break
         if obj is None:
+            # files of archive version 1 store no object ids: openNURBS makes new random ones
+            # at every read, so the object is found by its index in the object table
+            k = recs[0].source.get("object")
+            if isinstance(k, int) and 0 <= k < len(model.Objects) and \
+                    type(model.Objects[k].Geometry).__name__ == recs[0].source.get("geometry"):
+                obj = model.Objects[k]
+        if obj is None:
             raise InputError(f"write_curves: the template has no object with id {ident}")
+        before = _geometry_key(obj.Geometry)
         if recs[0].kind == "bspline":
             _edit_nurbs(rh, model, obj, recs[0])
         else:
             _edit_points(rh, obj, recs)
+        obj = next((model.Objects[k] for k in range(len(model.Objects))
+                    if str(model.Objects[k].Attributes.Id) == str(obj.Attributes.Id)), obj)
+        changed = changed or not _same_key(before, _geometry_key(obj.Geometry))
+    if template is not None and not others and not changed:
+        with atomic_path(path, suffix=".3dm") as tmp:   # nothing faired: the file as it was
+            shutil.copyfile(os.fspath(template), tmp)
+        return
     joined: dict[Any, list[CurveRecord]] = {}
     for i, r in enumerate(others):
         key = (r.path, r.format, r.source.get("id"), r.source.get("handle"),
@@ -358,5 +391,6 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
         else:
             _add_new(rh, model, recs[0])
     with atomic_path(path, suffix=".3dm") as tmp:
-        if not model.Write(os.fspath(tmp), max(min(version, 8), 2)):
+        # openNURBS writes no version 1; version 2 turns LineCurves into NurbsCurves
+        if not model.Write(os.fspath(tmp), max(min(version, 8), 3)):
             raise InputError(f"write_curves: openNURBS could not write {os.fspath(path)!r}")
