@@ -352,6 +352,44 @@ _CHENG_YU_KINDS = {1: "inflection (Cheng-Yu kind 1)", 2: "curvature extremum (Ch
                    3: "convexity (Cheng-Yu kind 3)"}
 
 
+def _c0_pieces(curve: Any) -> list[tuple[int, Any]]:
+    """An open clamped B-spline cut at its C0 knots (interior knots of multiplicity >= degree:
+    the curve passes through a control point there, a corner or a kink), as ``(index of the
+    piece's first control point in the curve, piece)``; ``[(0, curve)]`` when there are none.
+
+    With ``u = t_{k+1} = ... = t_{k+p}`` the curve is ``P_k`` at ``u``, and the two pieces are
+    the B-splines on ``P_0..P_k`` with knots ``t_0..t_{k+p}, u`` and on ``P_k..P_{n-1}`` with
+    knots ``u, t_{k+1}..t_{n+p}`` (the B-spline basis is local: no control point changes).
+    Closed curves are returned whole (their discrete curvature needs no split unless a C0
+    knot is present, which then makes :func:`curvefair.bad_points` refuse them).
+    """
+    import numpy as np
+
+    from . import BSplineCurve
+
+    p = curve.degree
+    if curve.closed:
+        return [(0, curve)]
+    t = np.asarray(curve.knots, dtype=float)
+    P = np.asarray(curve.control_points, dtype=float)
+    inner, counts = np.unique(t[p + 1:-p - 1], return_counts=True)
+    cuts = []
+    for u, m in zip(inner, counts, strict=True):
+        if m >= p:
+            k = int(np.searchsorted(t, u, side="left")) - 1   # t_{k+1} = u
+            cuts.append((int(k + m - p), u))
+    if not cuts:
+        return [(0, curve)]
+    out = []
+    start = 0
+    for k in [c for c, _ in cuts] + [P.shape[0] - 1]:
+        # P_start..P_k on the knots t_{start+1}..t_{k+p}, each end knot once more
+        knots = np.r_[t[start + 1], t[start + 1:k + p + 1], t[k + p]]
+        out.append((start, BSplineCurve(P[start:k + 1], knots, p)))
+        start = k
+    return out
+
+
 def _bad_point_list(curve: Any, a: Any) -> list[dict[str, Any]]:
     """The ranked bad points of a curve, from the library's measures.
 
@@ -363,10 +401,21 @@ def _bad_point_list(curve: Any, a: Any) -> list[dict[str, Any]]:
     from . import BSplineCurve, bad_points
 
     if isinstance(curve, BSplineCurve) and curve.degree == 3:
-        return [{"index": int(b.index), "index_of": "control point", "param": None,
-                 "measure": float(b.value), "measure_name": "z = D^2 (Cheng-Yu)",
-                 "kind": _CHENG_YU_KINDS.get(int(b.kind), str(b.kind)),
-                 "kinds": [int(k) for k in b.kinds]} for b in bad_points(curve)]
+        out = []
+        pieces = _c0_pieces(curve)
+        for piece, (offset, sub) in enumerate(pieces):
+            try:
+                found = bad_points(sub)
+            except CurvefairError:
+                continue              # too short a piece (a single Bezier segment)
+            out += [{"index": int(b.index) + offset, "index_of": "control point",
+                     "param": None, "measure": float(b.value),
+                     "measure_name": "z = D^2 (Cheng-Yu)",
+                     "kind": _CHENG_YU_KINDS.get(int(b.kind), str(b.kind)),
+                     "kinds": [int(k) for k in b.kinds]}
+                    | ({"piece": piece} if len(pieces) > 1 else {}) for b in found]
+        out.sort(key=lambda b: -b["measure"])
+        return out
     import numpy as np
 
     jumps, name, kind = np.asarray(a.jumps), "|Δr'''|", "third-derivative jump"
