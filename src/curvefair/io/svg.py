@@ -1,11 +1,14 @@
-"""SVG ``<path>`` elements through svgpathtools (``pip install 'curvefair[svg]'``).
+"""SVG shape elements through svgpathtools (``pip install 'curvefair[svg]'``).
 
 Read
 ----
-Every ``<path>`` element, in document order, split into its continuous subpaths:
+Every ``<path>``, ``<polygon>``, ``<polyline>``, ``<line>`` and ``<rect>`` element, in document
+order and with any namespace prefix (``<svg:path>``); each path is split into its continuous
+subpaths:
 
-- subpaths of straight segments only -> ``kind="polyline"``: the vertices (closed if the
-  subpath ends where it starts), split at corners like every point list;
+- subpaths of straight segments only, polygons (closed), polylines, lines and rectangles
+  (closed; rounded ones are unsupported) -> ``kind="polyline"``: the vertices (a path subpath
+  is closed if it ends where it starts), split at corners like every point list;
 - subpaths of cubic Beziers (quadratic Beziers and straight segments among them are
   degree-elevated, exactly) -> ``kind="bspline"``: a cubic :class:`~curvefair.BSplineCurve`
   equal to the chain. The parameter width of each segment follows the tangent-length ratio at
@@ -15,21 +18,32 @@ Every ``<path>`` element, in document order, split into its continuous subpaths:
   all joins get multiplicity 3, which is exact by construction). A closed chain is periodic
   when every join including the closing one is C2, otherwise an open curve from the start
   point round to it;
-- subpaths with elliptical arcs: unsupported (``on_unsupported``).
+- subpaths with elliptical arcs, ``<circle>`` and ``<ellipse>``: unsupported
+  (``on_unsupported``; skipped ones stay untouched in a write-back): an arc is not a
+  polynomial curve, and an approximation would move it without the user asking.
 
 Segments of length zero (an ``L`` to the current point, as matplotlib writes at the end of
 closed lines) carry no geometry and are dropped; a subpath rewritten on write-back loses them.
+Exactly repeated consecutive vertices are dropped with a warning (written back with their
+twin's value).
 
-Coordinates are the path's own user units (``transform`` attributes are not applied; they are
-kept in ``source["transform"]``). ``source`` keys: ``element`` (index among the ``<path>``
-elements), ``id``, ``subpath``, ``n_subpaths``, ``svg_closed``, ``beziers`` (the original
-segments of a bspline record, to tell unchanged curves) and the point-list keys.
+Coordinates are those of the document: the element's current transformation matrix (the
+product of its own and its ancestors' ``transform`` attributes, SVG 1.1 sec. 7.5, parsed by
+svgpathtools) is applied on read, and its inverse on write, so the file keeps every element's
+own coordinates and ``transform`` attributes. ``source`` keys: ``element`` (index among the
+curve elements), ``node`` (index among all elements), ``tag``, ``id``, ``subpath``,
+``n_subpaths``, ``svg_closed``, ``transform`` (the element's own attribute), ``ctm`` (the
+2x3 matrix row by row, or None for the identity), ``beziers`` (the original segments of a
+bspline record, in document coordinates, to tell unchanged curves) and the point-list keys.
 
 Write
 -----
-With ``template=`` the source text is copied and only the ``d`` attribute of the ``<path>``
-elements whose curves changed is rewritten (absolute ``M``/``L``/``C``/``Z`` commands, every
-other subpath of the element as it was; everything else in the file byte for byte). A
+With ``template=`` the source bytes are copied and only the ``d`` attribute of the ``<path>``
+elements whose curves changed (the ``points`` of a polygon/polyline, ``x1 y1 x2 y2`` of a
+line; a changed ``<rect>`` is refused) is rewritten, at the byte offsets the XML parser
+(expat) reports for the element, so text inside comments or CDATA is never edited
+(absolute ``M``/``L``/``C``/``Z`` commands, every other subpath of the element as it was,
+in the element's own coordinates; everything else in the file byte for byte). A
 B-spline is written as its cubic Bezier pieces (one per knot span: the same number of
 segments as read when the knots are unchanged). Without a template, a new SVG holding one
 ``<path>`` per curve (cubic curves only: degree <= 3). Numbers of a rewritten element get the
