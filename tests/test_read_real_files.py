@@ -279,3 +279,33 @@ def test_g2_hold_covering_everything_is_explained(tmp_path):
     res = _run("fair", p, "-o", tmp_path / "h.dat", "--tol", "1e-4", "--clamp", "g2",
                "--mode", "hermite")
     assert res.exit_code == 0 and "G2-clamped end" not in res.output
+
+
+def test_dxf_unsupported_skipped_kept_untouched_and_strict(tmp_path):
+    ezdxf = pytest.importorskip("ezdxf")
+    doc = ezdxf.new("R2010")
+    msp = doc.modelspace()
+    rat = msp.add_rational_spline([(0, 0), (1, 2), (3, 2), (4, 0)], [1, 0.5, 2, 1], degree=3)
+    x = np.linspace(0, 6, 25)
+    line = msp.add_lwpolyline(np.c_[x, np.sin(x) + 0.01 * np.cos(7 * x)].tolist())
+    p = tmp_path / "mix.dxf"
+    doc.saveas(p)
+    res = _run("fair", p, "-o", tmp_path / "o.dxf", "--tol", "0.01")
+    assert res.exit_code == 0, res.output
+    assert f"skipped SPLINE {rat.dxf.handle}" in res.output and "rational" in res.output
+    out = ezdxf.readfile(tmp_path / "o.dxf").modelspace()
+    (s2,) = out.query("SPLINE")
+    assert s2.dxf.handle == rat.dxf.handle
+    np.testing.assert_array_equal(np.asarray(s2.control_points), np.asarray(rat.control_points))
+    np.testing.assert_array_equal(np.asarray(s2.weights), np.asarray(rat.weights))
+    (l2,) = out.query("LWPOLYLINE")
+    assert l2.dxf.handle == line.dxf.handle
+    res = _run("fair", p, "-o", tmp_path / "s.dxf", "--tol", "0.01", "--strict")
+    assert res.exit_code == 1 and "without --strict" in res.output
+    assert not (tmp_path / "s.dxf").exists()
+    # a file holding only unsupported entities: no curves, and the message says why
+    doc = ezdxf.new("R2010")
+    doc.modelspace().add_rational_spline([(0, 0), (1, 2), (3, 2), (4, 0)], [1, 0.5, 2, 1])
+    doc.saveas(tmp_path / "only.dxf")
+    res = _run("fair", tmp_path / "only.dxf", "-o", tmp_path / "x.dxf")
+    assert res.exit_code == 1 and "1 unsupported entity skipped" in res.output

@@ -218,9 +218,22 @@ def _read(path: str, corner_angle: float | None, strict: bool = False,
     (kept untouched on write-back) unless ``strict``, which refuses the file."""
     from . import read_curves
 
-    with _warnings_to_stderr(quiet):
-        return read_curves(path, corner_angle=corner_angle,
-                           on_unsupported="raise" if strict else "skip")
+    seen: list[str] = []
+    try:
+        with _warnings_to_stderr(quiet, into=seen):
+            return read_curves(path, corner_angle=corner_angle,
+                               on_unsupported="raise" if strict else "skip")
+    except CurvefairError as exc:
+        skipped = sum(": skipped " in w for w in seen)
+        if skipped:
+            raise InputFailure(f"{exc} ({skipped} unsupported entit"
+                               f"{'y' if skipped == 1 else 'ies'} skipped"
+                               + (")" if quiet else ", see the warnings)")
+                               ) from None
+        if strict and "on_unsupported='skip'" in str(exc):
+            raise InputFailure(f"{exc}; without --strict the curvefair command skips it with "
+                               "a warning") from None
+        raise
 
 
 def _nothing_to_fair(rec: Any) -> bool:

@@ -344,6 +344,13 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
                 obj = model.Objects[k]
                 break
         if obj is None:
+            # Version 1 files store no object ids: openNURBS makes new ones on every read, so
+            # the object is found by its index (same geometry type) instead
+            k = int(recs[0].source.get("object", -1))
+            if version == 1 and 0 <= k < len(model.Objects) and \
+                    type(model.Objects[k].Geometry).__name__ == recs[0].source.get("geometry"):
+                obj = model.Objects[k]
+        if obj is None:
             raise InputError(f"write_curves: the template has no object with id {ident}")
         if recs[0].kind == "bspline":
             _edit_nurbs(rh, model, obj, recs[0])
