@@ -5,8 +5,8 @@ Layout read
 2 or 3 columns (x y [z]) separated by blanks, commas or semicolons; ``#`` starts a comment
 (whole line or after the numbers); one non-numeric line before the data is a header (kept);
 blank lines are kept. A row exactly equal to the row before it is dropped with a warning (and
-written back with its twin's value). A file whose last row repeats the first (4 rows or more) is a closed
-loop. One point list per file.
+written back with its twin's value). A file whose last row repeats the first (4 rows or more)
+is a closed loop. One point list per file.
 
 Records
 -------
