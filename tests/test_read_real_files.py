@@ -311,3 +311,21 @@ def test_dxf_unsupported_skipped_kept_untouched_and_strict(tmp_path):
     doc.saveas(tmp_path / "only.dxf")
     res = _run("fair", tmp_path / "only.dxf", "-o", tmp_path / "x.dxf")
     assert res.exit_code == 1 and "1 unsupported entity skipped" in res.output
+
+
+def test_dxf_rectangle_is_nothing_to_fair(tmp_path):
+    ezdxf = pytest.importorskip("ezdxf")
+    doc = ezdxf.new("R2010")
+    msp = doc.modelspace()
+    msp.add_lwpolyline([(0, 0), (10, 0), (10, 5), (0, 5)], close=True)
+    x = np.linspace(0, 6, 25)
+    msp.add_lwpolyline(np.c_[x, np.sin(x) + 0.01 * np.cos(7 * x)].tolist())
+    p = tmp_path / "rect.dxf"
+    doc.saveas(p)
+    res = _run("fair", p, "-o", tmp_path / "o.dxf", "--tol", "0.01", "--report",
+               tmp_path / "r.json")
+    assert res.exit_code == 0, res.output
+    rep = json.loads((tmp_path / "r.json").read_text())
+    assert [r["status"] for r in rep["curves"]] == ["nothing to fair"] * 4 + ["ok"]
+    (rect, _) = ezdxf.readfile(tmp_path / "o.dxf").modelspace().query("LWPOLYLINE")
+    assert [tuple(v) for v in rect.get_points("xy")] == [(0, 0), (10, 0), (10, 5), (0, 5)]

@@ -420,7 +420,7 @@ def _bad_point_list(curve: Any, a: Any) -> list[dict[str, Any]]:
             try:
                 found = bad_points(sub)
             except CurvefairError:
-                continue              # too short a piece (a single Bezier segment)
+                continue   # a single Bezier segment, or a closed curve with a C0 knot
             out += [{"index": int(b.index) + offset, "index_of": "control point",
                      "param": None, "measure": float(b.value),
                      "measure_name": "z = D^2 (Cheng-Yu)",
