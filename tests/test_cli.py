@@ -114,7 +114,8 @@ MALFORMED = {
     "empty.csv": ("", "empty"),
     "nocurve.csv": ("x,y\n", "no data"),
     "nan.csv": ("x,y\n1,1\n2,nan\n3,1\n4,2\n", "nan.csv:3"),
-    "dup.csv": ("x,y\n1,1\n2,1\n2,1\n3,1\n", "dup.csv:4"),
+    # (an exact repeat is dropped with a warning; one closer than rounding error is refused)
+    "dup.csv": ("x,y\n1,1\n2,1\n2.0000000000000004,1\n3,1\n", "dup.csv:4"),
 }
 
 

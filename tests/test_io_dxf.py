@@ -298,8 +298,14 @@ def test_no_curves_and_nan(tmp_path):
     doc = ezdxf.new("R2010")
     doc.modelspace().add_lwpolyline([(0, 0), (1, 1), (1, 1), (2, 0)])
     doc.saveas(tmp_path / "d.dxf")
+    with pytest.warns(UserWarning, match="dropped 1 exactly repeated"):
+        recs = read_curves(tmp_path / "d.dxf", corner_angle=None)
+    assert recs[0].points.shape == (3, 2)
+    doc = ezdxf.new("R2010")
+    doc.modelspace().add_lwpolyline([(0, 0), (1, 1), (1 + 2e-16, 1), (2, 0)])
+    doc.saveas(tmp_path / "d2.dxf")
     with pytest.raises(FileFormatError, match="duplicate consecutive"):
-        read_curves(tmp_path / "d.dxf")
+        read_curves(tmp_path / "d2.dxf")
 
 
 def test_real_libdxfrw_file(tmp_path):

@@ -236,7 +236,7 @@ def test_property_round_trip(tmp_path_factory, n, seed, sep, dim, dec):
     ("0 0 0 0\n1 1 1 1\n", 1, "2 or 3 columns"),
     ("0,0\n1,nan\n2,2\n", 2, "non-finite"),
     ("0,0\n1,inf\n2,2\n", 2, "non-finite"),
-    ("0,0\n1,1\n1,1\n2,2\n", 3, "duplicate consecutive"),
+    ("0,0\n1,1\n1.0000000000000002,1\n2,2\n", 3, "duplicate consecutive"),
     ("0,0\n", None, "at least 2 points"),
     ("0,0\n1,1\n2,2\n3,\n", 4, "not a row of numbers"),
 ])
@@ -364,10 +364,22 @@ def test_lednicer_truncated(tmp_path):
 
 
 def test_airfoil_garbage_after_data(tmp_path):
+    # text after the coordinates is a note (kept); coordinates after it are refused
     p = _write(tmp_path / "g.dat", "FOIL\n1 0\n0.5 0.1\n0 0\n0.5 -0.1\n1 0\nmodified 2013\n")
-    with pytest.raises(FileFormatError, match="not a row of numbers") as exc:
+    assert read_curves(p)[0].source["notes"] == ("modified 2013",)
+    p = _write(tmp_path / "g.dat", "FOIL\n1 0\n0.5 0.1\nmodified 2013\n0 0\n0.5 -0.1\n1 0\n")
+    with pytest.raises(FileFormatError, match="after the text at line 4") as exc:
         read_curves(p)
-    assert exc.value.line == 7
+    assert exc.value.line == 5
+
+
+def test_points_exact_duplicate_row_dropped(tmp_path):
+    p = _write(tmp_path / "d.csv", "0,0\n1,1\n1,1\n2,0\n3,1\n")
+    with pytest.warns(UserWarning, match="dropped 1 exactly repeated consecutive point.*line 3"):
+        (rec,) = read_curves(p, corner_angle=None)
+    np.testing.assert_array_equal(rec.points, [[0, 0], [1, 1], [2, 0], [3, 1]])
+    write_curves(tmp_path / "o.csv", rec.with_curve(rec.curve.replace(points=rec.points + 1)))
+    assert (tmp_path / "o.csv").read_text() == "1,1\n2,2\n2,2\n3,1\n4,2\n"
 
 
 def test_airfoil_to_csv_and_back(tmp_path):

@@ -222,8 +222,8 @@ def test_arcs_are_unsupported(tmp_path):
     ("<html><path d='M 0 0 L 1 1'/></html>", "not <svg>", None),
     ("<svg xmlns='http://www.w3.org/2000/svg'><path d='M 0 0 L 1 nan L 2 2'/></svg>",
      "bad path data|non-finite", None),
-    ("<svg xmlns='http://www.w3.org/2000/svg'><rect width='1' height='1'/></svg>",
-     "no curves", None),
+    ("<svg xmlns='http://www.w3.org/2000/svg'><text>1</text><rect width='0' height='1'/>"
+     "</svg>", "no curves", None),
 ])
 def test_malformed_svg(tmp_path, text, match, line):
     p = tmp_path / "bad.svg"

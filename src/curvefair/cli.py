@@ -183,10 +183,67 @@ def _fair_arguments() -> set[str]:
             if p.kind is not p.VAR_KEYWORD}
 
 
-def _read(path: str, corner_angle: float | None) -> list[Any]:
+def _warn(message: str, quiet: bool) -> None:
+    """One warning on stderr (``Warning: ...``), unless ``--quiet``."""
+    if not quiet:
+        click.echo(f"Warning: {message}", err=True)
+
+
+@contextlib.contextmanager
+def _warnings_to_stderr(quiet: bool, prefix: str = "",
+                        into: list[str] | None = None) -> Iterator[None]:
+    """Show the library's warnings raised inside the block as ``Warning:`` lines on stderr
+    (and collect them in ``into``), instead of Python's warning format."""
+    import warnings
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            yield
+        finally:
+            seen: set[str] = set()
+            for w in caught:
+                msg = prefix + str(w.message)
+                if msg in seen:
+                    continue
+                seen.add(msg)
+                if into is not None:
+                    into.append(str(w.message))
+                _warn(msg, quiet)
+
+
+def _read(path: str, corner_angle: float | None, strict: bool = False,
+          quiet: bool = False) -> list[Any]:
+    """The records of a file; entities curvefair cannot represent are skipped with a warning
+    (kept untouched on write-back) unless ``strict``, which refuses the file."""
     from . import read_curves
 
-    return read_curves(path, corner_angle=corner_angle)
+    seen: list[str] = []
+    try:
+        with _warnings_to_stderr(quiet, into=seen):
+            return read_curves(path, corner_angle=corner_angle,
+                               on_unsupported="raise" if strict else "skip")
+    except CurvefairError as exc:
+        skipped = sum(": skipped " in w for w in seen)
+        if skipped:
+            raise InputFailure(f"{exc} ({skipped} unsupported entit"
+                               f"{'y' if skipped == 1 else 'ies'} skipped"
+                               + (")" if quiet else ", see the warnings)")
+                               ) from None
+        if strict and "on_unsupported='skip'" in str(exc):
+            raise InputFailure(f"{exc}; without --strict the curvefair command skips it with "
+                               "a warning") from None
+        raise
+
+
+def _nothing_to_fair(rec: Any) -> bool:
+    """A point list of two points (a straight segment between corners, e.g. a rectangle's
+    side): no interior point, nothing a fairing method could move."""
+    pts = getattr(rec, "points", None)
+    if pts is None:
+        return False
+    n = len(pts) - (1 if getattr(rec.curve, "closed", False) else 0)
+    return n <= 2
 
 
 def _record_label(rec: Any, i: int) -> str:
@@ -201,6 +258,10 @@ def _reading_options(f: Any) -> Any:
                           "there into separate curves (the corner is kept fixed).")(f)
     f = click.option("--no-corners", is_flag=True,
                      help="Never split point lists at corners.")(f)
+    f = click.option("--strict", is_flag=True,
+                     help="Refuse a file holding an entity curvefair cannot represent exactly "
+                          "(rational or degree-1 splines, arcs, ...) [default: skip it with a "
+                          "warning and write it back untouched].")(f)
     return f
 
 
@@ -304,6 +365,44 @@ _CHENG_YU_KINDS = {1: "inflection (Cheng-Yu kind 1)", 2: "curvature extremum (Ch
                    3: "convexity (Cheng-Yu kind 3)"}
 
 
+def _c0_pieces(curve: Any) -> list[tuple[int, Any]]:
+    """An open clamped B-spline cut at its C0 knots (interior knots of multiplicity >= degree:
+    the curve passes through a control point there, a corner or a kink), as ``(index of the
+    piece's first control point in the curve, piece)``; ``[(0, curve)]`` when there are none.
+
+    With ``u = t_{k+1} = ... = t_{k+p}`` the curve is ``P_k`` at ``u``, and the two pieces are
+    the B-splines on ``P_0..P_k`` with knots ``t_0..t_{k+p}, u`` and on ``P_k..P_{n-1}`` with
+    knots ``u, t_{k+1}..t_{n+p}`` (the B-spline basis is local: no control point changes).
+    Closed curves are returned whole (their discrete curvature needs no split unless a C0
+    knot is present, which then makes :func:`curvefair.bad_points` refuse them).
+    """
+    import numpy as np
+
+    from . import BSplineCurve
+
+    p = curve.degree
+    if curve.closed:
+        return [(0, curve)]
+    t = np.asarray(curve.knots, dtype=float)
+    P = np.asarray(curve.control_points, dtype=float)
+    inner, counts = np.unique(t[p + 1:-p - 1], return_counts=True)
+    cuts = []
+    for u, m in zip(inner, counts, strict=True):
+        if m >= p:
+            k = int(np.searchsorted(t, u, side="left")) - 1   # t_{k+1} = u
+            cuts.append((int(k + m - p), u))
+    if not cuts:
+        return [(0, curve)]
+    out = []
+    start = 0
+    for k in [c for c, _ in cuts] + [P.shape[0] - 1]:
+        # P_start..P_k on the knots t_{start+1}..t_{k+p}, each end knot once more
+        knots = np.r_[t[start + 1], t[start + 1:k + p + 1], t[k + p]]
+        out.append((start, BSplineCurve(P[start:k + 1], knots, p)))
+        start = k
+    return out
+
+
 def _bad_point_list(curve: Any, a: Any) -> list[dict[str, Any]]:
     """The ranked bad points of a curve, from the library's measures.
 
@@ -315,10 +414,21 @@ def _bad_point_list(curve: Any, a: Any) -> list[dict[str, Any]]:
     from . import BSplineCurve, bad_points
 
     if isinstance(curve, BSplineCurve) and curve.degree == 3:
-        return [{"index": int(b.index), "index_of": "control point", "param": None,
-                 "measure": float(b.value), "measure_name": "z = D^2 (Cheng-Yu)",
-                 "kind": _CHENG_YU_KINDS.get(int(b.kind), str(b.kind)),
-                 "kinds": [int(k) for k in b.kinds]} for b in bad_points(curve)]
+        out = []
+        pieces = _c0_pieces(curve)
+        for piece, (offset, sub) in enumerate(pieces):
+            try:
+                found = bad_points(sub)
+            except CurvefairError:
+                continue   # a single Bezier segment, or a closed curve with a C0 knot
+            out += [{"index": int(b.index) + offset, "index_of": "control point",
+                     "param": None, "measure": float(b.value),
+                     "measure_name": "z = D^2 (Cheng-Yu)",
+                     "kind": _CHENG_YU_KINDS.get(int(b.kind), str(b.kind)),
+                     "kinds": [int(k) for k in b.kinds]}
+                    | ({"piece": piece} if len(pieces) > 1 else {}) for b in found]
+        out.sort(key=lambda b: -b["measure"])
+        return out
     import numpy as np
 
     jumps, name, kind = np.asarray(a.jumps), "|Δr'''|", "third-derivative jump"
@@ -344,13 +454,13 @@ def _bad_point_list(curve: Any, a: Any) -> list[dict[str, Any]]:
 @_reading_options
 @_quiet_option
 def analyze_cmd(infile: str, as_json: bool, top: int, corner_angle: float, no_corners: bool,
-                quiet: bool) -> None:
+                strict: bool, quiet: bool) -> None:
     """Analyse every curve of IN: energies, inflections, curvature extrema, the worst jumps,
     and the ranked list of bad points (index, measure, kind)."""
     from . import analyze
 
     with _user_errors():
-        records = _read(infile, _corner(corner_angle, no_corners))
+        records = _read(infile, _corner(corner_angle, no_corners), strict, quiet)
         out = []
         for i, rec in enumerate(records):
             a = analyze(rec.curve)
@@ -426,15 +536,16 @@ def analyze_cmd(infile: str, as_json: bool, top: int, corner_angle: float, no_co
 def plot_cmd(infile: str, other: str | None, out: str, comb_scale: float | None,
              comb_density: int | None, no_comb: bool, no_markers: bool, tol: float | None,
              projection: str, title: str | None, corner_angle: float, no_corners: bool,
-             quiet: bool) -> None:
+             strict: bool, quiet: bool) -> None:
     """Draw the curves of IN with their curvature combs and curvature plots into FIG."""
     _check_figure_path(out, "-o/--output")
     from .plot import figure
 
     corner = _corner(corner_angle, no_corners)
     with _user_errors():
-        curves = [r.curve for r in _read(infile, corner)]
-        others = None if other is None else [r.curve for r in _read(other, corner)]
+        curves = [r.curve for r in _read(infile, corner, strict, quiet)]
+        others = None if other is None else [r.curve for r in _read(other, corner, strict,
+                                                                      quiet)]
         labels = (Path(infile).name, Path(other).name if other else "")
         fig = figure(curves, compare=others, labels=labels, tol=tol, comb=not no_comb,
                      comb_scale=comb_scale, comb_density=comb_density, markers=not no_markers,
@@ -484,6 +595,8 @@ def _summary_card(row: dict[str, Any]) -> Any:
     """One curve's before/after summary as a narrow table."""
     from rich.table import Table
 
+    if row["status"] == "nothing to fair":
+        return f"[bold]#{row['index']} {row['label']}[/bold]: nothing to fair (two points)"
     if row["status"] != "ok":
         return f"[bold]#{row['index']} {row['label']}[/bold]: [red]failed[/red] (error below)"
     r = row["report"]
@@ -512,6 +625,10 @@ def _summary_table(rows: list[dict[str, Any]]) -> Any:
                       ("time", "right")):
         t.add_column(col, justify=just)  # type: ignore[arg-type]
     for row in rows:
+        if row["status"] == "nothing to fair":
+            t.add_row(str(row["index"]), row["label"], "nothing to fair", "0 (two points)", "-",
+                      "-", "-", "-", "0", "-")
+            continue
         if row["status"] != "ok":
             t.add_row(str(row["index"]), row["label"], "[red]failed[/red]", "-", "-", "-", "-",
                       "-", "(error below)", "-")
@@ -574,7 +691,7 @@ def fair_cmd(infile: str, out: str | None, in_place: bool, method: str | None,
              decimals: int | None, report: str | None,
              history: bool,
              plot_path: str | None, corner_angle: float, no_corners: bool,
-             quiet: bool) -> None:
+             strict: bool, quiet: bool) -> None:
     """Fair every curve in IN and write them to OUT.
 
     Prints a before/after table: strain energy, largest third-derivative jump, inflections,
@@ -612,7 +729,7 @@ def fair_cmd(infile: str, out: str | None, in_place: bool, method: str | None,
             out_fmt = detect_format(out)
         except CurvefairError:
             out_fmt = in_fmt
-        records = _read(infile, _corner(corner_angle, no_corners))
+        records = _read(infile, _corner(corner_angle, no_corners), strict, quiet)
     from . import fair, write_curves
 
     rows: list[dict[str, Any]] = []
@@ -624,23 +741,36 @@ def fair_cmd(infile: str, out: str | None, in_place: bool, method: str | None,
             label = _record_label(rec, i)
             row: dict[str, Any] = {"index": i, "label": label, "name": rec.name,
                                    "kind": rec.kind}
+            if _nothing_to_fair(rec):
+                row.update(status="nothing to fair",
+                           note="two points (a straight piece between corners): no interior "
+                                "point to move; written back unchanged")
+                faired.append(rec)
+                rows.append(row)
+                if prog is not None:
+                    prog[0].advance(prog[1])
+                continue
+            notes: list[str] = []
             try:
-                res = fair(rec.curve, method, tol=tol, eps=eps, max_steps=max_steps,
-                           clamp=clamp, protect=_local_protect(rec, user_protect), mode=mode,
-                           **options)
+                with _warnings_to_stderr(quiet, f"{infile}: curve {i} ({label}): ", notes):
+                    res = fair(rec.curve, method, tol=tol, eps=eps, max_steps=max_steps,
+                               clamp=clamp, protect=_local_protect(rec, user_protect),
+                               mode=mode, **options)
             except CurvefairError as exc:
                 row.update(status="failed", error=str(exc))
                 faired.append(rec)
             else:
                 row.update(status="ok", report=res.report)
+                if notes:
+                    row["warnings"] = notes
                 if history:
                     row["history"] = res.history.to_dict()
                 faired.append(rec.with_curve(res.curve))
             rows.append(row)
             if prog is not None:
                 prog[0].advance(prog[1])
-    failures = [r for r in rows if r["status"] != "ok"]
-    wrote_out = len(failures) < len(rows)  # nothing faired: nothing to write
+    failures = [r for r in rows if r["status"] == "failed"]
+    wrote_out = len(failures) < len(rows)  # every curve failed: nothing to write
     with _user_errors():
         if wrote_out:
             write_curves(out, faired, template=infile if out_fmt == in_fmt else None,
@@ -661,8 +791,11 @@ def fair_cmd(infile: str, out: str | None, in_place: bool, method: str | None,
                             "clamp": clamp, "protect": user_protect, "mode": mode,
                             "method_options": {k: _option_default(v)
                                                for k, v in options.items()},
-                            "corner_angle": _corner(corner_angle, no_corners)},
-                "n_curves": len(rows), "n_failed": len(failures), "output_written": wrote_out,
+                            "corner_angle": _corner(corner_angle, no_corners),
+                            "strict": strict},
+                "n_curves": len(rows), "n_failed": len(failures),
+                "n_nothing_to_fair": sum(r["status"] == "nothing to fair" for r in rows),
+                "output_written": wrote_out,
                 "time_s": time.perf_counter() - t0, "curves": rows})
     if not quiet:
         con = _console()

@@ -82,6 +82,7 @@ Closed curves: every point is eligible, the seam is point 0, ``clamp`` is ignore
 from __future__ import annotations
 
 import time
+import warnings
 from functools import partial
 from typing import Any
 
@@ -393,6 +394,18 @@ def hermite_driver(curve: HermiteSpline, *, method: str, tol: float | None, eps:
         reason = "nothing_to_move"
     else:
         reason = "tolerance" if np.any(blocked == 1) else "converged"
+    interior = set(range(1, nd - 1))
+    if n_elig == 0 and held and interior and interior <= set(held) | set(protect):
+        # the G2 hold of a short C2 cubic spline covers every interior point: say why
+        # nothing moved (the hold is exact, from hold_zone_cubic; see the module docstring)
+        note = (f"clamp='g2' on this {nd}-point C2 cubic spline holds the points next to each "
+                f"G2-clamped end ({len(held)} in all) so that no move can change the end "
+                "curvature, and that covers every interior point: nothing was moved. For an "
+                "exact G2 clamp on a short curve use mode='hermite' (CLI: --mode hermite) or "
+                "a quintic spline (interpolate_quintic), or clamp='g1'")
+        extra["g2_hold_covers_all"] = True
+        extra["note"] = note
+        warnings.warn(note, UserWarning, stacklevel=2)
     if not (np.isfinite(P).all() and np.isfinite(D).all()):  # pragma: no cover - safety net
         raise FloatingPointError(f"method {method!r} produced non-finite data")
     new = rebuild(curve, P, D)

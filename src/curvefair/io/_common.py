@@ -37,6 +37,7 @@ __all__ = [
     "split_at_corners",
     "points_curve",
     "check_points",
+    "drop_duplicates",
 ]
 
 #: What a record's ``kind`` can say the file held.
@@ -244,6 +245,45 @@ def check_points(pts: FloatArray, path: object, lines: Sequence[int | None] | No
             raise FileFormatError(
                 f"duplicate consecutive {what}s {i} and {i + 1}{where}: {pts[i].tolist()}",
                 path, ln)
+
+
+def drop_duplicates(pts: FloatArray, path: object, lines: Sequence[int | None] | None = None,
+                    what: str = "point") -> tuple[FloatArray, np.ndarray]:
+    """Drop exactly-duplicate consecutive points, with a warning naming them.
+
+    A point equal in every coordinate to the one before it carries no geometry (exporters
+    write them at the joins of pieces) but makes the chord-length parameterisation singular.
+    Points that are merely close stay and are refused by :func:`check_points`.
+
+    Returns
+    -------
+    kept : ndarray, shape (k, dim)
+        The points without the repeats.
+    where : int ndarray, shape (m,)
+        For every input point, the index in ``kept`` of the point it is (a dropped repeat maps
+        to its twin), to write the repeat back with its twin's value.
+    """
+    pts = np.asarray(pts, dtype=float)
+    m = pts.shape[0]
+    if m < 2:
+        return pts, np.arange(m)
+    rep = np.r_[False, np.all(pts[1:] == pts[:-1], axis=1)]
+    if not rep.any():
+        return pts, np.arange(m)
+    where = np.cumsum(~rep) - 1
+    drop = np.flatnonzero(rep)
+    if lines is not None and lines[int(drop[0])] is not None:
+        at = ", ".join(f"line {lines[int(i)]}" for i in drop[:5])
+    else:
+        at = ", ".join(f"{what} {int(i)}" for i in drop[:5])
+    more = f" and {drop.size - 5} more" if drop.size > 5 else ""
+    import warnings
+
+    warnings.warn(f"{os.fspath(path) if path is not None else '<data>'}: dropped "  # type: ignore[arg-type]
+                  f"{drop.size} exactly repeated consecutive {what}(s) ({at}{more}); they are "
+                  "written back with the value of the point they repeat", UserWarning,
+                  stacklevel=3)
+    return pts[~rep], where
 
 
 def turning_angles(points: FloatArray, closed: bool) -> FloatArray:

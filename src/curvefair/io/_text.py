@@ -154,6 +154,14 @@ class TextLayout:
     column_decimals : tuple of int
         Largest number of decimals per column in the file.
     encoding : str
+    values : ndarray, shape (rows, ncols)
+    leading : tuple of int
+        0-based indices of the non-numeric lines before the data other than the header
+        (``notes=True``: further name or remark lines, a line of a different number of
+        numbers); written back verbatim.
+    notes_from : int or None
+        0-based index of the first line of the trailing notes (``notes=True``): every line
+        from there on is text after the coordinates, written back verbatim.
     """
 
     lines: tuple[str, ...]
@@ -166,6 +174,8 @@ class TextLayout:
     column_decimals: tuple[int, ...]
     encoding: str
     values: FloatArray
+    leading: tuple[int, ...] = ()
+    notes_from: int | None = None
 
     @property
     def header_text(self) -> str | None:
@@ -240,21 +250,31 @@ def read_lines(path: str | os.PathLike[str]) -> tuple[list[str], str, bool, str]
 
 
 def parse_text(path: str | os.PathLike[str], *, header: bool = True,
-               ncols: Sequence[int] = (2, 3), what: str = "points file") -> TextLayout:
+               ncols: Sequence[int] = (2, 3), what: str = "points file",
+               notes: bool = False) -> TextLayout:
     """Parse a numeric text file into a :class:`TextLayout`.
 
     Comments start with ``#`` (whole lines or after the numbers), blank lines are kept, one
     non-numeric line before the first data row is the header (or the name line of an airfoil)
     when ``header`` is True. Separators: blanks, commas or semicolons.
 
+    ``notes=True`` (airfoil files, where remarks, URLs and ``Thickness: 7.99%`` lines are
+    common): every line before the first row of ``ncols`` numbers is a leading line (the
+    first non-blank one the header), and the first non-numeric line after the data starts
+    the trailing notes, which run to the end of the file. Both are kept verbatim
+    (:attr:`TextLayout.leading`, :attr:`TextLayout.notes_from`).
+
     Raises
     ------
     FileFormatError
         Empty file, no data, a non-numeric line among the data, a different number of columns
-        than the first data row, a column count not in ``ncols``.
+        than the first data row, a column count not in ``ncols``; with ``notes=True``, a row of
+        ``ncols`` numbers after the notes began (notes between coordinates are ambiguous).
     """
     lines, newline, final, encoding = read_lines(path)
     head: int | None = None
+    leading: list[int] = []
+    notes_from: int | None = None
     data_lines: list[int] = []
     rows: list[Row] = []
     width: int | None = None
@@ -263,7 +283,22 @@ def parse_text(path: str | os.PathLike[str], *, header: bool = True,
         if not s or s.startswith("#"):
             continue
         row = _split_row(line)
+        if notes and notes_from is not None:
+            if row is not None and len(row.tokens) == width:
+                raise FileFormatError(
+                    f"a row of {width} numbers after the text at line {notes_from + 1} that "
+                    "ends the coordinates (notes between coordinates are not read)", path, i + 1)
+            continue
+        if notes and not data_lines and (row is None or len(row.tokens) not in ncols):
+            if head is None and header:
+                head = i
+            else:
+                leading.append(i)
+            continue
         if row is None:
+            if notes:
+                notes_from = i
+                continue
             if not data_lines and head is None and header:
                 head = i
                 continue
@@ -293,7 +328,7 @@ def parse_text(path: str | os.PathLike[str], *, header: bool = True,
     values = np.array([[float(t.text) for t in r.tokens] for r in rows], dtype=np.float64)
     col_dec = tuple(max(r.tokens[j].decimals for r in rows) for j in range(width))
     return TextLayout(tuple(lines), newline, final, head, tuple(data_lines), tuple(rows), width,
-                      col_dec, encoding, values)
+                      col_dec, encoding, values, tuple(leading), notes_from)
 
 
 def fresh_text(values: FloatArray, *, sep: str, header: str | None = None,

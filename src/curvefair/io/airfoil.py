@@ -8,6 +8,13 @@ Lednicer
     surface from leading to trailing edge, then the lower surface from leading to trailing edge
     (usually separated by blank lines; both usually start with the same leading-edge point).
 
+Any lines before the coordinates are kept (the first non-blank one is the name; further
+name or remark lines, or a line of more than two numbers, are leading lines), and so is any
+text after them (``Thickness: 7.99%``, remarks, URLs: the trailing notes, from the first line
+that is not two numbers to the end of the file); both are written back verbatim. Exactly
+repeated consecutive points are dropped with a warning and written back with the value of
+the point they repeat.
+
 Records
 -------
 The contour in Selig order (Lednicer: upper reversed, then lower, the shared leading-edge
@@ -17,7 +24,8 @@ split there). ``name`` is the name line. ``source`` keys: ``layout`` (TextLayout
 ``airfoil_layout``
 (``"selig"`` or ``"lednicer"``), ``counts`` (Lednicer ``(NU, NL)``), ``row_map`` (file data row ->
 contour point; the count line is row 0 of a Lednicer file and maps to -1), ``indices``,
-``n_points``, ``closed`` (always False), ``piece``, ``n_pieces``.
+``n_points``, ``closed`` (always False), ``piece``, ``n_pieces``, ``leading_lines`` (lines
+before the data other than the name line) and ``notes`` (the trailing lines), as text.
 
 Writing
 -------
@@ -39,6 +47,7 @@ from ._common import (
     CurveRecord,
     atomic_write,
     check_points,
+    drop_duplicates,
     joined_points,
     piece_values,
     point_records,
@@ -57,7 +66,7 @@ def _is_count_row(v: np.ndarray) -> bool:
 def read(path: str | os.PathLike[str], *, corner_angle: float | None = 90.0,
          **_: Any) -> list[CurveRecord]:
     """Read a Selig or Lednicer airfoil file; see the module docstring."""
-    lay = parse_text(path, header=True, ncols=(2,), what="airfoil file")
+    lay = parse_text(path, header=True, ncols=(2,), what="airfoil file", notes=True)
     vals = lay.values
     lines = lay.line_numbers()
     name = lay.header_text.strip() if lay.header is not None else None
@@ -71,30 +80,36 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 90.0,
                 f"points, the file has {got}" + (" (truncated?)" if got < nu + nl else ""),
                 path, lines[-1])
         upper, lower = pts[:nu], pts[nu:]
-        check_points(upper, path, lines[1:nu + 1])
-        check_points(lower, path, lines[nu + 1:])
         shared = bool(np.array_equal(upper[0], lower[0]))
-        contour = np.vstack([upper[::-1], lower[1:] if shared else lower])
+        raw = np.vstack([upper[::-1], lower[1:] if shared else lower])
         lo_map = np.arange(nl) + (nu - 1 if shared else nu)
         # upper row i (LE -> TE) is contour point nu-1-i; the count line maps to -1
-        row_map = np.r_[-1, nu - 1 - np.arange(nu), lo_map]
+        raw_map = np.r_[-1, nu - 1 - np.arange(nu), lo_map]
         kind_layout = "lednicer"
         counts: tuple[int, int] | None = (nu, nl)
-        contour_lines = [lines[1 + nu - 1 - i] for i in range(nu)] + \
+        raw_lines = [lines[1 + nu - 1 - i] for i in range(nu)] + \
             [lines[1 + nu + j] for j in range(1 if shared else 0, nl)]
     else:
-        contour = vals
-        row_map = np.arange(vals.shape[0])
+        raw = vals
+        raw_map = np.arange(vals.shape[0])
         kind_layout = "selig"
         counts = None
-        contour_lines = lines
+        raw_lines = lines
+    # exactly repeated consecutive points: dropped (written back with their twin's value)
+    contour, where = drop_duplicates(raw, path, raw_lines)
+    row_map = np.where(raw_map < 0, -1, where[np.maximum(raw_map, 0)])
+    keep = np.r_[True, where[1:] != where[:-1]] if where.size else where.astype(bool)
+    contour_lines = [ln for ln, k in zip(raw_lines, keep, strict=True) if k]
     check_points(contour, path, contour_lines)
     if contour.shape[0] < 3:
         raise FileFormatError(f"an airfoil needs at least 3 points, got {contour.shape[0]}",
                               path)
+    notes = () if lay.notes_from is None else lay.lines[lay.notes_from:]
     src = {"format": FORMAT, "path": os.path.abspath(path), "layout": lay,
            "airfoil_layout": kind_layout, "counts": counts,
-           "row_map": tuple(int(i) for i in row_map)}
+           "row_map": tuple(int(i) for i in row_map),
+           "leading_lines": tuple(lay.lines[i] for i in lay.leading),
+           "notes": tuple(notes)}
     return point_records(contour, closed=False, corner_angle=corner_angle, kind="airfoil",
                          name=name, source=src, end_corners=True)
 

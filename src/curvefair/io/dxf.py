@@ -60,6 +60,7 @@ from ._common import (
     bspline_of,
     check_points,
     data_points,
+    drop_duplicates,
     is_clamped,
     joined_points,
     piece_values,
@@ -104,9 +105,12 @@ def _spline_record(e: Any, base: dict[str, Any], path: object, corner_angle: flo
         if fits.shape[0] < 2:
             raise FileFormatError(f"SPLINE {base['handle']} has neither control points nor 2 "
                                   "fit points", path)
-        check_points(fits, path, None, what=f"SPLINE {base['handle']} fit point")
+        what = f"SPLINE {base['handle']} fit point"
+        fits, where = drop_duplicates(fits, path, None, what=what)
+        check_points(fits, path, None, what=what)
         pts, z = planar(fits)
         distinct, row_map, closed = _ring(pts, closed_flag)
+        row_map = row_map[where]
         src = dict(base, z=z, row_map=tuple(int(i) for i in row_map),
                    has_end_tangents=bool(e.dxf.hasattr("start_tangent")))
         return point_records(distinct, closed=closed, corner_angle=None, kind="fit_points",
@@ -179,9 +183,15 @@ def _polyline_record(e: Any, base: dict[str, Any], path: object,
         pts, z = planar(xyz)
     if pts.shape[0] < 2:
         raise FileFormatError(f"{kind} {base['handle']} has fewer than 2 vertices", path)
-    check_points(pts, path, None, what=f"{kind} {base['handle']} vertex")
+    what = f"{kind} {base['handle']} vertex"
+    pts, where = drop_duplicates(pts, path, None, what=what)
+    if pts.shape[0] < 2:
+        raise FileFormatError(f"{kind} {base['handle']} has fewer than 2 distinct vertices",
+                              path)
+    check_points(pts, path, None, what=what)
     closed_flag = bool(e.closed) if kind == "LWPOLYLINE" else bool(e.is_closed)
     distinct, row_map, closed = _ring(pts, closed_flag)
+    row_map = row_map[where]
     src = dict(base, z=z, row_map=tuple(int(i) for i in row_map))
     return point_records(distinct, closed=closed, corner_angle=corner_angle, kind="polyline",
                          name=base["name"], source=src, first_index=index)

@@ -4,8 +4,9 @@ Layout read
 -----------
 2 or 3 columns (x y [z]) separated by blanks, commas or semicolons; ``#`` starts a comment
 (whole line or after the numbers); one non-numeric line before the data is a header (kept);
-blank lines are kept. A file whose last row repeats the first (4 rows or more) is a closed
-loop. One point list per file.
+blank lines are kept. A row exactly equal to the row before it is dropped with a warning (and
+written back with its twin's value). A file whose last row repeats the first (4 rows or more)
+is a closed loop. One point list per file.
 
 Records
 -------
@@ -37,6 +38,7 @@ from ._common import (
     CurveRecord,
     atomic_write,
     check_points,
+    drop_duplicates,
     joined_points,
     piece_values,
     point_records,
@@ -54,17 +56,20 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 90.0,
     lay = parse_text(path, header=True, ncols=(2, 3), what="points file")
     vals = lay.values
     lines = lay.line_numbers()
-    check_points(vals, path, lines)
+    # exactly repeated consecutive rows: dropped, written back with their twin's value
+    vals, where = drop_duplicates(vals, path, lines)
+    keep = np.r_[True, where[1:] != where[:-1]]
+    check_points(vals, path, [ln for ln, k in zip(lines, keep, strict=True) if k])
     R = vals.shape[0]
     if R < 2:
         raise FileFormatError(f"a curve needs at least 2 points, the file has {R}", path)
     loop = R >= 4 and bool(np.array_equal(vals[0], vals[-1]))
     if loop:
         distinct = vals[:-1]
-        row_map = np.r_[np.arange(R - 1), 0]
+        row_map = np.where(where == R - 1, 0, where)
     else:
         distinct = vals
-        row_map = np.arange(R)
+        row_map = where
     name = os.path.splitext(os.path.basename(path))[0]
     src = {"format": FORMAT, "path": os.path.abspath(path), "layout": lay,
            "row_map": tuple(int(i) for i in row_map), "header": lay.header_text}

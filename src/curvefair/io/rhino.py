@@ -61,6 +61,7 @@ from ._common import (
     bspline_of,
     check_points,
     data_points,
+    drop_duplicates,
     is_clamped,
     joined_points,
     lazy_import,
@@ -192,12 +193,16 @@ def _polyline(xyz: FloatArray, base: dict[str, Any], path: object,
               corner_angle: float | None, index: int) -> list[CurveRecord]:
     if xyz.shape[0] < 2:
         raise FileFormatError(f"object {base['id']}: fewer than 2 vertices", path)
-    check_points(xyz, path, None, what=f"object {base['id']} vertex")
+    what = f"object {base['id']} vertex"
+    xyz, where = drop_duplicates(xyz, path, None, what=what)
+    if xyz.shape[0] < 2:
+        raise FileFormatError(f"object {base['id']}: fewer than 2 distinct vertices", path)
+    check_points(xyz, path, None, what=what)
     pts, z = planar(xyz)
     n = pts.shape[0]
     closed = n >= 4 and bool(np.array_equal(pts[0], pts[-1]))
     distinct = pts[:-1] if closed else pts
-    row_map = np.r_[np.arange(n - 1), 0] if closed else np.arange(n)
+    row_map = (np.r_[np.arange(n - 1), 0] if closed else np.arange(n))[where]
     src = dict(base, z=z, row_map=tuple(int(k) for k in row_map))
     return point_records(distinct, closed=closed, corner_angle=corner_angle, kind="polyline",
                          name=base["name"], source=src, first_index=index)

@@ -1,11 +1,14 @@
-"""SVG ``<path>`` elements through svgpathtools (``pip install 'curvefair[svg]'``).
+"""SVG shape elements through svgpathtools (``pip install 'curvefair[svg]'``).
 
 Read
 ----
-Every ``<path>`` element, in document order, split into its continuous subpaths:
+Every ``<path>``, ``<polygon>``, ``<polyline>``, ``<line>`` and ``<rect>`` element, in document
+order and with any namespace prefix (``<svg:path>``); each path is split into its continuous
+subpaths:
 
-- subpaths of straight segments only -> ``kind="polyline"``: the vertices (closed if the
-  subpath ends where it starts), split at corners like every point list;
+- subpaths of straight segments only, polygons (closed), polylines, lines and rectangles
+  (closed; rounded ones are unsupported) -> ``kind="polyline"``: the vertices (a path subpath
+  is closed if it ends where it starts), split at corners like every point list;
 - subpaths of cubic Beziers (quadratic Beziers and straight segments among them are
   degree-elevated, exactly) -> ``kind="bspline"``: a cubic :class:`~curvefair.BSplineCurve`
   equal to the chain. The parameter width of each segment follows the tangent-length ratio at
@@ -15,21 +18,32 @@ Every ``<path>`` element, in document order, split into its continuous subpaths:
   all joins get multiplicity 3, which is exact by construction). A closed chain is periodic
   when every join including the closing one is C2, otherwise an open curve from the start
   point round to it;
-- subpaths with elliptical arcs: unsupported (``on_unsupported``).
+- subpaths with elliptical arcs, ``<circle>`` and ``<ellipse>``: unsupported
+  (``on_unsupported``; skipped ones stay untouched in a write-back): an arc is not a
+  polynomial curve, and an approximation would move it without the user asking.
 
 Segments of length zero (an ``L`` to the current point, as matplotlib writes at the end of
 closed lines) carry no geometry and are dropped; a subpath rewritten on write-back loses them.
+Exactly repeated consecutive vertices are dropped with a warning (written back with their
+twin's value).
 
-Coordinates are the path's own user units (``transform`` attributes are not applied; they are
-kept in ``source["transform"]``). ``source`` keys: ``element`` (index among the ``<path>``
-elements), ``id``, ``subpath``, ``n_subpaths``, ``svg_closed``, ``beziers`` (the original
-segments of a bspline record, to tell unchanged curves) and the point-list keys.
+Coordinates are those of the document: the element's current transformation matrix (the
+product of its own and its ancestors' ``transform`` attributes, SVG 1.1 sec. 7.5, parsed by
+svgpathtools) is applied on read, and its inverse on write, so the file keeps every element's
+own coordinates and ``transform`` attributes. ``source`` keys: ``element`` (index among the
+curve elements), ``node`` (index among all elements), ``tag``, ``id``, ``subpath``,
+``n_subpaths``, ``svg_closed``, ``transform`` (the element's own attribute), ``ctm`` (the
+2x3 matrix row by row, or None for the identity), ``beziers`` (the original segments of a
+bspline record, in document coordinates, to tell unchanged curves) and the point-list keys.
 
 Write
 -----
-With ``template=`` the source text is copied and only the ``d`` attribute of the ``<path>``
-elements whose curves changed is rewritten (absolute ``M``/``L``/``C``/``Z`` commands, every
-other subpath of the element as it was; everything else in the file byte for byte). A
+With ``template=`` the source bytes are copied and only the ``d`` attribute of the ``<path>``
+elements whose curves changed (the ``points`` of a polygon/polyline, ``x1 y1 x2 y2`` of a
+line; a changed ``<rect>`` is refused) is rewritten, at the byte offsets the XML parser
+(expat) reports for the element, so text inside comments or CDATA is never edited
+(absolute ``M``/``L``/``C``/``Z`` commands, every other subpath of the element as it was,
+in the element's own coordinates; everything else in the file byte for byte). A
 B-spline is written as its cubic Bezier pieces (one per knot span: the same number of
 segments as read when the knots are unchanged). Without a template, a new SVG holding one
 ``<path>`` per curve (cubic curves only: degree <= 3). Numbers of a rewritten element get the
@@ -59,6 +73,7 @@ from ._common import (
     bezier_pieces,
     check_points,
     data_points,
+    drop_duplicates,
     joined_points,
     lazy_import,
     piece_values,
@@ -68,8 +83,6 @@ from ._common import (
 __all__ = ["read", "write", "bezier_chain_to_bspline"]
 
 FORMAT = "svg"
-_PATH_TAG_RE = re.compile(r"<path\b[^>]*?>", re.DOTALL)
-_D_RE = re.compile(r"""(\sd\s*=\s*)(["'])(.*?)\2""", re.DOTALL)
 
 
 def _svgpathtools(what: str) -> Any:
@@ -213,15 +226,63 @@ def _segments_to_cubics(seg: Any, spt: Any) -> FloatArray:
     return np.array(out, dtype=float)
 
 
-def _path_elements(text: str, path: object) -> list[ET.Element]:
+_SHAPES = ("path", "polygon", "polyline", "rect", "circle", "ellipse", "line")
+_NUM_LIST_RE = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
+
+
+def _local(tag: object) -> str:
+    """Local name of an element tag: ``{ns}path``, ``svg:path`` and ``path`` are ``path``."""
+    t = str(tag)
+    return t.rsplit("}", 1)[-1].rsplit(":", 1)[-1]
+
+
+def _root(text: str, path: object) -> ET.Element:
     try:
         root = ET.fromstring(text)
     except ET.ParseError as exc:
         line = exc.position[0] if hasattr(exc, "position") else None
         raise FileFormatError(f"not well-formed XML ({exc})", path, line) from None
-    if not (root.tag == "svg" or root.tag.endswith("}svg")):
+    if _local(root.tag) != "svg":
         raise FileFormatError(f"the root element is <{root.tag}>, not <svg>", path)
-    return [el for el in root.iter() if el.tag == "path" or str(el.tag).endswith("}path")]
+    return root
+
+
+def _shape_elements(root: ET.Element, spt: Any, path: object
+                    ) -> list[tuple[int, ET.Element, np.ndarray | None]]:
+    """(index in document order among all elements, element, 2x3 affine matrix or None)
+    of every curve element, the matrix being the product of the ``transform`` attributes of
+    the element and its ancestors (its current transformation matrix, SVG 1.1 sec. 7.5)."""
+    out: list[tuple[int, ET.Element, np.ndarray | None]] = []
+    count = 0
+
+    def walk(el: ET.Element, ctm: np.ndarray) -> None:
+        nonlocal count
+        k = count
+        count += 1
+        tf = el.get("transform")
+        if tf is not None and tf.strip():
+            with warnings.catch_warnings():
+                warnings.simplefilter("error")
+                try:
+                    m = np.asarray(spt.parser.parse_transform(tf), dtype=float)
+                except Exception as exc:  # SVGSyntaxWarning, ValueError
+                    raise FileFormatError(f"<{_local(el.tag)}> element (id={el.get('id')!r}): "
+                                          f"bad transform {tf!r} ({exc})", path) from None
+            ctm = ctm @ m
+        if _local(el.tag) in _SHAPES:
+            ident = np.allclose(ctm, np.eye(3), rtol=0, atol=0)
+            out.append((k, el, None if ident else ctm[:2].copy()))
+        for child in el:
+            walk(child, ctm)
+
+    walk(root, np.eye(3))
+    return out
+
+
+def _path_elements(text: str, path: object) -> list[ET.Element]:
+    """The ``<path>`` elements of an SVG text in document order (any namespace prefix)."""
+    root = _root(text, path)
+    return [el for el in root.iter() if _local(el.tag) == "path"]
 
 
 def _read_text(path: object) -> str:
@@ -236,42 +297,146 @@ def _read_text(path: object) -> str:
         raise FileFormatError(f"not UTF-8 text ({exc.reason})", path) from None
 
 
+def _apply(m: np.ndarray | None, xy: FloatArray) -> FloatArray:
+    """Points (..., 2) mapped by the affine matrix ``m`` (2x3), or unchanged when None."""
+    if m is None:
+        return xy
+    return xy @ m[:, :2].T + m[:, 2]
+
+
+def _unapply(m: np.ndarray | None, xy: FloatArray) -> FloatArray:
+    """Points (..., 2) mapped back by the inverse of ``m`` (document -> element coords)."""
+    if m is None:
+        return xy
+    return np.linalg.solve(m[:, :2], (xy - m[:, 2]).reshape(-1, 2).T).T.reshape(xy.shape)
+
+
+def _points_attr(el: ET.Element, what: str, path: object) -> FloatArray:
+    """The ``points`` of a ``<polygon>``/``<polyline>`` (SVG 1.1 sec. 9.7: numbers separated
+    by blanks and/or one comma; an odd count drops the last, as browsers do, with an error
+    here instead)."""
+    raw = el.get("points") or ""
+    nums = _NUM_LIST_RE.findall(raw)
+    rest = _NUM_LIST_RE.sub(" ", raw).replace(",", " ").strip()
+    if rest:
+        raise FileFormatError(f"{what}: bad points attribute (unexpected {rest[:20]!r})", path)
+    if len(nums) % 2:
+        raise FileFormatError(f"{what}: odd number of coordinates in points", path)
+    return np.asarray([float(v) for v in nums], dtype=float).reshape(-1, 2)
+
+
+def _length(el: ET.Element, name: str, what: str, path: object) -> float:
+    v = (el.get(name) or "0").strip()
+    try:
+        return float(v)
+    except ValueError:
+        raise Unsupported(f"{name}={v!r} (only plain user units are read)") from None
+
+
 def read(path: str | os.PathLike[str], *, corner_angle: float | None = 90.0,
          on_unsupported: str = "raise", **_: Any) -> list[CurveRecord]:
-    """Read the curves of the ``<path>`` elements of an SVG file; see the module docstring."""
+    """Read the curves of the shape elements of an SVG file; see the module docstring."""
     spt = _svgpathtools("reading SVG files")
     text = _read_text(path)
     if not text.strip():
         raise FileFormatError("empty SVG file", path)
-    elements = _path_elements(text, path)
+    root = _root(text, path)
     records: list[CurveRecord] = []
     apath = os.path.abspath(path)
-    for k, el in enumerate(elements):
+
+    def skip(msg: str) -> None:
+        if on_unsupported == "raise":
+            raise FileFormatError(msg + " (read_curves(..., on_unsupported='skip') skips it)",
+                                  path) from None
+        warnings.warn(f"{os.fspath(path)}: skipped {msg}; kept untouched", UserWarning,
+                      stacklevel=4)
+
+    k = -1
+    for node, el, ctm in _shape_elements(root, spt, path):
+        tag = _local(el.tag)
+        ident = el.get("id")
+        base = {"format": FORMAT, "path": apath, "id": ident, "tag": tag, "node": node,
+                "transform": el.get("transform"),
+                "ctm": None if ctm is None else tuple(float(v) for v in ctm.reshape(-1))}
+        what = f"<{tag}> element (id={ident!r})"
+        if tag in ("circle", "ellipse"):
+            skip(f"{what}: unsupported <{tag}> (elliptical arcs are not polynomial curves)")
+            continue
+        k += 1
+        base["element"] = k
+        if tag in ("polygon", "polyline", "line", "rect"):
+            try:
+                pts, closed = _shape_points(el, tag, what, path)
+            except Unsupported as exc:
+                skip(f"{what}: unsupported {exc}")
+                continue
+            if pts.shape[0] < 2:
+                continue
+            pts = _apply(ctm, pts)
+            name = ident or f"{tag}{k}"
+            base.update(subpath=0, n_subpaths=1, svg_closed=closed)
+            try:
+                records.extend(_polyline_records(pts, closed, base, name, corner_angle, path,
+                                                 len(records)))
+            except Unsupported as exc:
+                skip(f"{what}: unsupported {exc}")
+            continue
         d = el.get("d")
         if d is None or not d.strip():
             continue
         try:
             parsed = spt.parse_path(d)
         except Exception as exc:  # svgpathtools raises ValueError/IndexError on bad data
-            raise FileFormatError(f"<path> element {k} (id={el.get('id')!r}): bad path data "
+            raise FileFormatError(f"<path> element {k} (id={ident!r}): bad path data "
                                   f"({type(exc).__name__}: {exc})", path) from None
         subs = parsed.continuous_subpaths() if len(parsed) else []
         for j, sub in enumerate(subs):
-            ident = el.get("id")
             name = f"{ident or 'path' + str(k)}" + (f"/{j}" if len(subs) > 1 else "")
-            base = {"format": FORMAT, "path": apath, "element": k, "id": ident, "subpath": j,
-                    "n_subpaths": len(subs), "transform": el.get("transform"),
-                    "svg_closed": bool(sub.isclosed())}
+            sbase = dict(base, subpath=j, n_subpaths=len(subs), svg_closed=bool(sub.isclosed()))
             try:
-                records.extend(_subpath_records(sub, spt, base, name, corner_angle, path,
-                                                len(records)))
+                records.extend(_subpath_records(sub, spt, sbase, name, corner_angle, path,
+                                                len(records), ctm))
             except Unsupported as exc:
-                msg = f"<path> element {k} (id={ident!r}) subpath {j}: unsupported {exc}"
-                if on_unsupported == "raise":
-                    raise FileFormatError(msg + " (read_curves(..., on_unsupported='skip') "
-                                          "skips it)", path) from None
-                warnings.warn(f"{os.fspath(path)}: skipped {msg}", UserWarning, stacklevel=3)
+                skip(f"<path> element {k} (id={ident!r}) subpath {j}: unsupported {exc}")
     return records
+
+
+def _shape_points(el: ET.Element, tag: str, what: str, path: object
+                  ) -> tuple[FloatArray, bool]:
+    """Vertices (in element coordinates) and closedness of a polygon, polyline, line or rect."""
+    if tag in ("polygon", "polyline"):
+        return _points_attr(el, what, path), tag == "polygon"
+    if tag == "line":
+        xy = [_length(el, n, what, path) for n in ("x1", "y1", "x2", "y2")]
+        return np.asarray(xy, dtype=float).reshape(2, 2), False
+    x, y, w, h = (_length(el, n, what, path) for n in ("x", "y", "width", "height"))
+    if el.get("rx") not in (None, "0") or el.get("ry") not in (None, "0"):
+        raise Unsupported("<rect> with rounded corners (elliptical arcs)")
+    if not (w > 0 and h > 0):
+        return np.zeros((0, 2)), True          # not rendered (SVG 1.1 sec. 9.2)
+    return np.array([[x, y], [x + w, y], [x + w, y + h], [x, y + h]], dtype=float), True
+
+
+def _polyline_records(pts: FloatArray, closed: bool, base: dict[str, Any], name: str,
+                      corner_angle: float | None, path: object, index: int
+                      ) -> list[CurveRecord]:
+    """Records of a vertex list (polyline subpath, polygon, polyline, line, rect): exact
+    repeats dropped (written back with their twin), a closed list not repeating its start."""
+    what = f"<{base['tag']}> element {base['element']} vertex"
+    if closed and pts.shape[0] > 1 and np.array_equal(pts[0], pts[-1]):
+        pts = pts[:-1]
+    kept, where = drop_duplicates(pts, path, None, what=what)
+    if closed and kept.shape[0] > 1 and np.array_equal(kept[0], kept[-1]):
+        kept = kept[:-1]
+        where = np.where(where == kept.shape[0], 0, where)
+    check_points(kept, path, None, what=what)
+    if closed and kept.shape[0] < 3:
+        closed = False
+    if kept.shape[0] < 2:
+        return []
+    src = dict(base, row_map=tuple(int(i) for i in where), n_vertices=int(pts.shape[0]))
+    return point_records(kept, closed=closed, corner_angle=corner_angle, kind="polyline",
+                         name=name, source=src, first_index=index)
 
 
 def _degenerate(g: Any, spt: Any) -> bool:
@@ -286,8 +451,8 @@ def _degenerate(g: Any, spt: Any) -> bool:
 
 
 def _subpath_records(sub: Any, spt: Any, base: dict[str, Any], name: str,
-                     corner_angle: float | None, path: object, index: int
-                     ) -> list[CurveRecord]:
+                     corner_angle: float | None, path: object, index: int,
+                     ctm: np.ndarray | None = None) -> list[CurveRecord]:
     closed = bool(sub.isclosed())
     segs = [g for g in sub if not _degenerate(g, spt)]
     if not segs:
@@ -295,16 +460,15 @@ def _subpath_records(sub: Any, spt: Any, base: dict[str, Any], name: str,
     sub = spt.Path(*segs)
     if all(isinstance(g, spt.Line) for g in sub):
         pts = np.array([_xy(g.start) for g in sub] + [_xy(sub[-1].end)], dtype=float)
-        check_points(pts, path, None, what=f"<path> element {base['element']} vertex")
-        distinct = pts[:-1] if closed else pts
-        if closed and distinct.shape[0] < 3:
-            distinct, closed = pts, False
-        src = dict(base, row_map=tuple(range(distinct.shape[0])))
-        return point_records(distinct, closed=closed, corner_angle=corner_angle,
-                             kind="polyline", name=name, source=src, first_index=index)
+        if not np.isfinite(pts).all():
+            raise FileFormatError(f"<path> element {base['element']}: non-finite coordinate",
+                                  path)
+        return _polyline_records(_apply(ctm, pts), closed, base, name, corner_angle, path,
+                                 index)
     P = _segments_to_cubics(sub, spt)
     if not np.isfinite(P).all():
         raise FileFormatError(f"<path> element {base['element']}: non-finite coordinate", path)
+    P = _apply(ctm, P)
     curve = bezier_chain_to_bspline(P, closed)
     src = dict(base, index=index, beziers=P.tolist())
     return [CurveRecord(curve, name, "bspline", src)]
@@ -363,17 +527,25 @@ def _d_original(sub: Any, spt: Any, decimals: int | None) -> str:
     return " ".join(out)
 
 
-def _record_d(recs: list[CurveRecord], decimals: int | None) -> tuple[str, bool]:
-    """The d of one subpath from its record(s), and whether it changed."""
+def _ctm(src: Any) -> np.ndarray | None:
+    m = src.get("ctm")
+    return None if m is None else np.asarray(m, dtype=float).reshape(2, 3)
+
+
+def _record_geometry(recs: list[CurveRecord]) -> tuple[str, FloatArray | None]:
+    """``("bspline", Bezier points (m, 4, 2))`` or ``("points", vertices (n, 2))`` of one
+    subpath / shape, in the ELEMENT's own coordinates (the inverse of its transformation
+    matrix applied), or ``(kind, None)`` when the record(s) hold the geometry read."""
     r0 = recs[0]
+    ctm = _ctm(r0.source)
     if r0.kind == "bspline":
         curve = r0.curve
         B = bezier_pieces(curve, "write_curves (SVG)", max_degree=3)
         orig = np.asarray(r0.source.get("beziers", []), dtype=float)
         scale = max(float(np.abs(orig).max()) if orig.size else 1.0, 1.0)
         if orig.shape == B.shape and np.abs(orig - B).max() <= 1e-12 * scale:
-            return "", False
-        return _d_cubics(B, bool(r0.source.get("svg_closed", curve.closed)), decimals), True
+            return "bspline", None
+        return "bspline", _unapply(ctm, B)
     n = int(r0.source["n_points"])
     dim = data_points(r0.curve, "write_curves (SVG)").shape[1]
     pts = piece_values(n, dim, recs, "write_curves (SVG)")
@@ -381,8 +553,97 @@ def _record_d(recs: list[CurveRecord], decimals: int | None) -> tuple[str, bool]
     for r in recs:
         orig[np.asarray(r.source["indices"])] = np.asarray(r.points)
     if np.array_equal(orig, pts):
+        return "points", None
+    full = pts[np.asarray(r0.source.get("row_map", range(n)), dtype=int)]
+    return "points", _unapply(ctm, full)
+
+
+def _record_d(recs: list[CurveRecord], decimals: int | None) -> tuple[str, bool]:
+    """The d of one subpath from its record(s), and whether it changed."""
+    kind, geo = _record_geometry(recs)
+    if geo is None:
         return "", False
-    return _d_points(pts, bool(r0.source.get("closed")), decimals), True
+    r0 = recs[0]
+    if kind == "bspline":
+        return _d_cubics(geo, bool(r0.source.get("svg_closed", r0.curve.closed)), decimals), True
+    return _d_points(geo, bool(r0.source.get("closed")), decimals), True
+
+
+def _start_tag_attrs(raw: bytes, i: int) -> dict[str, tuple[int, int]]:
+    """Byte spans of the attribute values of the start tag beginning at ``raw[i] == '<'``.
+
+    The tag was accepted by the XML parser, so it is ``< Name (S Attr = "value")* S? /? >``
+    (XML 1.0 production 40): names, blanks, ``=`` and quoted values, nothing else."""
+    ws = b" \t\r\n"
+    j = i + 1
+    while raw[j] not in ws and raw[j] not in b"/>":
+        j += 1
+    out: dict[str, tuple[int, int]] = {}
+    while True:
+        while raw[j] in ws:
+            j += 1
+        if raw[j] in b"/>":
+            return out
+        a = j
+        while raw[j] not in ws and raw[j] != 0x3D:      # '='
+            j += 1
+        name = raw[a:j].decode("utf-8", "replace")
+        while raw[j] in ws:
+            j += 1
+        j += 1                                          # '='
+        while raw[j] in ws:
+            j += 1
+        quote = raw[j]
+        start = j + 1
+        j = raw.index(bytes([quote]), start)
+        out[name] = (start, j)
+        j += 1
+
+
+def _locate(raw: bytes, path: object) -> tuple[list[dict[str, tuple[int, int]]], int]:
+    """For every element of the document in order (the order of ``ElementTree.iter``), the
+    byte spans of its attribute values, and the byte offset of the root's end tag.
+
+    Found with expat (the XML parser under ElementTree), which reports the byte offset of
+    every start tag: comments, CDATA and processing instructions that merely contain
+    ``<path d=...`` text are never taken for elements, and namespace prefixes (``<svg:path>``)
+    are elements like any other."""
+    import xml.parsers.expat as expat
+
+    starts: list[int] = []
+    depth = 0
+    root_end = -1
+    parser = expat.ParserCreate()
+
+    def start(name: str, attrs: Any) -> None:
+        nonlocal depth
+        starts.append(parser.CurrentByteIndex)
+        depth += 1
+
+    def end(name: str) -> None:
+        nonlocal depth, root_end
+        depth -= 1
+        if depth == 0:
+            root_end = parser.CurrentByteIndex
+
+    parser.StartElementHandler = start
+    parser.EndElementHandler = end
+    try:
+        parser.Parse(raw, True)
+    except expat.ExpatError as exc:
+        raise FileFormatError(f"not well-formed XML ({exc})", path, exc.lineno) from None
+    return [_start_tag_attrs(raw, i) for i in starts], root_end
+
+
+def _attr_value(raw: bytes, span: tuple[int, int]) -> str:
+    """An attribute value as the XML parser reads it (entities, blanks normalised)."""
+    text = raw[span[0]:span[1]].decode("utf-8")
+    return html.unescape(re.sub(r"\r\n|[\r\n\t]", " ", text))
+
+
+def _decimals_of(text: str) -> int | None:
+    found = re.findall(r"\.(\d+)", text)
+    return max((len(f) for f in found), default=None)
 
 
 def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
@@ -396,60 +657,72 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
         atomic_write(path, _fresh_svg(others, decimals))
         return
     text = _read_text(template)
-    elements = _path_elements(text, template)
-    tags = list(_PATH_TAG_RE.finditer(text))
-    spans: list[tuple[int, int, str]] = []
-    for mt in tags:
-        md = _D_RE.search(mt.group(0))
-        if md is None:
-            spans.append((-1, -1, ""))
-            continue
-        # XML attribute-value normalisation: line breaks and tabs read as blanks
-        value = html.unescape(re.sub(r"\r\n|[\r\n\t]", " ", md.group(3)))
-        spans.append((mt.start() + md.start(3), mt.start() + md.end(3), value))
-    if len(spans) != len(elements) or any(
-            (el.get("d") or "") != (sp[2] if sp[0] >= 0 else "") for el, sp in
-            zip(elements, spans, strict=False)):
-        raise FileFormatError("cannot locate the <path> elements in the text of the template "
-                              "for a write-back (comments or CDATA holding '<path'?)", template)
+    with open(template, "rb") as f:
+        raw = f.read()
+    nodes = list(_root(text, template).iter())
+    spans, root_end = _locate(raw, template)
+    if len(spans) != len(nodes):
+        raise FileFormatError("cannot locate the elements in the text of the template for a "
+                              "write-back", template)
     by_el: dict[int, dict[int, list[CurveRecord]]] = {}
     for r in ours:
-        by_el.setdefault(int(r.source["element"]), {}).setdefault(
+        if "node" not in r.source:
+            raise InputError("write_curves (SVG): a record without source['node'] (read by an "
+                             "older curvefair?); read the template again")
+        by_el.setdefault(int(r.source["node"]), {}).setdefault(
             int(r.source["subpath"]), []).append(r)
     edits: list[tuple[int, int, str]] = []
-    for k, subs in sorted(by_el.items()):
-        parsed = spt.parse_path(elements[k].get("d"))
+
+    def edit(node: int, attr: str, value: str) -> None:
+        el, sp = nodes[node], spans[node].get(attr)
+        if sp is None or _attr_value(raw, sp) != (el.get(attr) or ""):
+            raise FileFormatError(f"cannot locate the {attr} attribute of <{_local(el.tag)}> "
+                                  f"element (id={el.get('id')!r}) in the template text",
+                                  template)
+        edits.append((sp[0], sp[1], html.escape(value, quote=True)))
+
+    for node, subs in sorted(by_el.items()):
+        el = nodes[node]
+        tag = _local(el.tag)
+        if tag != "path":
+            kind, geo = _record_geometry(subs[0])
+            if geo is None:
+                continue
+            if tag == "rect":
+                raise InputError(f"write_curves (SVG): <rect> element (id={el.get('id')!r}) "
+                                 "changed; a rectangle is written back only unchanged")
+            if tag == "line":
+                for name, v in zip(("x1", "y1", "x2", "y2"), geo.reshape(-1), strict=True):
+                    dec = decimals if decimals is not None else _decimals_of(el.get(name) or "")
+                    edit(node, name, _num(v, dec))
+                continue
+            dec = decimals if decimals is not None else _decimals_of(el.get("points") or "")
+            edit(node, "points", " ".join(_pt(p, dec) for p in geo))
+            continue
+        parsed = spt.parse_path(el.get("d"))
         originals = parsed.continuous_subpaths()
+        d_text = el.get("d") or ""
+        changed = any(_record_d(subs[j], None)[1] for j in subs)
+        if not changed:
+            continue
+        # the precision of the element as it was: its largest number of decimals
+        dec = decimals if decimals is not None else _decimals_of(d_text)
         pieces = []
-        changed = False
         for j, sub in enumerate(originals):
-            if j in subs:
-                d, ch = _record_d(subs[j], decimals)
-                changed |= ch
-                pieces.append(d if ch else _d_original(sub, spt, None))
-            else:
-                pieces.append(_d_original(sub, spt, None))
-        if changed and decimals is None:
-            # the precision of the element as it was: its largest number of decimals
-            found = re.findall(r"\.(\d+)", elements[k].get("d") or "")
-            dec = max((len(f) for f in found), default=None)
-            if dec is not None:
-                pieces = []
-                for j, sub in enumerate(originals):
-                    d, ch = _record_d(subs[j], dec) if j in subs else ("", False)
-                    pieces.append(d if ch else _d_original(sub, spt, None))
-        if changed:
-            edits.append((spans[k][0], spans[k][1], html.escape(" ".join(pieces), quote=True)))
+            d, ch = _record_d(subs[j], dec) if j in subs else ("", False)
+            pieces.append(d if ch else _d_original(sub, spt, None))
+        edit(node, "d", " ".join(pieces))
     for a, b, new in sorted(edits, reverse=True):
-        text = text[:a] + new + text[b:]
+        raw = raw[:a] + new.encode("utf-8") + raw[b:]
     if others:
         extra = "".join(f'<path d="{_record_path_d(r, decimals)}" fill="none" stroke="black"/>\n'
                         for r in _join_foreign(others))
-        close = text.rfind("</svg>")
-        if close < 0:
+        if root_end < 0:
             raise FileFormatError("no closing </svg> tag", template)
-        text = text[:close] + extra + text[close:]
-    atomic_write(path, text)
+        shift = sum(len(new.encode("utf-8")) - (b - a) for a, b, new in edits if a < root_end)
+        at = root_end + shift
+        raw = raw[:at] + extra.encode("utf-8") + raw[at:]
+    atomic_write(path, raw)
 
 
 def _join_foreign(records: Sequence[CurveRecord]) -> list[CurveRecord]:
