@@ -31,7 +31,7 @@ from .errors import InputError
 
 __all__ = ["as_points", "as_vectors", "as_params", "as_positive", "choice", "check_finite",
            "as_nonnegative", "as_step_count", "as_count", "as_eval_params", "check_magnitude",
-           "MAX_MAGNITUDE", "MIN_EXTENT", "MIN_STEP", "MAX_STEPS"]
+           "magnitude", "MAX_MAGNITUDE", "MIN_EXTENT", "MIN_STEP", "MAX_STEPS"]
 
 #: Largest accepted magnitude of a coordinate, parameter, knot or tolerance.
 MAX_MAGNITUDE = 1e30
@@ -57,6 +57,15 @@ def check_finite(arr: FloatArray, name: str) -> None:
         else:
             where_s = f"index {where[0] if len(where) == 1 else where}"
         raise InputError(f"{name} contains a non-finite value {arr[tuple(idx)]!r} at {where_s}")
+
+
+def magnitude(arr: FloatArray) -> float:
+    """``max |arr|``, at least the smallest normal float: the scale for relative closeness
+    tests (``|a - b| <= rtol * magnitude``). No floor at 1: data of size 1e-20 compare at
+    their own scale, not as if they were all one point."""
+    if arr.size == 0:
+        return float(np.finfo(float).tiny)
+    return max(float(arr.max()), -float(arr.min()), float(np.finfo(float).tiny))
 
 
 def check_magnitude(arr: FloatArray, name: str, limit: float = MAX_MAGNITUDE) -> None:

@@ -28,7 +28,7 @@ from scipy.interpolate import BSpline, make_interp_spline, make_lsq_spline
 from scipy.sparse import csr_matrix
 
 from .._typing import ArrayLike, FloatArray
-from .._validate import (_as_float, as_count, as_params, as_points,
+from .._validate import (_as_float, as_count, as_params, as_points, magnitude,
                          check_steps)
 from ..errors import InputError
 from .parameterize import parameterize
@@ -392,7 +392,7 @@ class BSplineCurve(PiecewiseCurve):
             period = t[p:p + n + 1]
             T = period[-1] - period[0]
             dt = np.diff(t)
-            scale = max(float(np.abs(t).max()), 1.0)
+            scale = magnitude(t)
             bad = np.flatnonzero(np.abs(dt[n:] - dt[:-n]) > 1e-10 * scale)
             if bad.size:
                 i = int(bad[0])
@@ -605,7 +605,7 @@ class BSplineCurve(PiecewiseCurve):
             n = c.shape[0] - k
             if n < k + 1:
                 raise InputError(f"periodic spline has too few coefficients ({c.shape[0]})")
-            scale = max(float(np.abs(c).max()), 1.0)
+            scale = magnitude(c)
             if not np.allclose(c[n:], c[:k], rtol=0.0, atol=1e-10 * scale):
                 raise InputError("closed=True needs the last k coefficients of spl.c to repeat "
                                  "the first k (scipy's periodic layout)")
@@ -630,7 +630,7 @@ class BSplineCurve(PiecewiseCurve):
 def _closed_data(points: ArrayLike, param: Any) -> tuple[FloatArray, FloatArray]:
     """Distinct points (first not repeated) and their parameters plus the closing one."""
     pts = as_points(points, "points", min_points=3)
-    scale = max(float(np.abs(pts).max()), 1.0)
+    scale = magnitude(pts)
     if np.allclose(pts[0], pts[-1], rtol=0.0, atol=1e-12 * scale):
         pts = pts[:-1]
     loop = np.vstack([pts, pts[:1]])
