@@ -468,3 +468,57 @@ def test_fair_scalars_only_curvefair_errors_or_within_tol(method, tol_exp, steps
         u = np.linspace(*c.domain, 2001)
         ref = CubicHermiteSpline(np.array(c.params), np.array(c.points), np.array(c.tangents))
         assert np.linalg.norm(out(u) - ref(u), axis=1).max() <= tol * (1 + 1e-9)
+
+
+# ----------------------------------------------------------------------------------------------
+# files: the same window in the readers (FileFormatError naming the file and line) and no
+# traceback from the CLI
+# ----------------------------------------------------------------------------------------------
+def _write_files(tmp_path, scale):
+    import json
+
+    import ezdxf
+
+    P = wave() * scale
+    out = {}
+    out["csv"] = tmp_path / "p.csv"
+    np.savetxt(out["csv"], P, delimiter=",")
+    out["json"] = tmp_path / "p.json"
+    out["json"].write_text(json.dumps({"schema_version": 1, "curves": [
+        {"type": "points", "points": P.tolist()}]}))
+    doc = ezdxf.new()
+    doc.modelspace().add_spline(P)  # fit points, as ezdxf writes them
+    out["dxf"] = tmp_path / "p.dxf"
+    doc.saveas(out["dxf"])
+    return out
+
+
+@pytest.mark.parametrize("scale", [1e200, 1e-200])
+def test_files_outside_the_window_give_a_file_format_error(tmp_path, scale):
+    for fmt, path in _write_files(tmp_path, scale).items():
+        with pytest.raises(cf.CurvefairError, match=r"magnitudes up to|across") as exc:
+            cf.read_curves(path)
+        assert "p." + fmt in str(exc.value)
+    # inside the window the same files read back as written (checked against numpy's parse)
+    for fmt, path in _write_files(tmp_path, 2.0**-90).items():
+        recs = cf.read_curves(path)
+        got = np.asarray(recs[0].points if recs[0].points is not None else
+                         recs[0].curve.sample(2))
+        assert np.isfinite(got).all() and np.abs(got).max() < 1e-25, fmt
+
+
+def test_cli_reports_out_of_range_and_deeply_nested_files_without_traceback(tmp_path):
+    from click.testing import CliRunner
+
+    from curvefair.cli import main
+
+    files = list(_write_files(tmp_path, 1e200).values())
+    deep = tmp_path / "deep.json"
+    deep.write_text("[" * 100_000 + "]" * 100_000)
+    files.append(deep)
+    for path in files:
+        r = CliRunner().invoke(main, ["fair", str(path), "--tol", "0.01", "-o",
+                                      str(tmp_path / ("out_" + path.name))])
+        assert r.exit_code != 0
+        assert r.exception is None or isinstance(r.exception, SystemExit), repr(r.exception)
+        assert "Traceback" not in r.output and path.name in r.output
