@@ -396,6 +396,22 @@ def test_frozen_copy_does_not_share_the_callers_array():
     assert c.points[3, 0] == wave()[3, 0] and c.tangents[3, 0] == 1.0
 
 
+def test_result_arrays_cannot_be_made_writeable():
+    c = cf.interpolate_cubic(wave())
+    res = cf.fair(c, tol=0.05)
+    an = cf.analyze(c)
+    dev = cf.deviation(c, res.curve)
+    disc = cf.second_discrete_curvature(cf.interpolate_bspline(wave(), 3))
+    arrays = [res.history.step, res.history.index, res.history.measure,
+              res.history.displacement, dev.point_a, dev.point_b]
+    arrays += [v for v in vars(an).values() if isinstance(v, np.ndarray)]
+    arrays += [v for v in vars(disc).values() if isinstance(v, np.ndarray)]
+    assert len(arrays) > 10
+    for arr in arrays:
+        with pytest.raises(ValueError):
+            arr.setflags(write=True)
+
+
 def test_curve_record_points_cannot_be_made_writeable():
     from curvefair.io import CurveRecord
 

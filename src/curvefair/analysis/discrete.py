@@ -31,8 +31,9 @@ __all__ = [
 
 
 def _readonly(a: np.ndarray) -> np.ndarray:
-    a.setflags(write=False)
-    return a
+    from ..curves.piecewise import readonly
+
+    return readonly(np.asarray(a))
 
 
 def _cross2(a: FloatArray, b: FloatArray) -> FloatArray:

@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from .._typing import FloatArray
-from ..curves.piecewise import PiecewiseCurve
+from ..curves.piecewise import PiecewiseCurve, readonly
 from ..errors import InputError
 
 __all__ = [
@@ -75,9 +75,7 @@ class FairingHistory:
             raise InputError("history arrays must have the same length, got "
                              f"{idx.shape[0]}, {meas.shape[0]}, {disp.shape[0]}")
         arrs = [np.arange(1, idx.shape[0] + 1, dtype=np.int64), idx, meas, disp]
-        for a in arrs:
-            a.setflags(write=False)
-        return cls(*arrs)
+        return cls(*[readonly(a) for a in arrs])
 
     @classmethod
     def empty(cls) -> "FairingHistory":
