@@ -539,3 +539,22 @@ def test_cli_reports_out_of_range_and_deeply_nested_files_without_traceback(tmp_
         assert r.exit_code != 0
         assert r.exception is None or isinstance(r.exception, SystemExit), repr(r.exception)
         assert "Traceback" not in r.output and path.name in r.output
+
+
+@pytest.mark.parametrize("extra", [(1, 0), (0, 1), (2, 2)])
+def test_from_scipy_drops_end_knots_repeated_beyond_degree_plus_one(extra):
+    """scipy accepts an end knot k+2 times (the first basis function vanishes on the domain);
+    the converted curve equals scipy's spline on the domain and its end knots are (k+1)-fold."""
+    k = 3
+    rng = np.random.default_rng(5)
+    inner = np.array([1.0, 2.0, 2.5, 4.0])
+    t = np.r_[[0.0] * (k + 1 + extra[0]), inner, [5.0] * (k + 1 + extra[1])]
+    c = rng.normal(size=(t.shape[0] - k - 1, 2))
+    spl = BSpline(t, c, k)
+    curve = cf.BSplineCurve.from_scipy(spl)
+    np.testing.assert_array_equal(curve.knots, np.r_[[0.0] * 4, inner, [5.0] * 4])
+    # scipy evaluates a (k+2)-fold end knot as 0 exactly at the end: compare on [0, 5) and
+    # the end point with scipy's left limit
+    u = np.linspace(0.0, 5.0, 101)[:-1]
+    np.testing.assert_allclose(scipy_bspline(curve)(u), spl(u), rtol=0, atol=1e-13)
+    np.testing.assert_allclose(scipy_bspline(curve)(5.0), spl(5.0 - 1e-12), rtol=0, atol=1e-9)

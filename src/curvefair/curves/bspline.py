@@ -589,6 +589,8 @@ class BSplineCurve(PiecewiseCurve):
         last ``k`` coefficients repeating the first ``k``). An unclamped open spline is converted
         to the clamped knot vector with the same interior knots (the same curve on its domain
         ``[t_k, t_n]``, found by interpolation at the Greville abscissae: exact up to rounding).
+        End knots repeated more than ``k + 1`` times are reduced to ``k + 1`` (the dropped basis
+        functions vanish on the domain), so scipy splines with them convert exactly.
         """
         if not isinstance(spl, BSpline):
             raise InputError(f"spl must be a scipy.interpolate.BSpline, got "
@@ -611,6 +613,12 @@ class BSplineCurve(PiecewiseCurve):
                                  "the first k (scipy's periodic layout)")
             return cls(c[:n], t, k, closed=True)
         n = c.shape[0]
+        # an end knot repeated more than k + 1 times (scipy allows it) makes N_0 (N_{n-1})
+        # vanish on the domain [t_k, t_n]: its coefficient is no point of the curve, drop both
+        while n > k + 1 and t[k + 1] == t[k]:
+            t, c, n = t[1:], c[1:], n - 1
+        while n > k + 1 and t[n - 1] == t[n]:
+            t, c, n = t[:n + k], c[:n - 1], n - 1
         if k >= 2 and n >= k + 1 and (np.any(t[:k + 1] != t[0]) or np.any(t[n:] != t[-1])):
             # unclamped: the same curve on [t_k, t_n] on the clamped knot vector (the space is
             # the same there), by interpolation at the Greville abscissae -- exact up to rounding
