@@ -6,18 +6,24 @@ Each function converts to float64, checks finiteness and shape, and raises
 Working range
 -------------
 Every number curvefair accepts lies in a fixed magnitude window, so that the powers its
-formulas take stay finite and normal in float64 (``1e-308 .. 1e308``): a Hermite or B-spline
-power form divides coordinates by parameter steps up to the 5th power (quintic ``a_5 ~ b /
-D^5``, cubic Gram matrices of the 3rd derivative ``~ 1 / D^5``), energies square them. With
+formulas take stay finite and normal in float64 (``1e-308 .. 1e308``): on a polynomial piece of
+parameter width ``D`` over coordinates ``x`` the derivative of order ``k`` is ``~ x / D^k``
+(quintic power coefficient ``a_5 ~ x / D^5``, cubic Gram matrices of the 3rd derivative
+``~ 1 / D^5``), and the energies square it before multiplying by ``D``. With
 
 - coordinates: ``|x| <= MAX_MAGNITUDE = 1e30`` and, unless every point is the same, an extent
-  (largest coordinate range) ``>= MIN_EXTENT = 1e-30``;
-- parameters and knots: ``|t| <= 1e30`` and every non-zero step ``>= MIN_STEP = 1e-45``;
-- tolerances and other positive scalars: ``0`` (where allowed) or ``1e-45 .. 1e30``;
+  (largest coordinate range) ``>= MIN_EXTENT = 1e-15`` (chord-length parameter steps of such
+  data stay above ``MIN_STEP`` up to 1e9 points);
+- parameters and knots: ``|t| <= 1e30`` and every non-zero step ``>= MIN_STEP = 1e-24``;
+- derivative data (tangents, second derivatives): ``|v| <= MAX_DERIVATIVE = 1e60``;
+- tolerances and other positive scalars: ``0`` (where allowed) or ``1e-24 .. 1e30``;
 
-``x / D^5 <= 1e30 / 1e-225`` and ``x^2 / D^5 <= 1e285`` stay finite. Larger or smaller data are
-refused with an :class:`~curvefair.errors.InputError` that says to rescale (change units): a
-rescaling by a power of two is exact and changes no result but by that factor.
+``x / D^5 <= 1e30 / 1e-120 = 1e150``, so even the 5th-derivative energy of a quintic
+(``(x / D^5)^2 <= 1e300``) stays finite. Larger or smaller data are refused with an
+:class:`~curvefair.errors.InputError` that says to rescale (change units): a rescaling by a
+power of two is exact and changes no result but by that factor. What still overflows (the
+power form or an energy of a high-degree B-spline near the smallest steps) is refused where it
+is computed, never returned as inf or NaN.
 """
 
 from __future__ import annotations
@@ -35,10 +41,12 @@ __all__ = ["as_points", "as_vectors", "as_params", "as_positive", "choice", "che
 
 #: Largest accepted magnitude of a coordinate, parameter, knot or tolerance.
 MAX_MAGNITUDE = 1e30
+#: Largest accepted magnitude of given derivative data (tangents, second derivatives).
+MAX_DERIVATIVE = MAX_MAGNITUDE**2
 #: Smallest accepted extent (largest coordinate range) of a set of points that are not all equal.
-MIN_EXTENT = 1e-30
+MIN_EXTENT = 1e-15
 #: Smallest accepted non-zero step between parameters or knots, and smallest positive scalar.
-MIN_STEP = 1e-45
+MIN_STEP = 1e-24
 #: Step counts above this mean the same as this (no run can take 2**62 steps); it keeps every
 #: count a valid int64 in the compiled loops, with room for ``max_steps + 1``.
 MAX_STEPS = 2**62
@@ -212,11 +220,16 @@ def check_steps(arr: FloatArray, name: str, *, strict: bool) -> None:
 
 
 def as_vectors(vectors: ArrayLike, shape: tuple[int, ...], name: str) -> FloatArray:
-    """Validate an array of the exact ``shape`` (e.g. tangents matching points); float64 copy."""
+    """Validate an array of the exact ``shape`` (e.g. tangents matching points); float64 copy.
+
+    Derivative data are bounded by ``MAX_DERIVATIVE = 1e60`` (about a coordinate of ``1e30``
+    over the smallest parameter step): the power coefficients and energies built from them
+    stay finite (see the module docstring)."""
     arr = _as_float(vectors, name)
     if arr.shape != tuple(shape):
         raise InputError(f"{name} must have shape {tuple(shape)}, got {arr.shape}")
     check_finite(arr, name)
+    check_magnitude(arr, name, MAX_DERIVATIVE)
     return arr
 
 
