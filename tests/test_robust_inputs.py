@@ -400,6 +400,20 @@ def test_every_array_of_every_curve_cannot_be_made_writeable():
         np.testing.assert_array_equal(c(u), before)
 
 
+def test_pickled_and_copied_curves_stay_immutable():
+    import copy
+    import pickle
+
+    for c in _all_curves()[:9]:
+        u = np.linspace(*c.domain, 21)
+        for d in (pickle.loads(pickle.dumps(c)), copy.deepcopy(c), copy.copy(c)):
+            np.testing.assert_array_equal(d(u), c(u))
+            for name in ATTRS:
+                if hasattr(d, name):
+                    with pytest.raises(ValueError):
+                        getattr(d, name).setflags(write=True)
+
+
 def test_frozen_copy_does_not_share_the_callers_array():
     P = wave()
     tan = np.ones_like(P)

@@ -162,6 +162,22 @@ class PiecewiseCurve(abc.ABC):
     @abc.abstractmethod
     def _make_piecewise(self) -> PiecewisePolynomial: ...
 
+    def __setstate__(self, state: dict[str, object]) -> None:
+        """Unpickling / deep copies: the arrays come back writeable, so freeze them again
+        (:func:`readonly`) and drop the caches (rebuilt on demand)."""
+        st = {}
+        for k, v in state.items():
+            if k in ("piecewise", "spans"):
+                continue
+            if k == "_gram_cache":
+                v = {}
+            elif isinstance(v, np.ndarray):
+                v = readonly(v)
+            elif isinstance(v, list):
+                v = [readonly(x) if isinstance(x, np.ndarray) else x for x in v]
+            st[k] = v
+        self.__dict__.update(st)
+
     @cached_property
     def piecewise(self) -> PiecewisePolynomial:
         """The local power form (cached; the curve is immutable)."""
