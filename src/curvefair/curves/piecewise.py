@@ -81,6 +81,14 @@ class PiecewisePolynomial:
     breaks: FloatArray
     coeffs: FloatArray
 
+    def __post_init__(self) -> None:
+        # immutable like the curves: float64 arrays in memory nobody can write (readonly)
+        for name in ("breaks", "coeffs"):
+            a = getattr(self, name)
+            if not (isinstance(a, np.ndarray) and a.dtype == np.float64):
+                a = np.asarray(a, dtype=np.float64)
+            object.__setattr__(self, name, readonly(a))
+
     @property
     def degree(self) -> int:
         return self.coeffs.shape[1] - 1
@@ -180,7 +188,7 @@ class PiecewiseCurve(abc.ABC):
 
     @cached_property
     def piecewise(self) -> PiecewisePolynomial:
-        """The local power form (cached; the curve is immutable)."""
+        """The local power form (cached; the curve is immutable; refused if it overflows)."""
         pp = self._make_piecewise()
         coeffs = pp.coeffs
         if not np.isfinite(coeffs).all():
@@ -191,7 +199,7 @@ class PiecewiseCurve(abc.ABC):
                 f"{i} (parameter width {w!r}): coordinates divided by the width to the power "
                 f"{self.degree} leave the float64 range; rescale the parameters (knots) or the "
                 f"coordinates")
-        return PiecewisePolynomial(readonly(pp.breaks), readonly(coeffs))
+        return pp
 
     @property
     def domain(self) -> tuple[float, float]:
