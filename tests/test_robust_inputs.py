@@ -204,14 +204,14 @@ def _data(kind: str) -> np.ndarray:
 
 
 @pytest.mark.parametrize("kind", list(BUILDERS))
-@pytest.mark.parametrize("s", [1e200, 1e-200, 1e300, 1e-300, 1e31, 1e-17])
+@pytest.mark.parametrize("s", [1e200, 1e-200, 1e300, 1e-300, 1e31, 1e-22])
 def test_builders_refuse_scales_outside_the_window(kind, s):
     with pytest.raises(cf.InputError, match="magnitudes up to|at least .* across"):
         BUILDERS[kind](_data(kind) * s)
 
 
 @pytest.mark.parametrize("kind", list(BUILDERS))
-@pytest.mark.parametrize("k", [-46, -30, 60, 96])
+@pytest.mark.parametrize("k", [-62, -30, 60, 96])
 def test_builders_inside_the_window_give_exact_multiples(kind, k):
     """2**k P gives 2**k times the curve at 2**k times the (chord) parameters."""
     P = _data(kind)

@@ -12,11 +12,12 @@ parameter width ``D`` over coordinates ``x`` the derivative of order ``k`` is ``
 ``~ 1 / D^5``), and the energies square it before multiplying by ``D``. With
 
 - coordinates: ``|x| <= MAX_MAGNITUDE = 1e30`` and, unless every point is the same, an extent
-  (largest coordinate range) ``>= MIN_EXTENT = 1e-15`` (chord-length parameter steps of such
-  data stay above ``MIN_STEP`` up to 1e9 points);
+  (largest coordinate range) ``>= MIN_EXTENT = 1e-20`` (chord-length parameter steps of such
+  data stay above ``MIN_STEP`` up to ~1e4 points; more need coarser units);
 - parameters and knots: ``|t| <= 1e30`` and every non-zero step ``>= MIN_STEP = 1e-24``;
 - derivative data (tangents, second derivatives): ``|v| <= MAX_DERIVATIVE = 1e60``;
-- tolerances and other positive scalars: ``0`` (where allowed) or ``1e-24 .. 1e30``;
+- tolerances and other lengths (``window=True`` in :func:`as_positive`,
+  :func:`as_nonnegative`): ``0`` (where allowed) or ``1e-24 .. 1e30``;
 
 ``x / D^5 <= 1e30 / 1e-120 = 1e150``, so even the 5th-derivative energy of a quintic
 (``(x / D^5)^2 <= 1e300``) stays finite. Larger or smaller data are refused with an
@@ -44,7 +45,7 @@ MAX_MAGNITUDE = 1e30
 #: Largest accepted magnitude of given derivative data (tangents, second derivatives).
 MAX_DERIVATIVE = MAX_MAGNITUDE**2
 #: Smallest accepted extent (largest coordinate range) of a set of points that are not all equal.
-MIN_EXTENT = 1e-15
+MIN_EXTENT = 1e-20
 #: Smallest accepted non-zero step between parameters or knots, and smallest positive scalar.
 MIN_STEP = 1e-24
 #: Step counts above this mean the same as this (no run can take 2**62 steps); it keeps every
@@ -293,8 +294,10 @@ def _check_window(v: float, value: object, name: str) -> None:
                          f"formulas take, e.g. {name}**2); {_RESCALE}")
 
 
-def as_positive(value: object, name: str, *, allow_none: bool = False) -> float | None:
-    """A finite float > 0 (or None when allowed), within ``[MIN_STEP, MAX_MAGNITUDE]``."""
+def as_positive(value: object, name: str, *, allow_none: bool = False,
+                window: bool = False) -> float | None:
+    """A finite float > 0 (or None when allowed); ``window``: a length (tolerance, scale)
+    within the working range ``[MIN_STEP, MAX_MAGNITUDE]`` (see the module docstring)."""
     if value is None:
         if allow_none:
             return None
@@ -302,7 +305,8 @@ def as_positive(value: object, name: str, *, allow_none: bool = False) -> float 
     v = _as_scalar(value, name, "a number")
     if not np.isfinite(v) or v <= 0:
         raise InputError(f"{name} must be a finite number > 0, got {value!r}")
-    _check_window(v, value, name)
+    if window:
+        _check_window(v, value, name)
     return v
 
 
@@ -316,8 +320,10 @@ def choice(value: object, valid: Iterable[str], name: str) -> str:
     return value
 
 
-def as_nonnegative(value: object, name: str, *, none_means: float | None = None) -> float:
-    """A finite float >= 0; ``None`` returns ``none_means`` (an error if that is None too)."""
+def as_nonnegative(value: object, name: str, *, none_means: float | None = None,
+                   window: bool = False) -> float:
+    """A finite float >= 0; ``None`` returns ``none_means`` (an error if that is None too);
+    ``window``: 0 or a length within the working range ``[MIN_STEP, MAX_MAGNITUDE]``."""
     if value is None:
         if none_means is None:
             raise InputError(f"{name} is required")
@@ -326,7 +332,8 @@ def as_nonnegative(value: object, name: str, *, none_means: float | None = None)
     v = _as_scalar(value, name, f"a number >= 0{alt}")
     if not np.isfinite(v) or v < 0:
         raise InputError(f"{name} must be a finite number >= 0{alt}, got {value!r}")
-    _check_window(v, value, name)
+    if window:
+        _check_window(v, value, name)
     return v
 
 

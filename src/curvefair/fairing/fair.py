@@ -492,7 +492,7 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
             + ", ".join(repr(m) for m in available_methods(curve)))
     from .._validate import as_nonnegative, as_positive, as_step_count
 
-    tol_v = as_positive(tol, "tol", allow_none=True)
+    tol_v = as_positive(tol, "tol", allow_none=True, window=True)
     eps_v = None if eps is None else as_nonnegative(eps, "eps")
     if max_steps is not None:
         max_steps = as_step_count(max_steps, default=0)
