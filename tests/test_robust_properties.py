@@ -15,7 +15,9 @@ Independent references (none uses curvefair's own energy / deviation / curvature
   derivatives at the domain ends;
 - invariance: the input transformed by a similarity ``x -> s R x + b`` (params unchanged,
   derivatives scaled by ``s R``), faired with ``s tol``, compared with the same similarity
-  applied to the faired output. ``s`` includes the extreme scales 1e-6 and 1e6.
+  applied to the faired output. ``s`` includes the extreme scales 1e-6 and 1e6 and scales near
+  the edges of the working range (``2**-60 .. 2**90``); outside it (1e-300 .. 1e300) every
+  builder and method refuses with a curvefair error.
 
 Properties covered elsewhere for a subset of methods (tests/test_fair_properties.py,
 tests/test_bspline_fairing_properties.py) are here checked through the public ``fair`` for all
@@ -282,10 +284,10 @@ def _compare_transformed(case: Case, a: cf.FairingResult, b: cf.FairingResult,
 
 
 @settings(max_examples=60 * SCALE, **SETTINGS)
-@given(cases(), st.sampled_from([1.0, 0.25, 8.0, 0.37, 5.3, 1e-6, 1e6]))
+@given(cases(), st.sampled_from([1.0, 0.25, 8.0, 0.37, 5.3, 1e-6, 1e6, 2.0**-45, 1e24]))
 def test_deterministic_and_invariant_under_similarity(case, s):
     """Same input -> identical output; rotation + translation + uniform scaling (tol scaled,
-    including the extreme scales 1e-6 and 1e6) commute with fairing."""
+    including the extreme scales 1e-6, 1e6, 2**-45 and 1e24) commute with fairing."""
     try:
         a = case.run()
     except cf.CurvefairError:
@@ -310,10 +312,12 @@ def test_deterministic_and_invariant_under_similarity(case, s):
     _compare_transformed(case, a, b, R, s, shift)
 
 
-@pytest.mark.parametrize("s", [1e-6, 1e6])
+@pytest.mark.parametrize("s", [1e-6, 1e6, 2.0**-60, 2.0**90])
 @pytest.mark.parametrize("kind", KINDS)
 def test_extreme_scales_every_method_same_moves(kind, s):
-    """Every method at 1e-6 and 1e6 coordinates (scaled tol): same steps as at scale 1."""
+    """Every method at 1e-6 and 1e6 coordinates and near the edges of curvefair's working
+    range (``2**-60 ~ 8.7e-19``, ``2**90 ~ 1.2e27``; see ``curvefair._validate``), tol scaled:
+    same steps as at scale 1."""
     rng = np.random.default_rng(11)
     pts = sample_points(rng, 10, 2, False, 0.08)
     moved = 0
@@ -339,3 +343,16 @@ def test_extreme_scales_every_method_same_moves(kind, s):
         assert all(np.isfinite(v) for v in (b.report["energy_after"],
                                             b.report["max_jump_after"]))
     assert moved > 0
+
+
+@settings(max_examples=40 * SCALE, **SETTINGS)
+@given(kind=st.sampled_from(KINDS), closed=st.booleans(), exp10=st.one_of(
+    st.floats(-300, -22), st.floats(31, 300)), seed=st.integers(0, 2**32 - 1))
+def test_outside_the_working_range_every_builder_refuses(kind, closed, exp10, seed):
+    """Coordinates of magnitude 1e31..1e300 or extent 1e-300..1e-22: a curvefair error from
+    every builder (never a NaN curve or another exception); the same points at scale 1 build."""
+    rng = np.random.default_rng(seed)
+    pts = sample_points(rng, 9, int(rng.integers(2, 4)), closed, 0.05)
+    build(kind, pts, closed)
+    with pytest.raises(cf.CurvefairError):
+        build(kind, pts * 10.0**exp10, closed)

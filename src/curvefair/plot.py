@@ -272,7 +272,7 @@ def curvature_comb(curve: PiecewiseCurve, scale: float | None = None,
     if scale is None:
         scale = _auto_scale(float(np.nanmax(np.abs(smp.kappa))), _extent(smp.flat("r")))
     else:
-        scale = float(as_positive(scale, "scale"))  # type: ignore[arg-type]
+        scale = float(as_positive(scale, "scale", window=True))  # type: ignore[arg-type]
     base = smp.flat("r")
     tip = base - scale * smp.flat("kvec")
     return Comb(base=base, tip=tip, kappa=smp.flat("kappa"), u=smp.flat("u"), scale=scale)
@@ -391,7 +391,7 @@ def _prepare(curves: Sequence[PiecewiseCurve], names: Sequence[str], comb_densit
 
 def _joint_scale(prepared: list[_Prepared], comb_scale: object) -> float:
     if comb_scale is not None:
-        return float(as_positive(comb_scale, "comb_scale"))  # type: ignore[arg-type]
+        return float(as_positive(comb_scale, "comb_scale", window=True))  # type: ignore[arg-type]
     kmax = max((float(np.nanmax(np.abs(p.comb.kappa))) for p in prepared
                 if np.any(np.isfinite(p.comb.kappa))), default=0.0)
     extent = _extent(np.vstack([p.fine.flat("r") for p in prepared]))
@@ -786,7 +786,7 @@ def plot_compare(before: PiecewiseCurve, after: PiecewiseCurve, axes: Any = None
                 + _prepare([after], ["after"], comb_density, markers, n_bad))
     proj = _projector(prepared, projection)
     scale = _joint_scale(prepared, comb_scale)
-    tol = None if tol is None else as_positive(tol, "tol")
+    tol = None if tol is None else as_positive(tol, "tol", window=True)
     _draw_curve(ax_c, prepared[0], proj, comb=comb, scale=scale, markers=markers, style=_REF,
                 label=labels[0], points=True, ref=True, bad_labels=False)
     _draw_curve(ax_c, prepared[1], proj, comb=comb, scale=scale, markers=markers, style=_MAIN,
@@ -863,7 +863,7 @@ def figure(curve: PiecewiseCurve | Sequence[PiecewiseCurve],
                          "they are paired in order")
     if labels is None:
         labels = ("curve", "compare")
-    tol = None if tol is None else as_positive(tol, "tol")
+    tol = None if tol is None else as_positive(tol, "tol", window=True)
     prep = _prepare(curves, [f"curve[{i}]" for i in range(len(curves))], comb_density,
                     markers and others is None, n_bad)
     prep_o = ([] if others is None else

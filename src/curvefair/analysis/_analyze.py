@@ -9,7 +9,7 @@ import numpy as np
 
 from .._typing import FloatArray
 from .._validate import as_positive
-from ..curves.piecewise import PiecewiseCurve
+from ..curves.piecewise import PiecewiseCurve, readonly
 from ._core import bounding_diagonal, check_curve, falling, fields_to_dict
 from ._energy import segment_energies
 from ._sampling import QUAD_RTOL, sample_curve, scan_sign_changes
@@ -25,9 +25,7 @@ PLANAR_RTOL = 1e-9
 
 
 def _ro(a: np.ndarray) -> np.ndarray:
-    a = np.ascontiguousarray(a)
-    a.setflags(write=False)
-    return a
+    return readonly(np.asarray(a))
 
 
 @dataclass(frozen=True, eq=False)

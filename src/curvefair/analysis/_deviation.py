@@ -282,7 +282,8 @@ def deviation(curve_a: object, curve_b: object) -> Deviation:
     pa = np.asarray(a(t), dtype=float).reshape(-1)
     pb = np.asarray(b(min(max(t, b0), b1)), dtype=float).reshape(-1)
     mpd, idx = _point_displacement(a, b)
-    pa.setflags(write=False)
-    pb.setflags(write=False)
+    from ..curves.piecewise import readonly
+
+    pa, pb = readonly(pa), readonly(pb)
     return Deviation(max_distance=best, upper_bound=ub, param=t, point_a=pa, point_b=pb,
                      max_point_displacement=mpd, point_index=idx)

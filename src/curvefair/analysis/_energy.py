@@ -40,7 +40,13 @@ def segment_energies(curve: object, order: int = 2) -> np.ndarray:
             # int_0^1 u^(j+k) du = 1/(j+k+1); off-diagonal pairs twice
             g = np.sum(ds[:, j, :] * ds[:, k, :], axis=1)
             acc += g * ((1.0 if j == k else 2.0) / (j + k + 1.0))
-    return h * acc
+    out = h * acc
+    if not np.isfinite(out).all():
+        i = int(np.flatnonzero(~np.isfinite(out))[0])
+        raise InputError(f"the order-{o} energy of segment {i} (parameter width {float(h[i])!r}) "
+                         f"overflows float64: the derivative ~ coordinates / width^{o} is too "
+                         f"large to square; rescale the parameters (knots) or the coordinates")
+    return out
 
 
 def energy(curve: object, order: int = 2) -> float:

@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from .._typing import ArrayLike, FloatArray
-from .._validate import as_points
+from .._validate import as_points, magnitude
 from ..errors import InputError
 
 __all__ = [
@@ -31,8 +31,9 @@ __all__ = [
 
 
 def _readonly(a: np.ndarray) -> np.ndarray:
-    a.setflags(write=False)
-    return a
+    from ..curves.piecewise import readonly
+
+    return readonly(np.asarray(a))
 
 
 def _cross2(a: FloatArray, b: FloatArray) -> FloatArray:
@@ -104,7 +105,7 @@ def discrete_curvature(points: ArrayLike, closed: bool = False) -> FloatArray:
     closed = bool(closed)
     repeated = False
     if closed:
-        scale = max(float(np.abs(pts).max()), 1.0)
+        scale = magnitude(pts)
         if n > 3 and np.all(np.abs(pts[0] - pts[-1]) <= 4 * np.finfo(float).eps * scale):
             repeated = True
             pts = pts[:-1]

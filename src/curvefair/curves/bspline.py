@@ -25,11 +25,11 @@ from typing import Any
 import numpy as np
 from scipy.interpolate import BSpline, make_interp_spline, make_lsq_spline
 from scipy.sparse import csr_matrix
-from scipy.sparse.linalg import spsolve
 
 from .._jit import njit
 from .._typing import ArrayLike, FloatArray
-from .._validate import _as_float, as_params, as_points, check_finite
+from .._validate import (_as_float, as_count, as_params, as_points, magnitude,
+                         check_steps)
 from ..errors import InputError
 from .parameterize import parameterize
 from .piecewise import PiecewiseCurve, PiecewisePolynomial, readonly
@@ -295,12 +295,14 @@ def _gauss(nq: int) -> tuple[FloatArray, FloatArray]:
 # ------------------------------------------------------------------------------------------
 # the curve
 # ------------------------------------------------------------------------------------------
+#: Highest supported degree (as OCCT's ``Geom_BSplineCurve::MaxDegree()``): the power form and
+#: the basis derivatives take powers of the knot steps up to the degree, and Gram matrices up
+#: to ``2 degree - 1``.
+MAX_DEGREE = 25
+
+
 def _as_degree(degree: object) -> int:
-    if isinstance(degree, bool) or not isinstance(degree, (int, np.integer)):
-        raise InputError(f"degree must be an integer >= 2, got {degree!r}")
-    if degree < 2:
-        raise InputError(f"degree must be an integer >= 2, got {degree!r}")
-    return int(degree)
+    return as_count(degree, "degree", minimum=2, maximum=MAX_DEGREE)
 
 
 class BSplineCurve(PiecewiseCurve):
@@ -356,14 +358,7 @@ class BSplineCurve(PiecewiseCurve):
         t = _as_float(knots, "knots")
         if t.ndim != 1:
             raise InputError(f"knots must be 1-D, got shape {t.shape}")
-        check_finite(t, "knots")
-        if t.shape[0] > 1:
-            dt = np.diff(t)
-            bad = np.flatnonzero(dt < 0)
-            if bad.size:
-                i = int(bad[0])
-                raise InputError(f"knots must be non-decreasing: knots[{i}] = {float(t[i])!r} > "
-                                 f"knots[{i + 1}] = {float(t[i + 1])!r}")
+        check_steps(t, "knots", strict=False)
         if closed:
             t = self._periodic_knots(t, n, p)
         else:
@@ -405,6 +400,16 @@ class BSplineCurve(PiecewiseCurve):
         if not t[p] < t[n]:
             raise InputError(f"the domain [knots[{p}], knots[{n}]] = "
                              f"[{float(t[p])!r}, {float(t[n])!r}] is empty")
+        # end multiplicity exactly degree + 1: a (p+2)-fold end knot makes N_0 (or N_{n-1})
+        # vanish on the domain, so its control point would be no point of the curve
+        if not t[p + 1] > t[p]:
+            raise InputError(f"knot {float(t[0])!r} at the start has multiplicity > degree + 1 = "
+                             f"{p + 1} (knots[0..{p + 1}] are equal): an open clamped knot "
+                             f"vector repeats each end knot exactly degree + 1 times")
+        if not t[n - 1] < t[n]:
+            raise InputError(f"knot {float(t[-1])!r} at the end has multiplicity > degree + 1 = "
+                             f"{p + 1} (knots[{n - 1}..{n + p}] are equal): an open clamped "
+                             f"knot vector repeats each end knot exactly degree + 1 times")
         BSplineCurve._check_multiplicity(t[p + 1:n], p, offset=p + 1)
 
     @staticmethod
@@ -427,7 +432,7 @@ class BSplineCurve(PiecewiseCurve):
             period = t[p:p + n + 1]
             T = period[-1] - period[0]
             dt = np.diff(t)
-            scale = max(float(np.abs(t).max()), 1.0)
+            scale = magnitude(t)
             bad = np.flatnonzero(np.abs(dt[n:] - dt[:-n]) > 1e-10 * scale)
             if bad.size:
                 i = int(bad[0])
@@ -506,8 +511,7 @@ class BSplineCurve(PiecewiseCurve):
         K = t.shape[0]
         s = np.flatnonzero(t[p + 1:K - p] > t[p:K - p - 1])  # slices: no index gathers
         s += p
-        readonly(s)
-        return s
+        return readonly(s)
 
     def __repr__(self) -> str:
         return (f"BSplineCurve(n_ctrl={self.n_ctrl}, degree={self.degree}, dim={self.dim}, "
@@ -625,10 +629,15 @@ class BSplineCurve(PiecewiseCurve):
         last ``k`` coefficients repeating the first ``k``). An unclamped open spline is converted
         to the clamped knot vector with the same interior knots (the same curve on its domain
         ``[t_k, t_n]``, found by interpolation at the Greville abscissae: exact up to rounding).
+        End knots repeated more than ``k + 1`` times are reduced to ``k + 1`` (the dropped basis
+        functions vanish on the domain), so scipy splines with them convert exactly.
         """
-        t = np.asarray(spl.t, dtype=float)
-        k = int(spl.k)
-        c = np.asarray(spl.c, dtype=float)
+        if not isinstance(spl, BSpline):
+            raise InputError(f"spl must be a scipy.interpolate.BSpline, got "
+                             f"{type(spl).__name__}")
+        t = _as_float(spl.t, "spl.t")
+        k = _as_degree(spl.k)
+        c = _as_float(spl.c, "spl.c")
         if c.ndim != 2:
             raise InputError(f"spl.c must have shape (n, dim) with dim 2 or 3, got {c.shape}")
         c = c[: t.shape[0] - k - 1]
@@ -638,12 +647,18 @@ class BSplineCurve(PiecewiseCurve):
             n = c.shape[0] - k
             if n < k + 1:
                 raise InputError(f"periodic spline has too few coefficients ({c.shape[0]})")
-            scale = max(float(np.abs(c).max()), 1.0)
+            scale = magnitude(c)
             if not np.allclose(c[n:], c[:k], rtol=0.0, atol=1e-10 * scale):
                 raise InputError("closed=True needs the last k coefficients of spl.c to repeat "
                                  "the first k (scipy's periodic layout)")
             return cls(c[:n], t, k, closed=True)
         n = c.shape[0]
+        # an end knot repeated more than k + 1 times (scipy allows it) makes N_0 (N_{n-1})
+        # vanish on the domain [t_k, t_n]: its coefficient is no point of the curve, drop both
+        while n > k + 1 and t[k + 1] == t[k]:
+            t, c, n = t[1:], c[1:], n - 1
+        while n > k + 1 and t[n - 1] == t[n]:
+            t, c, n = t[:n + k], c[:n - 1], n - 1
         if k >= 2 and n >= k + 1 and (np.any(t[:k + 1] != t[0]) or np.any(t[n:] != t[-1])):
             # unclamped: the same curve on [t_k, t_n] on the clamped knot vector (the space is
             # the same there), by interpolation at the Greville abscissae -- exact up to rounding
@@ -663,7 +678,7 @@ class BSplineCurve(PiecewiseCurve):
 def _closed_data(points: ArrayLike, param: Any) -> tuple[FloatArray, FloatArray]:
     """Distinct points (first not repeated) and their parameters plus the closing one."""
     pts = as_points(points, "points", min_points=3)
-    scale = max(float(np.abs(pts).max()), 1.0)
+    scale = magnitude(pts)
     if np.allclose(pts[0], pts[-1], rtol=0.0, atol=1e-12 * scale):
         pts = pts[:-1]
     loop = np.vstack([pts, pts[:1]])
@@ -863,6 +878,26 @@ def _natural_cubic_gbsv(u: FloatArray, pts: FloatArray, T: FloatArray) -> FloatA
     return solve_banded((1, 1), ab, rhs, check_finite=False)
 
 
+def _solve_normal(AtA: Any, rhs: FloatArray, n: int, p: int) -> FloatArray:
+    """Solve the least-squares normal equations ``AtA x = rhs`` of :func:`fit_bspline` by a
+    sparse LU factorisation; refuse a (numerically) singular system -- some control point not
+    determined by the data -- by the ratio of the smallest to the largest pivot."""
+    from scipy.sparse.linalg import splu
+
+    try:
+        lu = splu(AtA.tocsc())
+    except RuntimeError:  # "Factor is exactly singular"
+        piv = np.zeros(1)
+    else:
+        piv = np.abs(lu.U.diagonal())
+    if not (piv.size and np.isfinite(piv).all() and piv.min() > 1e-12 * piv.max()):
+        raise InputError(f"fit_bspline: the least-squares system for {n} control points of "
+                         f"degree {p} is singular for these parameters (some control point is "
+                         f"not determined by the data); use fewer control points")
+    x = np.asarray(lu.solve(np.asarray(rhs)))
+    return x.reshape(n, -1)
+
+
 def fit_bspline(points: ArrayLike, n_ctrl: int, degree: int = 3,
                 param: str | ArrayLike = "chord", closed: bool = False) -> BSplineCurve:
     """Least-squares B-spline curve with ``n_ctrl`` control points approximating ``points``.
@@ -903,14 +938,25 @@ def fit_bspline(points: ArrayLike, n_ctrl: int, degree: int = 3,
         if not p + 1 <= n <= m:
             raise InputError(f"n_ctrl must be in [degree + 1, number of distinct points] = "
                              f"[{p + 1}, {m}], got {n}")
-        period = np.interp(np.arange(n + 1) * (m / n), np.arange(m + 1), t)
+        # period knots at equally spaced (fractional) data indices, on the periodic extension
+        # of the parameters; for even degree shifted by half a step, so that with n == m the
+        # data sit mid-span (odd degree: at the knots) -- the placement that keeps periodic
+        # interpolation regular (de Boor, A Practical Guide to Splines, ch. XIII: at the knots
+        # an even-degree uniform periodic collocation matrix is singular for even n)
+        T = t[-1] - t[0]
+        ext = np.r_[t, t[1:] + T]
+        shift = 0.5 * (m / n) if p % 2 == 0 else 0.0
+        period = np.interp(np.arange(n + 1) * (m / n) + shift, np.arange(2 * m + 1), ext)
         curve0 = BSplineCurve(np.zeros((n, pts.shape[1])), period, p, closed=True)
         full = np.array(curve0.knots)
-        A = BSpline.design_matrix(t[:-1], full, p).tocoo()
+        x = t[:-1]
+        if shift:
+            x = period[0] + np.mod(x - period[0], period[-1] - period[0])
+            x = np.minimum(x, np.nextafter(period[-1], -np.inf))
+        A = BSpline.design_matrix(x, full, p).tocoo()
         A = csr_matrix((A.data, (A.row, A.col % n)), shape=(m, n))
         AtA = (A.T @ A).tocsc()
-        ctrl = spsolve(AtA, A.T @ pts)
-        ctrl = np.asarray(ctrl).reshape(n, pts.shape[1])
+        ctrl = _solve_normal(AtA, A.T @ pts, n, p)
         return BSplineCurve(ctrl, full, p, closed=True)
     pts = as_points(points, "points", min_points=p + 1)
     m = pts.shape[0]

@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from .._typing import ArrayLike, FloatArray
-from .._validate import as_params, as_points, as_vectors
+from .._validate import as_params, as_points, as_vectors, magnitude
 from ..errors import InputError
 from .piecewise import PiecewiseCurve, PiecewisePolynomial, readonly
 
@@ -19,7 +19,7 @@ __all__ = ["CubicHermite", "QuinticHermite", "HermiteSpline"]
 
 def _check_closed(name: str, arrs: list[tuple[str, FloatArray]]) -> None:
     for label, a in arrs:
-        scale = max(float(np.abs(a).max()), 1.0)
+        scale = magnitude(a)
         if not np.allclose(a[0], a[-1], rtol=0.0, atol=1e-10 * scale):
             raise InputError(
                 f"closed {name}: {label}[0] = {a[0].tolist()} must equal {label}[-1] = "

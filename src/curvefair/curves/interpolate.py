@@ -14,7 +14,7 @@ from scipy.interpolate import CubicSpline
 from scipy.linalg.lapack import dgbsv
 
 from .._typing import ArrayLike, FloatArray
-from .._validate import as_points, as_vectors, choice
+from .._validate import as_points, as_vectors, choice, magnitude
 from ..errors import InputError
 from .hermite import CubicHermite, QuinticHermite
 from .parameterize import parameterize
@@ -31,7 +31,7 @@ EndCondition = Any
 
 def _close_points(pts: FloatArray) -> FloatArray:
     """Repeat the first point last unless it is already there."""
-    scale = max(float(np.abs(pts).max()), 1.0)
+    scale = magnitude(pts)
     if np.allclose(pts[0], pts[-1], rtol=0.0, atol=1e-12 * scale):
         pts = pts.copy()
         pts[-1] = pts[0]

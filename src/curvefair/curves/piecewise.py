@@ -19,15 +19,36 @@ from math import factorial
 import numpy as np
 
 from .._typing import ArrayLike, FloatArray
+from .._validate import as_count, as_eval_params
 from ..errors import InputError
 
 __all__ = ["PiecewisePolynomial", "PiecewiseCurve", "readonly"]
 
 
-def readonly(arr: FloatArray) -> FloatArray:
-    """Mark ``arr`` read-only and return it."""
-    arr.setflags(write=False)
-    return arr
+def _frozen(arr: np.ndarray) -> bool:
+    """True if ``arr`` is read-only and its memory is an immutable ``bytes`` object."""
+    if arr.flags.writeable:
+        return False
+    base = arr
+    while isinstance(base, np.ndarray):
+        base = base.base
+    return isinstance(base, bytes)
+
+
+def readonly(arr: np.ndarray) -> np.ndarray:
+    """A read-only array with the values of ``arr`` whose memory nobody can write.
+
+    ``setflags(write=False)`` alone can be undone (``setflags(write=True)`` on an array that
+    owns its data), which would make an immutable curve mutable and its cached evaluation
+    stale. The returned array is a view of an immutable ``bytes`` object: numpy refuses
+    ``setflags(write=True)`` on it and on every view of it. An array already like that is
+    returned as it is; otherwise this costs one copy. Use the returned array, not ``arr``.
+    """
+    if _frozen(arr):
+        return arr
+    a = np.ascontiguousarray(arr)
+    out = np.frombuffer(a.tobytes(), dtype=a.dtype).reshape(a.shape)
+    return out
 
 
 def derivative_coefficients(coeffs: FloatArray, nu: int) -> FloatArray:
@@ -59,6 +80,14 @@ class PiecewisePolynomial:
 
     breaks: FloatArray
     coeffs: FloatArray
+
+    def __post_init__(self) -> None:
+        # immutable like the curves: float64 arrays in memory nobody can write (readonly)
+        for name in ("breaks", "coeffs"):
+            a = getattr(self, name)
+            if not (isinstance(a, np.ndarray) and a.dtype == np.float64):
+                a = np.asarray(a, dtype=np.float64)
+            object.__setattr__(self, name, readonly(a))
 
     @property
     def degree(self) -> int:
@@ -141,12 +170,35 @@ class PiecewiseCurve(abc.ABC):
     @abc.abstractmethod
     def _make_piecewise(self) -> PiecewisePolynomial: ...
 
+    def __setstate__(self, state: dict[str, object]) -> None:
+        """Unpickling / deep copies: the arrays come back writeable, so freeze them again
+        (:func:`readonly`) and drop the caches (rebuilt on demand)."""
+        st = {}
+        for k, v in state.items():
+            if k in ("piecewise", "spans"):
+                continue
+            if k == "_gram_cache":
+                v = {}
+            elif isinstance(v, np.ndarray):
+                v = readonly(v)
+            elif isinstance(v, list):
+                v = [readonly(x) if isinstance(x, np.ndarray) else x for x in v]
+            st[k] = v
+        self.__dict__.update(st)
+
     @cached_property
     def piecewise(self) -> PiecewisePolynomial:
-        """The local power form (cached; the curve is immutable)."""
+        """The local power form (cached; the curve is immutable; refused if it overflows)."""
         pp = self._make_piecewise()
-        readonly(pp.breaks)
-        readonly(pp.coeffs)
+        coeffs = pp.coeffs
+        if not np.isfinite(coeffs).all():
+            i = int(np.flatnonzero(~np.isfinite(coeffs).all(axis=(1, 2)))[0])
+            w = float(pp.breaks[i + 1] - pp.breaks[i])
+            raise InputError(
+                f"the power form of this degree-{self.degree} curve overflows float64 on segment "
+                f"{i} (parameter width {w!r}): coordinates divided by the width to the power "
+                f"{self.degree} leave the float64 range; rescale the parameters (knots) or the "
+                f"coordinates")
         return pp
 
     @property
@@ -174,11 +226,10 @@ class PiecewiseCurve(abc.ABC):
         -------
         ndarray, shape ``np.shape(u) + (dim,)``
         """
-        if not isinstance(nu, (int, np.integer)) or nu < 0 or nu > self.max_derivative:
+        if (isinstance(nu, bool) or not isinstance(nu, (int, np.integer)) or nu < 0
+                or nu > self.max_derivative):
             raise InputError(f"nu must be an integer in [0, {self.max_derivative}], got {nu!r}")
-        u = np.asarray(u, dtype=float)
-        if not np.all(np.isfinite(u)):
-            raise InputError("u contains a non-finite parameter")
+        u = as_eval_params(u, "u")
         t0, t1 = self.domain
         if self.closed:
             u = t0 + np.mod(u - t0, t1 - t0)
@@ -192,6 +243,8 @@ class PiecewiseCurve(abc.ABC):
         return self.piecewise.evaluate(u, int(nu))
 
     def sample(self, n: int = 200) -> FloatArray:
-        """``n`` points at equally spaced parameters over the domain, shape ``(n, dim)``."""
+        """``n`` points at equally spaced parameters over the domain, shape ``(n, dim)``
+        (``n >= 0`` an integer)."""
+        m = as_count(n, "n", minimum=0)
         t0, t1 = self.domain
-        return self(np.linspace(t0, t1, int(n)))
+        return self(np.linspace(t0, t1, m))

@@ -739,7 +739,7 @@ def cheng_yu_driver(curve: Any, *, tol: float | None = None, eps: float = 1e-8,
     curve = _cubic_bspline(curve, "method 'cheng-yu' (Cheng & Yu's second discrete curvature)")
     n = curve.n_ctrl
     closed = bool(curve.closed)
-    e = as_nonnegative(tol, "tol", none_means=-1.0)  # -1: no tolerance
+    e = as_nonnegative(tol, "tol", none_means=-1.0, window=True)  # -1: no tolerance
     epsv = as_nonnegative(eps, "eps")
     max_steps = as_step_count(max_steps, default=100 * n)
     mask = _movable(curve, clamp, protect)

@@ -1011,7 +1011,7 @@ def eck_hadenfeld_fair(curve: BSplineCurve, *, l: int = 2, tol: float | None = N
     curve = check_bspline(curve)
     lv = check_l(l, curve.degree)
     n = curve.n_ctrl
-    tolv = as_nonnegative(tol, "tol", none_means=np.inf)
+    tolv = as_nonnegative(tol, "tol", none_means=np.inf, window=True)
     epsv = (default_eps(n) if eps_relative else 0.0) if eps is None else as_nonnegative(eps, "eps")
     max_steps = as_step_count(max_steps, default=100 * n)
     history_max = as_step_count(history_max, "history_max", default=1_000_000)

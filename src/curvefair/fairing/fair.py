@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from .._typing import FloatArray
-from ..curves.piecewise import PiecewiseCurve
+from ..curves.piecewise import PiecewiseCurve, readonly
 from ..errors import InputError
 
 __all__ = [
@@ -75,9 +75,7 @@ class FairingHistory:
             raise InputError("history arrays must have the same length, got "
                              f"{idx.shape[0]}, {meas.shape[0]}, {disp.shape[0]}")
         arrs = [np.arange(1, idx.shape[0] + 1, dtype=np.int64), idx, meas, disp]
-        for a in arrs:
-            a.setflags(write=False)
-        return cls(*arrs)
+        return cls(*[readonly(a) for a in arrs])
 
     @classmethod
     def empty(cls) -> "FairingHistory":
@@ -494,7 +492,7 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
             + ", ".join(repr(m) for m in available_methods(curve)))
     from .._validate import as_nonnegative, as_positive, as_step_count
 
-    tol_v = as_positive(tol, "tol", allow_none=True)
+    tol_v = as_positive(tol, "tol", allow_none=True, window=True)
     eps_v = None if eps is None else as_nonnegative(eps, "eps")
     if max_steps is not None:
         max_steps = as_step_count(max_steps, default=0)

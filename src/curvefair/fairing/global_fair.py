@@ -645,7 +645,7 @@ def _global_fair(curve: BSplineCurve, tol: float | None, l: Any,  # noqa: E741
     curve = check_bspline(curve)
     w = _weights(l, curve.degree)
     if tol is not None:  # (None: unconstrained; none_means only words the message "... or None")
-        tolv = as_nonnegative(tol, "tol", none_means=np.inf)
+        tolv = as_nonnegative(tol, "tol", none_means=np.inf, window=True)
     max_steps = as_step_count(max_steps, default=500)
     mask = movable_mask(curve, clamp, protect)
     p = curve.degree

@@ -419,7 +419,7 @@ def knot_removal_fair(curve: BSplineCurve, *, variant: Variant = "one-point",
                          + ", ".join(repr(v) for v in VARIANTS))
     if on_tol not in ("skip", "stop"):
         raise InputError(f"on_tol must be 'skip' or 'stop', got {on_tol!r}")
-    tolv = as_nonnegative(tol, "tol", none_means=np.inf)
+    tolv = as_nonnegative(tol, "tol", none_means=np.inf, window=True)
     mask = movable_mask(curve, clamp, protect)
     kd = _KnotData(curve)
     js = kd.js

@@ -151,7 +151,7 @@ def tube_energy_qp(curve: BSplineCurve, params: ArrayLike, points: ArrayLike, to
     ``2 G / E0 + A^T blockdiag(B_i) A`` is banded (cyclic for closed curves) and factorised by
     SuperLU with a minimum-degree ordering.
     """
-    tolv = as_positive(tol, "tol")
+    tolv = as_positive(tol, "tol", window=True)
     assert tolv is not None
     w = _energy_weights(l, curve.degree)
     u = np.asarray(params, dtype=float)
@@ -347,7 +347,7 @@ def fair_points(points: ArrayLike, tol: float, *, degree: int = 5, l: Any = 3,  
     (True, 'converged')
     """
     p = _as_degree(degree)
-    tolv = as_positive(tol, "tol")
+    tolv = as_positive(tol, "tol", window=True)
     assert tolv is not None
     w = _energy_weights(l, p)
     if isinstance(max_steps, bool) or not isinstance(max_steps, (int, np.integer)) \

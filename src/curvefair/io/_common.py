@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from .._typing import ArrayLike, FloatArray
+from .._validate import MAX_MAGNITUDE, MIN_EXTENT
 from ..curves.bspline import BSplineCurve
 from ..curves.hermite import CubicHermite, QuinticHermite
 from ..curves.interpolate import interpolate_cubic
@@ -234,7 +235,20 @@ def check_points(pts: FloatArray, path: object, lines: Sequence[int | None] | No
         ln = None if lines is None else lines[i]
         raise FileFormatError(f"{what} {i} has a non-finite coordinate {pts[i].tolist()}",
                               path, ln)
+    big = np.flatnonzero(np.abs(pts).max(axis=1) > MAX_MAGNITUDE) if pts.size else []
+    if len(big):
+        i = int(big[0])
+        ln = None if lines is None else lines[i]
+        raise FileFormatError(f"{what} {i} has the coordinate {pts[i].tolist()}: curvefair works "
+                              f"with magnitudes up to {MAX_MAGNITUDE:g} (float64 must hold the "
+                              f"powers of the data its formulas take); rescale the data", path, ln)
     if pts.shape[0] > 1:
+        extent = float(np.ptp(pts, axis=0).max())
+        if 0.0 < extent < MIN_EXTENT:
+            raise FileFormatError(f"the {what}s span only {extent!r}: curvefair works with "
+                                  f"point sets at least {MIN_EXTENT:g} across (float64 must hold "
+                                  f"the powers of the data its formulas take); rescale the data",
+                                  path)
         d = np.abs(np.diff(pts, axis=0)).max(axis=1)
         scale = max(float(np.abs(pts).max()), np.finfo(float).tiny)
         dup = np.flatnonzero(d <= 4 * np.finfo(float).eps * scale)

@@ -165,6 +165,9 @@ def read(path: str | os.PathLike[str], **_: Any) -> list[CurveRecord]:
                               exc.lineno) from None
     except ValueError as exc:
         raise FileFormatError(f"invalid JSON: {exc}", path) from None
+    except RecursionError:
+        raise FileFormatError("invalid JSON for curvefair: arrays or objects nested too deeply "
+                              "(a curve file nests at most a few levels)", path) from None
     if not isinstance(doc, dict):
         raise FileFormatError("the top level must be an object with 'schema_version' and "
                               "'curves'", path)
