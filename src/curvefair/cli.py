@@ -196,7 +196,7 @@ def _record_label(rec: Any, i: int) -> str:
 # shared options ---------------------------------------------------------------------------
 def _reading_options(f: Any) -> Any:
     f = click.option("--corner-angle", type=click.FloatRange(0, 180, min_open=True),
-                     default=90.0, show_default=True, metavar="DEG",
+                     default=60.0, show_default=True, metavar="DEG",
                      help="Point lists turning by DEG degrees or more at a point are split "
                           "there into separate curves (the corner is kept fixed).")(f)
     f = click.option("--no-corners", is_flag=True,

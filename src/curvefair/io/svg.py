@@ -236,7 +236,7 @@ def _read_text(path: object) -> str:
         raise FileFormatError(f"not UTF-8 text ({exc.reason})", path) from None
 
 
-def read(path: str | os.PathLike[str], *, corner_angle: float | None = 90.0,
+def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
          on_unsupported: str = "raise", **_: Any) -> list[CurveRecord]:
     """Read the curves of the ``<path>`` elements of an SVG file; see the module docstring."""
     spt = _svgpathtools("reading SVG files")
