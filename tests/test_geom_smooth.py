@@ -74,7 +74,7 @@ def _c0_join_angles(c: BSplineCurve) -> np.ndarray:
     p = c.degree
     vals, first, counts = np.unique(t, return_index=True, return_counts=True)
     out = []
-    for v, a, m in zip(vals, first, counts):
+    for v, a, m in zip(vals, first, counts, strict=True):
         if m != p or v in (t[0], t[-1]):
             continue
         j = a - 1
@@ -224,7 +224,7 @@ def test_noisy_square_keeps_its_corners(tmp_path):
     corners = sorted({int(r.source["indices"][0]) for r in recs})
     # each true corner (0, 30, 60, 90) is found within two samples, nothing else
     assert len(corners) == 4
-    for c, want in zip(corners, (0, 30, 60, 90)):
+    for c, want in zip(corners, (0, 30, 60, 90), strict=True):
         assert min(abs(c - want), 120 - abs(c - want)) <= 2
 
 

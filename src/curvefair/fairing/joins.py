@@ -55,7 +55,8 @@ __all__ = ["plan", "JoinPlan", "join_angles", "DEFAULT_G1_ANGLE"]
 #: Default largest angle (degrees) between the two tangents of a join that is treated as G1.
 DEFAULT_G1_ANGLE = 0.5
 _G2_REL = 1e-6
-_STRAIGHT_REL = 1e-9
+_STRAIGHT_REL = 1e-9  # straight: off the line by at most this times the piece's length
+_ROUND = 8 * np.finfo(float).eps  # plus this times the curve's size (rounding)
 _CLAMP_RANK = {"g0": 0, "g1": 1, "g2": 2}
 
 
@@ -152,33 +153,36 @@ def _size(pts: FloatArray) -> float:
                float(np.abs(pts).max()) if pts.size else 0.0, 1e-300)
 
 
-def _collinear(pts: FloatArray, eps: float) -> bool:
-    """All points within ``eps`` of the line through the first and last (which differ)."""
-    d = pts[-1] - pts[0]
-    L = float(np.linalg.norm(d))
-    if not L > eps:
-        return False
-    u = d / L
-    r = pts - pts[0]
-    off = r - np.outer(r @ u, u)
-    return bool(np.sqrt(np.sum(off * off, axis=1)).max() <= eps)
-
-
 def _straight_runs(pts: FloatArray, eps: float) -> set[int]:
-    """Indices of every run of >= 3 consecutive points within ``eps`` of a line."""
-    out: set[int] = set()
-    n = pts.shape[0]
-    i = 0
-    while i + 2 < n:
-        j = i + 2
-        if not _collinear(pts[i:j + 1], eps):
-            i += 1
-            continue
-        while j + 1 < n and _collinear(pts[i:j + 2], eps):
-            j += 1
-        out.update(range(i, j + 1))
-        i = j
-    return out
+    """Indices of the points of every run of >= 3 consecutive points where each point is
+    within ``eps`` of the chord of its two neighbours (exactly straight runs)."""
+    if pts.shape[0] < 3:
+        return set()
+    a, b, c = pts[:-2], pts[1:-1], pts[2:]
+    d = c - a
+    L = np.sqrt(np.sum(d * d, axis=1))
+    v = b - a
+    off = v - d * (np.sum(v * d, axis=1) / np.maximum(L * L, 1e-300))[:, None]
+    ok = (np.sqrt(np.sum(off * off, axis=1)) <= _STRAIGHT_REL * L + eps) & (L > eps)
+    mid = np.flatnonzero(ok) + 1
+    return {int(i) for i in np.unique(np.r_[mid - 1, mid, mid + 1])}
+
+
+def _straight_spans(curve: BSplineCurve, P: FloatArray, eps: float) -> tuple[set[int], int]:
+    """Control points of every knot span whose ``degree + 1`` control points are within
+    ``eps`` of the line through the first and last of them, and the number of such spans."""
+    p = curve.degree
+    s = np.asarray(curve.spans)
+    idx = curve.control_index(s[:, None] - p + np.arange(p + 1)[None, :])
+    W = P[idx]  # (spans, p+1, dim)
+    d = W[:, -1] - W[:, 0]
+    L = np.sqrt(np.sum(d * d, axis=1))
+    u = d / np.maximum(L, 1e-300)[:, None]
+    r = W - W[:, :1]
+    off = r - np.sum(r * u[:, None, :], axis=2)[:, :, None] * u[:, None, :]
+    lim = _STRAIGHT_REL * L + eps
+    ok = (np.sqrt(np.sum(off * off, axis=2)).max(axis=1) <= lim) & (L > eps)
+    return {int(i) for i in np.unique(idx[ok])}, int(ok.sum())
 
 
 def _side_support(curve: BSplineCurve, span: int, u: float, nder: int) -> list[int]:
@@ -196,17 +200,14 @@ def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozense
     t = np.asarray(curve.knots, dtype=float)
     P = np.asarray(curve.control_points, dtype=float)
     n = P.shape[0]
-    eps = _STRAIGHT_REL * _size(P)
+    eps = _ROUND * _size(P)
     hold: set[int] = set()
     rep = {"g1_joins": 0, "g1_joins_reparametrised": 0, "g2_joins_held": 0, "corners_held": 0,
            "straight_spans_held": 0}
 
     # straight spans: every control point of a span lying on one line
-    for s in curve.spans:
-        idx = curve.control_index(np.arange(s - p, s + 1))
-        if _collinear(P[idx], eps):
-            hold.update(int(i) for i in idx)
-            rep["straight_spans_held"] += 1
+    straight, rep["straight_spans_held"] = _straight_spans(curve, P, eps)
+    hold.update(straight)
 
     # distinct interior knots of the domain and their multiplicities
     lo, hi = curve.domain
@@ -214,17 +215,21 @@ def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozense
     pp = curve.piecewise
     br = np.asarray(pp.breaks)
     reduce: list[tuple[int, int, float, float]] = []  # (j, knot position a, dl, dr)
-    for v, a, m in zip(vals, first, counts, strict=True):
-        if not lo < v < hi or m >= p + 1:
-            continue
-        k = int(np.searchsorted(br, v))  # pieces k-1 | k meet at v
-        if not (0 < k < br.shape[0] - 1 and br[k] == v):
-            continue
-        vv = np.array([v])
-        d1l = pp.evaluate(vv, 1, segment=np.array([k - 1]))[0]
-        d1r = pp.evaluate(vv, 1, segment=np.array([k]))[0]
-        d2l = pp.evaluate(vv, 2, segment=np.array([k - 1]))[0]
-        d2r = pp.evaluate(vv, 2, segment=np.array([k]))[0]
+    # candidates: interior knots of multiplicity p - 1 or p (C1 / C0); C2 or smoother knots
+    # are left to the method, which cannot break them
+    cand = (vals > lo) & (vals < hi) & (counts <= p) & (counts >= p - 1)
+    cv, ca, cm = vals[cand], first[cand], counts[cand]
+    ck = np.searchsorted(br, cv)
+    okk = (ck > 0) & (ck < br.shape[0] - 1)
+    okk[okk] &= br[ck[okk]] == cv[okk]
+    cv, ca, cm, ck = cv[okk], ca[okk], cm[okk], ck[okk]
+    D1L = pp.evaluate(cv, 1, segment=ck - 1).reshape(-1, P.shape[1])
+    D1R = pp.evaluate(cv, 1, segment=ck).reshape(-1, P.shape[1])
+    D2L = pp.evaluate(cv, 2, segment=ck - 1).reshape(-1, P.shape[1])
+    D2R = pp.evaluate(cv, 2, segment=ck).reshape(-1, P.shape[1])
+    for q in range(cv.shape[0]):
+        v, a, m = float(cv[q]), int(ca[q]), int(cm[q])
+        d1l, d1r, d2l, d2r = D1L[q], D1R[q], D2L[q], D2R[q]
         nl, nr = float(np.linalg.norm(d1l)), float(np.linalg.norm(d1r))
         if not (nl > 0 and nr > 0):
             continue
@@ -264,7 +269,7 @@ def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozense
     out_clamp = list(clamp)
     if not curve.closed:
         e0, e1 = P[0], P[-1]
-        if np.abs(e0 - e1).max() <= eps:
+        if np.abs(e0 - e1).max() <= _STRAIGHT_REL * _size(P):
             d0 = curve(np.array([lo]), 1)[0]
             d1 = curve(np.array([hi]), 1)[0]
             if min(np.linalg.norm(d0), np.linalg.norm(d1)) > 0 and _angle(d1, d0) <= g1:
@@ -280,7 +285,7 @@ def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozense
     # a join is reduced only if its point is free and the reduction moves it little: the
     # re-inserted point is (R P_{j-1} + L P_{j+1}) / (L + R), L and R the handle lengths
     errs: dict[int, float] = {}
-    for j, a, dl, dr in reduce:
+    for j, *_ in reduce:
         L = float(np.linalg.norm(P[j] - P[j - 1]))
         R = float(np.linalg.norm(P[j + 1] - P[j]))
         e = (float(np.linalg.norm((R * P[j - 1] + L * P[j + 1]) / (L + R) - P[j]))
@@ -324,23 +329,22 @@ def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozense
             w = dl2 / (dl2 + dr2)
             ins.append((j, j - 1, j + 1, w))
             err = max(err, float(np.linalg.norm((1.0 - w) * P[j - 1] + w * P[j + 1] - P[j])))
-        if True:
-            inv = {int(o): r for r, o in enumerate(keep)}
-            jplan.curve = R0
-            jplan._orig = curve
-            jplan._keep = keep
-            jplan._ins = ins
-            jplan.margin = err
-            rep["g1_joins_reparametrised"] = len(drop_j)
-            rep["g1_reduction_error"] = err
-            hold_r = {inv[i] for i in hold if i in inv}
-            for i in hold:
-                if i not in inv:  # a dropped join point asked to hold: hold its neighbours
-                    hold_r.update((inv[i - 1], inv[i + 1]))
-            prot_r = {inv[i] for i in protect if i in inv}
-            jplan.protect = frozenset(hold_r | prot_r)
-            rep["held"] = sorted(hold)
-            return jplan
+        inv = {int(o): r for r, o in enumerate(keep)}
+        jplan.curve = R0
+        jplan._orig = curve
+        jplan._keep = keep
+        jplan._ins = ins
+        jplan.margin = err
+        rep["g1_joins_reparametrised"] = len(drop_j)
+        rep["g1_reduction_error"] = err
+        hold_r = {inv[i] for i in hold if i in inv}
+        for i in hold:
+            if i not in inv:  # a dropped join point asked to hold: hold its neighbours
+                hold_r.update((inv[i - 1], inv[i + 1]))
+        prot_r = {inv[i] for i in protect if i in inv}
+        jplan.protect = frozenset(hold_r | prot_r)
+        rep["held"] = sorted(hold)
+        return jplan
     jplan.protect = frozenset(hold | set(protect))
     rep["held"] = sorted(hold)
     return jplan
@@ -355,7 +359,7 @@ def plan(curve: PiecewiseCurve, clamp: tuple[str, str], protect: frozenset[int],
     pts = np.asarray(curve.points, dtype=float)  # type: ignore[attr-defined]
     if curve.closed:
         pts = pts[:-1]
-    hold = _straight_runs(pts, _STRAIGHT_REL * _size(pts)) if pts.shape[0] >= 3 else set()
+    hold = _straight_runs(pts, _ROUND * _size(pts)) if pts.shape[0] >= 3 else set()
     if not curve.closed:
         hold.discard(0)
         hold.discard(pts.shape[0] - 1)
