@@ -258,3 +258,15 @@ def test_default_run_never_worse_on_real_files(path, tol):
         worse_without_guard += (_counts(d.curve)[0] > i0) or (_counts(d.curve)[1] > e0)
         assert res.report["max_deviation"] <= tol
     assert worse_without_guard >= 1  # the files do show the problem without the guard
+
+
+def test_cli_says_when_the_guard_kept_the_input(tmp_path):
+    pytest.importorskip("ezdxf")
+    from click.testing import CliRunner
+
+    from curvefair.cli import main
+
+    out = tmp_path / "ae_out.dxf"
+    r = CliRunner().invoke(main, ["fair", str(AE_DXF), "-o", str(out), "--tol", "0.1"])
+    assert "inflections 0 -> 2; kept the input" in r.output
+    assert "Traceback" not in r.output
