@@ -270,3 +270,31 @@ def test_cli_says_when_the_guard_kept_the_input(tmp_path):
     r = CliRunner().invoke(main, ["fair", str(AE_DXF), "-o", str(out), "--tol", "0.1"])
     assert "inflections 0 -> 2; kept the input" in r.output
     assert "Traceback" not in r.output
+
+
+def test_g2_join_stays_g2():
+    # two cubic Beziers meeting at (0, 0) with tangent (1, 0) and curvature 2/3 on both sides
+    # (handles 1 and 2 long: G2, not C1), between two more pieces that can be faired
+    P = np.array([[-7, 2], [-6, 0], [-5, 2.5], [-4, 1], [-2, 1], [-1, 0], [0, 0], [2, 0],
+                  [4, 4], [6, 3]], dtype=float)
+    t = [0, 0, 0, 0, 1, 1, 1, 2, 2, 2, 3, 3, 3, 3]
+    c = BSplineCurve(P, t, 3)
+
+    def end_kappas(Q):
+        # signed Bezier end curvature r' x r'' / |r'|^3 from the control points: at the end of
+        # the left piece r' = 3 d, r'' = 6 (d - e) with d = B3 - B2, e = B2 - B1
+        d, e = Q[6] - Q[5], Q[5] - Q[4]
+        f = d - e
+        kl = 2 / 3 * (d[0] * f[1] - d[1] * f[0]) / np.linalg.norm(d) ** 3
+        d2, e2 = Q[7] - Q[6], Q[8] - Q[7]
+        kr = 2 / 3 * (d2[0] * e2[1] - d2[1] * e2[0]) / np.linalg.norm(d2) ** 3
+        return kl, kr
+
+    kl, kr = end_kappas(P)
+    assert abs(kl - kr) < 1e-12 and abs(kl) > 0.1
+    res = fair(c, "eck-hadenfeld", tol=0.3)
+    Q = np.asarray(res.curve.control_points)
+    kl1, kr1 = end_kappas(Q)
+    assert abs(kl1 - kr1) <= 1e-12 * abs(kl) and res.report["joins"]["g2_joins_held"] >= 1
+    assert _c0_join_angles(res.curve)[1] <= 1e-12
+    assert not np.array_equal(Q, P)
