@@ -540,6 +540,11 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
     if not isinstance(out, DriverOutput):
         raise TypeError(f"driver of {spec.name!r} returned {type(out).__name__}, "
                         "expected DriverOutput")
+    if not jp.restorable(out.curve):  # the method changed the knots: hold the joins instead
+        jp = _joins.plan(curve, clamp_pair, prot, g1_deg, tol_v, allow_reduce=False)
+        tol_w = tol_v
+        out = spec.driver(jp.curve, tol=tol_w, eps=eps_v, max_steps=max_steps, clamp=jp.clamp,
+                          protect=jp.protect, **kwargs)
     new = jp.restore(out.curve)
     if jp.reduced and out.history is not None and len(out.history):
         h = out.history

@@ -129,6 +129,15 @@ class JoinPlan:
     def reduced(self) -> bool:
         return self._orig is not None
 
+    def restorable(self, faired: PiecewiseCurve) -> bool:
+        """Whether :meth:`restore` can map ``faired`` back (same knots as :attr:`curve`)."""
+        if self._orig is None:
+            return True
+        c = self.curve
+        return (isinstance(faired, BSplineCurve) and isinstance(c, BSplineCurve)
+                and faired.degree == c.degree and faired.n_ctrl == c.n_ctrl
+                and np.array_equal(faired.knots, c.knots))
+
     def restore(self, faired: PiecewiseCurve) -> PiecewiseCurve:
         """The faired curve on the input's own knot vector (identity when nothing was reduced)."""
         if self._orig is None:
@@ -195,7 +204,7 @@ def _side_support(curve: BSplineCurve, span: int, u: float, nder: int) -> list[i
 
 
 def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozenset[int],
-                  g1: float, tol: float | None) -> JoinPlan:
+                  g1: float, tol: float | None, allow_reduce: bool = True) -> JoinPlan:
     p = curve.degree
     t = np.asarray(curve.knots, dtype=float)
     P = np.asarray(curve.control_points, dtype=float)
@@ -290,7 +299,8 @@ def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozense
         R = float(np.linalg.norm(P[j + 1] - P[j]))
         e = (float(np.linalg.norm((R * P[j - 1] + L * P[j + 1]) / (L + R) - P[j]))
              if L > 0 and R > 0 else np.inf)
-        if j in hold or (tol is not None and e > 0.25 * tol) or not np.isfinite(e):
+        if (not allow_reduce or j in hold or (tol is not None and e > 0.25 * tol)
+                or not np.isfinite(e)):
             hold.update((j - 1, j, j + 1))  # hold the join's three points instead
         else:
             errs[j] = e
@@ -351,11 +361,15 @@ def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozense
 
 
 def plan(curve: PiecewiseCurve, clamp: tuple[str, str], protect: frozenset[int],
-         g1_angle: float = DEFAULT_G1_ANGLE, tol: float | None = None) -> JoinPlan:
-    """Decide what the fairing keeps (module docstring); ``g1_angle`` in degrees."""
+         g1_angle: float = DEFAULT_G1_ANGLE, tol: float | None = None,
+         allow_reduce: bool = True) -> JoinPlan:
+    """Decide what the fairing keeps (module docstring); ``g1_angle`` in degrees.
+
+    ``allow_reduce=False``: hold the three control points of every G1 join instead of
+    reparametrising (for a method that changes the knot vector itself)."""
     g1 = float(np.radians(g1_angle))
     if isinstance(curve, BSplineCurve):
-        return _bspline_plan(curve, clamp, protect, g1, tol)
+        return _bspline_plan(curve, clamp, protect, g1, tol, allow_reduce)
     pts = np.asarray(curve.points, dtype=float)  # type: ignore[attr-defined]
     if curve.closed:
         pts = pts[:-1]
