@@ -27,8 +27,8 @@ geometry the curve's author drew on purpose. :func:`plan` looks at the curve fir
   ``P_j`` is held; the corner stays where it is and stays a corner.
 * **straight pieces**: the control points of a knot span whose control points are collinear
   (to 1e-9 of the curve's size: a line segment drawn as a B-spline or Bezier, a glyph stem)
-  are held, so the line stays that line; for a Hermite curve, every run of three or more
-  collinear data points.
+  are held, so the line stays that line. (Point lists are cut at their corners when read, so
+  a straight segment between two corners is a piece of its own with nothing to fair.)
 * **seams**: an open curve whose ends coincide (a closed outline written as an open chain) with
   a G1 (G2) seam gets at least a ``g1`` (``g2``) clamp at both ends.
 
@@ -160,21 +160,6 @@ class JoinPlan:
 def _size(pts: FloatArray) -> float:
     return max(float(np.ptp(pts, axis=0).max()) if pts.shape[0] else 0.0,
                float(np.abs(pts).max()) if pts.size else 0.0, 1e-300)
-
-
-def _straight_runs(pts: FloatArray, eps: float) -> set[int]:
-    """Indices of the points of every run of >= 3 consecutive points where each point is
-    within ``eps`` of the chord of its two neighbours (exactly straight runs)."""
-    if pts.shape[0] < 3:
-        return set()
-    a, b, c = pts[:-2], pts[1:-1], pts[2:]
-    d = c - a
-    L = np.sqrt(np.sum(d * d, axis=1))
-    v = b - a
-    off = v - d * (np.sum(v * d, axis=1) / np.maximum(L * L, 1e-300))[:, None]
-    ok = (np.sqrt(np.sum(off * off, axis=1)) <= _STRAIGHT_REL * L + eps) & (L > eps)
-    mid = np.flatnonzero(ok) + 1
-    return {int(i) for i in np.unique(np.r_[mid - 1, mid, mid + 1])}
 
 
 def _straight_spans(curve: BSplineCurve, P: FloatArray, eps: float) -> tuple[set[int], int]:
@@ -370,12 +355,7 @@ def plan(curve: PiecewiseCurve, clamp: tuple[str, str], protect: frozenset[int],
     g1 = float(np.radians(g1_angle))
     if isinstance(curve, BSplineCurve):
         return _bspline_plan(curve, clamp, protect, g1, tol, allow_reduce)
-    pts = np.asarray(curve.points, dtype=float)  # type: ignore[attr-defined]
-    if curve.closed:
-        pts = pts[:-1]
-    hold = _straight_runs(pts, _ROUND * _size(pts)) if pts.shape[0] >= 3 else set()
-    if not curve.closed:
-        hold.discard(0)
-        hold.discard(pts.shape[0] - 1)
-    rep = {"straight_points_held": len(hold), "held": sorted(hold)}
-    return JoinPlan(curve, frozenset(hold | set(protect)), clamp, 0.0, rep)
+    # Hermite curves (point data): the reader already cut point lists at their corners, and a
+    # straight piece between two corners has nothing to fair; a straight run inside a piece
+    # (a line with a bump) is what fairing is for, so nothing more is held here
+    return JoinPlan(curve, frozenset(protect), clamp, 0.0, {"held": []})
