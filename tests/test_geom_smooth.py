@@ -89,7 +89,12 @@ def _roundtrip(path, tmp_path, tol, **write_kw):
     faired = []
     for r in recs:
         if isinstance(r.curve, BSplineCurve):
-            faired.append(r.with_curve(fair(r.curve, tol=tol).curve))
+            res = fair(r.curve, tol=tol)
+            # the tolerance holds for every control point (hence the curve) of the write-back
+            d = np.linalg.norm(np.asarray(res.curve.control_points)
+                               - np.asarray(r.curve.control_points), axis=1)
+            assert d.max() <= tol and res.report["max_deviation"] <= tol
+            faired.append(r.with_curve(res.curve))
         else:
             faired.append(r)
     out = tmp_path / ("out" + path.suffix)
