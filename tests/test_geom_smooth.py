@@ -303,3 +303,25 @@ def test_g2_join_stays_g2():
     assert abs(kl1 - kr1) <= 1e-12 * abs(kl) and res.report["joins"]["g2_joins_held"] >= 1
     assert _c0_join_angles(res.curve)[1] <= 1e-12
     assert not np.array_equal(Q, P)
+
+
+def test_guard_on_a_hermite_curve_reports_and_keeps_the_counts():
+    from curvefair import interpolate_cubic
+
+    pts = np.column_stack([np.arange(1.0, 8.0), np.ones(7)])
+    pts[3] = (4.3, 1.6)
+    c = interpolate_cubic(pts)
+    i0, e0 = _counts(c)
+    plain = fair(c, "poliakoff", tol=0.5, mode="hermite", guard=False)
+    assert _counts(plain.curve)[0] > i0  # the method alone adds inflections here
+    res = fair(c, "poliakoff", tol=0.5, mode="hermite")
+    i1, e1 = _counts(res.curve)
+    assert i1 <= i0 and e1 <= e0
+    g = res.report["guard"]
+    assert g["kept"] in ("partial", "input") and "inflections" in g["reason"]
+    # what is returned is the input plus the stated fraction of the method's move
+    lam = g["fraction"]
+    want = np.asarray(c.points) + lam * (np.asarray(plain.curve.points) - np.asarray(c.points))
+    np.testing.assert_allclose(res.curve.points, want, rtol=0, atol=1e-12)
+    u = np.linspace(*c.domain, 2001)
+    assert np.linalg.norm(res.curve(u) - c(u), axis=1).max() <= 0.5
