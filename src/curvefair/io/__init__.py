@@ -37,9 +37,11 @@ The record
 
 Corners: a point list turning by ``corner_angle`` degrees (default 60: a regular pentagon's
 72 degree corners are corners, an airfoil's leading edge sampled at 60 points turns by less
-than 30) or more at a point is split into several records there, so that each record is smooth between its ends and the
-corner stays a corner; writing the records back joins the pieces again. Open airfoils also
-mark their first and last points (the trailing edge).
+than 30) or more at a point is split into several records there, so that each record is
+smooth between its ends and the corner stays a corner; writing the records back joins the
+pieces again. On a noisy list the turn is measured between chords longer than the noise, so a
+turn between two noisy samples is not a corner. Open airfoils also mark their first and last
+points (the trailing edge).
 
 Writing is always atomic (a temporary file in the destination folder, then ``os.replace``) and
 never replaces a file the curves were read from unless ``overwrite=True``.
