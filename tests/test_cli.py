@@ -214,13 +214,14 @@ def test_dxf_spline_fairing(tmp_path: Path):
                                      knots=list(b.knots))
     doc.saveas(tmp_path / "part.dxf")
     before = (tmp_path / "part.dxf").read_bytes()
-    res = cli(["fair", "part.dxf", "-o", "out.dxf", "--tol", "0.05"], tmp_path)
+    # tol 0.2: at 0.05 the fairing adds two inflections and the never-worse guard keeps the input
+    res = cli(["fair", "part.dxf", "-o", "out.dxf", "--tol", "0.2"], tmp_path)
     assert res.returncode == 0, res.stderr
     assert "eck-hadenfeld" in res.stdout  # the default B-spline method
     assert (tmp_path / "part.dxf").read_bytes() == before
     (rec,) = read_curves(tmp_path / "out.dxf")
     moved = np.linalg.norm(np.asarray(rec.curve.control_points) - b.control_points, axis=1)
-    assert 0 < moved.max() <= 0.05 * (1 + 1e-9)
+    assert 0 < moved.max() <= 0.2 * (1 + 1e-9)
 
 
 def test_console_script_and_version(tmp_path: Path):
@@ -289,7 +290,7 @@ def test_protect_indices_follow_file_order(tmp_path: Path, ex1: Path, monkeypatc
     r = CliRunner().invoke(main, ["fair", "ex1.csv", "-o", "o.csv", "--protect", "3",
                                   "--no-corners", "--decimals", "12", "-q"])
     assert r.exit_code == 0, r.output
-    (rec,) = read_curves(tmp_path / "o.csv")
+    (rec,) = read_curves(tmp_path / "o.csv", corner_angle=None)
     p0 = np.loadtxt(ex1, delimiter=",", skiprows=2)
     np.testing.assert_array_equal(np.asarray(rec.points)[3], p0[3])  # protected P4 stays
     assert np.max(np.abs(np.asarray(rec.points) - p0)) > 1e-3  # others moved

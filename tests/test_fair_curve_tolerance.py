@@ -23,7 +23,9 @@ def _example1():
 @pytest.mark.parametrize("tol", [0.5, 0.2, 0.05])
 def test_example1_curve_within_tol(method, mode, tol):
     c = cf.interpolate_cubic(_example1())
-    res = cf.fair(c, method=method, tol=tol, mode=mode)
+    # guard=False: the tolerance fix-up itself is tested (poliakoff in hermite mode adds
+    # inflections here, 4 -> 7 at tol 0.5, and the default guard would keep the input)
+    res = cf.fair(c, method=method, tol=tol, mode=mode, guard=False)
     assert _dense_max_distance(c, res.curve) <= tol * (1 + 1e-12)
     assert np.linalg.norm(res.curve.points - c.points, axis=1).max() <= tol * (1 + 1e-12)
     assert res.report["max_deviation"] <= tol * (1 + 1e-12)

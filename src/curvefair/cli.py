@@ -253,7 +253,7 @@ def _record_label(rec: Any, i: int) -> str:
 # shared options ---------------------------------------------------------------------------
 def _reading_options(f: Any) -> Any:
     f = click.option("--corner-angle", type=click.FloatRange(0, 180, min_open=True),
-                     default=90.0, show_default=True, metavar="DEG",
+                     default=60.0, show_default=True, metavar="DEG",
                      help="Point lists turning by DEG degrees or more at a point are split "
                           "there into separate curves (the corner is kept fixed).")(f)
     f = click.option("--no-corners", is_flag=True,
@@ -804,6 +804,10 @@ def fair_cmd(infile: str, out: str | None, in_place: bool, method: str | None,
         else:  # a narrow terminal: one small before/after table per curve
             for row in rows:
                 con.print(_summary_card(row))
+        for row in rows:  # the never-worse guard: say what was kept instead of the result
+            g = row.get("report", {}).get("guard") if row["status"] == "ok" else None
+            if g and g.get("kept") != "output":
+                con.print(f"#{row['index']} {row['label']}: {g.get('reason')}", markup=False)
         written = [f"wrote {out}" if wrote_out else f"{out} not written"]
         written += [f"report {report}"] if report else []
         written += [f"plot {plot_path}"] if plot_path else []

@@ -406,7 +406,8 @@ def _analysis_block(curve: PiecewiseCurve) -> dict[str, Any]:
 # ----------------------------------------------------------------------------------------------
 def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None = None,
          eps: float | None = None, max_steps: int | None = None, clamp: Any = "g0",
-         protect: Iterable[int] = (), mode: str = "spline", **options: Any) -> FairingResult:
+         protect: Iterable[int] = (), mode: str = "spline", joins: str = "keep",
+         g1_angle: float | None = None, guard: bool = True, **options: Any) -> FairingResult:
     """Fair a curve automatically: repeatedly apply a local step at the worst point.
 
     Parameters
@@ -439,6 +440,19 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
     mode : {"spline", "hermite"}
         For the Hermite methods: ``"spline"`` re-interpolates after every step (the papers'
         examples), ``"hermite"`` keeps the step's own derivatives.
+    joins : {"keep", "free"}
+        ``"keep"`` (default): G1 joins stay G1 (to rounding) and G2 joins G2, corners (C0 knots
+        whose tangents differ by more than ``g1_angle``) and straight pieces stay where they
+        are, a smooth seam of an open curve whose ends coincide stays smooth
+        (:mod:`curvefair.fairing.joins`). ``"free"``: the method alone decides.
+    g1_angle : float, optional
+        Degrees; a C0 knot whose two tangents differ by at most this is a G1 join (default
+        :data:`curvefair.fairing.joins.DEFAULT_G1_ANGLE`, 0.5).
+    guard : bool
+        Default True: if the faired curve has more inflections or curvature extrema than the
+        input (curvefair's own counts, :func:`curvefair.analyze`), the largest fraction of the
+        move (1/2, 1/4, 1/8) that does not is returned instead, or else the input itself;
+        ``report["guard"]`` says what was kept and why. False: the method's result as it is.
     **options
         Passed to the method's driver; :func:`method_options` lists each method's options and
         their defaults (e.g. ``schedule="sweep"`` for ``"eck-hadenfeld"``). An unknown name
@@ -509,14 +523,39 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
     if spec.modes != ("spline",):
         kwargs["mode"] = mode
 
+    from . import joins as _joins
+
+    if joins not in ("keep", "free"):
+        raise InputError(f"unknown joins {joins!r}; valid values are: 'keep', 'free'")
+    g1_deg = _joins.DEFAULT_G1_ANGLE if g1_angle is None else as_nonnegative(g1_angle,
+                                                                            "g1_angle")
     before = _analysis_block(curve)
-    out = spec.driver(curve, tol=tol_v, eps=eps_v, max_steps=max_steps, clamp=clamp_pair,
-                      protect=prot, **kwargs)
+    jp = (_joins.plan(curve, clamp_pair, prot, g1_deg, tol_v) if joins == "keep"
+          else _joins.JoinPlan(curve, prot, clamp_pair))
+    tol_w = None if tol_v is None else tol_v - jp.margin
+    out = spec.driver(jp.curve, tol=tol_w, eps=eps_v, max_steps=max_steps, clamp=jp.clamp,
+                      protect=jp.protect, **kwargs)
     if not isinstance(out, DriverOutput):
         raise TypeError(f"driver of {spec.name!r} returned {type(out).__name__}, "
                         "expected DriverOutput")
-    new = out.curve
+    if not jp.restorable(out.curve):  # the method changed the knots: hold the joins instead
+        jp = _joins.plan(curve, clamp_pair, prot, g1_deg, tol_v, allow_reduce=False)
+        tol_w = tol_v
+        out = spec.driver(jp.curve, tol=tol_w, eps=eps_v, max_steps=max_steps, clamp=jp.clamp,
+                          protect=jp.protect, **kwargs)
+    new = jp.restore(out.curve)
+    if jp.reduced and out.history is not None and len(out.history):
+        h = out.history
+        out.history = FairingHistory.from_arrays(jp.original_index(h.index), h.measure,
+                                                 h.displacement)
     after = _analysis_block(new)
+    guard_info: dict[str, Any] = {"kept": "output"}
+    if guard and (after["inflections"] > before["inflections"]
+                  or after["extrema"] > before["extrema"]):
+        from ._guard import never_worse
+
+        new, after, guard_info = never_worse(curve, new, before, after, jp, out.curve,
+                                             _analysis_block)
 
     from ..analysis import deviation
 
@@ -573,6 +612,9 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
         "clamp": list(clamp_pair),
         "protect": sorted(prot),
     }
+    if joins == "keep":
+        report["joins"] = jp.report
+    report["guard"] = guard_info
     for k, v in out.extra.items():
         report.setdefault(k, v)
     report["time_s"] = time.perf_counter() - t_start

@@ -127,20 +127,32 @@ def _end_bc(curve: HermiteSpline, clamp: str, side: int) -> list[tuple[int, Floa
     return [(1, ev(1)), (2, ev(2))]
 
 
-def spline_derivatives(curve: HermiteSpline, P: FloatArray, clamp: tuple[str, str]) -> FloatArray:
+def spline_derivatives(curve: HermiteSpline, P: FloatArray, clamp: tuple[str, str],
+                       g2_segment: tuple[bool, bool] = (False, False)) -> FloatArray:
     """Derivative data ``(nd, nb, dim)`` of the C2 cubic / C4 quintic spline through the
     distinct points ``P`` at ``curve.params``, with the end conditions described in the module
-    docstring (periodic for a closed curve)."""
+    docstring (periodic for a closed curve).
+
+    ``g2_segment`` (cubic, per end): keep the input's tangents at the end point AND its
+    neighbour, so the end segment is the input's own (its end curvature exact) and the spline
+    is C2 from the neighbour on (clamped there by the input's tangent)."""
     t = np.asarray(curve.params)
     pts = np.vstack([P, P[:1]]) if curve.closed else P
     if curve.degree == 3:
         if curve.closed:
             spl = CubicSpline(t, pts, bc_type="periodic", axis=0)
+            ders = [spl(t, 1)]
         else:
-            left = _end_bc(curve, clamp[0], 0)[0]
-            right = _end_bc(curve, clamp[1], -1)[0]
-            spl = CubicSpline(t, pts, bc_type=(left, right), axis=0)
-        ders = [spl(t, 1)]
+            T0 = np.asarray(curve.tangents, dtype=float)
+            lo = 1 if g2_segment[0] else 0
+            hi = t.shape[0] - 2 if g2_segment[1] else t.shape[0] - 1
+            d1 = np.array(T0)
+            if hi > lo:
+                left = (1, T0[1]) if g2_segment[0] else _end_bc(curve, clamp[0], 0)[0]
+                right = (1, T0[-2]) if g2_segment[1] else _end_bc(curve, clamp[1], -1)[0]
+                spl = CubicSpline(t[lo:hi + 1], pts[lo:hi + 1], bc_type=(left, right), axis=0)
+                d1[lo:hi + 1] = spl(t[lo:hi + 1], 1)
+            ders = [d1]
     else:
         # the banded Hermite solve of interpolate_quintic (make_interp_spline(k=5) is far less
         # accurate: relative errors up to 1e-6 in r', r'' on nearly straight data)
@@ -200,6 +212,31 @@ def _dense_inverse(nd: int, nb: int, h: FloatArray, degree: int) -> FloatArray:
 # ----------------------------------------------------------------------------------------------
 # the driver
 # ----------------------------------------------------------------------------------------------
+def _end_second_derivative_kept(curve: HermiteSpline, clamp: tuple[str, str]) -> list[bool]:
+    """Per end: does the C2 re-interpolation (end tangent clamped) keep the input's end
+    second derivative ``r''(t_end)`` to 1e-12 of its size? True for an input that is already
+    such a spline; only then can the hold zone keep a ``g2`` clamp.
+
+    The end segment's ``r''`` at ``t_0`` is ``6 (P_1 - P_0) / h^2 - (4 D_0 + 2 D_1) / h``
+    (the cubic Hermite basis), and symmetrically at the right end.
+    """
+    P, D, h = distinct_data(curve)
+    Dn = spline_derivatives(curve, P, clamp)[:, 0]
+    D = D[:, 0]
+
+    def r2(Dv: FloatArray, side: int) -> FloatArray:
+        if side == 0:
+            return 6 * (P[1] - P[0]) / h[0] ** 2 - (4 * Dv[0] + 2 * Dv[1]) / h[0]
+        return -6 * (P[-1] - P[-2]) / h[-1] ** 2 + (4 * Dv[-1] + 2 * Dv[-2]) / h[-1]
+
+    out = []
+    for side in (0, 1):
+        a, b = r2(D, side), r2(Dn, side)
+        size = max(float(np.abs(a).max()), float(np.abs(D).max()) / h[0 if side == 0 else -1])
+        out.append(bool(np.abs(a - b).max() <= 1e-12 * max(size, 1e-300)))
+    return out
+
+
 def prepare(curve: HermiteSpline, *, method: str, tol: float | None, eps: float | None,
             max_steps: int | None, clamp: tuple[str, str], protect: frozenset[int],
             mode: str = "spline") -> dict[str, Any]:
@@ -231,14 +268,26 @@ def prepare(curve: HermiteSpline, *, method: str, tol: float | None, eps: float 
     # -- who may move
     eligible = np.ones(nd, dtype=np.bool_)
     held: list[int] = []
+    g2_segment = [False, False]
     if not closed:
         eligible[0] = eligible[-1] = False
         if degree == 3 and spline:
+            kept = (_end_second_derivative_kept(curve, clamp) if "g2" in clamp
+                    else [True, True])
             for side, cl in enumerate(clamp):
                 if cl == "g2":
                     nh = hold_zone_cubic(h if side == 0 else h[::-1])
-                    zone = range(1, 1 + nh) if side == 0 else range(nd - 1 - nh, nd - 1)
+                    if 2 * nh <= nd - 2 and kept[side]:
+                        zone = range(1, 1 + nh) if side == 0 else range(nd - 1 - nh, nd - 1)
+                    else:
+                        # not a C2 spline at this end, or the zone would hold most points:
+                        # keep the end segment itself (tangents at the end and its neighbour)
+                        g2_segment[side] = True
+                        zone = range(1, 2) if side == 0 else range(nd - 2, nd - 1)
                     held.extend(zone)
+            if "g2" in clamp:
+                extra["g2_hold"] = ["segment" if g else ("zone" if cl == "g2" else None)
+                                    for g, cl in zip(g2_segment, clamp, strict=True)]
         elif degree == 3 and not spline:
             if clamp[0] == "g2":
                 held.append(1)
@@ -256,10 +305,12 @@ def prepare(curve: HermiteSpline, *, method: str, tol: float | None, eps: float 
             fixed[i, 0] = cl in ("g1", "g2")
             if degree == 5:
                 fixed[i, 1] = cl == "g2"
+            if g2_segment[side]:
+                fixed[1 if side == 0 else nd - 2, 0] = True
 
     # -- step 1: (re-)interpolate (derivatives given by the end conditions stay bit-identical)
     if spline:
-        D_new = spline_derivatives(curve, P, clamp)
+        D_new = spline_derivatives(curve, P, clamp, (g2_segment[0], g2_segment[1]))
         D_new[fixed] = D[fixed]
         scale = np.abs(D).max(axis=(0, 2)) + 1e-300
         extra["input_reinterpolation_change"] = float(
@@ -408,7 +459,9 @@ def hermite_driver(curve: HermiteSpline, *, method: str, tol: float | None, eps:
         warnings.warn(note, UserWarning, stacklevel=2)
     if not (np.isfinite(P).all() and np.isfinite(D).all()):  # pragma: no cover - safety net
         raise FloatingPointError(f"method {method!r} produced non-finite data")
-    new = rebuild(curve, P, D)
+    # no step taken: the input is returned as it was (spline mode would otherwise hand back its
+    # re-interpolation, a changed curve reported as "0 steps")
+    new = curve if int(steps) == 0 else rebuild(curve, P, D)
     extra.update({
         "measure": "third_derivative_jump" if degree == 3 else
                    ("energy_drop_position" if spline else "energy_drop"),

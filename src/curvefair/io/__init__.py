@@ -35,10 +35,13 @@ The record
 - ``corners``: indices of points to keep fixed (sharp corners, an airfoil's trailing edge):
   give them to the fairing as ``protect``.
 
-Corners: a point list turning by ``corner_angle`` degrees (default 90) or more at a point is
-split into several records there, so that each record is smooth between its ends and the
-corner stays a corner; writing the records back joins the pieces again. Open airfoils also
-mark their first and last points (the trailing edge).
+Corners: a point list turning by ``corner_angle`` degrees (default 60: a regular pentagon's
+72 degree corners are corners, an airfoil's leading edge sampled at 60 points turns by less
+than 30) or more at a point is split into several records there, so that each record is
+smooth between its ends and the corner stays a corner; writing the records back joins the
+pieces again. On a noisy list the turn is measured between chords longer than the noise, so a
+turn between two noisy samples is not a corner. Open airfoils also mark their first and last
+points (the trailing edge).
 
 Writing is always atomic (a temporary file in the destination folder, then ``os.replace``) and
 never replaces a file the curves were read from unless ``overwrite=True``.
@@ -123,7 +126,7 @@ def _module(fmt: str) -> Any:
 
 
 def read_curves(path: str | os.PathLike[str], *, format: FormatName | None = None,
-                corner_angle: float | None = 90.0,
+                corner_angle: float | None = 60.0,
                 on_unsupported: Literal["raise", "skip"] = "raise") -> list[CurveRecord]:
     """Read every curve of a file.
 
@@ -133,7 +136,9 @@ def read_curves(path: str | os.PathLike[str], *, format: FormatName | None = Non
     format : str, optional
         One of :data:`FORMATS`; default: from the extension.
     corner_angle : float or None
-        Point lists are split at points turning by this many degrees or more (None: never).
+        Point lists are split at points turning by this many degrees or more (default 60;
+        None: never). On a noisy list the turn is measured between chords longer than the noise
+        (:func:`curvefair.io._common.corner_turning`), so noise is not taken for corners.
     on_unsupported : {"raise", "skip"}
         What to do with a curve entity curvefair cannot represent exactly (a rational or
         unclamped DXF spline, a polyline with arcs, an SVG arc...): raise

@@ -35,6 +35,9 @@ __all__ = [
     "atomic_path",
     "lazy_import",
     "turning_angles",
+    "corner_turning",
+    "noise_scale",
+    "DEFAULT_CORNER_ANGLE",
     "split_at_corners",
     "points_curve",
     "check_points",
@@ -329,6 +332,103 @@ def turning_angles(points: FloatArray, closed: bool) -> FloatArray:
     return out
 
 
+#: Default corner angle (degrees) of the readers: a point list turning by this much or more at
+#: a point (at the scale of its noise, see :func:`corner_turning`) is split there.
+DEFAULT_CORNER_ANGLE = 60.0
+_NOISE_MIN_POINTS = 10
+_NOISE_ALTERNATION = 0.3
+_NOISE_MAX_REL = 0.01
+_NOISE_CHORDS = 6.0
+
+
+def noise_scale(points: FloatArray, closed: bool) -> float:
+    """Estimated noise amplitude of a point list, or 0 when it does not look noisy.
+
+    ``r_i`` is the distance of ``p_i`` from the chord ``p_{i-1} p_{i+1}``; the estimate is
+    ``median(r) / 0.6745`` (the median absolute deviation of a normal distribution). The list
+    is taken as noisy only if it has at least 10 points, the sign of the turning flips between
+    at least 30 % of consecutive points (a smooth sampling flips only at its inflections, a
+    convex polygon never) and the estimate is at most 1 % of the list's extent (a zigzag
+    polyline drawn on purpose, e.g. a gear or a staircase outline, has larger offsets).
+    """
+    p = np.asarray(points, dtype=float)
+    m = p.shape[0]
+    if m < _NOISE_MIN_POINTS:
+        return 0.0
+    if closed:
+        a, b, c = np.roll(p, 1, 0), p, np.roll(p, -1, 0)
+    else:
+        a, b, c = p[:-2], p[1:-1], p[2:]
+    d = c - a
+    L = np.linalg.norm(d, axis=1)
+    v = b - a
+    if p.shape[1] == 2:
+        cr = np.abs(v[:, 0] * d[:, 1] - v[:, 1] * d[:, 0])
+    else:
+        cr = np.linalg.norm(np.cross(v, d), axis=1)
+    ok = L > 0
+    if not ok.any():
+        return 0.0
+    e1, e2 = b - a, c - b
+    if p.shape[1] == 2:
+        sg = np.sign(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+        alt = float(np.mean(sg[1:] * sg[:-1] < 0))
+    else:
+        bn = np.cross(e1, e2)
+        alt = float(np.mean(np.einsum("ij,ij->i", bn[1:], bn[:-1]) < 0))
+    sigma = float(np.median(cr[ok] / L[ok])) / 0.6745
+    size = float(np.ptp(p, axis=0).max())
+    if alt < _NOISE_ALTERNATION or not sigma <= _NOISE_MAX_REL * size:
+        return 0.0
+    return sigma
+
+
+def corner_turning(points: FloatArray, closed: bool) -> FloatArray:
+    """Turning angle in degrees at every point, measured at the scale of the data's noise.
+
+    Without noise (:func:`noise_scale` is 0) this is :func:`turning_angles`: the angle between
+    the chords to the two neighbours. On a noisy list the two chords run from ``p_i`` to the
+    nearest points before and after it that are at least ``6 sigma`` away, so a turn between
+    two samples closer than the noise is not a corner, while a real tangent break (which
+    persists at every scale) still is; a point whose chord cannot reach that length before an
+    end of an open list gets 0, and of a run of neighbours turning by the same corner only the
+    one turning most keeps its angle.
+    """
+    p = np.asarray(points, dtype=float)
+    m = p.shape[0]
+    sigma = noise_scale(p, closed)
+    if sigma == 0.0:
+        return turning_angles(p, closed)
+    Lmin = _NOISE_CHORDS * sigma
+    out = np.zeros(m)
+    idx = range(m) if closed else range(1, m - 1)
+    for i in idx:
+        ends = []
+        for step in (-1, 1):
+            k, n_steps, found = i + step, 1, False
+            while n_steps < m // 2 + 1:
+                if not closed and not 0 <= k < m:
+                    break
+                if np.linalg.norm(p[k % m] - p[i]) >= Lmin:
+                    found = True
+                    break
+                k += step
+                n_steps += 1
+            ends.append(k % m if found else -1)
+        if ends[0] < 0 or ends[1] < 0:
+            continue
+        a, b = p[i] - p[ends[0]], p[ends[1]] - p[i]
+        na, nb = float(np.linalg.norm(a)), float(np.linalg.norm(b))
+        out[i] = np.degrees(np.arccos(np.clip(float(a @ b) / (na * nb), -1.0, 1.0)))
+    # one corner per run of turning neighbours: keep the local maxima
+    keep = np.ones(m, dtype=bool)
+    prev, nxt = np.roll(out, 1), np.roll(out, -1)
+    if not closed:
+        prev[0], nxt[-1] = -1.0, -1.0
+    keep &= (out >= prev) & (out >= nxt)
+    return np.where(keep, out, 0.0)
+
+
 def split_at_corners(points: FloatArray, closed: bool, corner_angle: float | None,
                      extra_corners: Sequence[int] = ()) -> tuple[list[np.ndarray], FloatArray]:
     """Cut a point list at its corners.
@@ -339,8 +439,8 @@ def split_at_corners(points: FloatArray, closed: bool, corner_angle: float | Non
         Distinct points (a closed loop does NOT repeat its first point).
     closed : bool
     corner_angle : float or None
-        A point whose turning angle (:func:`turning_angles`) is ``>= corner_angle`` degrees is a
-        corner; None: no detection.
+        A point whose turning angle (:func:`corner_turning`: at the scale of the data's noise)
+        is ``>= corner_angle`` degrees is a corner; None: no detection.
     extra_corners : sequence of int
         Points that are corners whatever their angle.
 
@@ -353,7 +453,7 @@ def split_at_corners(points: FloatArray, closed: bool, corner_angle: float | Non
     angles : ndarray, shape (m,)
     """
     m = points.shape[0]
-    angles = turning_angles(points, closed)
+    angles = corner_turning(points, closed)
     is_c = np.zeros(m, dtype=bool)
     if corner_angle is not None:
         is_c |= angles >= float(corner_angle)

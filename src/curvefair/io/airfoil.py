@@ -63,7 +63,7 @@ def _is_count_row(v: np.ndarray) -> bool:
     return bool(np.all(v >= 2) and np.all(v == np.round(v)))
 
 
-def read(path: str | os.PathLike[str], *, corner_angle: float | None = 90.0,
+def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
          **_: Any) -> list[CurveRecord]:
     """Read a Selig or Lednicer airfoil file; see the module docstring."""
     lay = parse_text(path, header=True, ncols=(2,), what="airfoil file", notes=True)

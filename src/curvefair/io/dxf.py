@@ -208,7 +208,7 @@ def _load(path: object, what: str) -> Any:
                               path) from None
 
 
-def read(path: str | os.PathLike[str], *, corner_angle: float | None = 90.0,
+def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
          on_unsupported: str = "raise", **_: Any) -> list[CurveRecord]:
     """Read the curves of a DXF drawing; see the module docstring."""
     doc = _load(path, "reading DXF files")

@@ -50,7 +50,7 @@ __all__ = ["read", "write"]
 FORMAT = "points"
 
 
-def read(path: str | os.PathLike[str], *, corner_angle: float | None = 90.0,
+def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
          **_: Any) -> list[CurveRecord]:
     """Read a CSV / whitespace point list; see the module docstring."""
     lay = parse_text(path, header=True, ncols=(2, 3), what="points file")

@@ -208,7 +208,7 @@ def _polyline(xyz: FloatArray, base: dict[str, Any], path: object,
                          name=base["name"], source=src, first_index=index)
 
 
-def read(path: str | os.PathLike[str], *, corner_angle: float | None = 90.0,
+def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
          on_unsupported: str = "raise", **_: Any) -> list[CurveRecord]:
     """Read the curves of a Rhino model; see the module docstring."""
     rh = _rhino("reading 3dm files")

@@ -333,7 +333,7 @@ def _length(el: ET.Element, name: str, what: str, path: object) -> float:
         raise Unsupported(f"{name}={v!r} (only plain user units are read)") from None
 
 
-def read(path: str | os.PathLike[str], *, corner_angle: float | None = 90.0,
+def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
          on_unsupported: str = "raise", **_: Any) -> list[CurveRecord]:
     """Read the curves of the shape elements of an SVG file; see the module docstring."""
     spt = _svgpathtools("reading SVG files")

@@ -1,0 +1,361 @@
+"""What :func:`curvefair.fair` keeps of a curve's structure: smooth joins, corners, straight pieces.
+
+A fairing method moves control points (or data points) one at a time and knows nothing of the
+geometry the curve's author drew on purpose. :func:`plan` looks at the curve first and tells
+:func:`~curvefair.fairing.fair.fair` what to hold:
+
+* **G1 joins at C0 knots** (a B-spline knot of multiplicity ``degree``: a poly-Bezier join, a
+  Rhino kink-free join, an SVG chain whose handles are collinear but of unequal length). The
+  curve passes through the control point ``P_j`` of the knot; its tangents there are
+  ``P_j - P_{j-1}`` and ``P_{j+1} - P_j``. A join whose tangent directions agree within
+  ``g1_angle`` is faired as a C1 join: the parameter of each C0-separated block of spans is
+  scaled (an affine map per block: the curve is unchanged, its control points too) so that
+  the two derivatives become equal, ``|P_j - P_{j-1}| / (s_l dl) = |P_{j+1} - P_j| / (s_r dr)``
+  (``dl``, ``dr`` the adjacent span widths); then one copy of the knot is removed, which drops
+  ``P_j`` -- exact when the join is exactly G1, otherwise within the distance ``err`` of ``P_j``
+  from ``(dr' P_{j-1} + dl' P_{j+1}) / (dl' + dr')`` (Boehm's knot insertion, which puts it
+  back). The method fairs that curve with the tolerance reduced by ``err``; the result is
+  written back on the original knot vector (insertion and the inverse scaling are exact), so
+  the join is C1 in the scaled parameter: G1 to rounding (about 1e-15 rad), and every control
+  point within ``tol`` of its original position (a knot-insertion row is a convex
+  combination).
+* **G2 joins** (the curvature also continuous, to ``1e-6`` of its size, at a C0 or C1 knot of a
+  curve that is not C2 there): the control points on which the value, tangent and second
+  derivative on either side depend are held, which keeps position, tangent and curvature of
+  both sides exactly.
+* **corners** (a C0 knot whose tangents differ by more than ``g1_angle``): the join point
+  ``P_j`` is held; the corner stays where it is and stays a corner.
+* **straight pieces**: the control points of a knot span whose control points are collinear
+  (to 1e-9 of the curve's size: a line segment drawn as a B-spline or Bezier, a glyph stem)
+  are held, so the line stays that line. (Point lists are cut at their corners when read, so
+  a straight segment between two corners is a piece of its own with nothing to fair.)
+* **seams**: an open curve whose ends coincide (a closed outline written as an open chain) with
+  a G1 (G2) seam gets at least a ``g1`` (``g2``) clamp at both ends.
+
+Closed (periodic) B-splines with C0 knots hold the three control points of each G1 join instead
+of reparametrising.
+
+``joins="free"`` in :func:`~curvefair.fairing.fair.fair` turns all this off (the method's
+plain behaviour).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .._typing import FloatArray
+from ..curves.bspline import BSplineCurve, basis_derivatives
+from ..curves.piecewise import PiecewiseCurve
+
+__all__ = ["plan", "JoinPlan", "join_angles", "DEFAULT_G1_ANGLE"]
+
+#: Default largest angle (degrees) between the two tangents of a join that is treated as G1.
+DEFAULT_G1_ANGLE = 0.5
+_G2_REL = 1e-6
+_STRAIGHT_REL = 1e-9  # straight: off the line by at most this times the piece's length
+_ROUND = 8 * np.finfo(float).eps  # plus this times the curve's size (rounding)
+_CLAMP_RANK = {"g0": 0, "g1": 1, "g2": 2}
+
+
+def _angle(a: FloatArray, b: FloatArray) -> float:
+    """Angle in radians between two vectors (atan2 of |a x b| and a.b: accurate near 0)."""
+    if a.shape[0] == 2:
+        cr = abs(float(a[0] * b[1] - a[1] * b[0]))
+    else:
+        cr = float(np.linalg.norm(np.cross(a, b)))
+    return float(np.arctan2(cr, float(a @ b)))
+
+
+def _curvature(d1: FloatArray, d2: FloatArray) -> float:
+    n1 = float(np.linalg.norm(d1))
+    if d1.shape[0] == 2:
+        cr = float(d1[0] * d2[1] - d1[1] * d2[0])
+    else:
+        cr = float(np.linalg.norm(np.cross(d1, d2)))
+    return cr / max(n1 ** 3, 1e-300)
+
+
+def join_angles(curve: PiecewiseCurve) -> FloatArray:
+    """Angle (radians) between the left and right tangent at every interior break of the
+    curve's piecewise-polynomial form (and at the seam of a closed curve), shape ``(k,)``.
+
+    The tangents are the first derivatives of the two polynomial pieces meeting there.
+    """
+    pp = curve.piecewise
+    c = np.asarray(pp.coeffs)
+    w = np.asarray(pp.widths)
+    p = c.shape[1] - 1
+    right = c[:, 1, :]
+    left = sum(j * c[:, j, :] * w[:, None] ** (j - 1) for j in range(1, p + 1))
+    pairs = [(left[k - 1], right[k]) for k in range(1, c.shape[0])]
+    if curve.closed:
+        pairs.append((left[-1], right[0]))
+    return np.array([_angle(a, b) for a, b in pairs])
+
+
+@dataclass
+class JoinPlan:
+    """What :func:`plan` decided; see the module docstring.
+
+    Attributes
+    ----------
+    curve : PiecewiseCurve
+        The curve to hand to the method (the input, or its reparametrised reduced form).
+    protect : frozenset of int
+        Indices (of ``curve``'s data/control points) that must not move.
+    clamp : (str, str)
+        The clamp to use (raised at a smooth seam).
+    margin : float
+        ``err``: how far the reduced curve's re-inserted control points are from the input's;
+        the method's tolerance is ``tol - margin``.
+    report : dict
+        Counts for the fairing report.
+    """
+
+    curve: PiecewiseCurve
+    protect: frozenset[int]
+    clamp: tuple[str, str]
+    margin: float = 0.0
+    report: dict[str, Any] = field(default_factory=dict)
+    # reduction data (B-splines with reduced G1 joins)
+    _orig: BSplineCurve | None = None
+    _keep: np.ndarray | None = None  # original index of each reduced control point
+    _ins: list[tuple[int, int, int, float]] = field(default_factory=list)  # (j, jl, jr, a)
+
+    @property
+    def reduced(self) -> bool:
+        return self._orig is not None
+
+    def restorable(self, faired: PiecewiseCurve) -> bool:
+        """Whether :meth:`restore` can map ``faired`` back (same knots as :attr:`curve`)."""
+        if self._orig is None:
+            return True
+        c = self.curve
+        return (isinstance(faired, BSplineCurve) and isinstance(c, BSplineCurve)
+                and faired.degree == c.degree and faired.n_ctrl == c.n_ctrl
+                and np.array_equal(faired.knots, c.knots))
+
+    def restore(self, faired: PiecewiseCurve) -> PiecewiseCurve:
+        """The faired curve on the input's own knot vector (identity when nothing was reduced)."""
+        if self._orig is None:
+            return faired
+        assert isinstance(faired, BSplineCurve) and self._keep is not None
+        Q = np.asarray(faired.control_points)
+        P = np.empty((self._orig.n_ctrl, Q.shape[1]))
+        P[self._keep] = Q
+        for j, jl, jr, a in self._ins:
+            P[j] = (1.0 - a) * P[jl] + a * P[jr]
+        return BSplineCurve(P, self._orig.knots, self._orig.degree, closed=False)
+
+    def original_index(self, idx: np.ndarray) -> np.ndarray:
+        """Map indices of ``curve``'s control points to the input's."""
+        if self._keep is None:
+            return np.asarray(idx)
+        return self._keep[np.asarray(idx, dtype=np.int64)]
+
+
+def _size(pts: FloatArray) -> float:
+    return max(float(np.ptp(pts, axis=0).max()) if pts.shape[0] else 0.0,
+               float(np.abs(pts).max()) if pts.size else 0.0, 1e-300)
+
+
+def _straight_spans(curve: BSplineCurve, P: FloatArray, eps: float) -> tuple[set[int], int]:
+    """Control points of every knot span whose ``degree + 1`` control points are within
+    ``eps`` of the line through the first and last of them, and the number of such spans."""
+    p = curve.degree
+    s = np.asarray(curve.spans)
+    idx = curve.control_index(s[:, None] - p + np.arange(p + 1)[None, :])
+    W = P[idx]  # (spans, p+1, dim)
+    d = W[:, -1] - W[:, 0]
+    L = np.sqrt(np.sum(d * d, axis=1))
+    u = d / np.maximum(L, 1e-300)[:, None]
+    r = W - W[:, :1]
+    off = r - np.sum(r * u[:, None, :], axis=2)[:, :, None] * u[:, None, :]
+    lim = _STRAIGHT_REL * L + eps
+    ok = (np.sqrt(np.sum(off * off, axis=2)).max(axis=1) <= lim) & (L > eps)
+    return {int(i) for i in np.unique(idx[ok])}, int(ok.sum())
+
+
+def _side_support(curve: BSplineCurve, span: int, u: float, nder: int) -> list[int]:
+    """Control-point indices whose basis functions (or their first ``nder`` derivatives) are
+    non-zero at ``u`` evaluated on knot span ``span`` (a one-sided limit at a knot)."""
+    p = curve.degree
+    ders = basis_derivatives(np.asarray(curve.knots), p, np.array([span]), np.array([u]), nder)
+    nz = np.flatnonzero(np.abs(ders[0]).max(axis=0) > 1e-14)
+    return [int(i) for i in curve.control_index(span - p + nz)]
+
+
+def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozenset[int],
+                  g1: float, tol: float | None, allow_reduce: bool = True) -> JoinPlan:
+    p = curve.degree
+    t = np.asarray(curve.knots, dtype=float)
+    P = np.asarray(curve.control_points, dtype=float)
+    n = P.shape[0]
+    eps = _ROUND * _size(P)
+    hold: set[int] = set()
+    rep = {"g1_joins": 0, "g1_joins_reparametrised": 0, "g2_joins_held": 0, "corners_held": 0,
+           "straight_spans_held": 0}
+
+    # straight spans: every control point of a span lying on one line
+    straight, rep["straight_spans_held"] = _straight_spans(curve, P, eps)
+    hold.update(straight)
+
+    # distinct interior knots of the domain and their multiplicities
+    lo, hi = curve.domain
+    vals, first, counts = np.unique(t, return_index=True, return_counts=True)
+    pp = curve.piecewise
+    br = np.asarray(pp.breaks)
+    reduce: list[tuple[int, int, float, float]] = []  # (j, knot position a, dl, dr)
+    # candidates: interior knots of multiplicity p - 1 or p (C1 / C0); C2 or smoother knots
+    # are left to the method, which cannot break them
+    cand = (vals > lo) & (vals < hi) & (counts <= p) & (counts >= p - 1)
+    cv, ca, cm = vals[cand], first[cand], counts[cand]
+    ck = np.searchsorted(br, cv)
+    okk = (ck > 0) & (ck < br.shape[0] - 1)
+    okk[okk] &= br[ck[okk]] == cv[okk]
+    cv, ca, cm, ck = cv[okk], ca[okk], cm[okk], ck[okk]
+    D1L = pp.evaluate(cv, 1, segment=ck - 1).reshape(-1, P.shape[1])
+    D1R = pp.evaluate(cv, 1, segment=ck).reshape(-1, P.shape[1])
+    D2L = pp.evaluate(cv, 2, segment=ck - 1).reshape(-1, P.shape[1])
+    D2R = pp.evaluate(cv, 2, segment=ck).reshape(-1, P.shape[1])
+    for q in range(cv.shape[0]):
+        v, a, m = float(cv[q]), int(ca[q]), int(cm[q])
+        d1l, d1r, d2l, d2r = D1L[q], D1R[q], D2L[q], D2R[q]
+        nl, nr = float(np.linalg.norm(d1l)), float(np.linalg.norm(d1r))
+        if not (nl > 0 and nr > 0):
+            continue
+        ang = _angle(d1l, d1r)
+        c0 = m == p
+        if c0 and ang > g1:
+            if curve.closed:
+                hold.add(int(curve.control_index(a - 1)))
+            else:
+                hold.add(int(a - 1))
+            rep["corners_held"] += 1
+            continue
+        if ang > g1:
+            continue
+        if c0:
+            rep["g1_joins"] += 1
+        # G2 (curvature continuous) at a join that is not C2
+        if m >= p - 1 and p >= 2:
+            kl, kr = _curvature(d1l, d2l), _curvature(d1r, d2r)
+            if abs(kl - kr) <= _G2_REL * max(abs(kl), abs(kr)) and max(abs(kl), abs(kr)) > 0:
+                sl = int(np.searchsorted(t, v, side="left")) - 1  # span ending at v
+                sr = int(np.searchsorted(t, v, side="right")) - 1  # span starting at v
+                hold.update(_side_support(curve, sl, v, 2))
+                hold.update(_side_support(curve, sr, v, 2))
+                rep["g2_joins_held"] += 1
+                continue
+        if not c0:
+            continue  # C1 or smoother: the method keeps the tangent continuous itself
+        j = int(a - 1)
+        if curve.closed or j in protect:
+            hold.update(int(i) for i in curve.control_index(np.arange(j - 1, j + 2)))
+            continue
+        dl = float(v - t[a - 1])
+        dr = float(t[a + p] - v)
+        reduce.append((j, int(a), dl, dr))
+
+    out_clamp = list(clamp)
+    if not curve.closed:
+        e0, e1 = P[0], P[-1]
+        if np.abs(e0 - e1).max() <= _STRAIGHT_REL * _size(P):
+            d0 = curve(np.array([lo]), 1)[0]
+            d1 = curve(np.array([hi]), 1)[0]
+            if min(np.linalg.norm(d0), np.linalg.norm(d1)) > 0 and _angle(d1, d0) <= g1:
+                k0 = _curvature(d0, curve(np.array([lo]), 2)[0])
+                k1 = _curvature(d1, curve(np.array([hi]), 2)[0])
+                want = "g2" if abs(k0 - k1) <= _G2_REL * max(abs(k0), abs(k1), 1e-300) else "g1"
+                for s in (0, 1):
+                    if _CLAMP_RANK[out_clamp[s]] < _CLAMP_RANK[want]:
+                        out_clamp[s] = want
+                rep["seam_clamp"] = want
+
+    jplan = JoinPlan(curve, frozenset(), (out_clamp[0], out_clamp[1]), 0.0, rep)
+    # a join is reduced only if its point is free and the reduction moves it little: the
+    # re-inserted point is (R P_{j-1} + L P_{j+1}) / (L + R), L and R the handle lengths
+    errs: dict[int, float] = {}
+    for j, *_ in reduce:
+        L = float(np.linalg.norm(P[j] - P[j - 1]))
+        R = float(np.linalg.norm(P[j + 1] - P[j]))
+        e = (float(np.linalg.norm((R * P[j - 1] + L * P[j + 1]) / (L + R) - P[j]))
+             if L > 0 and R > 0 else np.inf)
+        if (not allow_reduce or j in hold or (tol is not None and e > 0.25 * tol)
+                or not np.isfinite(e)):
+            hold.update((j - 1, j, j + 1))  # hold the join's three points instead
+        else:
+            errs[j] = e
+    reduce = [r for r in reduce if r[0] in errs]
+    if reduce:
+        # block scales: blocks are separated by the C0 knots; s_{b+1}/s_b from each reduced join
+        c0_knots = [float(v) for v, m in zip(vals, counts, strict=True)
+                    if lo < v < hi and m == p]
+        ratio = {}
+        for j, a, dl, dr in reduce:
+            L = float(np.linalg.norm(P[j] - P[j - 1]))
+            R = float(np.linalg.norm(P[j + 1] - P[j]))
+            if not (L > 0 and R > 0):
+                continue
+            ratio[float(t[a])] = (R * dl) / (L * dr)
+        scales = [1.0]
+        for v in c0_knots:
+            scales.append(scales[-1] * ratio.get(v, 1.0))
+        edges = np.array([lo] + c0_knots + [hi])
+        # phi: piecewise linear, slope scales[b] on block b, phi(lo) = lo
+        phi_e = lo + np.r_[0.0, np.cumsum(np.diff(edges) * np.array(scales))]
+        tau = np.interp(t, edges, phi_e)
+        tau[t <= lo] = lo
+        tau[t >= hi] = phi_e[-1]
+        drop_j = {j for j, *_ in reduce if float(t[j + 1]) in ratio}
+        drop_knot = sorted(j + 1 for j in drop_j)
+        keep = np.array([i for i in range(n) if i not in drop_j], dtype=np.int64)
+        tau_r = np.delete(tau, drop_knot)
+        R0 = BSplineCurve(P[keep], tau_r, p, closed=False)
+        ins = []
+        err = 0.0
+        for j in sorted(drop_j):
+            a = j + 1
+            dl2 = float(tau[a] - tau[a - 1])
+            dr2 = float(tau[a + p] - tau[a])
+            w = dl2 / (dl2 + dr2)
+            ins.append((j, j - 1, j + 1, w))
+            err = max(err, float(np.linalg.norm((1.0 - w) * P[j - 1] + w * P[j + 1] - P[j])))
+        inv = {int(o): r for r, o in enumerate(keep)}
+        jplan.curve = R0
+        jplan._orig = curve
+        jplan._keep = keep
+        jplan._ins = ins
+        jplan.margin = err
+        rep["g1_joins_reparametrised"] = len(drop_j)
+        rep["g1_reduction_error"] = err
+        hold_r = {inv[i] for i in hold if i in inv}
+        for i in hold:
+            if i not in inv:  # a dropped join point asked to hold: hold its neighbours
+                hold_r.update((inv[i - 1], inv[i + 1]))
+        prot_r = {inv[i] for i in protect if i in inv}
+        jplan.protect = frozenset(hold_r | prot_r)
+        rep["held"] = sorted(hold)
+        return jplan
+    jplan.protect = frozenset(hold | set(protect))
+    rep["held"] = sorted(hold)
+    return jplan
+
+
+def plan(curve: PiecewiseCurve, clamp: tuple[str, str], protect: frozenset[int],
+         g1_angle: float = DEFAULT_G1_ANGLE, tol: float | None = None,
+         allow_reduce: bool = True) -> JoinPlan:
+    """Decide what the fairing keeps (module docstring); ``g1_angle`` in degrees.
+
+    ``allow_reduce=False``: hold the three control points of every G1 join instead of
+    reparametrising (for a method that changes the knot vector itself)."""
+    g1 = float(np.radians(g1_angle))
+    if isinstance(curve, BSplineCurve):
+        return _bspline_plan(curve, clamp, protect, g1, tol, allow_reduce)
+    # Hermite curves (point data): the reader already cut point lists at their corners, and a
+    # straight piece between two corners has nothing to fair; a straight run inside a piece
+    # (a line with a bump) is what fairing is for, so nothing more is held here
+    return JoinPlan(curve, frozenset(protect), clamp, 0.0, {"held": []})
