@@ -33,8 +33,9 @@ other subpath of the element as it was; everything else in the file byte for byt
 B-spline is written as its cubic Bezier pieces (one per knot span: the same number of
 segments as read when the knots are unchanged). Without a template, a new SVG holding one
 ``<path>`` per curve (cubic curves only: degree <= 3). Numbers of a rewritten element get the
-largest number of decimals the element had (its precision; ``decimals=`` overrides), numbers
-of a new file the shortest exact representation.
+largest number of decimals the element had (its precision; ``decimals=`` overrides,
+``precision="exact"`` writes the shortest exact representation instead), numbers of a new file
+the shortest exact representation.
 """
 
 from __future__ import annotations
@@ -386,8 +387,14 @@ def _record_d(recs: list[CurveRecord], decimals: int | None) -> tuple[str, bool]
 
 
 def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
-          template: str | None = None, decimals: int | None = None, **_: Any) -> None:
-    """Write an SVG file; see the module docstring."""
+          template: str | None = None, decimals: int | None = None, precision: str = "file",
+          **_: Any) -> None:
+    """Write an SVG file; see the module docstring.
+
+    ``precision="exact"`` (with ``decimals=None``) writes the numbers of rewritten elements
+    in the shortest form that reads back as exactly the value, instead of the element's own
+    number of decimals.
+    """
     spt = _svgpathtools("writing SVG files")
     ours = [r for r in records if template is not None and r.format == FORMAT
             and r.path is not None and os.path.abspath(r.path) == os.path.abspath(template)]
@@ -429,7 +436,7 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
                 pieces.append(d if ch else _d_original(sub, spt, None))
             else:
                 pieces.append(_d_original(sub, spt, None))
-        if changed and decimals is None:
+        if changed and decimals is None and precision != "exact":
             # the precision of the element as it was: its largest number of decimals
             found = re.findall(r"\.(\d+)", elements[k].get("d") or "")
             dec = max((len(f) for f in found), default=None)

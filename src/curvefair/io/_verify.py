@@ -1,0 +1,241 @@
+"""Write, read back, measure: the tolerance checked in the file the user will read.
+
+:func:`write_checked` writes faired records to a temporary file next to the destination,
+reads that file back with the same reader, and measures every curve read back against the
+curve read from the input (what the user had before): the parametric deviation
+``max_t |a(t) - b(t)|`` when both curves have the same parameter domain (B-spline and
+Bezier entities: same knots), else the geometric (Hausdorff) distance
+(:func:`curvefair.deviation` with ``kind="auto"``) -- a point file stores only points, and the
+curve re-interpolated through moved points has new chord-length parameters.
+
+When a curve read back is farther than ``tol`` from the input:
+
+1. SVG elements rounded to their own number of decimals are written again with exact numbers
+   (the rounding is undone);
+2. point data (point lists, airfoils, polylines: the curve is re-interpolated on reading)
+   get their moves from the input scaled down, ``p = p0 + s (p_faired - p0)`` with
+   ``s < 1``, until the curve read back is within ``tol``;
+3. otherwise nothing is written (the destination is untouched) and
+   :class:`WriteCheckError` says which curve is how far.
+
+Only then is the temporary file moved onto the destination.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..errors import CurvefairError, InputError
+from ._common import CurveRecord, atomic_path, points_curve
+
+__all__ = ["WriteCheck", "WriteCheckError", "write_checked"]
+
+#: Record kinds whose curve is re-interpolated from data points on reading.
+POINT_KINDS = ("points", "airfoil", "polyline", "fit_points")
+_MAX_SHRINK = 12
+
+
+class WriteCheckError(InputError):
+    """The written file would not hold the curves within the tolerance (nothing written)."""
+
+
+@dataclass(frozen=True)
+class WriteCheck:
+    """What the read-back check measured on the written file.
+
+    Attributes
+    ----------
+    max_deviation : float
+        Largest distance of a curve read back from the written file to its input curve.
+    deviations : tuple of float
+        Per input record, in order.
+    kinds : tuple of str
+        ``"parametric"`` or ``"geometric"`` per record (see the module docstring).
+    max_point_displacement : float or None
+        Largest data/control point displacement read back, where the counts match.
+    precision : str
+        ``"file"`` (the file's own precision), ``"decimals"`` (as requested), or ``"exact"``
+        (the file's rounding exceeded the tolerance and was undone).
+    move_scale : tuple of float
+        Per record, the factor ``s`` applied to the moves of point data (1.0: as faired).
+    notes : tuple of str
+        What was changed to meet the tolerance, one sentence each.
+    """
+
+    max_deviation: float
+    deviations: tuple[float, ...]
+    kinds: tuple[str, ...]
+    max_point_displacement: float | None
+    precision: str
+    move_scale: tuple[float, ...]
+    notes: tuple[str, ...] = field(default_factory=tuple)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"max_deviation": self.max_deviation, "deviations": list(self.deviations),
+                "kinds": list(self.kinds),
+                "max_point_displacement": self.max_point_displacement,
+                "precision": self.precision, "move_scale": list(self.move_scale),
+                "notes": list(self.notes)}
+
+
+def _label(rec: CurveRecord, i: int) -> str:
+    return f"curve {i}" + (f" ({rec.name})" if rec.name else "")
+
+
+def _matched(reference: Sequence[CurveRecord], back: Sequence[CurveRecord]
+             ) -> list[Any] | None:
+    """The curves read back, one per reference record, or None when they cannot be paired.
+
+    Same number of records: in order. Otherwise (a point list split at other corners when
+    read back) each reference piece is rebuilt from the points read back at its indices.
+    """
+    if len(back) == len(reference):
+        return [b.curve for b in back]
+    if not all("indices" in r.source for r in list(reference) + list(back)):
+        return None
+    n = {int(r.source["n_points"]) for r in list(reference) + list(back)}
+    if len(n) != 1:
+        return None
+    full = np.full((n.pop(), back[0].points.shape[1]), np.nan)  # type: ignore[union-attr]
+    for b in back:
+        full[np.asarray(b.source["indices"], dtype=int)] = np.asarray(b.points)
+    if np.isnan(full).any():
+        return None
+    out = []
+    for r in reference:
+        idx = np.asarray(r.source["indices"], dtype=int)
+        out.append(points_curve(full[idx], bool(r.curve.closed)))
+    return out
+
+
+def _measure(reference: Sequence[CurveRecord], curves: Sequence[Any]
+             ) -> tuple[list[float], list[str], float | None]:
+    from ..analysis import deviation
+
+    devs, kinds, mpd = [], [], None
+    for r, c in zip(reference, curves, strict=True):
+        d = deviation(r.curve, c)
+        devs.append(float(d.max_distance))
+        kinds.append(d.kind)
+        if d.max_point_displacement is not None:
+            mpd = max(mpd or 0.0, float(d.max_point_displacement))
+    return devs, kinds, mpd
+
+
+def _scaled(rec: CurveRecord, ref: CurveRecord, s: float) -> CurveRecord:
+    """``rec`` with its data points moved ``s`` times as far from ``ref``'s as faired."""
+    p0 = np.asarray(ref.curve.points, dtype=float)  # type: ignore[attr-defined]
+    p1 = np.asarray(rec.curve.points, dtype=float)  # type: ignore[attr-defined]
+    pts = p0 + s * (p1 - p0)
+    # keep exactly the points that did not move (corners, clamped ends, protected points)
+    pts[np.all(p1 == p0, axis=1)] = p0[np.all(p1 == p0, axis=1)]
+    return rec.with_curve(points_curve(pts, bool(rec.curve.closed)))
+
+
+def _shrinkable(rec: CurveRecord, ref: CurveRecord) -> bool:
+    a = getattr(rec.curve, "points", None)
+    b = getattr(ref.curve, "points", None)
+    return (rec.kind in POINT_KINDS and isinstance(a, np.ndarray) and isinstance(b, np.ndarray)
+            and a.shape == b.shape)
+
+
+def write_checked(path: str | os.PathLike[str], records: Sequence[CurveRecord],
+                  reference: Sequence[CurveRecord], *, tol: float | None,
+                  reader: Callable[[str], list[CurveRecord]], template: object = None,
+                  format: str | None = None, overwrite: bool = False,
+                  decimals: int | None = None) -> WriteCheck:
+    """Write ``records`` to ``path`` only if the file read back is within ``tol`` of
+    ``reference``; see the module docstring.
+
+    Parameters
+    ----------
+    path : path-like
+    records : sequence of CurveRecord
+        The faired records, one per reference record, in the same order.
+    reference : sequence of CurveRecord
+        The records read from the input (the curves the user had).
+    tol : float or None
+        None: measure and report, enforce nothing (the file must still read back).
+    reader : callable
+        ``reader(path) -> records``: how the file is read (the same corner handling as the
+        input).
+    template, format, overwrite, decimals
+        As for :func:`curvefair.write_curves`; ``decimals`` given: the rounding asked for is
+        kept, and a file it puts out of tolerance is not written.
+
+    Raises
+    ------
+    WriteCheckError
+        The file would not read back, or a curve read back would be farther than ``tol``
+        from its input; nothing is written.
+    """
+    from . import detect_format, write_curves
+
+    if len(records) != len(reference):
+        raise InputError(f"write_checked: {len(records)} records for {len(reference)} "
+                         "reference records")
+    fmt = detect_format(path, format)
+    precision = "file" if decimals is None else "decimals"
+    recs = list(records)
+    scale = [1.0] * len(recs)
+    notes: list[str] = []
+    where = os.fspath(path)
+    with atomic_path(path) as tmp:
+        for _attempt in range(_MAX_SHRINK + 3):
+            write_curves(tmp, recs, template=template, format=fmt,  # type: ignore[arg-type]
+                         overwrite=overwrite, decimals=decimals,
+                         precision="exact" if precision == "exact" else "file")
+            try:
+                back = reader(os.fspath(tmp))
+            except CurvefairError as exc:
+                msg = str(exc).replace(os.fspath(tmp), where)
+                if precision == "file" and fmt == "svg":
+                    precision = "exact"
+                    notes.append("the file's own precision gave a file that does not read "
+                                 "back; written with exact numbers")
+                    continue
+                hint = f" (--decimals {decimals} rounds too much?)" if decimals is not None \
+                    else ""
+                raise WriteCheckError(f"{where}: not written: the file would not read back: "
+                                      f"{msg}{hint}") from None
+            curves = _matched(reference, back)
+            if curves is None:
+                raise WriteCheckError(
+                    f"{where}: not written: it reads back as {len(back)} curves, the input "
+                    f"had {len(reference)}")
+            devs, kinds, mpd = _measure(reference, curves)
+            over = [i for i, d in enumerate(devs) if tol is not None and not d <= tol]
+            if not over:
+                return WriteCheck(max(devs, default=0.0), tuple(devs), tuple(kinds), mpd,
+                                  precision, tuple(scale), tuple(notes))
+            if precision == "file" and fmt == "svg":
+                precision = "exact"
+                worst = max(over, key=lambda i: devs[i])
+                notes.append(f"rounded to the elements' own decimals, {_label(reference[worst], worst)} "
+                             f"read back {devs[worst]:.6g} from the input (> tol {tol:g}); "
+                             "written with exact numbers")
+                continue
+            fix = [i for i in over if _shrinkable(records[i], reference[i])]
+            if len(fix) < len(over) or precision == "decimals":
+                i = next(i for i in over if i not in fix) if len(fix) < len(over) else over[0]
+                why = (f"; --decimals {decimals} rounds too much" if precision == "decimals"
+                       else "")
+                raise WriteCheckError(
+                    f"{where}: not written: {_label(reference[i], i)} would read back "
+                    f"{devs[i]:.6g} from the input, more than tol {tol:g}{why}")
+            for i in fix:
+                # the deviation grows about linearly with the scale of the moves
+                s = scale[i] * min(0.98, 0.999 * float(tol) / devs[i])  # type: ignore[arg-type]
+                scale[i] = s
+                recs[i] = _scaled(records[i], reference[i], s)
+            if not notes or not notes[-1].startswith("point data"):
+                notes.append("point data: the curve re-interpolated through the written points "
+                             "was farther than tol from the input; the moves were scaled down")
+        raise WriteCheckError(f"{where}: not written: the curves read back stay farther than "
+                              f"tol {tol:g} from the input")
+    raise AssertionError("unreachable")  # pragma: no cover
