@@ -125,7 +125,7 @@ def _check_outputs(inputs: Sequence[tuple[str, str]], outputs: Sequence[tuple[st
         seen.append((key, p, opt))
 
 
-def _format_of(path: str, what: str) -> str:
+def _format_of(path: str, what: str = "") -> str:
     """The format of ``path`` from its extension (the CLI has no format option)."""
     from .io import FORMATS, detect_format
 
@@ -133,7 +133,8 @@ def _format_of(path: str, what: str) -> str:
         return detect_format(path)
     except CurvefairError:
         known = ", ".join(e for exts in FORMATS.values() for e in exts)
-        raise InputFailure(f"{what} {path!r}: cannot tell the format from the extension "
+        raise InputFailure(f"{what + ' ' if what else ''}{path!r}: cannot tell the format from "
+                           "the extension "
                            f"{Path(path).suffix!r}; known: {known}") from None
 
 
@@ -367,6 +368,7 @@ def _fair_arguments() -> set[str]:
 def _read(path: str, corner_angle: float | None) -> list[Any]:
     from . import read_curves
 
+    _format_of(path)  # a CLI message (the API's names format=, which the CLI lacks)
     return read_curves(path, corner_angle=corner_angle)
 
 

@@ -192,9 +192,11 @@ def write_target(path: str | os.PathLike[str]) -> Path:
     return dest
 
 
-def _user_os_error(exc: OSError, user: str, tmp: str | None) -> OSError:
-    """``exc`` naming the user's path instead of a temporary file (or no file)."""
-    if exc.filename in (None, tmp) or (tmp is not None and exc.filename == os.path.basename(tmp)):
+def _user_os_error(exc: OSError, user: str, tmp: str | None, always: bool = False) -> OSError:
+    """``exc`` naming the user's path instead of a temporary file (or no file); ``always``:
+    whatever file it names (an error creating the temporary file names only that)."""
+    if always or exc.filename in (None, tmp) or (
+            tmp is not None and exc.filename == os.path.basename(tmp)):
         new = OSError(exc.errno, exc.strerror or str(exc), user)
         if type(exc) is not OSError:
             with contextlib.suppress(TypeError):
@@ -228,7 +230,7 @@ def atomic_path(path: str | os.PathLike[str], suffix: str | None = None) -> Iter
     except OSError as exc:
         if not _LIVE_TEMPS:
             _restore_handlers()
-        raise _user_os_error(exc, user, None) from None
+        raise _user_os_error(exc, user, None, always=True) from None
     _LIVE_TEMPS.add(tmp)
     os.close(fd)
     tmp_path = Path(tmp)

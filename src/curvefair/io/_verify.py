@@ -113,6 +113,23 @@ def _matched(reference: Sequence[CurveRecord], back: Sequence[CurveRecord]
     return out
 
 
+def _lost_points(reference: Sequence[CurveRecord], back: Sequence[CurveRecord]) -> str | None:
+    """Why the point data read back is not the point data written (points merged or dropped
+    on reading, e.g. rounded onto each other), or None."""
+    n_ref = {int(r.source["n_points"]) for r in reference if "n_points" in r.source}
+    n_back = {int(r.source["n_points"]) for r in back if "n_points" in r.source}
+    if len(reference) == len(back):
+        for i, (r, b) in enumerate(zip(reference, back, strict=True)):
+            if r.points is not None and b.points is not None and \
+                    r.points.shape != b.points.shape:
+                return (f"{_label(r, i)} reads back with {b.points.shape[0]} points, "
+                        f"{r.points.shape[0]} were written")
+    elif n_ref and n_back and n_ref != n_back:
+        return (f"the point list reads back with {sorted(n_back)[0]} points, "
+                f"{sorted(n_ref)[0]} were written")
+    return None
+
+
 def _measure(reference: Sequence[CurveRecord], curves: Sequence[Any]
              ) -> tuple[list[float], list[str], float | None]:
     from ..analysis import deviation
@@ -203,6 +220,11 @@ def write_checked(path: str | os.PathLike[str], records: Sequence[CurveRecord],
                     else ""
                 raise WriteCheckError(f"{where}: not written: the file would not read back: "
                                       f"{msg}{hint}") from None
+            lost = _lost_points(reference, back)
+            if lost is not None:
+                hint = f" (--decimals {decimals} rounds too much?)" if decimals is not None \
+                    else ""
+                raise WriteCheckError(f"{where}: not written: {lost}{hint}")
             curves = _matched(reference, back)
             if curves is None:
                 raise WriteCheckError(
