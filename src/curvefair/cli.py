@@ -305,7 +305,8 @@ def _check_protect_range(records: Sequence[Any], user: Sequence[int]) -> None:
     n = max(counts)
     bad = [i for i in user if i >= n]
     if bad:
-        what = "points" if any("indices" in r.source for r in records) else "points / control points"
+        what = ("points" if any("indices" in r.source for r in records)
+                else "points / control points")
         raise click.BadParameter(f"index {bad[0]} is out of range: the curves of IN have at most "
                                  f"{n} {what} (indices 0..{n - 1})", param_hint="--protect")
 
