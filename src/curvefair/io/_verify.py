@@ -55,7 +55,9 @@ class WriteCheck:
     deviations : tuple of float
         Per input record, in order.
     kinds : tuple of str
-        ``"parametric"`` or ``"geometric"`` per record (see the module docstring).
+        Per record: ``"parametric"``, ``"geometric"`` (the refined Hausdorff distance), or
+        ``"geometric upper bound"`` (a cheap bound, used when it already meets ``tol``; see
+        :func:`curvefair.analysis._deviation.geometric_upper_bound`).
     max_point_displacement : float or None
         Largest data/control point displacement read back, where the counts match.
     precision : str
@@ -130,17 +132,35 @@ def _lost_points(reference: Sequence[CurveRecord], back: Sequence[CurveRecord]) 
     return None
 
 
-def _measure(reference: Sequence[CurveRecord], curves: Sequence[Any]
+def _same_domain(a: Any, b: Any) -> bool:
+    (a0, a1), (b0, b1) = a.domain, b.domain
+    t = 1e-12 * max(a1 - a0, b1 - b0, abs(a0), abs(a1))
+    return abs(a0 - b0) <= t and abs(a1 - b1) <= t
+
+
+def _measure(reference: Sequence[CurveRecord], curves: Sequence[Any], tol: float | None
              ) -> tuple[list[float], list[str], float | None]:
+    """Per curve: the parametric deviation (equal domains), else a cheap upper bound of the
+    Hausdorff distance when it already meets ``tol`` (or there is no tol), else the refined
+    geometric distance."""
     from ..analysis import deviation
+    from ..analysis._deviation import _point_displacement, geometric_upper_bound
 
     devs, kinds, mpd = [], [], None
     for r, c in zip(reference, curves, strict=True):
-        d = deviation(r.curve, c)
-        devs.append(float(d.max_distance))
-        kinds.append(d.kind)
-        if d.max_point_displacement is not None:
-            mpd = max(mpd or 0.0, float(d.max_point_displacement))
+        d_max: float | None = None
+        if not _same_domain(r.curve, c):
+            ub = geometric_upper_bound(r.curve, c)
+            if tol is None or ub <= tol:
+                d_max, kind = ub, "geometric upper bound"
+                m, _ = _point_displacement(r.curve, c)
+        if d_max is None:
+            d = deviation(r.curve, c)
+            d_max, kind, m = float(d.max_distance), d.kind, d.max_point_displacement
+        devs.append(d_max)
+        kinds.append(kind)
+        if m is not None:
+            mpd = max(mpd or 0.0, float(m))
     return devs, kinds, mpd
 
 
@@ -230,7 +250,7 @@ def write_checked(path: str | os.PathLike[str], records: Sequence[CurveRecord],
                 raise WriteCheckError(
                     f"{where}: not written: it reads back as {len(back)} curves, the input "
                     f"had {len(reference)}")
-            devs, kinds, mpd = _measure(reference, curves)
+            devs, kinds, mpd = _measure(reference, curves, tol)
             over = [i for i, d in enumerate(devs) if tol is not None and not d <= tol]
             if not over:
                 return WriteCheck(max(devs, default=0.0), tuple(devs), tuple(kinds), mpd,
