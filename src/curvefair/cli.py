@@ -749,7 +749,8 @@ def _summary_table(rows: list[dict[str, Any]]) -> Any:
                    "curve.")
 @click.option("--decimals", type=click.IntRange(min=0), metavar="N",
               help="Text formats: write every number with N decimals [default: the input "
-                   "file's precision].")
+                   "file's precision]. A rounding that puts a curve read back farther than "
+                   "--tol from the input, or points onto each other, writes nothing (exit 1).")
 @click.option("--report", metavar="REPORT.json", help="Write the full report as JSON.")
 @click.option("--history", is_flag=True, help="Include every step in the JSON report.")
 @click.option("--plot", "plot_path", metavar="PLOT.png",
@@ -769,6 +770,11 @@ def fair_cmd(infile: str, out: str | None, in_place: bool, method: str | None,
     curvature extrema, largest deviation and where, steps and time. A curve that cannot be
     faired is reported and written unchanged; the others are still processed and the exit
     code is 1.
+
+    OUT is written to a temporary file and read back first: every curve read back is measured
+    against IN's (the figure is printed and in the report). Farther than --tol: SVG rounding
+    to the file's decimals is undone, point data get smaller moves; otherwise OUT is not
+    written (exit 1).
     """
     from .io import detect_format
 
