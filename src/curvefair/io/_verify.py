@@ -250,7 +250,13 @@ def write_checked(path: str | os.PathLike[str], records: Sequence[CurveRecord],
                 raise WriteCheckError(
                     f"{where}: not written: it reads back as {len(back)} curves, the input "
                     f"had {len(reference)}")
-            devs, kinds, mpd = _measure(reference, curves, tol)
+            try:
+                devs, kinds, mpd = _measure(reference, curves, tol)
+            except CurvefairError:
+                raise
+            except (ValueError, ArithmeticError, MemoryError) as exc:
+                raise WriteCheckError(f"{where}: not written: the curves read back could not "
+                                      f"be measured against the input ({exc})") from None
             over = [i for i, d in enumerate(devs) if tol is not None and not d <= tol]
             if not over:
                 return WriteCheck(max(devs, default=0.0), tuple(devs), tuple(kinds), mpd,
