@@ -118,10 +118,111 @@ def test_to_dict_and_bad_input():
     json.dumps(d, allow_nan=False)
     assert isinstance(d["point_a"], list) and isinstance(d["point_index"], int)
     with pytest.raises(InputError, match="domain"):
-        cf.deviation(a, cf.interpolate_cubic(a.points, param=a.params * 2))
+        cf.deviation(a, cf.interpolate_cubic(a.points, param=a.params * 2), kind="parametric")
+    with pytest.raises(InputError, match="kind"):
+        cf.deviation(a, a, kind="hausdorff")
     with pytest.raises(InputError, match="3-D"):
         cf.deviation(a, cf.interpolate_cubic(np.c_[a.points, np.zeros(4)], param=a.params))
     with pytest.raises(InputError, match="curve_b"):
         cf.deviation(a, a.points)
     with pytest.raises(InputError, match="curve_a"):
         cf.deviation(None, a)
+
+
+# ---------------------------------------------------------------------------------------------
+# geometric (Hausdorff) distance: curves with different parameter domains
+# ---------------------------------------------------------------------------------------------
+def _hausdorff_reference(a, b, n=400_001, top=10):
+    """max(h(a, b), h(b, a)) with scipy: the distance of a point to the other curve by dense
+    sampling (k-d tree) and bounded minimisation around the nearest sample, maximised over
+    the curve by bounded (Brent) maximisation around the largest of 20,001 samples."""
+    from scipy.optimize import minimize_scalar
+    from scipy.spatial import cKDTree
+
+    def directed(x_curve, y_curve):
+        uy = np.linspace(*y_curve.domain, n)
+        tree = cKDTree(y_curve(uy))
+        h = uy[1] - uy[0]
+
+        def dist(t):
+            x = x_curve(t).reshape(-1)
+            d0, j = tree.query(x)
+            lo, hi = max(uy[j] - 2 * h, uy[0]), min(uy[j] + 2 * h, uy[-1])
+            r = minimize_scalar(lambda s: float(np.linalg.norm(y_curve(s) - x)),
+                                bounds=(lo, hi), method="bounded", options={"xatol": 1e-14})
+            return min(float(r.fun), float(d0))
+
+        ux = np.linspace(*x_curve.domain, 20_001)
+        d = tree.query(x_curve(ux))[0]
+        hx = ux[1] - ux[0]
+        out = 0.0
+        for i in np.argsort(-d)[:top]:
+            lo, hi = max(ux[i] - hx, ux[0]), min(ux[i] + hx, ux[-1])
+            r = minimize_scalar(lambda t: -dist(t), bounds=(lo, hi), method="bounded",
+                                options={"xatol": 1e-13})
+            out = max(out, -float(r.fun), dist(ux[i]))
+        return out
+
+    return max(directed(a, b), directed(b, a))
+
+
+def test_geometric_distance_of_reparametrised_and_offset_curves():
+    th = np.pi * np.linspace(0.0, 1.0, 25) ** 1.5  # uneven spacing: chord != uniform
+    p = np.c_[np.cos(th), np.sin(th)]
+    a = cf.interpolate_cubic(p)                       # chord-length parameters
+    # the same points, uniform parameters on another domain: another curve, close to a
+    b = cf.interpolate_cubic(p, param=np.linspace(0.0, 7.0, 25))
+    # scaled points: chord parameters scaled too, so the domains differ
+    c = cf.interpolate_cubic(1.01 * p)
+    for x, y in ((a, b), (a, c), (b, c)):
+        d = cf.deviation(x, y)
+        assert d.kind == "geometric" and d.upper_bound is None
+        ref = _hausdorff_reference(x, y)
+        # (scipy's bounded search stops at a relative parameter tolerance ~1.5e-8)
+        assert d.max_distance == pytest.approx(ref, rel=1e-6, abs=1e-7)
+        # the two points it names are on the curves and that far apart
+        assert np.linalg.norm(d.point_a - d.point_b) == pytest.approx(d.max_distance, rel=1e-9)
+        assert np.linalg.norm(d.point_a - x(d.param)) <= 1e-12
+        # the cheap bound of one dense pass: above the distance, within a sample gap of it
+        from curvefair.analysis._deviation import geometric_upper_bound
+
+        ub = geometric_upper_bound(x, y)
+        length = max(float(np.sum(np.linalg.norm(np.diff(cv(np.linspace(*cv.domain, 20001)),
+                                                          axis=0), axis=1))) for cv in (x, y))
+        assert ref * (1 - 1e-9) <= ub <= ref + length / 2048
+
+
+def test_geometric_distance_exact_cases():
+    # a straight line and the same line parametrised 5 times faster, then shifted by 0.3
+    a = cf.interpolate_cubic(np.c_[np.linspace(0, 1, 6), np.zeros(6)], param=np.linspace(0, 1, 6))
+    b = cf.interpolate_cubic(np.c_[np.linspace(0, 1, 6), np.full(6, 0.3)],
+                             param=np.linspace(0, 5, 6))
+    assert cf.deviation(a, b).max_distance == pytest.approx(0.3, rel=1e-12)
+    b0 = cf.interpolate_cubic(a.points, param=np.linspace(2, 7, 6))
+    assert cf.deviation(a, b0).max_distance <= 1e-12
+    # a shorter curve: the uncovered end of the longer one counts (h(a, b) side)
+    short = cf.interpolate_cubic(np.c_[np.linspace(0, 0.8, 5), np.zeros(5)])
+    assert cf.deviation(a, short).max_distance == pytest.approx(0.2, rel=1e-12)
+    assert cf.deviation(short, a).max_distance == pytest.approx(0.2, rel=1e-12)
+    # kind="geometric" on equal domains never exceeds the parametric figure
+    rng = np.random.default_rng(3)
+    pts = np.cumsum(rng.normal(size=(40, 2)), axis=0)
+    u = cf.interpolate_cubic(pts)
+    v = cf.interpolate_cubic(pts + rng.normal(scale=0.05, size=pts.shape), param=u.params)
+    geo, par = cf.deviation(u, v, kind="geometric"), cf.deviation(u, v, kind="parametric")
+    assert geo.max_distance <= par.upper_bound
+    assert geo.max_distance == pytest.approx(_hausdorff_reference(u, v), rel=1e-6)
+
+
+def test_geometric_distance_finds_nearest_point_on_long_straight_piece():
+    """A long straight piece next to short curved ones (an SVG glyph stem): the nearest point
+    lies on the long piece between its samples."""
+    from curvefair import BSplineCurve
+
+    P = np.array([[0, 0], [0, 1], [0, 2], [0, 100], [1, 100.5], [2, 100], [2, 99]], float)
+    knots = np.r_[0, 0, 0, 0, 3, 3, 3, 9, 9, 9, 9].astype(float)  # a C0 corner at 3
+    a = BSplineCurve(P, knots, 3)
+    b = BSplineCurve(P + [0.25, 0.0], knots * 2.0, 3)
+    d = cf.deviation(a, b)
+    assert d.kind == "geometric"
+    assert d.max_distance == pytest.approx(_hausdorff_reference(a, b), rel=1e-6)

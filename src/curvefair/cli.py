@@ -71,6 +71,54 @@ def _user_errors() -> Iterator[None]:
         raise InputFailure(f"{where}{exc.strerror or exc}") from None
 
 
+def _file_key(path: str) -> tuple[Any, ...]:
+    """What identifies the file ``path`` names: device and inode of an existing file (any
+    spelling, symbolic or hard link), else the resolved absolute path."""
+    real = os.path.realpath(path)
+    try:
+        st = os.stat(real)
+    except OSError:
+        return ("path", os.path.normcase(real))
+    return ("inode", st.st_dev, st.st_ino)
+
+
+def _check_outputs(inputs: Sequence[tuple[str, str]], outputs: Sequence[tuple[str | None, str]],
+                   in_place: bool = False) -> None:
+    """Refuse an output that is empty, a folder, an input (unless ``in_place`` for the first
+    output and the first input) or another output; usage errors naming the options."""
+    seen: list[tuple[tuple[Any, ...], str, str]] = []
+    keys_in = [(_file_key(p), p, what) for p, what in inputs]
+    for k, (p, opt) in enumerate(outputs):
+        if p is None:
+            continue
+        if not p.strip():
+            raise click.BadParameter("the file name is empty", param_hint=opt)
+        if os.path.isdir(p):
+            raise click.BadParameter(f"{p!r} is a folder; give a file name", param_hint=opt)
+        key = _file_key(p)
+        for kin, pin, what in keys_in:
+            if key == kin and not (in_place and k == 0 and what == "IN"):
+                extra = "; pass --in-place to replace it" if k == 0 and what == "IN" else ""
+                raise click.UsageError(f"{opt} {p!r} is the input file {what} ({pin!r}){extra}")
+        for kout, pout, optout in seen:
+            if key == kout:
+                raise click.UsageError(f"{opt} {p!r} is the same file as {optout} {pout!r}")
+        seen.append((key, p, opt))
+
+
+def _format_of(path: str, what: str = "") -> str:
+    """The format of ``path`` from its extension (the CLI has no format option)."""
+    from .io import FORMATS, detect_format
+
+    try:
+        return detect_format(path)
+    except CurvefairError:
+        known = ", ".join(e for exts in FORMATS.values() for e in exts)
+        raise InputFailure(f"{what + ' ' if what else ''}{path!r}: cannot tell the format from "
+                           "the extension "
+                           f"{Path(path).suffix!r}; known: {known}") from None
+
+
 def _console(stderr: bool = False, quiet: bool = False) -> Any:
     from rich.console import Console
 
@@ -175,6 +223,122 @@ def _parse_method_options(items: Sequence[str]) -> dict[str, Any]:
     return out
 
 
+def _option_kind(default: Any, annotation: Any) -> str | None:
+    """``"bool"``, ``"int"``, ``"float"`` or None (anything) for a method option."""
+    ann = str(annotation).replace(" ", "").replace("typing.", "")
+    ann = ann.replace("Optional[", "").rstrip("]").replace("|None", "")
+    if isinstance(default, bool) or ann in ("bool", "<class'bool'>"):
+        return "bool"
+    if isinstance(default, int) or ann in ("int", "<class'int'>"):
+        return "int"
+    if isinstance(default, float) or ann in ("float", "<class'float'>"):
+        return "float"
+    return None
+
+
+def _check_option_values(method: str | None, options: dict[str, Any]) -> None:
+    """Usage error for a ``-O`` value of the wrong type (``pair=3``, ``relative=maybe``).
+
+    The type comes from the method driver's default and annotation; with no ``--method``
+    every method that has the option is checked (the default method depends on the curve).
+    """
+    from .fairing import METHODS
+
+    names = [method] if method is not None and method in METHODS else list(METHODS)
+    for key, val in options.items():
+        for name in names:
+            try:
+                par = inspect.signature(METHODS[name].driver).parameters.get(key)
+            except (TypeError, ValueError):
+                continue
+            if par is None or par.kind is par.VAR_KEYWORD:
+                continue
+            kind = _option_kind(par.default, par.annotation)
+            ok = (kind is None or (kind == "bool" and isinstance(val, bool))
+                  or (kind == "int" and isinstance(val, int) and not isinstance(val, bool))
+                  or (kind == "float" and isinstance(val, (int, float))
+                      and not isinstance(val, bool) and math.isfinite(val)))
+            if not ok:
+                want = {"bool": "true or false", "int": "an integer",
+                        "float": "a finite number"}[kind]  # type: ignore[index]
+                shown = ("true" if val else "false") if isinstance(val, bool) else val
+                raise click.BadParameter(f"{key}={shown}: method {name!r} takes {want} for "
+                                         f"{key!r}", param_hint="'-O' / '--option'")
+
+
+def _check_protect_range(records: Sequence[Any], user: Sequence[int]) -> None:
+    """Usage error for a ``--protect`` index beyond every curve of the file (the API would
+    refuse it; a point list split at corners would silently drop it)."""
+    if not user:
+        return
+    counts = []
+    for rec in records:
+        if "indices" in rec.source:
+            counts.append(int(rec.source["n_points"]))
+        else:
+            pts = getattr(rec.curve, "control_points", None)
+            if pts is None:
+                pts = getattr(rec.curve, "points", None)
+            if pts is not None:
+                counts.append(int(pts.shape[0]))
+    if not counts:
+        return
+    n = max(counts)
+    bad = [i for i in user if i >= n]
+    if bad:
+        what = ("points" if any("indices" in r.source for r in records)
+                else "points / control points")
+        raise click.BadParameter(f"index {bad[0]} is out of range: the curves of IN have at most "
+                                 f"{n} {what} (indices 0..{n - 1})", param_hint="--protect")
+
+
+#: Most curvature-comb hairs a plot draws (memory: a few hundred bytes each).
+_MAX_HAIRS = 2_000_000
+#: Longest hair allowed, in multiples of the drawing's size.
+_MAX_HAIR_RATIO = 1000.0
+
+
+def _check_comb(curves: Sequence[Any], scale: float | None, density: int | None,
+                no_comb: bool) -> None:
+    """Usage errors for a comb that cannot be drawn: too many hairs (``--comb-density``) or
+    hairs overflowing the drawing (``--comb-scale``, longest hair = S * max curvature)."""
+    import numpy as np
+
+    if density is not None:
+        segs = sum(int(c.piecewise.n_segments) for c in curves)
+        if density * segs > _MAX_HAIRS:
+            raise click.BadParameter(
+                f"{density} hairs per segment on {segs} segments is {density * segs:,} hairs; "
+                f"at most {_MAX_HAIRS:,}", param_hint="--comb-density")
+    if scale is None or no_comb:
+        return
+    kmax, lo, hi = 0.0, None, None
+    for c in curves:
+        pp = c.piecewise
+        f = np.linspace(0.0, 1.0, 9)
+        br = np.asarray(pp.breaks, dtype=float)
+        u = (br[:-1, None] + np.diff(br)[:, None] * f[None, :]).reshape(-1)
+        d1, d2, r = pp.evaluate(u, 1), pp.evaluate(u, 2), pp.evaluate(u)
+        if d1.shape[1] == 2:
+            cross = np.abs(d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])
+        else:
+            cross = np.linalg.norm(np.cross(d1, d2), axis=1)
+        speed = np.linalg.norm(d1, axis=1)
+        with np.errstate(all="ignore"):
+            k = np.where(speed > 0, cross / speed**3, 0.0)
+        k = k[np.isfinite(k)]
+        kmax = max(kmax, float(k.max()) if k.size else 0.0)
+        lo = r.min(axis=0) if lo is None else np.minimum(lo, r.min(axis=0))
+        hi = r.max(axis=0) if hi is None else np.maximum(hi, r.max(axis=0))
+    size = float(np.linalg.norm(hi - lo)) if lo is not None else 0.0
+    longest = scale * kmax
+    if not math.isfinite(longest) or longest > _MAX_HAIR_RATIO * max(size, 1e-300):
+        raise click.BadParameter(
+            f"{scale:g} makes the longest hair {longest:.3g} long (max curvature {kmax:.3g}), "
+            f"more than {_MAX_HAIR_RATIO:g} times the size of the drawing ({size:.3g})",
+            param_hint="--comb-scale")
+
+
 def _fair_arguments() -> set[str]:
     """The named parameters of :func:`curvefair.fair` (they have their own flags)."""
     from . import fair
@@ -218,6 +382,7 @@ def _read(path: str, corner_angle: float | None, strict: bool = False,
     (kept untouched on write-back) unless ``strict``, which refuses the file."""
     from . import read_curves
 
+    _format_of(path)  # a CLI message (the API's names format=, which the CLI lacks)
     seen: list[str] = []
     try:
         with _warnings_to_stderr(quiet, into=seen):
@@ -538,6 +703,8 @@ def plot_cmd(infile: str, other: str | None, out: str, comb_scale: float | None,
              projection: str, title: str | None, corner_angle: float, no_corners: bool,
              strict: bool, quiet: bool) -> None:
     """Draw the curves of IN with their curvature combs and curvature plots into FIG."""
+    _check_outputs([(infile, "IN")] + ([(other, "--compare")] if other else []),
+                   [(out, "-o/--output")])
     _check_figure_path(out, "-o/--output")
     from .plot import figure
 
@@ -546,6 +713,8 @@ def plot_cmd(infile: str, other: str | None, out: str, comb_scale: float | None,
         curves = [r.curve for r in _read(infile, corner, strict, quiet)]
         others = None if other is None else [r.curve for r in _read(other, corner, strict,
                                                                       quiet)]
+    _check_comb(curves + (others or []), comb_scale, comb_density, no_comb)
+    with _user_errors():
         labels = (Path(infile).name, Path(other).name if other else "")
         fig = figure(curves, compare=others, labels=labels, tol=tol, comb=not no_comb,
                      comb_scale=comb_scale, comb_density=comb_density, markers=not no_markers,
@@ -678,7 +847,8 @@ def _summary_table(rows: list[dict[str, Any]]) -> Any:
                    "curve.")
 @click.option("--decimals", type=click.IntRange(min=0), metavar="N",
               help="Text formats: write every number with N decimals [default: the input "
-                   "file's precision].")
+                   "file's precision]. A rounding that puts a curve read back farther than "
+                   "--tol from the input, or points onto each other, writes nothing (exit 1).")
 @click.option("--report", metavar="REPORT.json", help="Write the full report as JSON.")
 @click.option("--history", is_flag=True, help="Include every step in the JSON report.")
 @click.option("--plot", "plot_path", metavar="PLOT.png",
@@ -698,6 +868,11 @@ def fair_cmd(infile: str, out: str | None, in_place: bool, method: str | None,
     curvature extrema, largest deviation and where, steps and time. A curve that cannot be
     faired is reported and written unchanged; the others are still processed and the exit
     code is 1.
+
+    OUT is written to a temporary file and read back first: every curve read back is measured
+    against IN's (the figure is printed and in the report). Farther than --tol: SVG rounding
+    to the file's decimals is undone, point data get smaller moves; otherwise OUT is not
+    written (exit 1).
     """
     from .io import detect_format
 
@@ -706,13 +881,11 @@ def fair_cmd(infile: str, out: str | None, in_place: bool, method: str | None,
             raise click.UsageError("missing option '-o' / '--output' (or pass --in-place to "
                                    "replace IN)")
         out = infile
-    if os.path.abspath(out) == os.path.abspath(infile) or (
-            os.path.exists(out) and os.path.samefile(out, infile)):
-        if not in_place:
-            raise click.UsageError(f"OUT {out!r} is the input file; pass --in-place to replace "
-                                   "it")
+    _check_outputs([(infile, "IN")], [(out, "-o/--output"), (report, "--report"),
+                                      (plot_path, "--plot")], in_place)
     user_protect = _parse_protect(protect)
     options = _parse_method_options(method_option)
+    _check_option_values(method, options)
     if plot_path is not None:
         _check_figure_path(plot_path, "--plot")
     for p, opt in ((report, "--report"), (plot_path, "--plot"), (out, "-o/--output")):
@@ -723,14 +896,16 @@ def fair_cmd(infile: str, out: str | None, in_place: bool, method: str | None,
     if method is not None and method not in METHODS:
         raise click.BadParameter(f"unknown method {method!r}; valid: " + ", ".join(METHODS),
                                  param_hint="--method")
+    in_fmt = _format_of(infile, "IN")
     with _user_errors():
-        in_fmt = detect_format(infile)
         try:
             out_fmt = detect_format(out)
         except CurvefairError:
             out_fmt = in_fmt
         records = _read(infile, _corner(corner_angle, no_corners), strict, quiet)
-    from . import fair, write_curves
+    _check_protect_range(records, user_protect)
+    from . import fair
+    from .io._verify import write_checked
 
     rows: list[dict[str, Any]] = []
     faired = []
@@ -771,11 +946,22 @@ def fair_cmd(infile: str, out: str | None, in_place: bool, method: str | None,
                 prog[0].advance(prog[1])
     failures = [r for r in rows if r["status"] == "failed"]
     wrote_out = len(failures) < len(rows)  # every curve failed: nothing to write
-    with _user_errors():
+    check = None
+    corner = _corner(corner_angle, no_corners)
+    with _user_errors(), _warnings_to_stderr(quiet):
         if wrote_out:
-            write_curves(out, faired, template=infile if out_fmt == in_fmt else None,
-                         format=out_fmt, overwrite=in_place,  # type: ignore[arg-type]
-                         decimals=decimals)
+            # written to a temporary file, read back and measured against the input; moved
+            # onto OUT only when every curve read back is within tol
+            check = write_checked(out, faired, records, tol=tol,
+                                  reader=lambda p: _read(p, corner, strict, True),
+                                  template=infile if out_fmt == in_fmt else None,
+                                  format=out_fmt, overwrite=in_place, decimals=decimals)
+            for row, d, kind in zip(rows, check.deviations, check.kinds, strict=True):
+                if row["status"] == "ok":
+                    row["report"]["on_disk_deviation"] = d
+                    row["report"]["on_disk_deviation_kind"] = kind
+            for note in check.notes:
+                click.echo(f"Warning: {out}: {note}", err=True)
         if plot_path is not None:
             from .plot import figure
 
@@ -796,6 +982,7 @@ def fair_cmd(infile: str, out: str | None, in_place: bool, method: str | None,
                 "n_curves": len(rows), "n_failed": len(failures),
                 "n_nothing_to_fair": sum(r["status"] == "nothing to fair" for r in rows),
                 "output_written": wrote_out,
+                "output_check": None if check is None else check.to_dict(),
                 "time_s": time.perf_counter() - t0, "curves": rows})
     if not quiet:
         con = _console()
@@ -809,6 +996,9 @@ def fair_cmd(infile: str, out: str | None, in_place: bool, method: str | None,
             if g and g.get("kept") != "output":
                 con.print(f"#{row['index']} {row['label']}: {g.get('reason')}", markup=False)
         written = [f"wrote {out}" if wrote_out else f"{out} not written"]
+        if check is not None:
+            written[0] += (f" (read back: max deviation {check.max_deviation:.6g} from the input"
+                           + (f", tol {tol:g})" if tol is not None else ")"))
         written += [f"report {report}"] if report else []
         written += [f"plot {plot_path}"] if plot_path else []
         con.print(", ".join(written))

@@ -232,7 +232,8 @@ def _template_path(template: object) -> str | None:
 def write_curves(path: str | os.PathLike[str], curves: CurveRecord | PiecewiseCurve |
                  Sequence[CurveRecord | PiecewiseCurve], *, template: object = None,
                  format: FormatName | None = None, overwrite: bool = False,
-                 decimals: int | None = None) -> None:
+                 decimals: int | None = None,
+                 precision: Literal["file", "exact"] = "file") -> None:
     """Write curves (usually faired records from :func:`read_curves`) to a file, atomically.
 
     Parameters
@@ -253,6 +254,11 @@ def write_curves(path: str | os.PathLike[str], curves: CurveRecord | PiecewiseCu
         Allow ``path`` to be a file the curves were read from (or the template).
     decimals : int, optional
         Text point formats: number of decimals for every number (default: as in the source).
+    precision : {"file", "exact"}
+        With ``decimals=None``: ``"file"`` writes a rewritten SVG element with the element's
+        own number of decimals (text point formats keep a token's decimals only where that
+        writes the value exactly); ``"exact"`` writes every changed number in the shortest
+        form that reads back as exactly the value. Binary and full-precision formats ignore it.
 
     Raises
     ------
@@ -276,8 +282,9 @@ def write_curves(path: str | os.PathLike[str], curves: CurveRecord | PiecewiseCu
     if fmt in ("points", "airfoil") and tpath is not None and \
             all(r.format != fmt for r in records):
         records = _fill_template(records, mod.read(tpath, corner_angle=None), tpath)
+    choice(precision, ("file", "exact"), "precision")
     writer: Callable[..., None] = mod.write
-    writer(path, records, template=tpath, decimals=decimals)
+    writer(path, records, template=tpath, decimals=decimals, precision=precision)
 
 
 def _fill_template(records: list[CurveRecord], tmpl: list[CurveRecord],

@@ -10,8 +10,10 @@ import contextlib
 import dataclasses
 import importlib
 import os
+import signal
 import stat
 import tempfile
+import threading
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -133,6 +135,81 @@ def _umask() -> int:
     return mask
 
 
+#: temporary files being written (cleaned up by the SIGTERM / SIGHUP handler)
+_LIVE_TEMPS: set[str] = set()
+_CLEANUP_SIGNALS = tuple(getattr(signal, n) for n in ("SIGTERM", "SIGHUP") if hasattr(signal, n))
+
+
+def _on_signal(signum: int, frame: Any) -> None:
+    """Delete the live temporary files, then die of the signal as the previous handler would."""
+    for tmp in list(_LIVE_TEMPS):
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        _LIVE_TEMPS.discard(tmp)
+    prev = _PREVIOUS_HANDLERS.get(signum, signal.SIG_DFL)
+    _restore_handlers()
+    if callable(prev):
+        prev(signum, frame)
+    elif prev != signal.SIG_IGN:
+        signal.signal(signum, signal.SIG_DFL)
+        os.kill(os.getpid(), signum)
+
+
+_PREVIOUS_HANDLERS: dict[int, Any] = {}
+
+
+def _install_handlers() -> None:
+    if _PREVIOUS_HANDLERS or threading.current_thread() is not threading.main_thread():
+        return
+    for sig in _CLEANUP_SIGNALS:
+        with contextlib.suppress(ValueError, OSError):
+            prev = signal.getsignal(sig)
+            if prev == signal.SIG_IGN:
+                continue
+            signal.signal(sig, _on_signal)
+            _PREVIOUS_HANDLERS[sig] = prev
+
+
+def _restore_handlers() -> None:
+    for sig, prev in list(_PREVIOUS_HANDLERS.items()):
+        with contextlib.suppress(ValueError, OSError, TypeError):
+            signal.signal(sig, prev if prev is not None else signal.SIG_DFL)
+    _PREVIOUS_HANDLERS.clear()
+
+
+def write_target(path: str | os.PathLike[str]) -> Path:
+    """The file a write to ``path`` replaces: ``path`` itself, or the final target when
+    ``path`` is a symbolic link (a write goes *through* the link, which stays a link).
+
+    Raises
+    ------
+    InputError
+        ``path`` is empty or names a folder.
+    """
+    raw = os.fspath(path)
+    if not str(raw).strip():
+        raise InputError("the output path is empty")
+    if os.path.isdir(raw):
+        raise InputError(f"{raw!r} is a folder, not a file name")
+    dest = Path(os.path.realpath(raw)) if os.path.islink(raw) else Path(raw)
+    if dest.is_dir():
+        raise InputError(f"{raw!r} is a link to the folder {str(dest)!r}, not to a file")
+    return dest
+
+
+def _user_os_error(exc: OSError, user: str, tmp: str | None, always: bool = False) -> OSError:
+    """``exc`` naming the user's path instead of a temporary file (or no file); ``always``:
+    whatever file it names (an error creating the temporary file names only that)."""
+    if always or exc.filename in (None, tmp) or (
+            tmp is not None and exc.filename == os.path.basename(tmp)):
+        new = OSError(exc.errno, exc.strerror or str(exc), user)
+        if type(exc) is not OSError:
+            with contextlib.suppress(TypeError):
+                new = type(exc)(exc.errno, exc.strerror or str(exc), user)
+        return new
+    return exc
+
+
 @contextlib.contextmanager
 def atomic_path(path: str | os.PathLike[str], suffix: str | None = None) -> Iterator[Path]:
     """Yield a temporary path in the destination folder; on success ``os.replace`` it onto
@@ -140,13 +217,26 @@ def atomic_path(path: str | os.PathLike[str], suffix: str | None = None) -> Iter
 
     For libraries that save to a file name (ezdxf, rhino3dm, OCC). ``suffix`` defaults to the
     destination's (some libraries choose the format by the extension).
+
+    A symbolic link is written through: the temporary file goes next to the link's final
+    target, which is replaced, and the link stays a link. The temporary file is removed on any
+    error, on KeyboardInterrupt, and on SIGTERM / SIGHUP (a handler is installed in the main
+    thread while a temporary file exists). OS errors name ``path``, never the temporary file.
     """
-    dest = Path(path)
+    user = os.fspath(path)
+    dest = write_target(path)
     folder = dest.parent if str(dest.parent) else Path(".")
     if not folder.is_dir():
-        raise InputError(f"path: the folder {str(folder)!r} does not exist")
-    fd, tmp = tempfile.mkstemp(prefix="." + dest.name + ".", suffix=dest.suffix if suffix is None
-                               else suffix, dir=folder)
+        raise InputError(f"{user!r}: the folder {str(folder)!r} does not exist")
+    _install_handlers()
+    try:
+        fd, tmp = tempfile.mkstemp(prefix="." + dest.name + ".",
+                                   suffix=dest.suffix if suffix is None else suffix, dir=folder)
+    except OSError as exc:
+        if not _LIVE_TEMPS:
+            _restore_handlers()
+        raise _user_os_error(exc, user, None, always=True) from None
+    _LIVE_TEMPS.add(tmp)
     os.close(fd)
     tmp_path = Path(tmp)
     try:
@@ -157,10 +247,18 @@ def atomic_path(path: str | os.PathLike[str], suffix: str | None = None) -> Iter
             mode = 0o666 & ~_umask()
         os.chmod(tmp_path, mode)
         os.replace(tmp_path, dest)
-    except BaseException:
+    except BaseException as exc:
         with contextlib.suppress(OSError):
             tmp_path.unlink()
+        if isinstance(exc, OSError):
+            new = _user_os_error(exc, user, tmp)
+            if new is not exc:
+                raise new from None
         raise
+    finally:
+        _LIVE_TEMPS.discard(tmp)
+        if not _LIVE_TEMPS:
+            _restore_handlers()
 
 
 def atomic_write(path: str | os.PathLike[str], data: str | bytes | Callable[[Any], None],

@@ -61,7 +61,7 @@ def _render(v: float, tok: Token, decimals: int) -> str:
         s = f"{v:.{decimals}f}"
         if decimals == 0 and tok.has_point:
             s += "."
-    if tok.bare_point and not tok.exponent:
+    if tok.bare_point and not tok.exponent and decimals > 0:  # ".5"; never "." or "-."
         if s.startswith("0."):
             s = s[1:]
         elif s.startswith("-0."):

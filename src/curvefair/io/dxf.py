@@ -38,7 +38,9 @@ the faired curve). Records that do not come from the template, and every record 
 no template, are added to the model space of the drawing (a new R2010 drawing without a
 template): B-splines and Hermite curves as ``SPLINE`` (Hermite pieces as Bezier segments, the
 same curve exactly), point kinds as ``LWPOLYLINE`` (2-D) or 3-D ``POLYLINE``, fit-point records
-as fit-point ``SPLINE``.
+as fit-point ``SPLINE``. A template read as DXF R12 (``AC1009``, which is also what a header
+without ``$ACADVER`` gives) that holds entities R12 cannot store (SPLINE, LWPOLYLINE, ...) is
+written as DXF R2000 (``AC1015``) with a warning, so that none of them is dropped.
 """
 
 from __future__ import annotations
@@ -387,6 +389,8 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
             _add_new(msp, whole, recs[0].source.get("z"))
         else:
             _add_new(msp, recs[0], recs[0].source.get("z"))
+    if template is not None:
+        _upgrade_r12(doc, template)
     with atomic_path(path, suffix=".dxf") as tmp:
         doc.saveas(os.fspath(tmp))
 
@@ -502,6 +506,34 @@ def _move_path(doc: Any, path: Any, src: list[str],
     ends = {tuple(map(float, getattr(ed, a))) for ed in path.edges
             if type(ed).__name__ == "LineEdge" for a in ("start", "end")}
     return all(v in ends or k == v for k, v in moved.items()) or not moved
+
+
+#: Graphical entities a DXF R12 (AC1009) file can hold; ezdxf drops every other kind when it
+#: saves a drawing as R12.
+_R12_ENTITIES = frozenset({
+    "LINE", "POINT", "CIRCLE", "ARC", "TRACE", "SOLID", "3DFACE", "SHAPE", "INSERT", "ATTDEF",
+    "ATTRIB", "TEXT", "POLYLINE", "VERTEX", "SEQEND", "DIMENSION", "VIEWPORT", "BLOCK",
+    "ENDBLK"})
+
+
+def _upgrade_r12(doc: Any, template: str | os.PathLike[str]) -> None:
+    """Save a drawing loaded as R12 as R2000 when it holds entities R12 cannot store.
+
+    ezdxf loads a file without ``$ACADVER`` (or with ``AC1009``) as R12 and saves it as R12,
+    which has no SPLINE (nor LWPOLYLINE, ELLIPSE, HATCH, ...): they would be dropped without a
+    word. ezdxf keeps the R2000 structures of every drawing it loads, so setting
+    ``doc.dxfversion`` to ``AC1015`` writes them all; a warning says so.
+    """
+    if doc.dxfversion >= "AC1015":
+        return
+    kinds = sorted({e.dxftype() for blk in doc.blocks for e in blk} - _R12_ENTITIES)
+    if not kinds:
+        return
+    doc.dxfversion = "AC1015"
+    warnings.warn(f"{os.fspath(template)}: read as DXF R12 ({doc.loaded_dxfversion}; also what a "
+                  f"header without $ACADVER gives), which cannot hold {', '.join(kinds)} "
+                  "entities; the output is written as DXF R2000 (AC1015) so that none is lost",
+                  UserWarning, stacklevel=3)
 
 
 def _group_foreign(records: Sequence[CurveRecord]) -> dict[Any, list[CurveRecord]]:

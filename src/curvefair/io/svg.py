@@ -47,8 +47,9 @@ in the element's own coordinates; everything else in the file byte for byte). A
 B-spline is written as its cubic Bezier pieces (one per knot span: the same number of
 segments as read when the knots are unchanged). Without a template, a new SVG holding one
 ``<path>`` per curve (cubic curves only: degree <= 3). Numbers of a rewritten element get the
-largest number of decimals the element had (its precision; ``decimals=`` overrides), numbers
-of a new file the shortest exact representation.
+largest number of decimals the element had (its precision; ``decimals=`` overrides,
+``precision="exact"`` writes the shortest exact representation instead), numbers of a new file
+the shortest exact representation.
 """
 
 from __future__ import annotations
@@ -647,8 +648,14 @@ def _decimals_of(text: str) -> int | None:
 
 
 def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
-          template: str | None = None, decimals: int | None = None, **_: Any) -> None:
-    """Write an SVG file; see the module docstring."""
+          template: str | None = None, decimals: int | None = None, precision: str = "file",
+          **_: Any) -> None:
+    """Write an SVG file; see the module docstring.
+
+    ``precision="exact"`` (with ``decimals=None``) writes the numbers of rewritten elements
+    in the shortest form that reads back as exactly the value, instead of the element's own
+    number of decimals.
+    """
     spt = _svgpathtools("writing SVG files")
     ours = [r for r in records if template is not None and r.format == FORMAT
             and r.path is not None and os.path.abspath(r.path) == os.path.abspath(template)]
@@ -693,10 +700,12 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
                                  "changed; a rectangle is written back only unchanged")
             if tag == "line":
                 for name, v in zip(("x1", "y1", "x2", "y2"), geo.reshape(-1), strict=True):
-                    dec = decimals if decimals is not None else _decimals_of(el.get(name) or "")
+                    dec = decimals if decimals is not None else (
+                        None if precision == "exact" else _decimals_of(el.get(name) or ""))
                     edit(node, name, _num(v, dec))
                 continue
-            dec = decimals if decimals is not None else _decimals_of(el.get("points") or "")
+            dec = decimals if decimals is not None else (
+                None if precision == "exact" else _decimals_of(el.get("points") or ""))
             edit(node, "points", " ".join(_pt(p, dec) for p in geo))
             continue
         parsed = spt.parse_path(el.get("d"))
@@ -705,8 +714,10 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
         changed = any(_record_d(subs[j], None)[1] for j in subs)
         if not changed:
             continue
-        # the precision of the element as it was: its largest number of decimals
-        dec = decimals if decimals is not None else _decimals_of(d_text)
+        # the precision of the element as it was: its largest number of decimals (all digits
+        # with precision="exact", when that rounding would break the tolerance on disk)
+        dec = decimals if decimals is not None else (
+            None if precision == "exact" else _decimals_of(d_text))
         pieces = []
         for j, sub in enumerate(originals):
             d, ch = _record_d(subs[j], dec) if j in subs else ("", False)

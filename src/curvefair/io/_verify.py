@@ -1,0 +1,294 @@
+"""Write, read back, measure: the tolerance checked in the file the user will read.
+
+:func:`write_checked` writes faired records to a temporary file next to the destination,
+reads that file back with the same reader, and measures every curve read back against the
+curve read from the input (what the user had before): the parametric deviation
+``max_t |a(t) - b(t)|`` when both curves have the same parameter domain (B-spline and
+Bezier entities: same knots), else the geometric (Hausdorff) distance
+(:func:`curvefair.deviation` with ``kind="auto"``) -- a point file stores only points, and the
+curve re-interpolated through moved points has new chord-length parameters.
+
+When a curve read back is farther than ``tol`` from the input:
+
+1. SVG elements rounded to their own number of decimals are written again with exact numbers
+   (the rounding is undone);
+2. point data (point lists, airfoils, polylines: the curve is re-interpolated on reading)
+   get their moves from the input scaled down, ``p = p0 + s (p_faired - p0)`` with
+   ``s < 1`` (aiming at ``0.995 tol``), until the curve read back is within ``tol``;
+3. otherwise nothing is written (the destination is untouched) and
+   :class:`WriteCheckError` says which curve is how far.
+
+Only then is the temporary file moved onto the destination.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..errors import CurvefairError, InputError
+from ._common import CurveRecord, atomic_path, points_curve
+
+__all__ = ["WriteCheck", "WriteCheckError", "write_checked"]
+
+#: Record kinds whose curve is re-interpolated from data points on reading.
+POINT_KINDS = ("points", "airfoil", "polyline", "fit_points")
+_MAX_SHRINK = 12
+
+
+class WriteCheckError(InputError):
+    """The written file would not hold the curves within the tolerance (nothing written)."""
+
+
+@dataclass(frozen=True)
+class WriteCheck:
+    """What the read-back check measured on the written file.
+
+    Attributes
+    ----------
+    max_deviation : float
+        Largest distance of a curve read back from the written file to its input curve.
+    deviations : tuple of float
+        Per input record, in order.
+    kinds : tuple of str
+        Per record: ``"parametric"``, ``"geometric"`` (the refined Hausdorff distance), or
+        ``"geometric upper bound"`` (a cheap bound, used when it already meets ``tol``; see
+        :func:`curvefair.analysis._deviation.geometric_upper_bound`).
+    max_point_displacement : float or None
+        Largest data/control point displacement read back, where the counts match.
+    precision : str
+        ``"file"`` (the file's own precision), ``"decimals"`` (as requested), or ``"exact"``
+        (the file's rounding exceeded the tolerance and was undone).
+    move_scale : tuple of float
+        Per record, the factor ``s`` applied to the moves of point data (1.0: as faired).
+    notes : tuple of str
+        What was changed to meet the tolerance, one sentence each.
+    """
+
+    max_deviation: float
+    deviations: tuple[float, ...]
+    kinds: tuple[str, ...]
+    max_point_displacement: float | None
+    precision: str
+    move_scale: tuple[float, ...]
+    notes: tuple[str, ...] = field(default_factory=tuple)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"max_deviation": self.max_deviation, "deviations": list(self.deviations),
+                "kinds": list(self.kinds),
+                "max_point_displacement": self.max_point_displacement,
+                "precision": self.precision, "move_scale": list(self.move_scale),
+                "notes": list(self.notes)}
+
+
+def _label(rec: CurveRecord, i: int) -> str:
+    return f"curve {i}" + (f" ({rec.name})" if rec.name else "")
+
+
+def _matched(reference: Sequence[CurveRecord], back: Sequence[CurveRecord]
+             ) -> list[Any] | None:
+    """The curves read back, one per reference record, or None when they cannot be paired.
+
+    Same number of records: in order. Otherwise (a point list split at other corners when
+    read back) each reference piece is rebuilt from the points read back at its indices.
+    """
+    if len(back) == len(reference):
+        return [b.curve for b in back]
+    if not all("indices" in r.source for r in list(reference) + list(back)):
+        return None
+    n = {int(r.source["n_points"]) for r in list(reference) + list(back)}
+    if len(n) != 1:
+        return None
+    full = np.full((n.pop(), back[0].points.shape[1]), np.nan)  # type: ignore[union-attr]
+    for b in back:
+        full[np.asarray(b.source["indices"], dtype=int)] = np.asarray(b.points)
+    if np.isnan(full).any():
+        return None
+    out = []
+    for r in reference:
+        idx = np.asarray(r.source["indices"], dtype=int)
+        out.append(points_curve(full[idx], bool(r.curve.closed)))
+    return out
+
+
+def _lost_points(reference: Sequence[CurveRecord], back: Sequence[CurveRecord]) -> str | None:
+    """Why the point data read back is not the point data written (points merged or dropped
+    on reading, e.g. rounded onto each other), or None."""
+    n_ref = {int(r.source["n_points"]) for r in reference if "n_points" in r.source}
+    n_back = {int(r.source["n_points"]) for r in back if "n_points" in r.source}
+    if len(reference) == len(back):
+        for i, (r, b) in enumerate(zip(reference, back, strict=True)):
+            if r.points is not None and b.points is not None and \
+                    r.points.shape != b.points.shape:
+                return (f"{_label(r, i)} reads back with {b.points.shape[0]} points, "
+                        f"{r.points.shape[0]} were written")
+    elif n_ref and n_back and n_ref != n_back:
+        return (f"the point list reads back with {sorted(n_back)[0]} points, "
+                f"{sorted(n_ref)[0]} were written")
+    return None
+
+
+def _same_domain(a: Any, b: Any) -> bool:
+    (a0, a1), (b0, b1) = a.domain, b.domain
+    t = 1e-12 * max(a1 - a0, b1 - b0, abs(a0), abs(a1))
+    return abs(a0 - b0) <= t and abs(a1 - b1) <= t
+
+
+def _measure(reference: Sequence[CurveRecord], curves: Sequence[Any], tol: float | None
+             ) -> tuple[list[float], list[str], float | None]:
+    """Per curve: the parametric deviation (equal domains), else a cheap upper bound of the
+    Hausdorff distance when it already meets ``tol`` (or there is no tol), else the refined
+    geometric distance."""
+    from ..analysis import deviation
+    from ..analysis._deviation import _point_displacement, geometric_upper_bound
+
+    devs, kinds, mpd = [], [], None
+    for r, c in zip(reference, curves, strict=True):
+        d_max: float | None = None
+        if not _same_domain(r.curve, c):
+            ub = geometric_upper_bound(r.curve, c)
+            if tol is None or ub <= tol:
+                d_max, kind = ub, "geometric upper bound"
+                m, _ = _point_displacement(r.curve, c)
+        if d_max is None:
+            d = deviation(r.curve, c)
+            d_max, kind, m = float(d.max_distance), d.kind, d.max_point_displacement
+        devs.append(d_max)
+        kinds.append(kind)
+        if m is not None:
+            mpd = max(mpd or 0.0, float(m))
+    return devs, kinds, mpd
+
+
+def _scaled(rec: CurveRecord, ref: CurveRecord, s: float) -> CurveRecord:
+    """``rec`` with its data points moved ``s`` times as far from ``ref``'s as faired."""
+    p0 = np.asarray(ref.curve.points, dtype=float)  # type: ignore[attr-defined]
+    p1 = np.asarray(rec.curve.points, dtype=float)  # type: ignore[attr-defined]
+    pts = p0 + s * (p1 - p0)
+    # keep exactly the points that did not move (corners, clamped ends, protected points)
+    pts[np.all(p1 == p0, axis=1)] = p0[np.all(p1 == p0, axis=1)]
+    return rec.with_curve(points_curve(pts, bool(rec.curve.closed)))
+
+
+def _shrinkable(rec: CurveRecord, ref: CurveRecord) -> bool:
+    a = getattr(rec.curve, "points", None)
+    b = getattr(ref.curve, "points", None)
+    return (rec.kind in POINT_KINDS and isinstance(a, np.ndarray) and isinstance(b, np.ndarray)
+            and a.shape == b.shape)
+
+
+def write_checked(path: str | os.PathLike[str], records: Sequence[CurveRecord],
+                  reference: Sequence[CurveRecord], *, tol: float | None,
+                  reader: Callable[[str], list[CurveRecord]], template: object = None,
+                  format: str | None = None, overwrite: bool = False,
+                  decimals: int | None = None) -> WriteCheck:
+    """Write ``records`` to ``path`` only if the file read back is within ``tol`` of
+    ``reference``; see the module docstring.
+
+    Parameters
+    ----------
+    path : path-like
+    records : sequence of CurveRecord
+        The faired records, one per reference record, in the same order.
+    reference : sequence of CurveRecord
+        The records read from the input (the curves the user had).
+    tol : float or None
+        None: measure and report, enforce nothing (the file must still read back).
+    reader : callable
+        ``reader(path) -> records``: how the file is read (the same corner handling as the
+        input).
+    template, format, overwrite, decimals
+        As for :func:`curvefair.write_curves`; ``decimals`` given: the rounding asked for is
+        kept, and a file it puts out of tolerance is not written.
+
+    Raises
+    ------
+    WriteCheckError
+        The file would not read back, or a curve read back would be farther than ``tol``
+        from its input; nothing is written.
+    """
+    from . import detect_format, write_curves
+
+    if len(records) != len(reference):
+        raise InputError(f"write_checked: {len(records)} records for {len(reference)} "
+                         "reference records")
+    fmt = detect_format(path, format)
+    precision = "file" if decimals is None else "decimals"
+    recs = list(records)
+    scale = [1.0] * len(recs)
+    notes: list[str] = []
+    where = os.fspath(path)
+    with atomic_path(path) as tmp:
+        for _attempt in range(_MAX_SHRINK + 3):
+            write_curves(tmp, recs, template=template, format=fmt,  # type: ignore[arg-type]
+                         overwrite=overwrite, decimals=decimals,
+                         precision="exact" if precision == "exact" else "file")
+            try:
+                back = reader(os.fspath(tmp))
+            except CurvefairError as exc:
+                msg = str(exc).replace(os.fspath(tmp), where)
+                if precision == "file" and fmt == "svg":
+                    precision = "exact"
+                    notes.append("the file's own precision gave a file that does not read "
+                                 "back; written with exact numbers")
+                    continue
+                hint = f" (--decimals {decimals} rounds too much?)" if decimals is not None \
+                    else ""
+                raise WriteCheckError(f"{where}: not written: the file would not read back: "
+                                      f"{msg}{hint}") from None
+            lost = _lost_points(reference, back)
+            if lost is not None:
+                hint = f" (--decimals {decimals} rounds too much?)" if decimals is not None \
+                    else ""
+                raise WriteCheckError(f"{where}: not written: {lost}{hint}")
+            curves = _matched(reference, back)
+            if curves is None:
+                raise WriteCheckError(
+                    f"{where}: not written: it reads back as {len(back)} curves, the input "
+                    f"had {len(reference)}")
+            try:
+                devs, kinds, mpd = _measure(reference, curves, tol)
+            except CurvefairError:
+                raise
+            except (ValueError, ArithmeticError, MemoryError) as exc:
+                raise WriteCheckError(f"{where}: not written: the curves read back could not "
+                                      f"be measured against the input ({exc})") from None
+            over = [i for i, d in enumerate(devs) if tol is not None and not d <= tol]
+            if not over:
+                return WriteCheck(max(devs, default=0.0), tuple(devs), tuple(kinds), mpd,
+                                  precision, tuple(scale), tuple(notes))
+            if precision == "file" and fmt == "svg":
+                precision = "exact"
+                worst = max(over, key=lambda i: devs[i])
+                notes.append("rounded to the elements' own decimals, "
+                             f"{_label(reference[worst], worst)} "
+                             f"read back {devs[worst]:.6g} from the input (> tol {tol:g}); "
+                             "written with exact numbers")
+                continue
+            fix = [i for i in over if _shrinkable(records[i], reference[i])]
+            if len(fix) < len(over) or precision == "decimals":
+                i = next(i for i in over if i not in fix) if len(fix) < len(over) else over[0]
+                why = (f"; --decimals {decimals} rounds too much" if precision == "decimals"
+                       else "")
+                raise WriteCheckError(
+                    f"{where}: not written: {_label(reference[i], i)} would read back "
+                    f"{devs[i]:.6g} from the input, more than tol {tol:g}{why}")
+            if all(sc == 1.0 for sc in scale):
+                worst = max(fix, key=lambda i: devs[i])
+                notes.append(f"point data: the curve re-interpolated through the written points "
+                             f"of {_label(reference[worst], worst)} read back {devs[worst]:.6g} "
+                             f"from the input (> tol {tol:g}); the moves of {len(fix)} curve(s) "
+                             "were scaled down until within tol")
+            for i in fix:
+                # the deviation grows about linearly with the scale of the moves; aim at
+                # 0.995 tol (the geometric measure is not certified: leave it room)
+                s = scale[i] * min(0.998, 0.995 * float(tol) / devs[i])  # type: ignore[arg-type]
+                scale[i] = s
+                recs[i] = _scaled(records[i], reference[i], s)
+        raise WriteCheckError(f"{where}: not written: the curves read back stay farther than "
+                              f"tol {tol:g} from the input")
+    raise AssertionError("unreachable")  # pragma: no cover
