@@ -85,8 +85,9 @@ def format_number(v: float, tok: Token, column_decimals: int,
     """Text for ``v`` in the style of the token it replaces.
 
     1. ``decimals`` given: that many decimals, the token's style (fixed or exponent).
-    2. The token's own number of decimals if that writes ``v`` exactly (untouched values come
-       back character for character).
+    2. ``v`` is the token's own value: the token's text, character for character (also where
+       the file has more digits than a float64 holds, e.g. 18 decimals).
+       Else the token's own number of decimals if that writes ``v`` exactly.
     3. Otherwise the column's largest number of decimals in the file if that writes ``v``
        exactly, else the shortest representation that reads back as exactly ``v``. A faired
        value is never rounded to the file's precision behind the user's back: rounding could
@@ -94,6 +95,8 @@ def format_number(v: float, tok: Token, column_decimals: int,
     """
     if decimals is not None:
         return _render(v, tok, int(decimals))
+    if float(tok.text) == v:
+        return tok.text
     s = _render(v, tok, tok.decimals)
     if float(s) == v:
         return s
