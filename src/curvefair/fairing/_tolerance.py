@@ -193,14 +193,24 @@ def enforce_tolerance(original: PiecewiseCurve, new: PiecewiseCurve, tol: float 
     -------
     (curve, Certificate)
     """
-    comparable = _comparable(original, new)
-    if tol is None or not comparable:
-        dmax, ub, t = difference_deviation(original, new)
-        return new, Certificate(dmax, ub, t, 0, 1.0)
     fo = curve_fields(original)
     fn = curve_fields(new)
-    assert fo is not None and fn is not None
+    if (tol is None or fo is None or fn is None or type(original) is not type(new)
+            or fo[next(iter(fo))].shape != fn[next(iter(fn))].shape):
+        dmax, ub, t = difference_deviation(original, new)
+        return new, Certificate(dmax, ub, t, 0, 1.0)
     pos = next(iter(fo))
+    if not _comparable(original, new):
+        # other knots / parameters: the data points are still bounded (pulled back), but the
+        # curve change is not the curve of the data differences, so it is measured, not scaled
+        fixed, pulled = _pull_back(fo[pos], fn[pos], tol)
+        cur = new
+        if pulled:
+            cf = dict(fn)
+            cf[pos] = fixed
+            cur = _rebuild(new, cf)
+        dmax, ub, t = difference_deviation(original, cur)
+        return cur, Certificate(dmax, ub, t, pulled, 1.0)
     delta = {k: fn[k] - fo[k] for k in fo}
     pulled_total = 0
     scale = 1.0
