@@ -28,7 +28,8 @@ Every check is independent of curvefair's evaluation and deviation code:
   (the rounding of evaluating coordinates of size ``max|x|``). Checked only where the method
   promises the curve (all of them here: B-splines by the convex hull property, the Hermite
   methods with their default ``tol_on="curve"``);
-- the report's ``max_point_displacement`` and ``max_deviation`` are ``<= tol`` too, and its
+- the report's ``max_point_displacement``, ``max_deviation`` and its certified
+  ``max_deviation_upper_bound`` are ``<= tol`` too, and its
   ``moved`` displacements are exactly ``np.linalg.norm(moved - original, axis=1)``;
 - in at least 5 % of the cases a point or the curve moves at least tol / 2, so the
   tolerance is actually used (knot removal skips a move exceeding tol, and the Hermite
@@ -241,6 +242,9 @@ def violations(c: Any, res: Any, tol: float, clamp: tuple[str, str], protect: li
         bad.append(f"curve deviation {dev2!r} > tol + rounding {tol + slack!r}")
     if res.report["max_deviation"] > tol:
         bad.append(f"report max_deviation {res.report['max_deviation']!r} > tol")
+    ub = res.report["max_deviation_upper_bound"]
+    if ub is None or ub > tol:
+        bad.append(f"report max_deviation_upper_bound {ub!r} > tol")
     return bad
 
 
