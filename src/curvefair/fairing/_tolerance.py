@@ -23,6 +23,8 @@ makes the promise exact:
    difference -- are kept bitwise) and step 1 is repeated.
 
 Only moved points change: a point with zero difference stays bitwise equal to its original.
+A pulled-back Hermite point keeps its derivatives, so a ``mode="spline"`` result is then a
+spline interpolant only up to the pull-back (a few ulp of the coordinates).
 """
 
 from __future__ import annotations
