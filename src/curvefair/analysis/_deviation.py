@@ -8,6 +8,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from .._distance import point_distances
 from .._jit import njit
 from .._typing import FloatArray
 from ..curves.piecewise import PiecewiseCurve
@@ -80,7 +81,7 @@ def _point_displacement(a: PiecewiseCurve, b: PiecewiseCurve
     da, db = _data_points(a), _data_points(b)
     if da is None or db is None or da[0] != db[0] or da[1].shape != db[1].shape:
         return None, None
-    d = np.sqrt(np.sum((np.asarray(da[1]) - np.asarray(db[1])) ** 2, axis=1))
+    d = point_distances(np.asarray(da[1]), np.asarray(db[1]))  # as fair()'s report
     if d.size == 0:
         return None, None
     k = int(np.argmax(d))

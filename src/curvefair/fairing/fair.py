@@ -113,6 +113,9 @@ class DriverOutput:
         The effective values when the driver chose defaults (reported).
     extra : dict
         Method-specific report entries (JSON-serialisable).
+    curve_within_tol : bool
+        The method promises the whole curve within ``tol`` (not only the data points):
+        :func:`fair` then certifies the curve deviation and scales the moves back if needed.
     """
 
     curve: PiecewiseCurve
@@ -122,6 +125,7 @@ class DriverOutput:
     eps: float | None = None
     max_steps: int | None = None
     extra: dict[str, Any] = field(default_factory=dict)
+    curve_within_tol: bool = True
 
 
 @dataclass(frozen=True)
@@ -425,7 +429,11 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
         control points, so the curve follows by the convex hull property; the Hermite methods
         also check the whole curve with the certified bound of :func:`curvefair.deviation` and
         shrink the moves where an interpolant bulges between its points (their option
-        ``tol_on="points"`` bounds only the data points, as the papers do).
+        ``tol_on="points"`` bounds only the data points, as the papers do). The promise holds
+        in float64 as the report prints it: every result passes through
+        :func:`curvefair.fairing._tolerance.enforce_tolerance`, which pulls a point that rounding
+        left outside ``np.linalg.norm(moved - original) <= tol`` back along its move and
+        certifies the curve deviation on the difference curve.
     eps : float >= 0, optional
         Stop when the largest ranking measure is below ``eps``; ``0`` runs until ``max_steps``
         or until the tolerance blocks every move. Default: method-specific (relative to the
@@ -478,7 +486,10 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
     of the ``degree``-th derivative: the meaningful one for a C4 quintic),
     ``energy3_before/after``, ``sapidis_sum_before/after``, ``dkds_energy_before/after``
     (``int (dkappa/ds)^2 ds``), ``inflections_before/after``, ``extrema_before/after``,
-    ``max_point_displacement`` (+ ``max_point_index``), ``max_deviation`` (+ where:
+    ``max_point_displacement`` (+ ``max_point_index``; ``np.linalg.norm(moved - original)``),
+    ``tolerance_guard`` (points pulled back inside ``tol`` at rounding level, and the factor the
+    moves were scaled by to certify the curve), ``max_deviation`` (at equal parameter, on the
+    difference curve; + where:
     ``max_deviation_param``, ``max_deviation_point``), ``tol``, ``eps``, ``max_steps``,
     ``clamp``, ``protect``, ``mode``, ``time_s`` and method-specific entries.
 
@@ -556,23 +567,21 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
 
         new, after, guard_info = never_worse(curve, new, before, after, jp, out.curve,
                                              _analysis_block)
+    # the one final guarantee every result passes through (after the joins are restored and
+    # the never-worse guard chose): data points within tol in float64 (pulled back if rounding
+    # put one outside), curve deviation certified on the difference curve
+    from ._tolerance import enforce_tolerance, point_report
 
-    from ..analysis import deviation
+    checked, cert = enforce_tolerance(curve, new, tol_v, curve_bound=out.curve_within_tol)
+    if checked is not new:
+        new, after = checked, _analysis_block(checked)
 
     p0 = data_points(curve)
-    p1 = data_points(new)
-    moved_mask = np.any(p0 != p1, axis=1) if p0.shape == p1.shape else np.ones(len(p1), bool)
-    moved_idx = np.flatnonzero(moved_mask)
-    disp = (np.sqrt(np.sum((p1[moved_idx] - p0[moved_idx]) ** 2, axis=1))
-            if p0.shape == p1.shape else np.zeros(0))
-    dev = deviation(curve, new)
-    if dev.max_point_displacement is not None:
-        max_disp = float(dev.max_point_displacement)
-        max_idx = None if dev.point_index is None else int(dev.point_index)
-    elif disp.size:
-        max_disp, max_idx = float(disp.max()), int(moved_idx[int(np.argmax(disp))])
-    else:
-        max_disp, max_idx = 0.0, None
+    moved_idx, disp, max_disp, max_idx = point_report(curve, new)
+    dev_point = None
+    if math.isfinite(cert.param):
+        a0, a1 = curve.domain
+        dev_point = np.asarray(curve(min(max(cert.param, a0), a1)), dtype=float).reshape(-1)
     history = out.history if out.history is not None else FairingHistory.empty()
     report: dict[str, Any] = {
         "method": spec.name,
@@ -602,10 +611,11 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
         "extrema_after": after["extrema"],
         "max_point_displacement": max_disp,
         "max_point_index": max_idx,
-        "max_deviation": float(dev.max_distance),
-        "max_deviation_upper_bound": _finite_or_none(float(getattr(dev, "upper_bound", math.nan))),
-        "max_deviation_param": None if dev.param is None else float(dev.param),
-        "max_deviation_point": None if dev.point_a is None else np.asarray(dev.point_a),
+        "max_deviation": cert.max_distance,
+        "max_deviation_upper_bound": _finite_or_none(cert.upper_bound),
+        "max_deviation_param": _finite_or_none(cert.param),
+        "max_deviation_point": dev_point,
+        "tolerance_guard": {"pulled_back": cert.pulled_back, "scale": cert.scale},
         "tol": tol_v,
         "eps": out.eps if out.eps is not None else eps_v,
         "max_steps": out.max_steps if out.max_steps is not None else max_steps,

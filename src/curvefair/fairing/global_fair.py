@@ -699,8 +699,11 @@ def _global_fair(curve: BSplineCurve, tol: float | None, l: Any,  # noqa: E741
     g0 = residual(d0)
     v, lam_, steps, reason = _solve_balls(system, g0, mask, tolv, gap, max_steps)
     # strict feasibility in floating point, with a rounding margin (active points end on
-    # their sphere): every fl(x_i - o_i) and the evaluated curve stay within tol
-    margin = min(1e-9 * tolv, 1e-13 * tolv + 4.0 * np.finfo(float).eps * _absmax(d0))
+    # their sphere): every fl(x_i - o_i) and the evaluated curve stay within tol. Rounding
+    # o_i + v_i moves each coordinate by at most half an ulp of |o_i| <= eps max|o| / 2, so
+    # 8 eps max|o| covers it (at most a quarter of tol when the coordinates' ulp is not small
+    # against tol; fair() then pulls any remaining point back, _tolerance.enforce_tolerance)
+    margin = min(0.25 * tolv, 1e-13 * tolv + 8.0 * np.finfo(float).eps * _absmax(d0))
     # x in the (no longer needed) gradient's memory: pages already mapped
     x = g0 if g0.flags.c_contiguous and not np.shares_memory(g0, v) else np.empty_like(d0)
     act = np.empty(n, dtype=np.bool_)

@@ -477,7 +477,8 @@ def hermite_driver(curve: HermiteSpline, *, method: str, tol: float | None, eps:
         extra["window_truncations"] = int(n_trunc)
     return DriverOutput(new, int(steps), reason,
                         FairingHistory.from_arrays(h_idx, h_meas, h_disp),
-                        eps=eps_eff, max_steps=st["max_steps"], extra=extra)
+                        eps=eps_eff, max_steps=st["max_steps"], extra=extra,
+                        curve_within_tol=tol_on == "curve")
 
 
 _SPECS = [

@@ -1,0 +1,259 @@
+"""The final tolerance guarantee every result of :func:`curvefair.fair` passes through.
+
+Each method keeps its moves inside the tolerance ball in exact arithmetic, with a rounding
+margin where it is cheap. What the user checks is float64: ``|moved_i - original_i| <= tol``
+with the coordinates as stored, and the distance between the two curves. Near the sphere
+(a point clamped onto it, coordinates far from the origin so that an ulp of a coordinate is
+not small against ``tol``) rounding can put a point a few ulp outside. :func:`enforce_tolerance`
+makes the promise exact:
+
+1. every data point (B-spline control points, Hermite points) that is farther than ``tol``
+   from its original by any of the usual float64 formulas (:func:`curvefair._distance.exceeds`)
+   is pulled back along its own move, ``o + s (m - o)`` with ``s`` shrinking from
+   ``tol / |m - o|`` in steps that grow geometrically, until the float64 check passes
+   (``s = 0`` returns the original, so this ends);
+2. the curve deviation ``max_t |a(t) - b(t)|`` is certified on the DIFFERENCE curve: every
+   curve type here is linear in its data (B-spline control points, Hermite points and
+   derivatives) for fixed knots / parameters, so ``a(t) - b(t)`` is the curve of the data
+   differences, whose Bernstein bound (:func:`curvefair.deviation`) carries no rounding of
+   the coordinates' offset. Where the method promises the curve within ``tol`` (the B-spline
+   methods by the convex hull property, the Hermite methods with ``tol_on="curve"``) and the
+   certified bound exceeds ``tol``, all data differences are scaled by one factor ``s < 1``
+   (linear, so clamp conditions ``A (data - original) = 0`` and protected points -- zero
+   difference -- are kept bitwise) and step 1 is repeated.
+
+Only moved points change: a point with zero difference stays bitwise equal to its original.
+A pulled-back Hermite point keeps its derivatives, so a ``mode="spline"`` result is then a
+spline interpolant only up to the pull-back (a few ulp of the coordinates).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._distance import exceeds, point_distances
+from .._typing import FloatArray
+from ..curves.bspline import BSplineCurve, basis_derivatives
+from ..curves.hermite import (
+    CubicHermite,
+    QuinticHermite,
+    cubic_hermite_coefficients,
+    quintic_hermite_coefficients,
+)
+from ..curves.piecewise import PiecewiseCurve, PiecewisePolynomial
+
+__all__ = ["Certificate", "enforce_tolerance", "curve_fields", "difference_deviation",
+           "point_report"]
+
+_MAX_SCALINGS = 8
+
+
+@dataclass(frozen=True)
+class Certificate:
+    """What :func:`enforce_tolerance` measured on the final curve.
+
+    ``max_distance`` / ``upper_bound``: lower and certified upper bound of
+    ``max_t |a(t) - b(t)|`` at equal parameter; ``param``: where the lower bound is attained;
+    ``pulled_back``: number of data points moved back inside ``tol``; ``scale``: the factor the
+    data differences were multiplied by to certify the curve (1.0: none).
+    """
+
+    max_distance: float
+    upper_bound: float
+    param: float
+    pulled_back: int
+    scale: float
+
+
+def curve_fields(curve: PiecewiseCurve) -> dict[str, FloatArray] | None:
+    """The data arrays the curve is linear in, position first; None for other curve types."""
+    if isinstance(curve, BSplineCurve):
+        return {"control_points": np.asarray(curve.control_points)}
+    if isinstance(curve, QuinticHermite):
+        return {"points": np.asarray(curve.points), "d1": np.asarray(curve.d1),
+                "d2": np.asarray(curve.d2)}
+    if isinstance(curve, CubicHermite):
+        return {"points": np.asarray(curve.points), "tangents": np.asarray(curve.tangents)}
+    return None
+
+
+def _comparable(a: PiecewiseCurve, b: PiecewiseCurve) -> bool:
+    """Same type, degree, closedness, knots / parameters (bitwise) and data shapes."""
+    if type(a) is not type(b) or a.closed != b.closed or a.degree != b.degree:
+        return False
+    fa, fb = curve_fields(a), curve_fields(b)
+    if fa is None or fb is None or any(fa[k].shape != fb[k].shape for k in fa):
+        return False
+    if isinstance(a, BSplineCurve):
+        return bool(np.array_equal(a.knots, b.knots))  # type: ignore[attr-defined]
+    return bool(np.array_equal(a.params, b.params))  # type: ignore[attr-defined]
+
+
+class _PowerForm(PiecewiseCurve):
+    """A bare piecewise polynomial as a curve (the difference curve; not exported)."""
+
+    def __init__(self, pp: PiecewisePolynomial, closed: bool) -> None:
+        self._pp = pp
+        self._closed = closed
+        self.degree = pp.degree
+
+    @property
+    def dim(self) -> int:
+        return int(self._pp.dim)
+
+    @property
+    def closed(self) -> bool:
+        return self._closed
+
+    def _make_piecewise(self) -> PiecewisePolynomial:
+        return self._pp
+
+
+def _difference_form(a: PiecewiseCurve, delta: dict[str, FloatArray]) -> PiecewisePolynomial:
+    """Power form of the curve with ``a``'s knots / parameters and data ``delta``."""
+    if isinstance(a, BSplineCurve):
+        p = a.degree
+        t = np.asarray(a.knots)
+        s = np.asarray(a.spans)
+        ders = basis_derivatives(t, p, s, t[s], p)
+        idx = a.control_index(s[:, None] - p + np.arange(p + 1)[None, :])
+        local = delta["control_points"][idx]
+        fact = np.cumprod(np.r_[1.0, np.arange(1, p + 1, dtype=float)])
+        coeffs = np.einsum("mka,mad->mkd", ders, local) / fact[None, :, None]
+        return PiecewisePolynomial(np.append(t[s], t[s[-1] + 1]), coeffs)
+    params = np.asarray(a.params)  # type: ignore[attr-defined]
+    if isinstance(a, QuinticHermite):
+        c = quintic_hermite_coefficients(delta["points"], delta["d1"], delta["d2"], params)
+    else:
+        c = cubic_hermite_coefficients(delta["points"], delta["tangents"], params)
+    return PiecewisePolynomial(np.array(params), c)
+
+
+def difference_deviation(a: PiecewiseCurve, b: PiecewiseCurve) -> tuple[float, float, float]:
+    """``(max_distance, upper_bound, param)`` of ``max_t |a(t) - b(t)|``.
+
+    On the difference curve when ``a`` and ``b`` share type, knots / parameters and data
+    shapes (exactly linear, no rounding of the coordinates' offset), else
+    :func:`curvefair.deviation` of the two curves.
+    """
+    from ..analysis import deviation
+
+    if _comparable(a, b):
+        fa, fb = curve_fields(a), curve_fields(b)
+        assert fa is not None and fb is not None
+        delta = {k: fb[k] - fa[k] for k in fa}
+        pp = _difference_form(a, delta)
+        zero = PiecewisePolynomial(np.array(pp.breaks), np.zeros_like(pp.coeffs))
+        d = deviation(_PowerForm(pp, a.closed), _PowerForm(zero, a.closed))
+    else:
+        d = deviation(a, b)
+    return float(d.max_distance), float(d.upper_bound), float(d.param)
+
+
+def _rebuild(template: PiecewiseCurve, fields: dict[str, FloatArray]) -> PiecewiseCurve:
+    return template.replace(**fields)  # type: ignore[attr-defined]
+
+
+def _pull_back(orig: FloatArray, moved: FloatArray, tol: float) -> tuple[FloatArray, int]:
+    """``moved`` with every row outside ``tol`` (any float64 formula) pulled back along its move."""
+    bad = np.flatnonzero(exceeds(moved, orig, tol))
+    if bad.size == 0:
+        return moved, 0
+    out = np.array(moved, dtype=np.float64)
+    for i in bad.tolist():
+        o = orig[i]
+        d = moved[i] - o
+        r = float(np.linalg.norm(d))
+        base = tol / r if r > 0.0 else 0.0
+        row = o.copy()
+        for k in range(60):
+            shrink = 1.0 - 2.0 ** (-52 + k) if k < 52 else 0.0
+            cand = o + (base * shrink) * d
+            if not exceeds(cand[None, :], o[None, :], tol)[0]:
+                row = cand
+                break
+        out[i] = row
+    return out, int(bad.size)
+
+
+def enforce_tolerance(original: PiecewiseCurve, new: PiecewiseCurve, tol: float | None,
+                      curve_bound: bool = True) -> tuple[PiecewiseCurve, Certificate]:
+    """``new`` made to satisfy the tolerance exactly in float64 (see the module docstring).
+
+    Parameters
+    ----------
+    original, new : PiecewiseCurve
+        The input of a fairing method and its result.
+    tol : float or None
+        ``None``: nothing is enforced, only the deviation is measured.
+    curve_bound : bool
+        The method promises the curve within ``tol`` too (certify and scale if needed).
+
+    Returns
+    -------
+    (curve, Certificate)
+    """
+    fo = curve_fields(original)
+    fn = curve_fields(new)
+    if (tol is None or fo is None or fn is None or type(original) is not type(new)
+            or fo[next(iter(fo))].shape != fn[next(iter(fn))].shape):
+        dmax, ub, t = difference_deviation(original, new)
+        return new, Certificate(dmax, ub, t, 0, 1.0)
+    pos = next(iter(fo))
+    if not _comparable(original, new):
+        # other knots / parameters: the data points are still bounded (pulled back), but the
+        # curve change is not the curve of the data differences, so it is measured, not scaled
+        fixed, pulled = _pull_back(fo[pos], fn[pos], tol)
+        cur = new
+        if pulled:
+            cf = dict(fn)
+            cf[pos] = fixed
+            cur = _rebuild(new, cf)
+        dmax, ub, t = difference_deviation(original, cur)
+        return cur, Certificate(dmax, ub, t, pulled, 1.0)
+    delta = {k: fn[k] - fo[k] for k in fo}
+    pulled_total = 0
+    scale = 1.0
+    cur = new
+    for attempt in range(_MAX_SCALINGS + 1):
+        moved = (fn[pos] if attempt == 0 and scale == 1.0
+                 else np.asarray(curve_fields(cur)[pos]))  # type: ignore[index]
+        fixed, pulled = _pull_back(fo[pos], moved, tol)
+        if pulled:
+            pulled_total += pulled
+            cf = dict(curve_fields(cur))  # type: ignore[arg-type]
+            cf[pos] = fixed
+            cur = _rebuild(new, cf)
+        dmax, ub, t = difference_deviation(original, cur)
+        if not curve_bound or ub <= tol:
+            return cur, Certificate(dmax, ub, t, pulled_total, scale)
+        if attempt == _MAX_SCALINGS:
+            break
+        # the curve strays past tol between points: scale every data difference by one factor
+        scale *= (tol / ub) * (1.0 - 2.0 ** (-40 + 4 * attempt))
+        cf = {k: fo[k] + scale * delta[k] for k in fo}
+        cur = _rebuild(new, cf)
+    # could not certify by scaling (cannot happen unless the bound is dominated by rounding):
+    # give the input back, which is within every tolerance
+    dmax, ub, t = difference_deviation(original, original)
+    return original, Certificate(dmax, ub, t, pulled_total, 0.0)
+
+
+def point_report(original: PiecewiseCurve, new: PiecewiseCurve
+                 ) -> tuple[np.ndarray, FloatArray, float, int | None]:
+    """``(moved indices, their displacement, max displacement, its index)`` of the data points
+    (with :func:`curvefair._distance.point_distances`); zero moves when the shapes differ."""
+    from .fair import data_points
+
+    p0 = data_points(original)
+    p1 = data_points(new)
+    if p0.shape != p1.shape:
+        return np.arange(len(p1)), np.zeros(0), 0.0, None
+    moved = np.flatnonzero(np.any(p0 != p1, axis=1))
+    disp = point_distances(p1[moved], p0[moved])
+    if disp.size == 0:
+        return moved, disp, 0.0, None
+    k = int(np.argmax(disp))
+    return moved, disp, float(disp[k]), int(moved[k])
