@@ -184,12 +184,11 @@ def _polyline_record(e: Any, base: dict[str, Any], path: object,
         xyz = np.asarray([tuple(v.dxf.location) for v in verts], dtype=float).reshape(-1, 3)
         pts, z = planar(xyz)
     if pts.shape[0] < 2:
-        raise FileFormatError(f"{kind} {base['handle']} has fewer than 2 vertices", path)
+        raise Unsupported(f"{kind} with fewer than 2 vertices")
     what = f"{kind} {base['handle']} vertex"
     pts, where = drop_duplicates(pts, path, None, what=what)
     if pts.shape[0] < 2:
-        raise FileFormatError(f"{kind} {base['handle']} has fewer than 2 distinct vertices",
-                              path)
+        raise Unsupported(f"{kind} with fewer than 2 distinct vertices (a point, not a curve)")
     check_points(pts, path, None, what=what)
     closed_flag = bool(e.closed) if kind == "LWPOLYLINE" else bool(e.is_closed)
     distinct, row_map, closed = _ring(pts, closed_flag)
