@@ -260,9 +260,6 @@ def test_dxf_closed_spline_is_read_closed_and_written_closed(tmp_path):
     assert float(np.linalg.norm(back - raw, axis=1).max()) <= tol
 
 
-@pytest.mark.xfail(strict=True, reason="open in issue 11: a closed (periodic) spline whose seam "
-                   "is a knot of multiplicity degree (trimesh spline.DXF 7A, read as closed "
-                   "since session 5) still gets a kink there (0.021 rad at tol 1e-3 of size)")
 def test_dxf_closed_spline_seam_stays_g1():
     src = REAL / "trimesh" / "spline.DXF"
     r = next(r for r in _read(src) if r.source["handle"] == "7A")

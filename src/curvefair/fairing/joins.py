@@ -260,6 +260,26 @@ def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozense
         dr = float(t[a + p] - v)
         reduce.append((j, int(a), dl, dr))
 
+    if curve.closed:
+        # the seam of a closed curve sits at the domain's ends, which the knots above leave out:
+        # a seam knot of multiplicity degree (a closed outline stored clamped, e.g. a DXF
+        # closed SPLINE) is a join like any other -- its point held if it is a corner, its three
+        # points held if it is G1 (a periodic curve is not reduced)
+        m0 = int(np.count_nonzero(t == lo))
+        if m0 >= p:
+            a0 = int(np.flatnonzero(t == lo)[0])
+            d0 = pp.evaluate(np.array([lo]), 1, segment=np.array([0])).reshape(-1)
+            d1 = pp.evaluate(np.array([hi]), 1,
+                             segment=np.array([br.shape[0] - 2])).reshape(-1)
+            if np.linalg.norm(d0) > 0 and np.linalg.norm(d1) > 0:
+                j = a0 - 1
+                if _angle(d1, d0) > g1:
+                    hold.add(int(curve.control_index(j)))
+                    rep["corners_held"] += 1
+                else:
+                    hold.update(int(i) for i in curve.control_index(np.arange(j - 1, j + 2)))
+                    rep["g1_joins"] += 1
+
     out_clamp = list(clamp)
     if not curve.closed:
         e0, e1 = P[0], P[-1]
