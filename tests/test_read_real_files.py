@@ -265,22 +265,31 @@ def test_dxf_duplicate_vertex_dropped_and_written_back(tmp_path):
     assert res.exit_code == 0 and "Warning:" in res.output
 
 
-def test_g2_hold_covering_everything_is_explained(tmp_path):
+def test_g2_hold_on_short_airfoils_and_when_it_covers_everything(tmp_path):
+    # e387 (61 points): the hold zone of a C2 spline would hold most points, so the end
+    # segment itself is kept (g2_hold "segment") and the interior is faired
     p = REAL / "uiuc" / "e387.dat"
     res = _run("fair", p, "-o", tmp_path / "o.dat", "--tol", "1e-4", "--clamp", "g2",
                "--report", tmp_path / "r.json")
     assert res.exit_code == 0
-    assert "holds the points next to each G2-clamped end" in res.output
+    assert "G2-clamped end" not in res.output
     rep = json.loads((tmp_path / "r.json").read_text())
     (row,) = rep["curves"]
+    assert row["report"]["steps"] > 0 and row["report"]["g2_hold"] == ["segment", "segment"]
+    got, orig = read_curves(tmp_path / "o.dat")[0].points, read_curves(p)[0].points
+    assert not np.array_equal(got, orig)
+    np.testing.assert_array_equal(got[[0, 1, -2, -1]], orig[[0, 1, -2, -1]])  # end segments
+    # 4 points: the end segments are every interior point; nothing moves, and the run says why
+    q = tmp_path / "four.csv"
+    q.write_text("0 0\n1 0.5\n2 0.4\n3 0\n")
+    res = _run("fair", q, "-o", tmp_path / "f.csv", "--tol", "0.1", "--clamp", "g2",
+               "--report", tmp_path / "f.json")
+    assert res.exit_code == 0
+    assert "holds the points next to each G2-clamped end" in res.output
+    (row,) = json.loads((tmp_path / "f.json").read_text())["curves"]
     assert row["report"]["steps"] == 0 and row["warnings"]
-    # the curve is the input: every point held (independent check on the written file)
-    np.testing.assert_array_equal(read_curves(tmp_path / "o.dat")[0].points,
-                                  read_curves(p)[0].points)
-    # hermite mode holds only the point next to each end: the warning is not given
-    res = _run("fair", p, "-o", tmp_path / "h.dat", "--tol", "1e-4", "--clamp", "g2",
-               "--mode", "hermite")
-    assert res.exit_code == 0 and "G2-clamped end" not in res.output
+    np.testing.assert_array_equal(read_curves(tmp_path / "f.csv")[0].points,
+                                  read_curves(q)[0].points)
 
 
 def test_dxf_unsupported_skipped_kept_untouched_and_strict(tmp_path):
