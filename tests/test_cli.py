@@ -349,11 +349,11 @@ def test_methods_lists_options_with_defaults():
 
     r = CliRunner().invoke(main, ["methods"])
     assert r.exit_code == 0
-    assert "schedule" in r.output and "schedule=ranking" in r.output
+    assert "schedule" in r.output and "schedule=sweep" in r.output
     assert "variant=one-point" in r.output
     r = CliRunner().invoke(main, ["methods", "--json"])
     rows = {x["name"]: x for x in json.loads(r.output)}
-    assert rows["eck-hadenfeld"]["options"]["schedule"] == "ranking"
+    assert rows["eck-hadenfeld"]["options"]["schedule"] == "sweep"
     for name, row in rows.items():
         assert list(row["options"]) == list(method_options(name))
 

@@ -193,7 +193,13 @@ def test_sweep_through_fair_and_errors():
     c = random_curve(np.random.default_rng(3), 30, 3, 2, False)
     r = cf.fair(c, "eck-hadenfeld", tol=0.02, schedule="sweep")
     assert r.report["schedule"] == "sweep" and r.report["steps"] > 0
-    assert cf.fair(c, "eck-hadenfeld", tol=0.02).report["schedule"] == "ranking"
+    # fair()'s default schedule is the sweep; the paper's function keeps the ranking list
+    d = cf.fair(c, "eck-hadenfeld", tol=0.02)
+    assert d.report["schedule"] == "sweep"
+    np.testing.assert_array_equal(d.curve.control_points, r.curve.control_points)
+    assert cf.fair(c, "eck-hadenfeld", tol=0.02, schedule="ranking").report["schedule"] == "ranking"
+    assert eck_hadenfeld_fair(c, tol=0.02).steps == eck_hadenfeld_fair(
+        c, tol=0.02, schedule="ranking").steps
     assert r.report["max_deviation"] <= 0.02 * (1 + 1e-12)
     again = cf.fair(c, "eck-hadenfeld", tol=0.02, schedule="SWEEP")
     np.testing.assert_array_equal(again.curve.control_points, r.curve.control_points)
@@ -252,4 +258,4 @@ def test_option_checks():
         with pytest.raises(InputError, match=next(iter(kw))):
             eck_hadenfeld_fair(c, **kw)
     from curvefair.fairing import method_options
-    assert method_options("eck-hadenfeld")["schedule"] == "ranking"
+    assert method_options("eck-hadenfeld")["schedule"] == "sweep"

@@ -46,7 +46,7 @@ def test_hermite_driver_takes_kwargs_and_checks_them_itself():
 def test_known_options_still_work():
     b = _bspline()
     assert fair(b, "eck-hadenfeld", schedule="sweep").report["schedule"] == "sweep"
-    assert fair(b, "eck-hadenfeld").report["schedule"] == "ranking"
+    assert fair(b, "eck-hadenfeld").report["schedule"] == "sweep"
     r = fair(b, "knot-removal", variant="least-squares", tol=0.1)
     assert r.report["method"] == "knot-removal"
     assert r.report["variant"] == "least-squares"
@@ -55,15 +55,15 @@ def test_known_options_still_work():
 def test_method_options_contents():
     eh = method_options("eck-hadenfeld")
     assert eh == {"l": 2, "eps_relative": True, "history_max": 1_000_000,
-                  "schedule": "ranking"}
+                  "schedule": "sweep"}
     assert method_options("knot-removal")["variant"] == "one-point"
     assert method_options("global") == {"l": 2}
     assert method_options("poliakoff") == {"tol_on": "curve"}  # 'method' is bound by partial
     for name in METHODS:
         opts = method_options(name)
         assert not {"tol", "eps", "max_steps", "clamp", "protect", "mode", "curve"} & set(opts)
-    eh["schedule"] = "sweep"  # a copy: the registry is not changed
-    assert method_options("eck-hadenfeld")["schedule"] == "ranking"
+    eh["schedule"] = "ranking"  # a copy: the registry is not changed
+    assert method_options("eck-hadenfeld")["schedule"] == "sweep"
     with pytest.raises(InputError, match="unknown method 'nope'"):
         method_options("nope")
 

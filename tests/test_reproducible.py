@@ -47,7 +47,7 @@ for dim in (2, 3):
         bsp = cf.interpolate_bspline(pts, closed=closed)
         uni = cf.interpolate_cubic(pts, param="uniform", bc="periodic" if closed else "natural")
         runs = [("kjellander", uni, {}), ("poliakoff", cub, {}), ("wang-cao", cub, {}),
-                ("wang-quintic", qui, {}), ("eck-hadenfeld", bsp, {}),
+                ("wang-quintic", qui, {}), ("eck-hadenfeld", bsp, {"schedule": "ranking"}),
                 ("eck-hadenfeld", bsp, {"schedule": "sweep"}), ("knot-removal", bsp, {}),
                 ("cheng-yu", bsp, {}), ("global", bsp, {})]
         for method, curve, kw in runs:
