@@ -171,6 +171,14 @@ def test_sample_count_must_be_a_whole_number(n):
         c.sample(n)
 
 
+def test_sample_too_large_for_memory_is_an_input_error():
+    # 1e12 points of a planar curve: ~90 TiB with temporaries; numpy raised MemoryError
+    c = cf.interpolate_cubic(np.c_[np.arange(5.0), np.sin(np.arange(5.0))])
+    with pytest.raises(cf.InputError, match=r"sample\(1000000000000\) needs about .* GiB"):
+        c.sample(10**12)
+    assert c.sample(7).shape == (7, 2)
+
+
 def test_sample_matches_scipy():
     c = cf.interpolate_bspline(wave())
     a, b = c.domain

@@ -29,6 +29,7 @@ is computed, never returned as inf or NaN.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Iterable, Sequence
 
 import numpy as np
@@ -272,6 +273,24 @@ def as_count(value: object, name: str, *, minimum: int = 0, maximum: int | None 
         rng = f">= {minimum}" if maximum is None else f"in [{minimum}, {maximum}]"
         raise InputError(f"{name} must be an integer {rng}, got {value!r}")
     return v
+
+
+def physical_memory() -> int | None:
+    """Bytes of physical memory of this machine, or None where the OS does not say."""
+    try:
+        return int(os.sysconf("SC_PAGE_SIZE")) * int(os.sysconf("SC_PHYS_PAGES"))
+    except (AttributeError, ValueError, OSError):
+        return None
+
+
+def check_fits(n_bytes: float, what: str) -> None:
+    """Refuse an allocation of ``n_bytes`` (with its temporaries) that cannot fit in this
+    machine's memory, with an InputError naming ``what`` (numpy would raise MemoryError after
+    trying, or the OS would kill the process)."""
+    mem = physical_memory()
+    if mem is not None and n_bytes > mem:
+        raise InputError(f"{what} needs about {n_bytes / 2**30:.3g} GiB, more than this "
+                         f"machine's {mem / 2**30:.3g} GiB of memory")
 
 
 def _as_scalar(value: object, name: str, what: str) -> float:

@@ -19,7 +19,7 @@ from math import factorial
 import numpy as np
 
 from .._typing import ArrayLike, FloatArray
-from .._validate import as_count, as_eval_params
+from .._validate import as_count, as_eval_params, check_fits
 from ..errors import InputError
 
 __all__ = ["PiecewisePolynomial", "PiecewiseCurve", "readonly"]
@@ -246,5 +246,7 @@ class PiecewiseCurve(abc.ABC):
         """``n`` points at equally spaced parameters over the domain, shape ``(n, dim)``
         (``n >= 0`` an integer)."""
         m = as_count(n, "n", minimum=0)
+        # the parameters, the points and the evaluation's temporaries: about 4 arrays of (m, dim)
+        check_fits(32.0 * m * (self.dim + 1), f"sample({m})")
         t0, t1 = self.domain
         return self(np.linspace(t0, t1, m))
