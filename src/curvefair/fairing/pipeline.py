@@ -365,7 +365,11 @@ def fair_points(points: ArrayLike, tol: float, *, degree: int = 5, l: Any = 3,  
         u_all = parameterize(pts, param)
         u = u_all
     c0 = _start_curve(pts, u_all, p, closed, w)
-    curve, mult, its, reason = tube_energy_qp(c0, u, pts, tolv, l=w, max_steps=int(max_steps))
+    # the tube is solved a rounding margin inside tol, so that |C(u_i) - p_i| <= tol holds as
+    # float64 evaluates it (the interior-point iterate may end within 1e-12 of the constraint)
+    margin = min(0.25 * tolv, 1e-10 * tolv + 64.0 * np.finfo(float).eps * float(np.abs(pts).max()))
+    curve, mult, its, reason = tube_energy_qp(c0, u, pts, tolv - margin, l=w,
+                                              max_steps=int(max_steps))
     dev = np.sqrt(np.sum((curve(u) - pts) ** 2, axis=1))
     i = int(np.argmax(dev))
     G = _gram(curve, w)
