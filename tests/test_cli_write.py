@@ -322,7 +322,7 @@ def test_svg_rounding_to_element_decimals_undone_when_it_breaks_tol(tmp_path: Pa
 def test_real_glyph_svg_within_tol(tmp_path: Path):
     """Font Awesome 3.svg at --tol 1: rounded to its 1 decimal after fairing it reads back
     1.03 from the input; curvefair writes exact numbers instead."""
-    (tmp_path / "3.svg").write_bytes((REAL / "font-awesome" / "3.svg").read_bytes())
+    (tmp_path / "3.svg").write_bytes((REAL / "fontawesome" / "3.svg").read_bytes())
     res = cli(["fair", "3.svg", "-o", "o.svg", "--tol", "1", "--report", "r.json"], tmp_path)
     assert res.returncode == 0, res.stderr
     # samples 1/100 apart: the bound exceeds the true distance by 5e-3 at most

@@ -60,9 +60,9 @@ from pathlib import Path  # noqa: E402
 from curvefair import BSplineCurve, read_curves, write_curves  # noqa: E402
 
 REAL = Path(__file__).parent / "data" / "real"
-NURBS_3DM = REAL / "mcneel+rhino-developer-samples" / "nurbscurve.3dm"
-MIL_SVG = REAL / "mikedh+trimesh" / "MIL.svg"
-AE_DXF = REAL / "mikedh+trimesh" / "ae.r2013a.dxf"
+NURBS_3DM = REAL / "rhino-developer-samples" / "nurbscurve.3dm"
+MIL_SVG = REAL / "trimesh" / "MIL.svg"
+AE_DXF = REAL / "trimesh" / "ae.r2013a.dxf"
 
 
 def _c0_join_angles(c: BSplineCurve) -> np.ndarray:

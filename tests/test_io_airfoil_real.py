@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from _helpers import record_points
 
 from curvefair import read_curves, write_curves
 from curvefair.errors import FileFormatError
@@ -59,12 +60,7 @@ def _expected_selig(text: str) -> tuple[np.ndarray, int | None]:
     return pts[keep], notes
 
 
-def _contour(recs) -> np.ndarray:
-    n = int(recs[0].source["n_points"])
-    out = np.full((n, 2), np.nan)
-    for r in recs:
-        out[np.asarray(r.source["indices"])] = r.points
-    return out
+_contour = record_points
 
 
 # ------------------------------------------------------------------------------------------
@@ -217,4 +213,4 @@ def test_every_uiuc_file_of_the_aerosandbox_wheel(aerosandbox_wheel, tmp_path):
         f"documented but read: {sorted(set(refused_doc) - set(refused))}")
     assert read_ok == 2174 - len(refused_doc)
     assert notes >= 300        # 341 files carry notes after the coordinates
-    assert not_identical == [], f"{len(not_identical)} unchanged files not written back as they were"
+    assert not_identical == [], f"{len(not_identical)} unchanged files not written back as read"

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from _helpers import record_points
 from click.testing import CliRunner
 
 from curvefair import read_curves, write_curves
@@ -35,12 +36,7 @@ def _xy(z: complex) -> list[float]:
     return [z.real, z.imag]
 
 
-def _vertices(recs) -> np.ndarray:
-    n = int(recs[0].source["n_points"])
-    out = np.full((n, 2), np.nan)
-    for r in recs:
-        out[np.asarray(r.source["indices"])] = r.points
-    return out
+_vertices = record_points
 
 
 def _by_node(recs):
