@@ -377,7 +377,7 @@ def _warnings_to_stderr(quiet: bool, prefix: str = "",
 
 
 def _read(path: str, corner_angle: float | None, strict: bool = False,
-          quiet: bool = False) -> list[Any]:
+          quiet: bool = False, glyphs: str | None = None) -> list[Any]:
     """The records of a file; entities curvefair cannot represent are skipped with a warning
     (kept untouched on write-back) unless ``strict``, which refuses the file."""
     from . import read_curves
@@ -387,7 +387,8 @@ def _read(path: str, corner_angle: float | None, strict: bool = False,
     try:
         with _warnings_to_stderr(quiet, into=seen):
             return read_curves(path, corner_angle=corner_angle,
-                               on_unsupported="raise" if strict else "skip")
+                               on_unsupported="raise" if strict else "skip",
+                               **({} if glyphs is None else {"glyphs": glyphs}))
     except CurvefairError as exc:
         skipped = sum(": skipped " in w for w in seen)
         if skipped:
@@ -815,7 +816,7 @@ def _summary_table(rows: list[dict[str, Any]]) -> Any:
 
 @main.command("fair", epilog="Default method per curve type: " + _default_methods_text()
               + ". List all with 'curvefair methods'.")
-@click.argument("infile", metavar="IN", type=click.Path(exists=True, dir_okay=False))
+@click.argument("infile", metavar="IN", type=click.Path(exists=True, dir_okay=True))
 @click.option("-o", "--output", "out", metavar="OUT",
               help="Output file; its extension picks the format (default: IN's format). "
                    "Required unless --in-place.")
@@ -853,6 +854,8 @@ def _summary_table(rows: list[dict[str, Any]]) -> Any:
 @click.option("--history", is_flag=True, help="Include every step in the JSON report.")
 @click.option("--plot", "plot_path", metavar="PLOT.png",
               help="Write a before/after figure (.png, .svg or .pdf).")
+@click.option("--glyphs", metavar="A,B,...",
+              help="Fonts (.ufo, .ttf, .otf): fair only these glyphs (names, comma separated).")
 @_reading_options
 @_quiet_option
 def fair_cmd(infile: str, out: str | None, in_place: bool, method: str | None,
@@ -861,7 +864,7 @@ def fair_cmd(infile: str, out: str | None, in_place: bool, method: str | None,
              decimals: int | None, report: str | None,
              history: bool,
              plot_path: str | None, corner_angle: float, no_corners: bool,
-             strict: bool, quiet: bool) -> None:
+             strict: bool, quiet: bool, glyphs: str | None = None) -> None:
     """Fair every curve in IN and write them to OUT.
 
     Prints a before/after table: strain energy, largest third-derivative jump, inflections,
@@ -902,7 +905,7 @@ def fair_cmd(infile: str, out: str | None, in_place: bool, method: str | None,
             out_fmt = detect_format(out)
         except CurvefairError:
             out_fmt = in_fmt
-        records = _read(infile, _corner(corner_angle, no_corners), strict, quiet)
+        records = _read(infile, _corner(corner_angle, no_corners), strict, quiet, glyphs)
     _check_protect_range(records, user_protect)
     from . import fair
     from .io._verify import write_checked
@@ -953,7 +956,7 @@ def fair_cmd(infile: str, out: str | None, in_place: bool, method: str | None,
             # written to a temporary file, read back and measured against the input; moved
             # onto OUT only when every curve read back is within tol
             check = write_checked(out, faired, records, tol=tol,
-                                  reader=lambda p: _read(p, corner, strict, True),
+                                  reader=lambda p: _read(p, corner, strict, True, glyphs),
                                   template=infile if out_fmt == in_fmt else None,
                                   format=out_fmt, overwrite=in_place, decimals=decimals)
             for row, d, kind in zip(rows, check.deviations, check.kinds, strict=True):

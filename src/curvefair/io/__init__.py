@@ -17,6 +17,8 @@ format        extensions                   needs
 ``svg``       .svg                         ``pip install 'curvefair[svg]'`` (svgpathtools)
 ``iges``      .igs .iges                   ``pip install 'curvefair[occ]'`` (cadquery-ocp)
 ``step``      .stp .step                   ``pip install 'curvefair[occ]'`` (cadquery-ocp)
+``ufo``       .ufo (a folder)              ``pip install 'curvefair[fonts]'`` (ufoLib2)
+``opentype``  .ttf .otf                    ``pip install 'curvefair[fonts]'`` (fontTools)
 ============  ===========================  ==========================================
 
 The record
@@ -78,7 +80,8 @@ from ._common import KINDS, CurveRecord, atomic_path, atomic_write, curve_kind, 
 __all__ = ["read_curves", "write_curves", "CurveRecord", "KINDS", "FORMATS", "detect_format",
            "atomic_write", "atomic_path"]
 
-FormatName = Literal["points", "airfoil", "json", "dxf", "3dm", "svg", "iges", "step"]
+FormatName = Literal["points", "airfoil", "json", "dxf", "3dm", "svg", "iges", "step", "ufo",
+                     "opentype"]
 
 #: format name -> file extensions
 FORMATS: dict[str, tuple[str, ...]] = {
@@ -90,7 +93,13 @@ FORMATS: dict[str, tuple[str, ...]] = {
     "svg": (".svg",),
     "iges": (".igs", ".iges"),
     "step": (".stp", ".step"),
+    "ufo": (".ufo",),
+    "opentype": (".ttf", ".otf"),
 }
+
+#: formats stored as a folder, and the formats that take ``glyphs=``
+FOLDER_FORMATS = ("ufo",)
+FONT_FORMATS = ("ufo", "opentype")
 
 
 def detect_format(path: str | os.PathLike[str], format: str | None = None) -> str:
@@ -120,6 +129,8 @@ def _module(fmt: str) -> Any:
         from . import rhino as m
     elif fmt == "svg":
         from . import svg as m
+    elif fmt in FONT_FORMATS:
+        from . import fonts as m
     else:
         from . import occ as m
     return m
@@ -127,7 +138,8 @@ def _module(fmt: str) -> Any:
 
 def read_curves(path: str | os.PathLike[str], *, format: FormatName | None = None,
                 corner_angle: float | None = 60.0,
-                on_unsupported: Literal["raise", "skip"] = "raise") -> list[CurveRecord]:
+                on_unsupported: Literal["raise", "skip"] = "raise",
+                glyphs: Sequence[str] | str | None = None) -> list[CurveRecord]:
     """Read every curve of a file.
 
     Parameters
@@ -143,6 +155,9 @@ def read_curves(path: str | os.PathLike[str], *, format: FormatName | None = Non
         What to do with a curve entity curvefair cannot represent exactly (a rational or
         unclamped DXF spline, a polyline with arcs, an SVG arc...): raise
         :class:`~curvefair.FileFormatError` naming it, or skip it with a warning.
+    glyphs : sequence of str or str, optional
+        Fonts (``ufo``, ``opentype``): only these glyphs (names, or one comma-separated
+        string); one record per contour with curves, named ``"<glyph>#<contour>"``.
 
     Returns
     -------
@@ -180,9 +195,13 @@ def read_curves(path: str | os.PathLike[str], *, format: FormatName | None = Non
     p = Path(path)
     if not p.exists():
         raise FileFormatError("no such file", path)
-    if p.is_dir():
+    if p.is_dir() and fmt not in FOLDER_FORMATS:
         raise FileFormatError("is a folder, not a file", path)
-    records = _module(fmt).read(path, corner_angle=corner_angle, on_unsupported=on_unsupported)
+    if glyphs is not None and fmt not in FONT_FORMATS:
+        raise InputError(f"glyphs= is for fonts (ufo, opentype), not {fmt} files")
+    extra = {} if glyphs is None else {"glyphs": glyphs}
+    records = _module(fmt).read(path, corner_angle=corner_angle, on_unsupported=on_unsupported,
+                                **extra)
     if not records:
         raise FileFormatError(f"no curves in the {fmt} file", path)
     return records
@@ -216,7 +235,8 @@ def _template_path(template: object) -> str | None:
         template = [template]
     if isinstance(template, (str, os.PathLike)):
         t = os.path.abspath(os.fspath(template))
-        if not os.path.isfile(t):
+        if not (os.path.isfile(t) or (os.path.isdir(t) and
+                                      Path(t).suffix.lower() in FORMATS["ufo"])):
             raise InputError(f"template: no such file {t!r}")
         return t
     if isinstance(template, Sequence) and template and \

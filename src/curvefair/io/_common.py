@@ -10,6 +10,7 @@ import contextlib
 import dataclasses
 import importlib
 import os
+import shutil
 import signal
 import stat
 import tempfile
@@ -144,7 +145,7 @@ def _on_signal(signum: int, frame: Any) -> None:
     """Delete the live temporary files, then die of the signal as the previous handler would."""
     for tmp in list(_LIVE_TEMPS):
         with contextlib.suppress(OSError):
-            os.unlink(tmp)
+            _remove(tmp)
         _LIVE_TEMPS.discard(tmp)
     prev = _PREVIOUS_HANDLERS.get(signum, signal.SIG_DFL)
     _restore_handlers()
@@ -177,6 +178,35 @@ def _restore_handlers() -> None:
     _PREVIOUS_HANDLERS.clear()
 
 
+#: destinations that are folders (a UFO font)
+FOLDER_SUFFIXES = (".ufo",)
+
+
+def _remove(path: str | os.PathLike[str]) -> None:
+    """Delete a temporary file, or a temporary folder (a UFO font is a folder)."""
+    if os.path.isdir(path) and not os.path.islink(path):
+        shutil.rmtree(path)
+    else:
+        os.unlink(path)
+
+
+def _replace(tmp: Path, dest: Path) -> None:
+    """``os.replace(tmp, dest)``; a folder replaces a folder by moving the old one aside first
+    (``rename`` cannot replace a non-empty folder), which is put back if the move fails."""
+    if not (tmp.is_dir() and dest.is_dir() and not dest.is_symlink()):
+        os.replace(tmp, dest)
+        return
+    aside = Path(tempfile.mkdtemp(prefix="." + dest.name + ".old.", dir=dest.parent))
+    os.rmdir(aside)
+    os.replace(dest, aside)
+    try:
+        os.replace(tmp, dest)
+    except BaseException:
+        os.replace(aside, dest)
+        raise
+    shutil.rmtree(aside, ignore_errors=True)
+
+
 def write_target(path: str | os.PathLike[str]) -> Path:
     """The file a write to ``path`` replaces: ``path`` itself, or the final target when
     ``path`` is a symbolic link (a write goes *through* the link, which stays a link).
@@ -189,10 +219,10 @@ def write_target(path: str | os.PathLike[str]) -> Path:
     raw = os.fspath(path)
     if not str(raw).strip():
         raise InputError("the output path is empty")
-    if os.path.isdir(raw):
+    if os.path.isdir(raw) and Path(raw).suffix.lower() not in FOLDER_SUFFIXES:
         raise InputError(f"{raw!r} is a folder, not a file name")
     dest = Path(os.path.realpath(raw)) if os.path.islink(raw) else Path(raw)
-    if dest.is_dir():
+    if dest.is_dir() and dest.suffix.lower() not in FOLDER_SUFFIXES:
         raise InputError(f"{raw!r} is a link to the folder {str(dest)!r}, not to a file")
     return dest
 
@@ -215,8 +245,10 @@ def atomic_path(path: str | os.PathLike[str], suffix: str | None = None) -> Iter
     """Yield a temporary path in the destination folder; on success ``os.replace`` it onto
     ``path``, on error delete it. The destination keeps its permissions if it existed.
 
-    For libraries that save to a file name (ezdxf, rhino3dm, OCC). ``suffix`` defaults to the
-    destination's (some libraries choose the format by the extension).
+    For libraries that save to a file name (ezdxf, rhino3dm, OCC, fontTools). ``suffix``
+    defaults to the destination's (some libraries choose the format by the extension). The
+    writer may replace the temporary file by a folder of the same name (a UFO font): it then
+    replaces the destination folder.
 
     A symbolic link is written through: the temporary file goes next to the link's final
     target, which is replaced, and the link stays a link. The temporary file is removed on any
@@ -241,15 +273,15 @@ def atomic_path(path: str | os.PathLike[str], suffix: str | None = None) -> Iter
     tmp_path = Path(tmp)
     try:
         yield tmp_path
-        if dest.exists():
+        if dest.exists() and dest.is_dir() == tmp_path.is_dir():
             mode = stat.S_IMODE(dest.stat().st_mode)
         else:
-            mode = 0o666 & ~_umask()
+            mode = (0o777 if tmp_path.is_dir() else 0o666) & ~_umask()
         os.chmod(tmp_path, mode)
-        os.replace(tmp_path, dest)
+        _replace(tmp_path, dest)
     except BaseException as exc:
         with contextlib.suppress(OSError):
-            tmp_path.unlink()
+            _remove(tmp_path)
         if isinstance(exc, OSError):
             new = _user_os_error(exc, user, tmp)
             if new is not exc:

@@ -1,0 +1,315 @@
+"""Glyph contours as B-splines, and back with the outline's structure kept exactly.
+
+A contour is the list of its points in file order, each on- or off-curve, with the UFO
+``smooth`` flag (binary fonts: a node whose neighbours are exactly collinear with it).
+
+**To a B-spline** (:func:`contour_curve`). The contour is walked from one on-curve point (the
+first corner, else the first on-curve point: the seam of the closed chain) round to itself:
+
+- cubic contours (UFO ``curve``, CFF): each segment is a cubic Bezier (a line ``A B`` is the
+  exactly degree-elevated ``A, A + (B - A)/3, A + 2(B - A)/3, B``), joined by knots of
+  multiplicity 3 -- the B-spline form of a poly-Bezier, with spans of width 1;
+- quadratic contours (UFO ``qcurve``, TrueType ``glyf``): a run of ``k`` off-curve points
+  between two on-curve points is a quadratic B-spline of ``k`` spans of width 1 with simple
+  knots between them. Its joins are the midpoints of consecutive off-curve points, which is
+  TrueType's implied on-curve point (the point at a simple knot ``u_i`` of a quadratic B-spline
+  is ``(h_{i+1} P_{i-1} + h_i P_i)/(h_i + h_{i+1})`` for span widths ``h``: the midpoint when
+  they are equal), so the B-spline is the TrueType outline exactly, and every B-spline with
+  these knots is one; explicit on-curve points are knots of multiplicity 2; a line is the
+  elevated ``A, (A + B)/2, B``.
+
+The control points of the B-spline are the contour's points plus the elevated interior points
+of lines; ``index[k]`` gives the control point of the contour's point ``k``.
+
+**Back** (:func:`constrained_points`): the faired control points at ``index`` are the new
+contour points, then the outline's rules are enforced exactly:
+
+- points of straight segments and corner nodes (on-curve points that are not smooth) keep
+  their input position;
+- a smooth node stays smooth: its on-curve point is put on the segment between its two
+  neighbours (the collinear handles of a cubic node, the two off-curve points of a TrueType
+  node), or the handle next to a line on that line's extension;
+- a smooth node at a horizontal (vertical) extremum -- its neighbours have exactly its ``y``
+  (``x``) -- keeps that: the neighbours get the node's ``y`` (``x``);
+- integer formats (binary fonts) round to integers; a smooth node then needs three lattice
+  points on a line: the nearest lattice point of the segment, else the input's three points
+  moved by the node's rounded move (a translation keeps them collinear), else the input's
+  three points;
+- the moves are then scaled down, ``p = p0 + s (p1 - p0)`` with ``s`` halved from 1, until no
+  point is farther than ``tol`` from its input position (``s = 0`` is the input itself). A
+  B-spline's distance to another with the same knots is at most the largest distance of
+  their control points (convex hull property of the difference curve), so the written outline
+  is within ``tol`` of the input everywhere.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from math import gcd
+
+import numpy as np
+
+from .._typing import FloatArray
+from ..curves.bspline import BSplineCurve
+from ._common import Unsupported
+
+__all__ = ["Contour", "contour_curve", "constrained_points", "smooth_angle"]
+
+#: a node flagged smooth is kept exactly smooth when its input turns by at most this (degrees,
+#: the G1 threshold of :mod:`curvefair.fairing.joins`)
+SMOOTH_ANGLE = 0.5
+
+
+@dataclass(frozen=True)
+class Contour:
+    """One contour: ``points (n, 2)`` in file order, ``on (n,)`` on-curve flags, ``smooth``
+    flags, ``closed``, ``quadratic`` (TrueType-style off-curve runs) and ``grid`` (integer
+    coordinates on write)."""
+
+    points: FloatArray
+    on: tuple[bool, ...]
+    smooth: tuple[bool, ...]
+    closed: bool
+    quadratic: bool
+    grid: bool = False
+
+
+def _angle(a: FloatArray, b: FloatArray) -> float:
+    cr = float(a[0] * b[1] - a[1] * b[0])
+    return float(np.arctan2(abs(cr), float(a @ b)))
+
+
+def smooth_angle(c: Contour, k: int) -> float | None:
+    """Turning angle (radians) at the on-curve point ``k`` between its neighbours, or None
+    when it has not two neighbours."""
+    n = len(c.on)
+    if not c.closed and (k == 0 or k == n - 1):
+        return None
+    a, b = c.points[(k - 1) % n], c.points[(k + 1) % n]
+    p = c.points[k]
+    if np.array_equal(a, p) or np.array_equal(b, p):
+        return None
+    return _angle(p - a, b - p)
+
+
+def _node_kinds(c: Contour) -> tuple[list[int], list[int], list[int]]:
+    """(smooth nodes kept exactly smooth, corner nodes, points of straight segments)."""
+    n = len(c.on)
+    smooth, corners, line = [], [], set()
+    for k in range(n):
+        if not c.on[k]:
+            continue
+        nxt = (k + 1) % n
+        if (c.closed or k < n - 1) and c.on[nxt]:
+            line.update((k, nxt))
+        ang = smooth_angle(c, k)
+        both_on = ang is not None and c.on[(k - 1) % n] and c.on[(k + 1) % n]
+        if ang is not None and c.smooth[k] and not both_on and \
+                ang <= np.radians(SMOOTH_ANGLE) and (not c.grid or ang == 0.0):
+            smooth.append(k)
+        else:
+            corners.append(k)
+    return smooth, corners, sorted(line)
+
+
+def _rotation(c: Contour, corners: list[int]) -> int:
+    if not c.closed:
+        return 0
+    if corners:
+        return corners[0]
+    return next(k for k in range(len(c.on)) if c.on[k])
+
+
+def contour_curve(c: Contour) -> tuple[BSplineCurve, np.ndarray, list[int]]:
+    """The B-spline of a contour (see the module docstring).
+
+    Returns
+    -------
+    curve : BSplineCurve
+        Degree 3 (cubic contours) or 2 (quadratic), clamped, from the seam node round to it.
+    index : ndarray of int, shape (n,)
+        Control point of each contour point.
+    corners : list of int
+        Control points of the corner nodes and the ends of straight segments (to hold).
+
+    Raises
+    ------
+    Unsupported
+        No on-curve point, fewer than two points, a cubic segment with other than 0 or 2
+        off-curve points, zero-length segments.
+    """
+    n = len(c.on)
+    if n < 2 or not any(c.on):
+        raise Unsupported("a contour without on-curve points" if n >= 2 else
+                          "a contour of fewer than two points")
+    smooth, corners, line = _node_kinds(c)
+    r = _rotation(c, corners)
+    order = [(r + i) % n for i in range(n)] + ([r] if c.closed else [])
+    if not c.closed and not c.on[0]:
+        raise Unsupported("an open contour starting with an off-curve point")
+    p = 2 if c.quadratic else 3
+    P = c.points
+    ctl: list[FloatArray] = [P[order[0]]]
+    index = np.full(n, -1, dtype=np.intp)
+    index[order[0]] = 0
+    knots: list[float] = [0.0] * (p + 1)
+    u = 0.0
+    i = 0
+    while i < len(order) - 1:
+        j = i + 1
+        while not c.on[order[j]]:
+            j += 1
+            if j == len(order):
+                raise Unsupported("an open contour ending with an off-curve point")
+        a, b = P[order[i]], P[order[j]]
+        offs = order[i + 1:j]
+        if not offs:  # a line
+            if np.array_equal(a, b):
+                raise Unsupported("a zero-length line segment")
+            inner = [a + (b - a) / 2] if p == 2 else [a + (b - a) / 3, a + 2 * (b - a) / 3]
+            ctl.extend(inner)
+            u += 1.0
+        elif p == 3:
+            if len(offs) != 2:
+                raise Unsupported(f"a cubic segment with {len(offs)} off-curve points")
+            for k in offs:
+                index[k] = len(ctl)
+                ctl.append(P[k])
+            u += 1.0
+        else:
+            for m, k in enumerate(offs):
+                index[k] = len(ctl)
+                ctl.append(P[k])
+                if m > 0:
+                    knots.append(u)
+                u += 1.0
+        if j < len(order) - 1 or not c.closed:
+            index[order[j]] = len(ctl)
+        ctl.append(b)
+        if j < len(order) - 1:
+            knots.extend([u] * p)
+        i = j
+    knots.extend([u] * (p + 1))
+    cp = np.array(ctl, dtype=np.float64)
+    curve = BSplineCurve(cp, np.array(knots), p)
+    hold = sorted({int(index[k]) for k in corners} | {int(index[k]) for k in line}
+                  | ({len(ctl) - 1} if c.closed and (r in corners or r in line) else set()))
+    return curve, index, hold
+
+
+def _primitive(v: FloatArray) -> tuple[int, int]:
+    x, y = int(v[0]), int(v[1])
+    g = gcd(x, y) or 1
+    return x // g, y // g
+
+
+def _exact_smooth(c: Contour, q: FloatArray, k: int, horizontal: bool, vertical: bool) -> bool:
+    n = len(c.on)
+    a, b = q[(k - 1) % n], q[(k + 1) % n]
+    d1, d2 = q[k] - a, b - q[k]
+    if not (np.any(d1) and np.any(d2)):
+        return False
+    cr = d1[0] * d2[1] - d1[1] * d2[0]
+    ok = float(d1 @ d2) > 0 and (cr == 0.0 if c.grid else _angle(d1, d2) <= 1e-12)
+    if horizontal:
+        ok = ok and a[1] == q[k][1] == b[1]
+    if vertical:
+        ok = ok and a[0] == q[k][0] == b[0]
+    return bool(ok)
+
+
+def _place(c: Contour, q: FloatArray, target: FloatArray, k: int, horizontal: bool,
+           vertical: bool, fixed: np.ndarray) -> None:
+    """Make node ``k`` exactly smooth in ``q`` (in place), near ``target``."""
+    n = len(c.on)
+    ia, ib = (k - 1) % n, (k + 1) % n
+    P0 = c.points
+    if horizontal or vertical:
+        ax = 1 if horizontal else 0
+        val = q[k][ax]
+        for j in (ia, ib):
+            if not fixed[j]:
+                q[j][ax] = val
+        if fixed[ia] or fixed[ib]:
+            val = q[ia][ax] if fixed[ia] else q[ib][ax]
+            q[k][ax] = q[ia][ax] = q[ib][ax] = val
+        return
+    if fixed[ia] or fixed[ib]:  # a line on one side: the other neighbour on its extension
+        f, m = (ia, ib) if fixed[ia] else (ib, ia)
+        if fixed[m]:
+            return
+        d = P0[k] - P0[f]
+        t = float((target[m] - q[k]) @ d) / float(d @ d)
+        if c.grid:
+            dx, dy = _primitive(d)
+            g = max(abs(int(d[0])) // max(abs(dx), 1), abs(int(d[1])) // max(abs(dy), 1))
+            s = max(1, round(t * g))
+            q[m] = q[k] + s * np.array([dx, dy], dtype=float)
+        else:
+            q[m] = q[k] + max(t, 1e-3) * d
+        return
+    a, b = q[ia], q[ib]
+    if not c.grid:
+        d = b - a
+        t = float((q[k] - a) @ d) / float(d @ d)
+        q[k] = a + min(max(t, 1e-3), 1 - 1e-3) * d
+        return
+    best: tuple[float, FloatArray, FloatArray, FloatArray] | None = None
+    d = b - a
+    g = gcd(int(abs(d[0])), int(abs(d[1])))
+    if g >= 2:
+        step = d / g
+        t = float((q[k] - a) @ d) / float(d @ d)
+        m = min(max(round(t * g), 1), g - 1)
+        cand = a + m * step
+        best = (float(np.linalg.norm(cand - target[k])), a.copy(), cand, b.copy())
+    move = np.round(q[k] - P0[k])
+    tr = (P0[ia] + move, P0[k] + move, P0[ib] + move)
+    err = max(float(np.linalg.norm(tr[i] - target[j])) for i, j in enumerate((ia, k, ib)))
+    if best is None or err < best[0]:
+        best = (err, *tr)
+    q[ia], q[k], q[ib] = best[1], best[2], best[3]
+
+
+def constrained_points(c: Contour, new: FloatArray, tol: float | None,
+                       ) -> tuple[FloatArray, float]:
+    """The contour's points from faired ones with the outline's rules enforced (module
+    docstring); returns ``(points, s)``, ``s`` the scale of the moves that was kept."""
+    P0 = np.asarray(c.points, dtype=np.float64)
+    new = np.asarray(new, dtype=np.float64)
+    smooth, corners, line = _node_kinds(c)
+    n = len(c.on)
+    fixed = np.zeros(n, dtype=bool)
+    fixed[corners] = True
+    fixed[line] = True
+    ext = {}
+    for k in smooth:
+        a, b = P0[(k - 1) % n], P0[(k + 1) % n]
+        ext[k] = (bool(a[1] == P0[k][1] == b[1]), bool(a[0] == P0[k][0] == b[0]))
+    s = 1.0
+    for _ in range(14):
+        target = P0 + s * (new - P0)
+        target[fixed] = P0[fixed]
+        q = np.round(target) if c.grid else target.copy()
+        q[fixed] = P0[fixed]
+        for k in smooth:
+            _place(c, q, target, k, *ext[k], fixed)
+        # a node spoilt by a neighbour's placement (TrueType: two nodes share an off-curve
+        # point) gets its input points back, until every smooth node is exactly smooth
+        held = fixed.copy()
+        for _ in range(n + 1):
+            bad = [k for k in smooth if not _exact_smooth(c, q, k, *ext[k])
+                   and not all(np.array_equal(q[j], P0[j]) for j in ((k - 1) % n, k, (k + 1) % n))]
+            if not bad:
+                break
+            for k in bad:
+                for j in ((k - 1) % n, k, (k + 1) % n):
+                    q[j] = P0[j]
+                    held[j] = True
+        else:  # pragma: no cover - the input itself satisfies every rule
+            q = P0.copy()
+        dmax = float(np.max(np.linalg.norm(q - P0, axis=1))) if n else 0.0
+        if tol is None or dmax <= tol:
+            return q, s
+        s *= 0.5
+    return P0.copy(), 0.0

@@ -1,0 +1,460 @@
+"""Font sources and binaries: UFO (ufoLib2) and OpenType/TrueType (fontTools).
+
+``pip install 'curvefair[fonts]'``.
+
+Read
+----
+One record per contour of every glyph (``glyphs=`` chooses glyphs by name), in glyph order:
+the default layer of a UFO (``.ufo`` folder), the ``glyf`` (quadratic) or ``CFF `` (cubic)
+outlines of a ``.ttf``/``.otf``. Units are font units, ``y`` up. Contours made of straight
+lines only, components and empty glyphs carry no curve and are not records (they are written
+back untouched). The curve is the contour's B-spline of :mod:`curvefair.io._outline`
+(cubic poly-Bezier with knots of multiplicity 3; quadratic B-spline with TrueType's implied
+on-curve points exact); ``corners`` holds the corner nodes and straight segments.
+
+``name`` is ``"<glyph>#<contour>"``; ``source`` keys: ``glyph``, ``contour`` (0-based index in
+the glyph), ``handle`` (= name), ``layer`` (UFO), ``table`` (``glyf``/``CFF ``), ``outline``
+(the contour's points, on-curve flags, smooth flags, closedness, quadratic, integer grid) and
+``index`` (control point of each contour point).
+
+Write
+-----
+Only with the source as template (a font is never made from curves alone). The faired control
+points become the contour's points with the outline's rules enforced
+(:func:`curvefair.io._outline.constrained_points`: same points in the same order, smooth
+nodes exactly smooth, extrema keep their horizontal/vertical tangent, corners and straight
+segments unmoved, integers in binary fonts), each contour no farther from its input than the
+record's faired control points are (so within the fairing's ``tol``).
+
+- UFO: the template folder is copied and only the ``.glif`` files of changed glyphs are
+  rewritten (through fontTools' glifLib, in the glyph's own GLIF format version); kerning,
+  features, groups, lib, other layers, components, anchors, guidelines come back byte for byte.
+- TrueType: the changed glyphs' coordinates are replaced (instructions, flags and point
+  counts kept), bounds recomputed, the left side bearing follows ``xMin`` where it was equal.
+- CFF: the charstrings are desubroutinized and each changed glyph's drawing operators
+  rewritten as ``rmoveto``/``rlineto``/``rrcurveto`` (hints, hint masks and width kept).
+
+The font is saved with fontTools (head/hhea/maxp bounds recomputed) and read back by the
+caller's check.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import warnings
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .._typing import FloatArray
+from ..errors import FileFormatError, InputError
+from ._common import CurveRecord, Unsupported, lazy_import
+from ._outline import Contour, constrained_points, contour_curve
+
+__all__ = ["read", "write", "glyph_contours", "font_contours"]
+
+
+def _ufolib2(what: str) -> Any:
+    return lazy_import("ufoLib2", "ufoLib2", "fonts", what)
+
+
+def _fonttools(what: str) -> Any:
+    return lazy_import("fontTools", "fonttools", "fonts", what)
+
+
+# ------------------------------------------------------------------------------------------
+# contours of the formats
+# ------------------------------------------------------------------------------------------
+def ufo_contour(points: Sequence[Any], path: object = None) -> Contour:
+    """A :class:`Contour` from a UFO contour's points (``x, y, type/segmentType, smooth``)."""
+    types = [getattr(p, "type", None) if hasattr(p, "type") else p.segmentType for p in points]
+    closed = not (types and types[0] == "move")
+    quad = "qcurve" in types
+    if quad and "curve" in types:
+        raise Unsupported("a contour mixing cubic and quadratic segments")
+    xy = np.array([(float(p.x), float(p.y)) for p in points], dtype=np.float64)
+    on = tuple(t is not None and t != "offcurve" for t in types)
+    smooth = tuple(bool(p.smooth) for p in points)
+    return Contour(xy, on, smooth, closed, quad, grid=False)
+
+
+def _exact_smooth_flags(xy: FloatArray, on: Sequence[bool]) -> tuple[bool, ...]:
+    n = len(on)
+    out = []
+    for k in range(n):
+        a, p, b = xy[(k - 1) % n], xy[k], xy[(k + 1) % n]
+        d1, d2 = p - a, b - p
+        out.append(bool(on[k] and d1[0] * d2[1] - d1[1] * d2[0] == 0 and float(d1 @ d2) > 0))
+    return tuple(out)
+
+
+def _binary_contour(xy: FloatArray, on: Sequence[bool], quadratic: bool) -> Contour:
+    return Contour(xy, tuple(bool(o) for o in on), _exact_smooth_flags(xy, on), True,
+                   quadratic, grid=True)
+
+
+def _glyf_contours(font: Any, name: str) -> list[Contour]:
+    glyf = font["glyf"]
+    g = glyf[name]
+    if g.isComposite() or g.numberOfContours <= 0:
+        return []
+    coords, ends, flags = g.getCoordinates(glyf)
+    xy = np.array(coords, dtype=np.float64)
+    out, start = [], 0
+    for e in ends:
+        out.append(_binary_contour(xy[start:e + 1], [bool(f & 1) for f in flags[start:e + 1]],
+                                   True))
+        start = e + 1
+    return out
+
+
+def _cff_commands(font: Any, name: str) -> list[tuple[str, list[Any]]]:
+    from fontTools.cffLib.specializer import generalizeCommands, programToCommands
+
+    cs = font["CFF "].cff.topDictIndex[0].CharStrings[name]
+    cs.decompile()
+    return generalizeCommands(programToCommands(cs.program))
+
+
+def _cff_walk(cmds: list[tuple[str, list[Any]]]) -> list[tuple[list[FloatArray], list[bool],
+                                                                  bool]]:
+    """Contours of generalized charstring commands: (points, on flags, closing point equals
+    the start)."""
+    contours: list[tuple[list[FloatArray], list[bool], bool]] = []
+    cur = np.zeros(2)
+    pts: list[FloatArray] = []
+    on: list[bool] = []
+
+    def close() -> None:
+        if pts:
+            dup = len(pts) > 1 and np.array_equal(pts[-1], pts[0]) and on[-1]
+            if dup:
+                pts.pop()
+                on.pop()
+            contours.append((list(pts), list(on), bool(dup)))
+            pts.clear()
+            on.clear()
+
+    for op, args in cmds:
+        if op == "rmoveto":
+            close()
+            cur = cur + np.array(args[:2], dtype=float)
+            pts.append(cur.copy())
+            on.append(True)
+        elif op == "rlineto":
+            cur = cur + np.array(args[:2], dtype=float)
+            pts.append(cur.copy())
+            on.append(True)
+        elif op in ("rrcurveto", "flex"):
+            for s in range(0, 12 if op == "flex" else 6, 6):
+                for j, o in ((0, False), (2, False), (4, True)):
+                    cur = cur + np.array(args[s + j:s + j + 2], dtype=float)
+                    pts.append(cur.copy())
+                    on.append(o)
+        elif op == "endchar":
+            close()
+        elif op in ("", "hstem", "vstem", "hstemhm", "vstemhm", "hintmask", "cntrmask"):
+            continue
+        else:
+            raise Unsupported(f"charstring operator {op!r}")
+    close()
+    return contours
+
+
+def _cff_contours(font: Any, name: str) -> list[Contour]:
+    walked = _cff_walk(_cff_commands(font, name))
+    return [_binary_contour(np.array(p), o, False) for p, o, _ in walked]
+
+
+def _open_binary(path: object) -> Any:
+    _fonttools("OpenType/TrueType fonts")
+    from fontTools.ttLib import TTFont
+    try:
+        font = TTFont(os.fspath(path))  # type: ignore[arg-type]
+        font.getGlyphOrder()
+    except Exception as exc:  # fontTools raises many kinds for a garbled file
+        raise FileFormatError(f"not a font fontTools can read ({exc})", path) from None
+    if "glyf" not in font and "CFF " not in font:
+        raise FileFormatError("no glyf or CFF outlines (CFF2 variable outlines are not "
+                              "supported)", path)
+    if "CFF " in font:
+        font["CFF "].cff.desubroutinize()
+    return font
+
+
+def _open_ufo(path: object) -> Any:
+    ufoLib2 = _ufolib2("UFO sources")
+    try:
+        return ufoLib2.Font.open(os.fspath(path), lazy=True)  # type: ignore[arg-type]
+    except Exception as exc:
+        raise FileFormatError(f"not a UFO ufoLib2 can read ({exc})", path) from None
+
+
+def _glyph_order(names: Sequence[str], order: Sequence[str] | None) -> list[str]:
+    known = set(names)
+    first = [g for g in (order or []) if g in known]
+    seen = set(first)
+    return first + sorted(g for g in names if g not in seen)
+
+
+def _select(names: list[str], glyphs: Sequence[str] | None, path: object) -> list[str]:
+    if glyphs is None:
+        return names
+    if isinstance(glyphs, str):
+        glyphs = [g for g in glyphs.split(",") if g]
+    missing = [g for g in glyphs if g not in set(names)]
+    if missing:
+        raise InputError(f"glyphs: {', '.join(map(repr, missing[:10]))} not in "
+                         f"{os.fspath(path)!r}")  # type: ignore[arg-type]
+    want = set(glyphs)
+    return [g for g in names if g in want]
+
+
+def font_contours(path: str | os.PathLike[str], glyphs: Sequence[str] | None = None
+                  ) -> tuple[str, list[tuple[str, list[Contour]]]]:
+    """``(format, [(glyph name, contours)])`` of a UFO or binary font, in glyph order."""
+    p = Path(path)
+    if p.suffix.lower() == ".ufo":
+        font = _open_ufo(path)
+        layer = font.layers.defaultLayer
+        names = _select(_glyph_order(list(layer.keys()), font.glyphOrder), glyphs, path)
+        out = []
+        for g in names:
+            conts = []
+            for ci, c in enumerate(layer[g].contours):
+                try:
+                    conts.append(ufo_contour(c.points))
+                except Unsupported as exc:
+                    conts.append(exc)  # type: ignore[arg-type]
+                del ci
+            out.append((g, conts))
+        return "ufo", out
+    font = _open_binary(path)
+    names = _select(list(font.getGlyphOrder()), glyphs, path)
+    get = _glyf_contours if "glyf" in font else _cff_contours
+    out = []
+    for g in names:
+        try:
+            out.append((g, get(font, g)))
+        except Unsupported as exc:
+            out.append((g, [exc]))  # type: ignore[list-item]
+    return "opentype", out
+
+
+# ------------------------------------------------------------------------------------------
+# read
+# ------------------------------------------------------------------------------------------
+def glyph_contours(glyph: str, contours: Sequence[Contour | Exception], base: dict[str, Any],
+                   skip: Any, start: int = 0) -> list[CurveRecord]:
+    """Records of one glyph's contours (contours of lines only are not records)."""
+    recs = []
+    for ci, c in enumerate(contours):
+        name = f"{glyph}#{ci}"
+        if isinstance(c, Exception):
+            skip(f"glyph {glyph!r}: {c}")
+            continue
+        if all(c.on):
+            continue
+        try:
+            curve, index, hold = contour_curve(c)
+        except Unsupported as exc:
+            skip(f"glyph {glyph!r} contour {ci}: {exc}")
+            continue
+        src = dict(base, index=start + len(recs), glyph=glyph, contour=ci, handle=name,
+                   outline=c, point_index=tuple(int(i) for i in index))
+        recs.append(CurveRecord(curve, name, "bspline", src, None, tuple(hold)))
+    return recs
+
+
+def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
+         on_unsupported: str = "raise", glyphs: Sequence[str] | None = None
+         ) -> list[CurveRecord]:
+    """Every contour with curves of the chosen glyphs (module docstring)."""
+    del corner_angle  # outlines carry their own corners (the nodes' smooth flags)
+    where = os.path.abspath(os.fspath(path))
+
+    def skip(msg: str) -> None:
+        if on_unsupported == "raise":
+            raise FileFormatError(f"unsupported: {msg} (on_unsupported='skip' leaves it "
+                                  "unchanged)", path)
+        warnings.warn(f"{where}: skipped (left unchanged): {msg}", stacklevel=4)
+
+    fmt, per_glyph = font_contours(path, glyphs)
+    base = {"format": fmt, "path": where}
+    recs: list[CurveRecord] = []
+    for g, conts in per_glyph:
+        recs.extend(glyph_contours(g, conts, base, skip, len(recs)))
+    return recs
+
+
+# ------------------------------------------------------------------------------------------
+# write
+# ------------------------------------------------------------------------------------------
+def record_points(rec: CurveRecord, tol: float | None = None) -> FloatArray:
+    """The contour points to write for a (faired) record: its control points at the contour's
+    indices with the outline's rules enforced, no farther from the input than ``tol`` (default:
+    the farthest faired control point, i.e. the fairing's own tolerance)."""
+    c: Contour = rec.source["outline"]
+    idx = np.asarray(rec.source["point_index"], dtype=np.intp)
+    cp = np.asarray(rec.curve.control_points, dtype=np.float64)  # type: ignore[attr-defined]
+    if cp.ndim != 2 or cp.shape[1] != 2 or cp.shape[0] <= int(idx.max()):
+        raise InputError(f"{rec.name}: the curve has {cp.shape[0]} control points, the contour "
+                         "needs its own structure back (same knots)")
+    new = cp[idx]
+    if tol is None:
+        ref, _, _ = contour_curve(c)
+        P0 = np.asarray(ref.control_points)
+        if P0.shape != cp.shape:
+            raise InputError(f"{rec.name}: {cp.shape[0]} control points, the contour has "
+                             f"{P0.shape[0]}: its structure must be kept")
+        tol = float(np.max(np.linalg.norm(cp - P0, axis=1)))
+    pts, _ = constrained_points(c, new, tol)
+    return pts
+
+
+def _by_glyph(records: Sequence[CurveRecord], tpath: str) -> dict[str, dict[int, FloatArray]]:
+    out: dict[str, dict[int, FloatArray]] = {}
+    for i, r in enumerate(records):
+        if "outline" not in r.source or "glyph" not in r.source:
+            raise InputError(f"curves[{i}] was not read from a font: a font is written from "
+                             "its own records")
+        if r.path is not None and os.path.abspath(r.path) != tpath:
+            raise InputError(f"curves[{i}] comes from {r.path!r}, not from the template "
+                             f"{tpath!r}")
+        pts = record_points(r)
+        c: Contour = r.source["outline"]
+        if np.array_equal(pts, c.points):
+            continue
+        out.setdefault(r.source["glyph"], {})[int(r.source["contour"])] = pts
+    return out
+
+
+def _glif_version(text: bytes) -> tuple[int, int] | None:
+    m = re.search(rb'<glyph[^>]*\bformat="(\d+)"', text)
+    if not m:
+        return None
+    m2 = re.search(rb'<glyph[^>]*\bformatMinor="(\d+)"', text)
+    return int(m.group(1)), int(m2.group(1)) if m2 else 0
+
+
+def write_ufo(path: str | os.PathLike[str], changes: dict[str, dict[int, FloatArray]],
+              template: str) -> None:
+    """Copy the UFO ``template`` to ``path`` and rewrite the changed glyphs' ``.glif`` files."""
+    ufoLib2 = _ufolib2("UFO sources")
+    from fontTools.ufoLib import UFOReader
+    from fontTools.ufoLib.glifLib import GlyphSet
+
+    dest = os.fspath(path)
+    if os.path.lexists(dest):
+        if os.path.isdir(dest) and not os.path.islink(dest):
+            shutil.rmtree(dest)
+        else:
+            os.unlink(dest)
+    shutil.copytree(template, dest, symlinks=True)
+    if not changes:
+        return
+    with UFOReader(template, validate=False) as reader:
+        layer_dir = reader.getGlyphSet().dirName
+        ufo_version = reader.formatVersionTuple
+    gs = GlyphSet(os.path.join(dest, layer_dir), ufoFormatVersion=ufo_version, validateRead=False,
+                  validateWrite=True)
+    for gname, conts in changes.items():
+        glyph = ufoLib2.objects.Glyph(gname)
+        gs.readGlyph(gname, glyph, glyph.getPointPen())
+        for ci, pts in conts.items():
+            for p, (x, y) in zip(glyph.contours[ci].points, pts, strict=True):
+                p.x, p.y = _number(x), _number(y)
+        version = _glif_version(gs.getGLIF(gname))
+        gs.writeGlyph(gname, glyph, glyph.drawPoints, formatVersion=version)
+
+
+def _number(v: float) -> float | int:
+    return int(v) if float(v).is_integer() else float(v)
+
+
+def write_binary(path: str | os.PathLike[str], changes: dict[str, dict[int, FloatArray]],
+                 template: str) -> None:
+    """Replace the changed glyphs' outlines in a copy of the binary font ``template``."""
+    font = _open_binary(template)
+    if "glyf" in font:
+        glyf, hmtx = font["glyf"], font["hmtx"]
+        for gname, conts in changes.items():
+            g = glyf[gname]
+            coords = g.coordinates
+            old_xmin = g.xMin
+            start = 0
+            for ci, e in enumerate(g.endPtsOfContours):
+                if ci in conts:
+                    for k, (x, y) in enumerate(conts[ci]):
+                        coords[start + k] = (int(x), int(y))
+                start = e + 1
+            g.recalcBounds(glyf)
+            adv, lsb = hmtx[gname]
+            if lsb == old_xmin:
+                hmtx[gname] = (adv, g.xMin)
+    else:
+        from fontTools.cffLib.specializer import commandsToProgram
+
+        cs = font["CFF "].cff.topDictIndex[0].CharStrings
+        for gname, conts in changes.items():
+            cmds = _cff_commands(font, gname)
+            walked = _cff_walk(cmds)
+            new_abs = [conts.get(ci, np.array(p)) for ci, (p, _, _) in enumerate(walked)]
+            cs[gname].program = commandsToProgram(_cff_rewrite(cmds, walked, new_abs))
+    font.save(os.fspath(path))
+
+
+def _cff_rewrite(cmds: list[tuple[str, list[Any]]], walked: list[Any],
+                 new_abs: list[FloatArray]) -> list[tuple[str, list[Any]]]:
+    """The generalized commands with every drawn point replaced by ``new_abs`` (integers)."""
+    seq: list[FloatArray] = []
+    for (pts, _on, dup), new in zip(walked, new_abs, strict=True):
+        seq.extend(np.asarray(new, dtype=float))
+        if dup:
+            seq.append(np.asarray(new[0], dtype=float))
+    it = iter(seq)
+    cur = np.zeros(2)
+    out = []
+
+    def rel() -> list[int]:
+        nonlocal cur
+        p = next(it)
+        d = p - cur
+        cur = p
+        return [_number(d[0]), _number(d[1])]
+
+    for op, args in cmds:
+        if op in ("rmoveto", "rlineto"):
+            out.append((op, rel()))
+        elif op == "rrcurveto":
+            out.append((op, rel() + rel() + rel()))
+        elif op == "flex":
+            out.append((op, [v for _ in range(6) for v in rel()] + list(args[12:])))
+        else:
+            out.append((op, args))
+    return out
+
+
+def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
+          template: str | None = None, decimals: int | None = None,
+          precision: str = "file") -> None:
+    """Write faired records into a copy of their font (module docstring)."""
+    del decimals, precision  # font units: the font's own number types
+    if template is None:
+        paths = {r.path for r in records}
+        if len(paths) != 1 or None in paths:
+            raise InputError("a font is written into a copy of the font its records were read "
+                             "from: pass template= (or records from one font)")
+        template = paths.pop()
+    tpath = os.path.abspath(os.fspath(template))  # type: ignore[arg-type]
+    changes = _by_glyph(records, tpath)
+    if Path(tpath).suffix.lower() == ".ufo":
+        if Path(os.fspath(path)).suffix.lower() != ".ufo":
+            raise InputError(f"{os.fspath(path)!r}: a UFO is written as a .ufo folder")
+        write_ufo(path, changes, tpath)
+    else:
+        write_binary(path, changes, tpath)
