@@ -93,7 +93,8 @@ def _check_outputs(inputs: Sequence[tuple[str, str]], outputs: Sequence[tuple[st
             continue
         if not p.strip():
             raise click.BadParameter("the file name is empty", param_hint=opt)
-        if os.path.isdir(p):
+        if os.path.isdir(p) and not (opt == "-o/--output" and p.lower().rstrip("/\\")
+                                     .endswith(".ufo")):  # a UFO font is a folder
             raise click.BadParameter(f"{p!r} is a folder; give a file name", param_hint=opt)
         key = _file_key(p)
         for kin, pin, what in keys_in:

@@ -313,3 +313,58 @@ def constrained_points(c: Contour, new: FloatArray, tol: float | None,
             return q, s
         s *= 0.5
     return P0.copy(), 0.0
+
+
+def harmonize(c: Contour, q: FloatArray, tol: float | None, sweeps: int = 8) -> FloatArray:
+    """G2 at the smooth nodes of a cubic contour, moving only their two handles along the
+    tangent, each point within ``tol`` of the input.
+
+    At a node ``P`` with handles ``P - a u`` and ``P + b u`` (``u`` the unit tangent), the
+    curvature of the incoming cubic at its end is ``(2/3) h / a**2`` and of the outgoing one at
+    its start ``(2/3) k / b**2`` (``h``, ``k``: signed distances of the segments' other
+    handles from the tangent line; e.g. Farin, *Curves and Surfaces for CAGD*, eq. for the
+    end curvature of a Bezier curve). Where ``h k > 0`` (no inflection at the node) the
+    handles are set to ``a/b = sqrt(h/k)`` with ``a + b`` kept, which makes the two
+    curvatures equal; a move that would leave ``tol`` is shortened. The neighbouring nodes'
+    curvatures depend on these handles too, so the nodes are swept ``sweeps`` times. Integer
+    contours: only horizontal/vertical nodes, rounded (the tangent stays exact). Quadratic
+    contours are returned unchanged.
+    """
+    if c.quadratic:
+        return q
+    q = np.array(q, dtype=np.float64)
+    P0 = np.asarray(c.points, dtype=np.float64)
+    smooth, _, _ = _node_kinds(c)
+    n = len(c.on)
+    nodes = [k for k in smooth if not c.on[(k - 1) % n] and not c.on[(k + 1) % n]
+             and (c.closed or 2 <= k <= n - 3)]
+
+    def ok(j: int, p: FloatArray) -> bool:
+        return tol is None or float(np.linalg.norm(p - P0[j])) <= tol
+
+    for _ in range(sweeps):
+        for k in nodes:
+            ia, ib = (k - 1) % n, (k + 1) % n
+            P, A, B = q[k], q[ia], q[ib]
+            d = B - A
+            if c.grid and d[0] != 0 and d[1] != 0:
+                continue
+            u = d / np.linalg.norm(d)
+            a, b = float((P - A) @ u), float((B - P) @ u)
+            h = float(u[0] * (q[(k - 2) % n] - P)[1] - u[1] * (q[(k - 2) % n] - P)[0])
+            kk = float(u[0] * (q[(k + 2) % n] - P)[1] - u[1] * (q[(k + 2) % n] - P)[0])
+            if a <= 0 or b <= 0 or h * kk <= 0:
+                continue
+            r = float(np.sqrt(h / kk))
+            L = a + b
+            a1 = L * r / (1 + r)
+            for t in (1.0, 0.5, 0.25, 0.125, 0.0625, 0.0):
+                at = a + t * (a1 - a)
+                na, nb = P - at * u, P + (L - at) * u
+                if c.grid:
+                    na, nb = np.round(na), np.round(nb)
+                if ok(ia, na) and ok(ib, nb) and float((P - na) @ u) > 0 and \
+                        float((nb - P) @ u) > 0:
+                    q[ia], q[ib] = na, nb
+                    break
+    return q

@@ -54,6 +54,7 @@ from .._typing import FloatArray
 from ..errors import FileFormatError, InputError
 from ._common import CurveRecord, Unsupported, lazy_import
 from ._outline import Contour, constrained_points, contour_curve
+from ._outline import harmonize as _harmonize
 
 __all__ = ["read", "write", "glyph_contours", "font_contours"]
 
@@ -225,12 +226,11 @@ def font_contours(path: str | os.PathLike[str], glyphs: Sequence[str] | None = N
         out = []
         for g in names:
             conts = []
-            for ci, c in enumerate(layer[g].contours):
+            for c in layer[g].contours:
                 try:
                     conts.append(ufo_contour(c.points))
                 except Unsupported as exc:
                     conts.append(exc)  # type: ignore[arg-type]
-                del ci
             out.append((g, conts))
         return "ufo", out
     font = _open_binary(path)
@@ -294,7 +294,8 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
 # ------------------------------------------------------------------------------------------
 # write
 # ------------------------------------------------------------------------------------------
-def record_points(rec: CurveRecord, tol: float | None = None) -> FloatArray:
+def record_points(rec: CurveRecord, tol: float | None = None, *, harmonize: bool = False
+                  ) -> FloatArray:
     """The contour points to write for a (faired) record: its control points at the contour's
     indices with the outline's rules enforced, no farther from the input than ``tol`` (default:
     the farthest faired control point, i.e. the fairing's own tolerance)."""
@@ -313,6 +314,8 @@ def record_points(rec: CurveRecord, tol: float | None = None) -> FloatArray:
                              f"{P0.shape[0]}: its structure must be kept")
         tol = float(np.max(np.linalg.norm(cp - P0, axis=1)))
     pts, _ = constrained_points(c, new, tol)
+    if harmonize:
+        pts = _harmonize(c, pts, tol)
     return pts
 
 
@@ -412,7 +415,7 @@ def _cff_rewrite(cmds: list[tuple[str, list[Any]]], walked: list[Any],
                  new_abs: list[FloatArray]) -> list[tuple[str, list[Any]]]:
     """The generalized commands with every drawn point replaced by ``new_abs`` (integers)."""
     seq: list[FloatArray] = []
-    for (pts, _on, dup), new in zip(walked, new_abs, strict=True):
+    for (_pts, _on, dup), new in zip(walked, new_abs, strict=True):
         seq.extend(np.asarray(new, dtype=float))
         if dup:
             seq.append(np.asarray(new[0], dtype=float))

@@ -1,0 +1,327 @@
+"""Fairing where fonts are made: outlines, a fontTools point pen, a ufo2ft filter.
+
+``pip install 'curvefair[fonts]'``.
+
+- :func:`fair_contours` fairs a glyph's contours (UFO-style points) and gives their new
+  points with the outline's structure kept (:mod:`curvefair.io._outline`: same points in the
+  same order, quadratic stays quadratic, smooth nodes exactly smooth, extrema keep their
+  horizontal/vertical tangent, corners and straight segments unmoved), every point within
+  ``tol`` font units of its input, so the outline is within ``tol`` everywhere.
+- :class:`FairPointPen`: a fontTools point pen that fairs each contour drawn into it and
+  passes it on (components and everything else unchanged), e.g.
+  ``glyph.drawPoints(FairPointPen(other.getPointPen(), tol=2))``.
+- :class:`FairFilter`: a ufo2ft filter (``ufo2ft.filters.BaseFilter``), so that
+  ``fontmake -u Font.ufo --filter "curvefair.fonts::FairFilter(tol=2)"`` fairs at build time
+  (or ``ufo2ft.compileOTF(ufo, filters=[FairFilter(tol=2)])``).
+- :func:`font_to_ufo` writes a binary font's outlines as a UFO (smooth flags from the exact
+  collinearity of each node's neighbours), to fair a font that has no source.
+- :func:`fair_designspace` fairs every master of a designspace document with the same
+  options and checks that they still interpolate (fontTools' ``varLib.interpolatable``).
+
+Fairing uses :func:`curvefair.fair` on the contour's B-spline (``method=None``: the B-spline
+default), with ``protect`` = the corner nodes and the points of straight segments.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from types import SimpleNamespace
+from typing import Any
+
+import numpy as np
+
+from ._typing import FloatArray
+from .errors import CurvefairError, InputError, MissingDependencyError
+from .io._common import CurveRecord
+from .io._outline import Contour
+from .io.fonts import glyph_contours, record_points, ufo_contour
+
+__all__ = ["fair_contours", "FairPointPen", "FairFilter", "font_to_ufo",  # noqa: F822
+           "fair_designspace", "interpolation_problems"]
+
+
+def _check_tol(tol: object) -> float:
+    if isinstance(tol, bool) or not isinstance(tol, (int, float)) or not np.isfinite(tol) \
+            or tol <= 0:
+        raise InputError(f"tol must be a positive number of font units, got {tol!r}")
+    return float(tol)
+
+
+def fair_contours(contours: Sequence[Contour], tol: float, *, method: str | None = None,
+                  harmonize: bool = False, glyph: str = "glyph", **options: Any
+                  ) -> list[FloatArray | None]:
+    """New points of each contour (None: unchanged: no curve, or nothing to gain).
+
+    Parameters
+    ----------
+    contours : sequence of Contour
+        See :func:`curvefair.io.fonts.ufo_contour`.
+    tol : float
+        Largest move of any point, in font units.
+    method, options
+        As for :func:`curvefair.fair`.
+    harmonize : bool
+        Also make smooth nodes G2 by moving their handles along the tangent
+        (:func:`curvefair.io._outline.harmonize`), within ``tol``.
+    """
+    from .fairing.fair import fair
+
+    tol = _check_tol(tol)
+    recs = glyph_contours(glyph, list(contours), {"format": None, "path": None},
+                          skip=lambda msg: None)
+    out: list[FloatArray | None] = [None] * len(contours)
+    for r in recs:
+        try:
+            res = fair(r.curve, method, tol=tol, protect=r.corners, **options)
+        except CurvefairError:
+            continue
+        pts = record_points(r.with_curve(res.curve), tol, harmonize=harmonize)
+        c: Contour = r.source["outline"]
+        if not np.array_equal(pts, c.points):
+            out[int(r.source["contour"])] = pts
+    return out
+
+
+class FairPointPen:
+    """A fontTools point pen that fairs every contour drawn into it, then draws it into
+    ``out_pen`` (components, identifiers, names and smooth flags passed on unchanged).
+
+    Parameters
+    ----------
+    out_pen : AbstractPointPen
+    tol : float
+        Largest move of any point, in font units.
+    grid : bool
+        Round to integers (a glyph bound for a binary font).
+    method, harmonize, options
+        As for :func:`fair_contours`.
+    """
+
+    def __init__(self, out_pen: Any, tol: float, *, grid: bool = False,
+                 method: str | None = None, harmonize: bool = False, **options: Any) -> None:
+        self.out_pen = out_pen
+        self.tol = _check_tol(tol)
+        self.grid = bool(grid)
+        self.method, self.harmonize, self.options = method, harmonize, options
+        self._points: list[tuple[Any, ...]] | None = None
+        self._path_kwargs: dict[str, Any] = {}
+
+    def beginPath(self, identifier: str | None = None, **kwargs: Any) -> None:  # noqa: N802
+        self._points = []
+        self._path_kwargs = dict(kwargs, identifier=identifier)
+
+    def addPoint(self, pt: tuple[float, float], segmentType: str | None = None,  # noqa: N802,N803
+                 smooth: bool = False, name: str | None = None, identifier: str | None = None,
+                 **kwargs: Any) -> None:
+        if self._points is None:
+            raise InputError("FairPointPen: addPoint outside beginPath/endPath")
+        self._points.append((pt, segmentType, smooth, name, identifier, kwargs))
+
+    def endPath(self) -> None:  # noqa: N802
+        pts = self._points or []
+        self._points = None
+        new = None
+        if pts:
+            ns = [SimpleNamespace(x=p[0][0], y=p[0][1], segmentType=p[1], smooth=p[2])
+                  for p in pts]
+            try:
+                c = ufo_contour(ns)
+                if self.grid:
+                    c = Contour(c.points, c.on, c.smooth, c.closed, c.quadratic, grid=True)
+                new = fair_contours([c], self.tol, method=self.method,
+                                    harmonize=self.harmonize, **self.options)[0]
+            except CurvefairError:
+                new = None
+            except Exception as exc:  # an unsupported contour: passed on unchanged
+                if type(exc).__name__ != "Unsupported":
+                    raise
+        kw = {k: v for k, v in self._path_kwargs.items() if k != "identifier" or v is not None}
+        self.out_pen.beginPath(**kw)
+        for k, (pt, seg, smooth, name, ident, kwargs) in enumerate(pts):
+            xy = pt if new is None else (_num(new[k][0]), _num(new[k][1]))
+            extra = dict(kwargs)
+            if ident is not None:
+                extra["identifier"] = ident
+            self.out_pen.addPoint(xy, segmentType=seg, smooth=smooth, name=name, **extra)
+        self.out_pen.endPath()
+
+    def addComponent(self, baseGlyphName: str, transformation: Any,  # noqa: N802,N803
+                     identifier: str | None = None, **kwargs: Any) -> None:
+        if identifier is not None:
+            kwargs["identifier"] = identifier
+        self.out_pen.addComponent(baseGlyphName, transformation, **kwargs)
+
+
+def _num(v: float) -> float | int:
+    return int(v) if float(v).is_integer() else float(v)
+
+
+def _filter_class() -> type:
+    try:
+        from ufo2ft.filters import BaseFilter
+    except ImportError:  # pragma: no cover - the fonts extra installs it
+        raise MissingDependencyError("FairFilter needs ufo2ft: pip install 'curvefair[fonts]'"
+                                     ) from None
+
+    class FairFilter(BaseFilter):  # type: ignore[misc,valid-type]
+        """ufo2ft filter: fair every glyph's contours within ``tol`` font units.
+
+        Options (keyword arguments, also in ``--filter "curvefair.fonts::FairFilter(...)"``):
+        ``tol`` (default 2), ``method`` (default: the B-spline default), ``harmonize``
+        (default False), and ufo2ft's ``include``/``exclude``/``pre``.
+        """
+
+        _kwargs = {"tol": 2.0, "method": None, "harmonize": False}
+
+        def start(self) -> None:
+            self.options.tol = _check_tol(self.options.tol)
+
+        def filter(self, glyph: Any) -> bool:
+            conts = []
+            for contour in glyph:
+                try:
+                    conts.append(ufo_contour(list(contour)))
+                except Exception:  # an unsupported contour stays as it is
+                    conts.append(RuntimeError("unsupported"))
+            if not conts:
+                return False
+            new = fair_contours(conts, self.options.tol, method=self.options.method,
+                                harmonize=self.options.harmonize,
+                                glyph=getattr(glyph, "name", "glyph") or "glyph")
+            changed = False
+            for contour, pts in zip(glyph, new, strict=True):
+                if pts is None:
+                    continue
+                for p, (x, y) in zip(list(contour), pts, strict=True):
+                    p.x, p.y = _num(x), _num(y)
+                changed = True
+            return changed
+
+    FairFilter.__module__ = __name__
+    FairFilter.__qualname__ = "FairFilter"
+    return FairFilter
+
+
+_FILTER: type | None = None
+
+
+def __getattr__(name: str) -> Any:
+    global _FILTER
+    if name == "FairFilter":
+        if _FILTER is None:
+            _FILTER = _filter_class()
+        return _FILTER
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def font_to_ufo(src: str | os.PathLike[str], dest: str | os.PathLike[str], *,
+                glyphs: Sequence[str] | None = None) -> None:
+    """Write the outlines, advance widths and code points of a binary font as a UFO.
+
+    Each point is as in the font (TrueType: off-curve points and ``qcurve`` nodes, implied
+    on-curve points left implied; CFF: ``curve``/``line`` nodes); ``smooth`` where the node's
+    neighbours are exactly collinear with it. Components stay components.
+    """
+    import ufoLib2
+    from fontTools.pens.pointPen import SegmentToPointPen
+    from fontTools.ttLib import TTFont
+
+    from .io.fonts import _exact_smooth_flags
+
+    font = TTFont(os.fspath(src))
+    gs = font.getGlyphSet()
+    cmap = font.getBestCmap() or {}
+    uni: dict[str, list[int]] = {}
+    for code, g in cmap.items():
+        uni.setdefault(g, []).append(code)
+    ufo = ufoLib2.Font()
+    names = list(font.getGlyphOrder()) if glyphs is None else list(glyphs)
+    for g in names:
+        glyph = ufo.newGlyph(g)
+        glyph.width = font["hmtx"][g][0]
+        glyph.unicodes = sorted(uni.get(g, []))
+        pen = glyph.getPointPen()
+        if "glyf" in font:
+            gs[g].drawPoints(pen)
+        else:
+            gs[g].draw(SegmentToPointPen(pen))
+        for contour in glyph.contours:
+            xy = np.array([(p.x, p.y) for p in contour.points], dtype=float)
+            on = [p.type is not None for p in contour.points]
+            for p, s in zip(contour.points, _exact_smooth_flags(xy, on), strict=True):
+                p.smooth = s
+    ufo.glyphOrder = names
+    ufo.info.unitsPerEm = font["head"].unitsPerEm
+    ufo.info.familyName = font["name"].getDebugName(1)
+    ufo.save(os.fspath(dest), overwrite=True)
+
+
+def fair_designspace(path: str | os.PathLike[str], out_dir: str | os.PathLike[str], tol: float,
+                     *, glyphs: Sequence[str] | None = None, method: str | None = None,
+                     **options: Any) -> dict[str, Any]:
+    """Fair every source (master) UFO of a designspace document into ``out_dir``.
+
+    ``out_dir`` gets a copy of the document (same file name) and of every source UFO (same
+    relative file names) whose contours are faired within ``tol`` with the same options. The
+    structure of every contour is kept, so masters that were compatible stay compatible;
+    that is checked with fontTools' ``varLib.interpolatable`` on the result (``problems`` in
+    the returned dict: what it reports for the output, and ``problems_before`` for the
+    input).
+    """
+    from fontTools.designspaceLib import DesignSpaceDocument
+
+    from .fairing.fair import fair
+    from .io import read_curves
+    from .io._common import atomic_write
+    from .io.fonts import write_ufo
+
+    tol = _check_tol(tol)
+    src = os.path.abspath(os.fspath(path))
+    out = os.path.abspath(os.fspath(out_dir))
+    if os.path.dirname(src) == out:
+        raise InputError("out_dir must not be the folder of the designspace document")
+    os.makedirs(out, exist_ok=True)
+    doc = DesignSpaceDocument.fromfile(src)
+    base = os.path.dirname(src)
+    done: dict[str, Any] = {"sources": []}
+    for s in doc.sources:
+        ufo = s.path or os.path.join(base, s.filename)
+        rel = os.path.relpath(ufo, base)
+        if s.layerName:
+            raise InputError(f"designspace source {rel!r}: sparse layer masters are not "
+                             "supported")
+        recs = read_curves(ufo, glyphs=glyphs, on_unsupported="skip")
+        faired: list[CurveRecord] = []
+        for r in recs:
+            try:
+                res = fair(r.curve, method, tol=tol, protect=r.corners, **options)
+                faired.append(r.with_curve(res.curve))
+            except CurvefairError:
+                faired.append(r)
+        from .io.fonts import _by_glyph
+
+        dest = os.path.join(out, rel)
+        os.makedirs(os.path.dirname(dest), exist_ok=True)
+        write_ufo(dest, _by_glyph(faired, os.path.abspath(ufo)), os.path.abspath(ufo))
+        done["sources"].append({"ufo": rel, "contours": len(recs)})
+    with open(src, "rb") as fh:
+        atomic_write(os.path.join(out, os.path.basename(src)), fh.read())
+    done["problems_before"] = interpolation_problems(src)
+    done["problems"] = interpolation_problems(os.path.join(out, os.path.basename(src)))
+    return done
+
+
+def interpolation_problems(designspace: str | os.PathLike[str]) -> list[dict[str, Any]]:
+    """What ``fontTools.varLib.interpolatable`` reports for a designspace's masters (empty:
+    compatible)."""
+    import ufoLib2
+    from fontTools.designspaceLib import DesignSpaceDocument
+    from fontTools.varLib.interpolatable import test as interpolatable_test
+
+    doc = DesignSpaceDocument.fromfile(os.fspath(designspace))
+    fonts = [ufoLib2.Font.open(s.path) for s in doc.sources]
+    names = [os.path.basename(s.path) for s in doc.sources]
+    glyphsets = [{g.name: g for g in f} for f in fonts]
+    problems = interpolatable_test(glyphsets, names=names)
+    return [dict(p, glyph=g) for g, ps in problems.items() for p in ps]

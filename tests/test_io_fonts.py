@@ -1,0 +1,471 @@
+"""Fonts (issue 16): UFO, TrueType (DejaVu inside matplotlib), OpenType/CFF (Lobster subset from
+the fontTools test data), the ufo2ft filter, the point pen, designspace masters.
+
+Every check re-reads the written font with fontTools/ufoLib2 and compares it with the input
+independently of curvefair's B-spline code: point structure, positions (every point within tol;
+the outline, sampled from the Bernstein form of each segment as fontTools decomposes it, within
+tol), smooth nodes (exact collinearity of the neighbours), extrema (axis-aligned neighbours),
+corners and straight segments (unmoved), and every other table / file byte for byte.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("fontTools")
+ufoLib2 = pytest.importorskip("ufoLib2")
+
+from fontTools.pens.basePen import decomposeQuadraticSegment  # noqa: E402
+from fontTools.pens.recordingPen import RecordingPen, RecordingPointPen  # noqa: E402
+from fontTools.ttLib import TTFont  # noqa: E402
+
+from curvefair import fair, read_curves, write_curves  # noqa: E402
+from curvefair.errors import CurvefairError, InputError  # noqa: E402
+
+HERE = Path(__file__).parent
+LOBSTER = HERE / "data" / "real" / "fonttools" / "Lobster.subset.otf"
+GLYPHS = ["a", "o", "S", "e", "g", "B", "R", "ampersand"]
+
+
+def _dejavu() -> Path:
+    mpl = pytest.importorskip("matplotlib")
+    p = Path(mpl.__file__).parent / "mpl-data" / "fonts" / "ttf" / "DejaVuSans.ttf"
+    if not p.is_file():
+        pytest.skip("matplotlib ships no DejaVuSans.ttf")
+    return p
+
+
+# ------------------------------------------------------------------------------------------
+# independent readers (fontTools pens) and checks
+# ------------------------------------------------------------------------------------------
+def point_contours(glyphset, name):
+    """[(points (n,2), segment types, smooth flags)] and components, from a point pen."""
+    pen = RecordingPointPen()
+    glyphset[name].drawPoints(pen)
+    conts, comps, cur = [], [], None
+    for op, args, _kw in pen.value:
+        if op == "beginPath":
+            cur = []
+        elif op == "addPoint":
+            cur.append((args[0], args[1], bool(args[2])))  # (pt, segmentType, smooth, name)
+        elif op == "endPath":
+            conts.append((np.array([p[0] for p in cur], float), [p[1] for p in cur],
+                          [p[2] for p in cur]))
+        elif op == "addComponent":
+            comps.append((args[0], tuple(args[1])))
+    return conts, comps
+
+
+def bezier_samples(glyphset, name, m=17):
+    """Points of the outline at m parameters per Bezier segment, as fontTools decomposes it."""
+    pen = RecordingPen()
+    glyphset[name].draw(pen)
+    t = np.linspace(0, 1, m)[:, None]
+    out, cur, start = [], None, None
+    for op, args in pen.value:
+        if op == "moveTo":
+            cur = start = np.array(args[0], float)
+        elif op == "lineTo":
+            b = np.array(args[0], float)
+            out.append(cur + t * (b - cur))
+            cur = b
+        elif op == "curveTo":
+            p1, p2, p3 = (np.array(a, float) for a in args)
+            out.append((1 - t) ** 3 * cur + 3 * t * (1 - t) ** 2 * p1 + 3 * t ** 2 * (1 - t) * p2
+                       + t ** 3 * p3)
+            cur = p3
+        elif op == "qCurveTo":
+            if args[-1] is None:  # an all-off-curve TrueType contour
+                pytest.skip("all-off-curve contour")
+            for c, e in decomposeQuadraticSegment(args):
+                c, e = np.array(c, float), np.array(e, float)
+                out.append((1 - t) ** 2 * cur + 2 * t * (1 - t) * c + t ** 2 * e)
+                cur = e
+        elif op in ("closePath", "endPath"):
+            if start is not None and cur is not None and not np.array_equal(cur, start):
+                out.append(cur + t * (start - cur))
+            cur = start
+    return np.concatenate(out) if out else np.zeros((0, 2))
+
+
+def _cross(a, b):
+    return a[0] * b[1] - a[1] * b[0]
+
+
+def check_outlines(gs_in, gs_out, names, tol, *, smooth_from="geometry", exact_grid=True):
+    """Structure kept and tolerance met, glyph by glyph; returns the largest point move."""
+    worst = 0.0
+    for g in names:
+        ci, ki = point_contours(gs_in, g)
+        co, ko = point_contours(gs_out, g)
+        assert ki == ko, g
+        assert len(ci) == len(co), g
+        for (p0, t0, s0), (p1, t1, s1) in zip(ci, co, strict=True):
+            assert t0 == t1, g  # same point types in the same order
+            assert s0 == s1, g  # same smooth flags
+            assert p0.shape == p1.shape, g
+            d = np.linalg.norm(p1 - p0, axis=1)
+            assert d.max() <= tol, (g, d.max())
+            worst = max(worst, float(d.max()))
+            if exact_grid:
+                assert np.array_equal(p1, np.round(p1)), g
+            n = len(t0)
+            closed = t0[0] != "move"
+            for k in range(n):
+                if t0[k] is None or (not closed and k in (0, n - 1)):
+                    continue
+                a0, b0 = p0[(k - 1) % n], p0[(k + 1) % n]
+                a1, b1 = p1[(k - 1) % n], p1[(k + 1) % n]
+                on_a, on_b = t0[(k - 1) % n] is not None, t0[(k + 1) % n] is not None
+                smooth_in = (s0[k] if smooth_from == "flags" else True) and \
+                    _cross(p0[k] - a0, b0 - p0[k]) == 0 and (p0[k] - a0) @ (b0 - p0[k]) > 0
+                if smooth_in and not (on_a and on_b):
+                    u, v = p1[k] - a1, b1 - p1[k]
+                    ang = np.arctan2(abs(_cross(u, v)), u @ v)
+                    assert ang <= 1e-9, (g, k, ang)
+                    if a0[1] == p0[k][1] == b0[1]:
+                        assert a1[1] == p1[k][1] == b1[1], (g, k, "horizontal extremum")
+                    if a0[0] == p0[k][0] == b0[0]:
+                        assert a1[0] == p1[k][0] == b1[0], (g, k, "vertical extremum")
+                elif smooth_from == "flags" and not s0[k]:
+                    assert np.array_equal(p1[k], p0[k]), (g, k, "corner moved")
+                if on_b:  # a straight segment k -> k+1 stays where it was
+                    assert np.array_equal(p1[k], p0[k]) and \
+                        np.array_equal(p1[(k + 1) % n], p0[(k + 1) % n]), (g, k, "line moved")
+        s0, s1 = bezier_samples(gs_in, g), bezier_samples(gs_out, g)
+        assert s0.shape == s1.shape
+        if len(s0):
+            assert np.linalg.norm(s1 - s0, axis=1).max() <= tol + 1e-9 * 1000, g
+    return worst
+
+
+def _fair_records(recs, tol, **kw):
+    out = []
+    for r in recs:
+        res = fair(r.curve, tol=tol, protect=r.corners, **kw)
+        out.append(r.with_curve(res.curve))
+    return out
+
+
+# ------------------------------------------------------------------------------------------
+# TrueType / OpenType binaries
+# ------------------------------------------------------------------------------------------
+def test_truetype_dejavu_round_trip(tmp_path):
+    src = _dejavu()
+    recs = read_curves(src, glyphs=GLYPHS)
+    assert {r.source["glyph"] for r in recs} == set(GLYPHS) - set()
+    assert all(r.curve.degree == 2 for r in recs)
+    # the B-spline is the TrueType outline exactly: sampled at its knots it passes through the
+    # on-curve and implied on-curve points fontTools decomposes the contour into
+    f = TTFont(src)
+    gs = f.getGlyphSet()
+    r0 = next(r for r in recs if r.name == "o#0")
+    pen = RecordingPen()
+    gs["o"].draw(pen)
+    pts = []
+    for op, args in pen.value:
+        if op == "qCurveTo":
+            pts += [np.array(e, float) for _, e in decomposeQuadraticSegment(args)]
+        if op == "closePath":
+            break
+    knots = np.unique(r0.curve.knots)
+    on = r0.curve(knots)
+    for p in pts:
+        assert np.min(np.linalg.norm(on - p, axis=1)) <= 1e-9
+    out = tmp_path / "faired.ttf"
+    write_curves(out, _fair_records(recs, 2.0), template=src)
+    g = TTFont(out)
+    worst = check_outlines(gs, g.getGlyphSet(), GLYPHS, 2.0)
+    assert worst > 0  # something was faired
+    # glyphs not asked for, and every table but the outline ones, come back unchanged
+    for name in ("b", "x", "A"):
+        assert point_contours(gs, name) [0][0][0].tolist() == \
+            point_contours(g.getGlyphSet(), name)[0][0][0].tolist()
+    for tag in ("cmap", "name", "GSUB", "GPOS", "OS/2", "post", "kern", "fpgm", "prep", "cvt "):
+        if tag in f.reader:
+            assert f.reader[tag] == g.reader[tag], tag
+    # bounds recomputed; the left side bearing follows xMin
+    for name in GLYPHS:
+        gl = g["glyf"][name]
+        xy = np.array(gl.getCoordinates(g["glyf"])[0])
+        assert (gl.xMin, gl.yMin, gl.xMax, gl.yMax) == (*xy.min(0), *xy.max(0))
+        assert g["hmtx"][name] == (f["hmtx"][name][0], gl.xMin)
+    # TrueType instructions and flags are kept
+    for name in GLYPHS:
+        a, b = f["glyf"][name], g["glyf"][name]
+        assert a.endPtsOfContours == b.endPtsOfContours
+        assert list(a.flags) == list(b.flags)
+        assert getattr(a, "program", None) == getattr(b, "program", None) or \
+            a.program.getBytecode() == b.program.getBytecode()
+
+
+def test_cff_lobster_round_trip(tmp_path):
+    recs = read_curves(LOBSTER)
+    f = TTFont(LOBSTER)
+    names = sorted({r.source["glyph"] for r in recs})
+    assert all(r.curve.degree == 3 for r in recs)
+    out = tmp_path / "faired.otf"
+    write_curves(out, _fair_records(recs, 2.0), template=LOBSTER)
+    g = TTFont(out)
+    worst = check_outlines(f.getGlyphSet(), g.getGlyphSet(), names, 2.0)
+    assert worst > 0
+    # hints and widths kept: the hint operators of each charstring are those of the input
+    for name in names:
+        def hints(font, name=name):
+            cs = font["CFF "].cff.topDictIndex[0].CharStrings[name]
+            cs.decompile()
+            return [t for t in cs.program if isinstance(t, str) and "stem" in t], \
+                font["hmtx"][name]
+        f2 = TTFont(LOBSTER)
+        f2["CFF "].cff.desubroutinize()
+        assert hints(f2) == hints(g)
+    for tag in ("cmap", "name", "GSUB", "GPOS", "OS/2"):
+        assert f.reader[tag] == g.reader[tag], tag
+    # fontTools reads it back completely and writes it again
+    g.ensureDecompiled()
+    g.save(tmp_path / "again.otf")
+
+
+def test_cli_fair_font(tmp_path):
+    from click.testing import CliRunner
+
+    from curvefair.cli import main
+
+    shutil.copy(LOBSTER, tmp_path / "L.otf")
+    res = CliRunner().invoke(main, ["fair", str(tmp_path / "L.otf"), "-o",
+                                    str(tmp_path / "F.otf"), "--tol", "2", "--glyphs",
+                                    "zero,two", "-q"])
+    assert res.exit_code == 0, res.output
+    g = TTFont(tmp_path / "F.otf")
+    f = TTFont(LOBSTER)
+    check_outlines(f.getGlyphSet(), g.getGlyphSet(), ["zero", "two"], 2.0)
+    # other glyphs untouched
+    for name in ("A", "B", "one"):
+        assert bezier_samples(f.getGlyphSet(), name).tolist() == \
+            bezier_samples(g.getGlyphSet(), name).tolist()
+    res = CliRunner().invoke(main, ["fair", str(tmp_path / "L.otf"), "-o",
+                                    str(tmp_path / "G.otf"), "--glyphs", "nosuchglyph"])
+    assert res.exit_code != 0 and "nosuchglyph" in res.output
+    assert "Traceback" not in res.output
+
+
+# ------------------------------------------------------------------------------------------
+# UFO
+# ------------------------------------------------------------------------------------------
+@pytest.fixture
+def ufo_pair(tmp_path):
+    """UFOs made from the real fonts by curvefair.fonts.font_to_ufo, with kerning, features,
+    an anchor and a component added (what must come back byte for byte)."""
+    from curvefair.fonts import font_to_ufo
+
+    out = {}
+    for key, src, names in (("tt", _dejavu(), GLYPHS + ["Aacute", "A", "acute"]),
+                            ("cff", LOBSTER, None)):
+        p = tmp_path / f"{key}.ufo"
+        font_to_ufo(src, p, glyphs=names)
+        u = ufoLib2.Font.open(p)
+        first = next(iter(u.keys()))
+        u.kerning[("a", "o") if key == "tt" else ("A", "B")] = -25
+        u.features.text = "feature kern { pos a o -25; } kern;\n" if key == "tt" else ""
+        u[first].appendAnchor({"x": 10, "y": 20, "name": "top"})
+        u.save(p, overwrite=True)
+        out[key] = p
+    return out
+
+
+def _ufo_glyphset(p):
+    return ufoLib2.Font.open(p)
+
+
+def test_ufo_round_trip_and_files_kept(ufo_pair, tmp_path):
+    for key, p in ufo_pair.items():
+        recs = read_curves(p)
+        names = sorted({r.source["glyph"] for r in recs})
+        out = tmp_path / f"faired-{key}.ufo"
+        write_curves(out, _fair_records(recs, 2.0), template=p)
+        worst = check_outlines(_ufo_glyphset(p), _ufo_glyphset(out), names, 2.0,
+                               smooth_from="flags", exact_grid=False)
+        assert worst > 1.0  # floats: the moves are not rounded away
+        changed = 0
+        for f in sorted(Path(p).rglob("*")):
+            rel = f.relative_to(p)
+            g = out / rel
+            assert g.exists(), rel
+            if f.is_file() and f.read_bytes() != g.read_bytes():
+                assert f.suffix == ".glif", rel  # only changed glyphs are rewritten
+                changed += 1
+        assert changed > 0
+        assert sorted(x.relative_to(out) for x in out.rglob("*")) == \
+            sorted(x.relative_to(p) for x in Path(p).rglob("*"))
+
+
+def test_cli_fair_ufo_folder(ufo_pair, tmp_path):
+    from click.testing import CliRunner
+
+    from curvefair.cli import main
+
+    p = ufo_pair["tt"]
+    out = tmp_path / "Faired.ufo"
+    for _ in range(2):  # the second run replaces the folder written by the first
+        res = CliRunner().invoke(main, ["fair", str(p), "-o", str(out), "--tol", "2",
+                                        "--glyphs", "a,o,S", "-q"])
+        assert res.exit_code == 0, res.output
+    check_outlines(_ufo_glyphset(p), _ufo_glyphset(out), ["a", "o", "S"], 2.0,
+                   smooth_from="flags", exact_grid=False)
+    assert (p / "kerning.plist").read_bytes() == (out / "kerning.plist").read_bytes()
+    assert (p / "features.fea").read_bytes() == (out / "features.fea").read_bytes()
+    assert (p / "glyphs" / "e.glif").read_bytes() == (out / "glyphs" / "e.glif").read_bytes()
+    assert not [x for x in tmp_path.iterdir() if x.name.startswith(".Faired")]  # no temp left
+
+
+def test_harmonize_makes_g2_within_tol(ufo_pair):
+    """harmonize=True: curvature continuous at smooth cubic nodes where it can be, handles
+    moved along the tangent only (curvature computed here from the Bezier end formula)."""
+    from curvefair.fonts import FairFilter
+
+    p = ufo_pair["cff"]
+    base = ufoLib2.Font.open(p)
+    f0, f1 = ufoLib2.Font.open(p), ufoLib2.Font.open(p)
+    FairFilter(tol=2)(f0)
+    FairFilter(tol=2, harmonize=True)(f1)
+    names = sorted(base.keys())
+    check_outlines(base, f1, names, 2.0, smooth_from="flags", exact_grid=False)
+
+    def g2_gaps(font):
+        gaps = []
+        for g in names:
+            for c in point_contours(font, g)[0]:
+                P, t, s = c
+                n = len(t)
+                for k in range(n):
+                    if t[k] is None or not s[k] or t[(k - 1) % n] is not None or \
+                            t[(k + 1) % n] is not None:
+                        continue
+                    A, B = P[(k - 1) % n], P[(k + 1) % n]
+                    A2, B2 = P[(k - 2) % n], P[(k + 2) % n]
+                    ka = 2 / 3 * _cross(A - A2, P[k] - A) / np.linalg.norm(P[k] - A) ** 3
+                    kb = 2 / 3 * _cross(B - P[k], B2 - B) / np.linalg.norm(B - P[k]) ** 3
+                    gaps.append(abs(ka - kb) / max(abs(ka), abs(kb), 1e-12))
+        return np.array(gaps)
+
+    g0, g1 = g2_gaps(f0), g2_gaps(f1)
+    assert len(g0) > 10
+    assert np.median(g1) < 0.5 * np.median(g0)
+    assert np.sum(g1 < 1e-6) > np.sum(g0 < 1e-6)
+
+
+# ------------------------------------------------------------------------------------------
+# build-time hooks
+# ------------------------------------------------------------------------------------------
+def test_ufo2ft_filter_from_string_and_compile(ufo_pair):
+    ufo2ft = pytest.importorskip("ufo2ft")
+    from ufo2ft.filters import loadFilterFromString
+
+    p = ufo_pair["cff"]
+    flt = loadFilterFromString("curvefair.fonts::FairFilter(tol=2)")
+    u = ufoLib2.Font.open(p)
+    modified = flt(u)
+    assert modified
+    check_outlines(ufoLib2.Font.open(p), u, sorted(modified), 2.0, smooth_from="flags",
+                   exact_grid=False)
+    plain = ufo2ft.compileOTF(ufoLib2.Font.open(p), optimizeCFF=0)
+    built = ufo2ft.compileOTF(ufoLib2.Font.open(p), filters=[flt], optimizeCFF=0)
+    # the compiled font holds the faired outlines: within tol of the unfiltered build (CFF
+    # rounds to integers, so add half a unit's diagonal), and different from it
+    moved = 0.0
+    for g in sorted(modified):
+        s0 = bezier_samples(plain.getGlyphSet(), g)
+        s1 = bezier_samples(built.getGlyphSet(), g)
+        d = np.linalg.norm(s1 - s0, axis=1).max()
+        assert d <= 2.0 + np.sqrt(0.5), g
+        moved = max(moved, d)
+    assert moved > 0
+
+
+def test_point_pen_passes_everything_on():
+    from curvefair.fonts import FairPointPen
+
+    font = TTFont(LOBSTER)
+    gs = font.getGlyphSet()
+    for g in ("zero", "B"):
+        rec = RecordingPointPen()
+        from fontTools.pens.pointPen import SegmentToPointPen
+
+        gs[g].draw(SegmentToPointPen(FairPointPen(rec, tol=2, grid=True)))
+        ref = RecordingPointPen()
+        gs[g].draw(SegmentToPointPen(ref))
+        ops = [(op, a[1:] if op == "addPoint" else a, kw) for op, a, kw in rec.value]
+        ops0 = [(op, a[1:] if op == "addPoint" else a, kw) for op, a, kw in ref.value]
+        assert [o[0] for o in ops] == [o[0] for o in ops0]
+        p0 = np.array([a[0] for op, a, kw in ref.value if op == "addPoint"], float)
+        p1 = np.array([a[0] for op, a, kw in rec.value if op == "addPoint"], float)
+        assert np.linalg.norm(p1 - p0, axis=1).max() <= 2.0
+        assert np.any(p1 != p0)
+
+
+def test_designspace_masters_stay_compatible(ufo_pair, tmp_path):
+    pytest.importorskip("fontTools.varLib.interpolatable")
+    from fontTools.designspaceLib import AxisDescriptor, DesignSpaceDocument, SourceDescriptor
+
+    from curvefair.fonts import fair_designspace, interpolation_problems
+
+    base = ufoLib2.Font.open(ufo_pair["cff"])
+    d = tmp_path / "ds"
+    d.mkdir()
+    base.save(d / "Light.ufo")
+    # a bold master: the same outlines, widened and wobbled point by point (same structure)
+    bold = ufoLib2.Font.open(ufo_pair["cff"])
+    rng = np.random.default_rng(5)
+    for g in bold:
+        for c in g.contours:
+            for pt in c.points:
+                pt.x = round(pt.x * 1.08 + rng.integers(-2, 3))
+                pt.y = round(pt.y + rng.integers(-2, 3))
+    bold.save(d / "Bold.ufo")
+    doc = DesignSpaceDocument()
+    ax = AxisDescriptor()
+    ax.name, ax.tag, ax.minimum, ax.default, ax.maximum = "Weight", "wght", 300, 300, 700
+    doc.addAxis(ax)
+    for name, w in (("Light", 300), ("Bold", 700)):
+        s = SourceDescriptor()
+        s.filename, s.location, s.name = f"{name}.ufo", {"Weight": w}, name
+        doc.addSource(s)
+    doc.write(d / "Fam.designspace")
+    before = interpolation_problems(d / "Fam.designspace")
+    res = fair_designspace(d / "Fam.designspace", tmp_path / "out", tol=2)
+    assert [s["ufo"] for s in res["sources"]] == ["Light.ufo", "Bold.ufo"]
+    kinds = {p["type"] for p in res["problems"]}
+    kinds_before = {p["type"] for p in before}
+    assert kinds <= kinds_before, kinds - kinds_before
+    assert not {"path_count", "node_count", "node_incompatibility", "contour_order",
+                "wrong_start_point"} & kinds
+    for name in ("Light.ufo", "Bold.ufo"):
+        a, b = ufoLib2.Font.open(d / name), ufoLib2.Font.open(tmp_path / "out" / name)
+        check_outlines(a, b, sorted(a.keys()), 2.0, smooth_from="flags", exact_grid=False)
+
+
+# ------------------------------------------------------------------------------------------
+# errors
+# ------------------------------------------------------------------------------------------
+def test_font_errors(tmp_path):
+    with pytest.raises(InputError, match="nosuch"):
+        read_curves(LOBSTER, glyphs=["nosuch"])
+    with pytest.raises(InputError, match="glyphs="):
+        read_curves(HERE / "data" / "real" / "fontawesome" / "3.svg", glyphs=["a"])
+    bad = tmp_path / "bad.ttf"
+    bad.write_bytes(b"\x00\x01\x00\x00garbage")
+    with pytest.raises(CurvefairError, match="bad.ttf"):
+        read_curves(bad)
+    folder = tmp_path / "x.ufo"
+    folder.mkdir()
+    with pytest.raises(CurvefairError):
+        read_curves(folder)
+    recs = read_curves(LOBSTER, glyphs=["zero"])
+    with pytest.raises(InputError, match="input"):
+        write_curves(LOBSTER, recs)
+    assert os.path.getsize(LOBSTER) == 3756
