@@ -469,3 +469,51 @@ def test_font_errors(tmp_path):
     with pytest.raises(InputError, match="input"):
         write_curves(LOBSTER, recs)
     assert os.path.getsize(LOBSTER) == 3756
+
+
+# ------------------------------------------------------------------------------------------
+# Glyphs sources
+# ------------------------------------------------------------------------------------------
+GLYPHS_SRC = HERE / "data" / "real" / "glyphsLib" / "GlyphsUnitTestSans3.glyphs"
+
+
+def _master_layers(font):
+    """{master name: {glyph: layer}} of a glyphsLib GSFont."""
+    out = {m.name: {} for m in font.masters}
+    names = {m.id: m.name for m in font.masters}
+    for g in font.glyphs:
+        for layer in g.layers:
+            if layer.layerId in names:
+                out[names[layer.layerId]][g.name] = layer
+    return out
+
+
+def test_glyphs_source_round_trip_and_compatible(tmp_path):
+    glyphsLib = pytest.importorskip("glyphsLib")
+    recs = read_curves(GLYPHS_SRC)
+    assert {r.source["master"] for r in recs} == {"Light", "Regular", "Bold"}
+    assert all(r.name == f"{r.source['glyph']}@{r.source['master']}#{r.source['contour']}"
+               for r in recs)
+    out = tmp_path / "faired.glyphs"
+    write_curves(out, _fair_records(recs, 2.0), template=GLYPHS_SRC)
+    a, b = glyphsLib.GSFont(str(GLYPHS_SRC)), glyphsLib.GSFont(str(out))
+    la, lb = _master_layers(a), _master_layers(b)
+    worst = 0.0
+    for m in la:
+        names = sorted({r.source["glyph"] for r in recs if r.source["master"] == m})
+        worst = max(worst, check_outlines(la[m], lb[m], names, 2.0, smooth_from="flags"))
+    assert worst > 0
+    # the rest of the file is what glyphsLib read: unchanged glyphs, features, kerning
+    assert a.features[0].code == b.features[0].code
+    assert a.kerningLTR == b.kerningLTR if hasattr(a, "kerningLTR") else a.kerning == b.kerning
+    # masters stay interpolation-compatible: fontTools' interpolatable on the UFO masters
+    from fontTools.varLib.interpolatable import test as interpolatable_test
+
+    def problems(font):
+        ds = glyphsLib.to_designspace(font, minimal=True)
+        sets = [{g.name: g for g in s.font} for s in ds.sources]
+        return {p["type"] for ps in interpolatable_test(sets).values() for p in ps}
+
+    after, before = problems(b), problems(a)
+    assert after <= before, after - before
+    assert not {"path_count", "node_count", "node_incompatibility", "contour_order"} & after

@@ -614,7 +614,7 @@ def _bad_point_list(curve: Any, a: Any) -> list[dict[str, Any]]:
 
 
 @main.command("analyze")
-@click.argument("infile", metavar="IN", type=click.Path(exists=True, dir_okay=False))
+@click.argument("infile", metavar="IN", type=click.Path(exists=True, dir_okay=True))
 @click.option("--json", "as_json", is_flag=True, help="Machine-readable output (JSON on stdout).")
 @click.option("--top", type=click.IntRange(min=0), default=10, show_default=True,
               help="Bad points listed per curve in the table (--json lists all).")
@@ -679,7 +679,7 @@ def analyze_cmd(infile: str, as_json: bool, top: int, corner_angle: float, no_co
 # plot
 # ------------------------------------------------------------------------------------------
 @main.command("plot")
-@click.argument("infile", metavar="IN", type=click.Path(exists=True, dir_okay=False))
+@click.argument("infile", metavar="IN", type=click.Path(exists=True, dir_okay=True))
 @click.option("--compare", "other", metavar="OTHER",
               type=click.Path(exists=True, dir_okay=False),
               help="A second file with as many curves (e.g. the faired one): drawn over IN, "

@@ -19,6 +19,7 @@ format        extensions                   needs
 ``step``      .stp .step                   ``pip install 'curvefair[occ]'`` (cadquery-ocp)
 ``ufo``       .ufo (a folder)              ``pip install 'curvefair[fonts]'`` (ufoLib2)
 ``opentype``  .ttf .otf                    ``pip install 'curvefair[fonts]'`` (fontTools)
+``glyphs``    .glyphs                      ``pip install 'curvefair[fonts]'`` (glyphsLib)
 ============  ===========================  ==========================================
 
 The record
@@ -81,7 +82,7 @@ __all__ = ["read_curves", "write_curves", "CurveRecord", "KINDS", "FORMATS", "de
            "atomic_write", "atomic_path"]
 
 FormatName = Literal["points", "airfoil", "json", "dxf", "3dm", "svg", "iges", "step", "ufo",
-                     "opentype"]
+                     "opentype", "glyphs"]
 
 #: format name -> file extensions
 FORMATS: dict[str, tuple[str, ...]] = {
@@ -95,11 +96,12 @@ FORMATS: dict[str, tuple[str, ...]] = {
     "step": (".stp", ".step"),
     "ufo": (".ufo",),
     "opentype": (".ttf", ".otf"),
+    "glyphs": (".glyphs",),
 }
 
 #: formats stored as a folder, and the formats that take ``glyphs=``
 FOLDER_FORMATS = ("ufo",)
-FONT_FORMATS = ("ufo", "opentype")
+FONT_FORMATS = ("ufo", "opentype", "glyphs")
 
 
 def detect_format(path: str | os.PathLike[str], format: str | None = None) -> str:
@@ -156,7 +158,7 @@ def read_curves(path: str | os.PathLike[str], *, format: FormatName | None = Non
         unclamped DXF spline, a polyline with arcs, an SVG arc...): raise
         :class:`~curvefair.FileFormatError` naming it, or skip it with a warning.
     glyphs : sequence of str or str, optional
-        Fonts (``ufo``, ``opentype``): only these glyphs (names, or one comma-separated
+        Fonts (``ufo``, ``opentype``, ``glyphs``): only these glyphs (names, or one comma-separated
         string); one record per contour with curves, named ``"<glyph>#<contour>"``.
 
     Returns
@@ -198,7 +200,7 @@ def read_curves(path: str | os.PathLike[str], *, format: FormatName | None = Non
     if p.is_dir() and fmt not in FOLDER_FORMATS:
         raise FileFormatError("is a folder, not a file", path)
     if glyphs is not None and fmt not in FONT_FORMATS:
-        raise InputError(f"glyphs= is for fonts (ufo, opentype), not {fmt} files")
+        raise InputError(f"glyphs= is for fonts (ufo, opentype, glyphs), not {fmt} files")
     extra = {} if glyphs is None else {"glyphs": glyphs}
     records = _module(fmt).read(path, corner_angle=corner_angle, on_unsupported=on_unsupported,
                                 **extra)

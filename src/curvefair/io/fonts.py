@@ -1,4 +1,4 @@
-"""Font sources and binaries: UFO (ufoLib2) and OpenType/TrueType (fontTools).
+"""Font sources and binaries: UFO (ufoLib2), OpenType/TrueType (fontTools), Glyphs (glyphsLib).
 
 ``pip install 'curvefair[fonts]'``.
 
@@ -6,14 +6,16 @@ Read
 ----
 One record per contour of every glyph (``glyphs=`` chooses glyphs by name), in glyph order:
 the default layer of a UFO (``.ufo`` folder), the ``glyf`` (quadratic) or ``CFF `` (cubic)
-outlines of a ``.ttf``/``.otf``. Units are font units, ``y`` up. Contours made of straight
+outlines of a ``.ttf``/``.otf``, every master layer of a ``.glyphs`` source (brace, bracket
+and backup layers are left as they are). Units are font units, ``y`` up. Contours made of straight
 lines only, components and empty glyphs carry no curve and are not records (they are written
 back untouched). The curve is the contour's B-spline of :mod:`curvefair.io._outline`
 (cubic poly-Bezier with knots of multiplicity 3; quadratic B-spline with TrueType's implied
 on-curve points exact); ``corners`` holds the corner nodes and straight segments.
 
 ``name`` is ``"<glyph>#<contour>"``; ``source`` keys: ``glyph``, ``contour`` (0-based index in
-the glyph), ``handle`` (= name), ``layer`` (UFO), ``table`` (``glyf``/``CFF ``), ``outline``
+the glyph), ``handle`` (= name), ``master`` (Glyphs sources with several masters: the name is
+then ``"<glyph>@<master>#<contour>"``), ``outline``
 (the contour's points, on-curve flags, smooth flags, closedness, quadratic, integer grid) and
 ``index`` (control point of each contour point).
 
@@ -31,6 +33,10 @@ record's faired control points are (so within the fairing's ``tol``).
   features, groups, lib, other layers, components, anchors, guidelines come back byte for byte.
 - TrueType: the changed glyphs' coordinates are replaced (instructions, flags and point
   counts kept), bounds recomputed, the left side bearing follows ``xMin`` where it was equal.
+- Glyphs: glyphsLib loads the source, the changed master layers' nodes are moved and it saves
+  the file again (glyphsLib writes what it read: unchanged sources come back byte for byte).
+  Integer coordinates stay integers (Glyphs' default grid); other coordinates are written
+  with glyphsLib's 5 decimals.
 - CFF: the charstrings are desubroutinized and each changed glyph's drawing operators
   rewritten as ``rmoveto``/``rlineto``/``rrcurveto`` (hints, hint masks and width kept).
 
@@ -195,6 +201,40 @@ def _open_ufo(path: object) -> Any:
         raise FileFormatError(f"not a UFO ufoLib2 can read ({exc})", path) from None
 
 
+def _open_glyphs(path: object) -> Any:
+    glyphsLib = lazy_import("glyphsLib", "glyphsLib", "fonts", "Glyphs sources")
+    try:
+        return glyphsLib.GSFont(os.fspath(path))  # type: ignore[arg-type]
+    except Exception as exc:
+        raise FileFormatError(f"not a Glyphs source glyphsLib can read ({exc})", path) from None
+
+
+def _glyphs_layers(font: Any, names: Sequence[str]) -> list[tuple[str, str, Any]]:
+    """(glyph, master name, layer) of every master layer of the glyphs, in glyph order."""
+    masters = {m.id: m.name for m in font.masters}
+    out = []
+    for g in names:
+        for layer in font.glyphs[g].layers:
+            if layer.layerId in masters:
+                out.append((g, masters[layer.layerId], layer))
+    return out
+
+
+def glyphs_contour(path: Any) -> Contour:
+    """A :class:`Contour` from a glyphsLib ``GSPath`` (integer grid when its coordinates are
+    integers, as Glyphs writes them by default)."""
+    nodes = list(path.nodes)
+    types = [n.type for n in nodes]
+    quad = "qcurve" in types
+    if quad and "curve" in types:
+        raise Unsupported("a path mixing cubic and quadratic segments")
+    xy = np.array([(float(n.position.x), float(n.position.y)) for n in nodes], dtype=np.float64)
+    on = tuple(t != "offcurve" for t in types)
+    smooth = tuple(bool(n.smooth) for n in nodes)
+    grid = bool(np.array_equal(xy, np.round(xy)))
+    return Contour(xy, on, smooth, bool(path.closed), quad, grid=grid)
+
+
 def _glyph_order(names: Sequence[str], order: Sequence[str] | None) -> list[str]:
     known = set(names)
     first = [g for g in (order or []) if g in known]
@@ -219,6 +259,20 @@ def font_contours(path: str | os.PathLike[str], glyphs: Sequence[str] | None = N
                   ) -> tuple[str, list[tuple[str, list[Contour]]]]:
     """``(format, [(glyph name, contours)])`` of a UFO or binary font, in glyph order."""
     p = Path(path)
+    if p.suffix.lower() == ".glyphs":
+        font = _open_glyphs(path)
+        names = _select([g.name for g in font.glyphs], glyphs, path)
+        multi = len(font.masters) > 1
+        out = []
+        for g, master, layer in _glyphs_layers(font, names):
+            conts = []
+            for c in layer.paths:
+                try:
+                    conts.append(glyphs_contour(c))
+                except Unsupported as exc:
+                    conts.append(exc)  # type: ignore[arg-type]
+            out.append((f"{g}@{master}" if multi else g, conts))
+        return "glyphs", out
     if p.suffix.lower() == ".ufo":
         font = _open_ufo(path)
         layer = font.layers.defaultLayer
@@ -250,10 +304,14 @@ def font_contours(path: str | os.PathLike[str], glyphs: Sequence[str] | None = N
 # ------------------------------------------------------------------------------------------
 def glyph_contours(glyph: str, contours: Sequence[Contour | Exception], base: dict[str, Any],
                    skip: Any, start: int = 0) -> list[CurveRecord]:
-    """Records of one glyph's contours (contours of lines only are not records)."""
+    """Records of one glyph's contours (contours of lines only are not records); ``glyph``
+    may be ``"<glyph>@<master>"`` (a Glyphs source with several masters)."""
     recs = []
+    label = glyph
+    glyph, _, master = label.partition("@") if "@" in label and \
+        base.get("format") == "glyphs" else (label, "", "")
     for ci, c in enumerate(contours):
-        name = f"{glyph}#{ci}"
+        name = f"{label}#{ci}"
         if isinstance(c, Exception):
             skip(f"glyph {glyph!r}: {c}")
             continue
@@ -266,6 +324,8 @@ def glyph_contours(glyph: str, contours: Sequence[Contour | Exception], base: di
             continue
         src = dict(base, index=start + len(recs), glyph=glyph, contour=ci, handle=name,
                    outline=c, point_index=tuple(int(i) for i in index))
+        if master:
+            src["master"] = master
         recs.append(CurveRecord(curve, name, "bspline", src, None, tuple(hold)))
     return recs
 
@@ -332,7 +392,8 @@ def _by_glyph(records: Sequence[CurveRecord], tpath: str) -> dict[str, dict[int,
         c: Contour = r.source["outline"]
         if np.array_equal(pts, c.points):
             continue
-        out.setdefault(r.source["glyph"], {})[int(r.source["contour"])] = pts
+        label = str(r.source["handle"]).rsplit("#", 1)[0]
+        out.setdefault(label, {})[int(r.source["contour"])] = pts
     return out
 
 
@@ -373,6 +434,24 @@ def write_ufo(path: str | os.PathLike[str], changes: dict[str, dict[int, FloatAr
                 p.x, p.y = _number(x), _number(y)
         version = _glif_version(gs.getGLIF(gname))
         gs.writeGlyph(gname, glyph, glyph.drawPoints, formatVersion=version)
+
+
+def write_glyphs(path: str | os.PathLike[str], changes: dict[str, dict[int, FloatArray]],
+                 template: str) -> None:
+    """Save a copy of the Glyphs source ``template`` with the changed master layers' nodes
+    moved (glyphsLib writes the rest of the file as it read it)."""
+    font = _open_glyphs(template)
+    multi = len(font.masters) > 1
+    names = sorted({k.split("@")[0] for k in changes} if multi else set(changes))
+    for g, master, layer in _glyphs_layers(font, [n for n in names if n in font.glyphs]):
+        conts = changes.get(f"{g}@{master}" if multi else g)
+        if not conts:
+            continue
+        paths = list(layer.paths)
+        for ci, pts in conts.items():
+            for node, (x, y) in zip(paths[ci].nodes, pts, strict=True):
+                node.position = (_number(x), _number(y))
+    font.save(os.fspath(path))
 
 
 def _number(v: float) -> float | int:
@@ -455,7 +534,9 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
         template = paths.pop()
     tpath = os.path.abspath(os.fspath(template))  # type: ignore[arg-type]
     changes = _by_glyph(records, tpath)
-    if Path(tpath).suffix.lower() == ".ufo":
+    if Path(tpath).suffix.lower() == ".glyphs":
+        write_glyphs(path, changes, tpath)
+    elif Path(tpath).suffix.lower() == ".ufo":
         if Path(os.fspath(path)).suffix.lower() != ".ufo":
             raise InputError(f"{os.fspath(path)!r}: a UFO is written as a .ufo folder")
         write_ufo(path, changes, tpath)
