@@ -80,8 +80,15 @@ def bezier_samples(glyphset, name, m=17):
                        + t ** 3 * p3)
             cur = p3
         elif op == "qCurveTo":
-            if args[-1] is None:  # an all-off-curve TrueType contour
-                pytest.skip("all-off-curve contour")
+            if args[-1] is None:  # an all-off-curve TrueType contour: implied midpoints
+                offs = [np.array(a, float) for a in args[:-1]]
+                m = len(offs)
+                for i in range(m):
+                    a0 = (offs[i - 1] + offs[i]) / 2
+                    e = (offs[i] + offs[(i + 1) % m]) / 2
+                    out.append((1 - t) ** 2 * a0 + 2 * t * (1 - t) * offs[i] + t ** 2 * e)
+                cur = start = None
+                continue
             for c, e in decomposeQuadraticSegment(args):
                 c, e = np.array(c, float), np.array(e, float)
                 out.append((1 - t) ** 2 * cur + 2 * t * (1 - t) * c + t ** 2 * e)
@@ -202,6 +209,32 @@ def test_truetype_dejavu_round_trip(tmp_path):
         assert list(a.flags) == list(b.flags)
         assert getattr(a, "program", None) == getattr(b, "program", None) or \
             a.program.getBytecode() == b.program.getBytecode()
+
+
+def test_truetype_implied_only_and_repeated_points(tmp_path):
+    """DejaVu contours of off-curve points only (periodic quadratic B-splines) and with a
+    repeated on-curve point (a zero-length line) are read, faired and written exactly."""
+    src = _dejavu()
+    names = ["uni0652", "u1F62E", "nu"]
+    recs = read_curves(src, glyphs=names)
+    assert any(r.curve.closed for r in recs)  # the periodic ones
+    f = TTFont(src)
+    flags = {g: list(f["glyf"][g].flags) for g in names}
+    def all_off(g):  # some contour of the glyph has no on-curve point
+        gl, start = f["glyf"][g], 0
+        for e in gl.endPtsOfContours:
+            if not any(x & 1 for x in gl.flags[start:e + 1]):
+                return True
+            start = e + 1
+        return False
+
+    assert any(all_off(n) for n in names)
+    out = tmp_path / "faired.ttf"
+    write_curves(out, _fair_records(recs, 3.0), template=src)
+    g = TTFont(out)
+    worst = check_outlines(f.getGlyphSet(), g.getGlyphSet(), names, 3.0)
+    assert worst > 0
+    assert {n: list(g["glyf"][n].flags) for n in names} == flags
 
 
 def test_cff_lobster_round_trip(tmp_path):

@@ -9,6 +9,9 @@ first corner, else the first on-curve point: the seam of the closed chain) round
 - cubic contours (UFO ``curve``, CFF): each segment is a cubic Bezier (a line ``A B`` is the
   exactly degree-elevated ``A, A + (B - A)/3, A + 2(B - A)/3, B``), joined by knots of
   multiplicity 3 -- the B-spline form of a poly-Bezier, with spans of width 1;
+- a TrueType contour of off-curve points only (every on-curve point implied, as in many
+  circles) is the periodic quadratic B-spline with uniform knots on those points;
+- a repeated on-curve point (a zero-length line) is one control point, held;
 - quadratic contours (UFO ``qcurve``, TrueType ``glyf``): a run of ``k`` off-curve points
   between two on-curve points is a quadratic B-spline of ``k`` spans of width 1 with simple
   knots between them. Its joins are the midpoints of consecutive off-curve points, which is
@@ -139,6 +142,13 @@ def contour_curve(c: Contour) -> tuple[BSplineCurve, np.ndarray, list[int]]:
         off-curve points, zero-length segments.
     """
     n = len(c.on)
+    if not any(c.on) and c.quadratic and c.closed and n >= 3:
+        # TrueType: every on-curve point implied -- the periodic quadratic B-spline with
+        # uniform knots whose control points are the off-curve points
+        if any(np.array_equal(c.points[k], c.points[(k + 1) % n]) for k in range(n)):
+            raise Unsupported("an all-off-curve contour with repeated points")
+        return (BSplineCurve(c.points, np.arange(n + 1, dtype=np.float64), 2, closed=True),
+                np.arange(n, dtype=np.intp), [])
     if n < 2 or not any(c.on):
         raise Unsupported("a contour without on-curve points" if n >= 2 else
                           "a contour of fewer than two points")
@@ -163,9 +173,16 @@ def contour_curve(c: Contour) -> tuple[BSplineCurve, np.ndarray, list[int]]:
                 raise Unsupported("an open contour ending with an off-curve point")
         a, b = P[order[i]], P[order[j]]
         offs = order[i + 1:j]
+        if not offs and np.array_equal(a, b):
+            # a zero-length line (a repeated on-curve point): no span; the twin is the same
+            # control point and, like every line end, is held
+            if j < len(order) - 1 or not c.closed:
+                index[order[j]] = len(ctl) - 1
+            if j == len(order) - 1 and len(knots) > p + 1:
+                del knots[-p:]  # the chain ends at the join before
+            i = j
+            continue
         if not offs:  # a line
-            if np.array_equal(a, b):
-                raise Unsupported("a zero-length line segment")
             inner = [a + (b - a) / 2] if p == 2 else [a + (b - a) / 3, a + 2 * (b - a) / 3]
             ctl.extend(inner)
             u += 1.0

@@ -57,7 +57,7 @@ from typing import Any
 import numpy as np
 
 from .._typing import FloatArray
-from ..errors import FileFormatError, InputError
+from ..errors import CurvefairError, FileFormatError, InputError
 from ._common import CurveRecord, Unsupported, lazy_import
 from ._outline import Contour, constrained_points, contour_curve
 from ._outline import harmonize as _harmonize
@@ -319,7 +319,7 @@ def glyph_contours(glyph: str, contours: Sequence[Contour | Exception], base: di
             continue
         try:
             curve, index, hold = contour_curve(c)
-        except Unsupported as exc:
+        except (Unsupported, CurvefairError) as exc:
             skip(f"glyph {glyph!r} contour {ci}: {exc}")
             continue
         src = dict(base, index=start + len(recs), glyph=glyph, contour=ci, handle=name,
