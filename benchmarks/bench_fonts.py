@@ -226,8 +226,8 @@ def main() -> None:
                            "DejaVuSans.ttf"), a.glyphs.split(",")),
              (os.path.join(here, "..", "tests", "data", "real", "fonttools",
                            "Lobster.subset.otf"), None)]
-    print(f"method {a.method or 'default'}, tol {a.tol:g} font units; E = int kappa^2 ds summed over smooth runs, relative to "
-          "the input; extrema = curvature extrema summed")
+    print(f"method {a.method or 'default'}, tol {a.tol:g} font units; E = int kappa^2 ds "
+          "summed over smooth runs, relative to the input; extrema = curvature extrema summed")
     print("| font | contours (runs) | E curvefair / input | E curvefair floats / input | "
           "E peer / input | extrema input -> curvefair / floats / peer | max dev curvefair | "
           "control points input / peer | curvefair time s |")
@@ -237,7 +237,8 @@ def main() -> None:
         print(f"| {os.path.basename(path)} | {n} ({t['n']}) | {t['E_cf'] / t['E_in']:.3f} | "
               f"{t['E_fl'] / t['E_in']:.3f} | "
               f"{t['E_peer'] / t['E_in']:.3f} | {t['ext_in']} -> {t['ext_cf']} / "
-              f"{t['ext_fl']} / {t['ext_peer']} | {t['dev_cf']:.3g} | {t['ctl_in']} / {t['ctl_peer']} | "
+              f"{t['ext_fl']} / {t['ext_peer']} | {t['dev_cf']:.3g} | "
+              f"{t['ctl_in']} / {t['ctl_peer']} | "
               f"{t['t']:.2f} |")
 
 
