@@ -24,6 +24,7 @@ default), with ``protect`` = the corner nodes and the points of straight segment
 
 from __future__ import annotations
 
+import dataclasses
 import os
 from collections.abc import Sequence
 from types import SimpleNamespace
@@ -169,21 +170,31 @@ def _filter_class() -> type:
 
         Options (keyword arguments, also in ``--filter "curvefair.fonts::FairFilter(...)"``):
         ``tol`` (default 2), ``method`` (default: the B-spline default), ``harmonize``
-        (default False), and ufo2ft's ``include``/``exclude``/``pre``.
+        (default False), ``grid`` (``"auto"``, the default: contours with integer coordinates
+        get integers, so that the compiled font's rounding neither moves points nor breaks
+        smooth nodes; True/False: always/never), and ufo2ft's ``include``/``exclude``/``pre``.
         """
 
-        _kwargs = {"tol": 2.0, "method": None, "harmonize": False}
+        _kwargs = {"tol": 2.0, "method": None, "harmonize": False, "grid": "auto"}
 
         def start(self) -> None:
             self.options.tol = _check_tol(self.options.tol)
+            if self.options.grid not in ("auto", True, False):
+                raise InputError(f"grid must be 'auto', True or False, got "
+                                 f"{self.options.grid!r}")
 
         def filter(self, glyph: Any) -> bool:
-            conts = []
+            conts: list[Any] = []
             for contour in glyph:
                 try:
-                    conts.append(ufo_contour(list(contour)))
+                    c = ufo_contour(list(contour))
                 except Exception:  # an unsupported contour stays as it is
                     conts.append(RuntimeError("unsupported"))
+                    continue
+                grid = self.options.grid
+                if grid == "auto":  # integer sources stay integer: the binary keeps G1
+                    grid = bool(np.array_equal(c.points, np.round(c.points)))
+                conts.append(dataclasses.replace(c, grid=bool(grid)))
             if not conts:
                 return False
             new = fair_contours(conts, self.options.tol, method=self.options.method,

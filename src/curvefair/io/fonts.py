@@ -80,7 +80,8 @@ def ufo_contour(points: Sequence[Any], path: object = None) -> Contour:
     """A :class:`Contour` from a UFO contour's points (``x, y, type/segmentType, smooth``)."""
     types = [getattr(p, "type", None) if hasattr(p, "type") else p.segmentType for p in points]
     closed = not (types and types[0] == "move")
-    quad = "qcurve" in types
+    # a closed contour of off-curve points only is a quadratic (TrueType) curve (UFO 3 spec)
+    quad = "qcurve" in types or (closed and all(t in (None, "offcurve") for t in types))
     if quad and "curve" in types:
         raise Unsupported("a contour mixing cubic and quadratic segments")
     xy = np.array([(float(p.x), float(p.y)) for p in points], dtype=np.float64)
