@@ -466,6 +466,15 @@ def test_designspace_masters_stay_compatible(ufo_pair, tmp_path):
         s.filename, s.location, s.name = f"{name}.ufo", {"Weight": w}, name
         doc.addSource(s)
     doc.write(d / "Fam.designspace")
+    # read_curves reads every master (records named glyph@source#contour); writing a
+    # designspace goes through fair_designspace (masters included)
+    recs = read_curves(d / "Fam.designspace")
+    n_light = len(read_curves(d / "Light.ufo"))
+    assert len(recs) == 2 * n_light
+    assert {r.source["master"] for r in recs} == {"Light", "Bold"}
+    assert recs[0].name == f"{recs[0].source['glyph']}@Light#{recs[0].source['contour']}"
+    with pytest.raises(InputError, match="fair_designspace"):
+        write_curves(tmp_path / "x.designspace", recs, template=d / "Fam.designspace")
     before = interpolation_problems(d / "Fam.designspace")
     res = fair_designspace(d / "Fam.designspace", tmp_path / "out", tol=2)
     assert [s["ufo"] for s in res["sources"]] == ["Light.ufo", "Bold.ufo"]

@@ -6,21 +6,22 @@ copy of the source file when ``template=`` names it (every other entity untouche
 
 Formats (chosen by extension, or ``format=``):
 
-============  ===========================  ==========================================
-format        extensions                   needs
-============  ===========================  ==========================================
-``points``    .csv .txt .xyz .pts          --
-``airfoil``   .dat (Selig or Lednicer)     --
-``json``      .json (curvefair schema 1)   --
-``dxf``       .dxf                         ``pip install 'curvefair[dxf]'`` (ezdxf)
-``3dm``       .3dm                         ``pip install 'curvefair[rhino]'`` (rhino3dm)
-``svg``       .svg                         ``pip install 'curvefair[svg]'`` (svgpathtools)
-``iges``      .igs .iges                   ``pip install 'curvefair[occ]'`` (cadquery-ocp)
-``step``      .stp .step                   ``pip install 'curvefair[occ]'`` (cadquery-ocp)
-``ufo``       .ufo (a folder)              ``pip install 'curvefair[fonts]'`` (ufoLib2)
-``opentype``  .ttf .otf                    ``pip install 'curvefair[fonts]'`` (fontTools)
-``glyphs``    .glyphs                      ``pip install 'curvefair[fonts]'`` (glyphsLib)
-============  ===========================  ==========================================
+================  ===========================  ==========================================
+format            extensions                   needs
+================  ===========================  ==========================================
+``points``        .csv .txt .xyz .pts          --
+``airfoil``       .dat (Selig or Lednicer)     --
+``json``          .json (curvefair schema 1)   --
+``dxf``           .dxf                         ``pip install 'curvefair[dxf]'`` (ezdxf)
+``3dm``           .3dm                         ``pip install 'curvefair[rhino]'`` (rhino3dm)
+``svg``           .svg                         ``pip install 'curvefair[svg]'`` (svgpathtools)
+``iges``          .igs .iges                   ``pip install 'curvefair[occ]'`` (cadquery-ocp)
+``step``          .stp .step                   ``pip install 'curvefair[occ]'`` (cadquery-ocp)
+``ufo``           .ufo (a folder)              ``pip install 'curvefair[fonts]'`` (ufoLib2)
+``opentype``      .ttf .otf                    ``pip install 'curvefair[fonts]'`` (fontTools)
+``glyphs``        .glyphs                      ``pip install 'curvefair[fonts]'`` (glyphsLib)
+``designspace``   .designspace (read only)     ``pip install 'curvefair[fonts]'`` (fontTools)
+================  ===========================  ==========================================
 
 The record
 ----------
@@ -82,7 +83,7 @@ __all__ = ["read_curves", "write_curves", "CurveRecord", "KINDS", "FORMATS", "de
            "atomic_write", "atomic_path"]
 
 FormatName = Literal["points", "airfoil", "json", "dxf", "3dm", "svg", "iges", "step", "ufo",
-                     "opentype", "glyphs"]
+                     "opentype", "glyphs", "designspace"]
 
 #: format name -> file extensions
 FORMATS: dict[str, tuple[str, ...]] = {
@@ -97,11 +98,12 @@ FORMATS: dict[str, tuple[str, ...]] = {
     "ufo": (".ufo",),
     "opentype": (".ttf", ".otf"),
     "glyphs": (".glyphs",),
+    "designspace": (".designspace",),
 }
 
 #: formats stored as a folder, and the formats that take ``glyphs=``
 FOLDER_FORMATS = ("ufo",)
-FONT_FORMATS = ("ufo", "opentype", "glyphs")
+FONT_FORMATS = ("ufo", "opentype", "glyphs", "designspace")
 
 
 def detect_format(path: str | os.PathLike[str], format: str | None = None) -> str:

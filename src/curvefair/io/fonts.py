@@ -7,11 +7,14 @@ Read
 One record per contour of every glyph (``glyphs=`` chooses glyphs by name), in glyph order:
 the default layer of a UFO (``.ufo`` folder), the ``glyf`` (quadratic) or ``CFF `` (cubic)
 outlines of a ``.ttf``/``.otf``, every master layer of a ``.glyphs`` source (brace, bracket
-and backup layers are left as they are). Units are font units, ``y`` up. Contours made of straight
-lines only, components and empty glyphs carry no curve and are not records (they are written
-back untouched). The curve is the contour's B-spline of :mod:`curvefair.io._outline`
-(cubic poly-Bezier with knots of multiplicity 3; quadratic B-spline with TrueType's implied
-on-curve points exact); ``corners`` holds the corner nodes and straight segments.
+and backup layers are left as they are), every source UFO of a ``.designspace`` document
+(read only: :func:`curvefair.fonts.fair_designspace` writes one, masters included; records
+named ``"<glyph>@<source name>#<contour>"``). Units are font units, ``y`` up. Contours made
+of straight lines only, components and empty glyphs carry no curve and are not records (they
+are written back untouched). The curve is the contour's B-spline of
+:mod:`curvefair.io._outline` (cubic poly-Bezier with knots of multiplicity 3; quadratic
+B-spline with TrueType's implied on-curve points exact); ``corners`` holds the corner nodes
+and straight segments.
 
 ``name`` is ``"<glyph>#<contour>"``; ``source`` keys: ``glyph``, ``contour`` (0-based index in
 the glyph), ``handle`` (= name), ``master`` (Glyphs sources with several masters: the name is
@@ -236,6 +239,27 @@ def glyphs_contour(path: Any) -> Contour:
     return Contour(xy, on, smooth, bool(path.closed), quad, grid=grid)
 
 
+def _designspace_contours(path: object, glyphs: Sequence[str] | None
+                          ) -> list[tuple[str, list[Contour]]]:
+    """Every source UFO's contours, labelled ``"<glyph>@<source name>"``."""
+    _fonttools("designspace documents")
+    from fontTools.designspaceLib import DesignSpaceDocument
+
+    try:
+        doc = DesignSpaceDocument.fromfile(os.fspath(path))  # type: ignore[arg-type]
+    except Exception as exc:
+        raise FileFormatError(f"not a designspace document fontTools can read ({exc})",
+                              path) from None
+    out: list[tuple[str, list[Contour]]] = []
+    for k, s in enumerate(doc.sources):
+        if not s.path or not os.path.isdir(s.path):
+            raise FileFormatError(f"source {k} ({s.filename!r}): no such UFO", path)
+        label = s.name or s.styleName or f"source{k}"
+        _, per = font_contours(s.path, glyphs)
+        out += [(f"{g}@{label}", c) for g, c in per]
+    return out
+
+
 def _glyph_order(names: Sequence[str], order: Sequence[str] | None) -> list[str]:
     known = set(names)
     first = [g for g in (order or []) if g in known]
@@ -260,6 +284,8 @@ def font_contours(path: str | os.PathLike[str], glyphs: Sequence[str] | None = N
                   ) -> tuple[str, list[tuple[str, list[Contour]]]]:
     """``(format, [(glyph name, contours)])`` of a UFO or binary font, in glyph order."""
     p = Path(path)
+    if p.suffix.lower() == ".designspace":
+        return "designspace", _designspace_contours(path, glyphs)
     if p.suffix.lower() == ".glyphs":
         font = _open_glyphs(path)
         names = _select([g.name for g in font.glyphs], glyphs, path)
@@ -310,7 +336,7 @@ def glyph_contours(glyph: str, contours: Sequence[Contour | Exception], base: di
     recs = []
     label = glyph
     glyph, _, master = label.partition("@") if "@" in label and \
-        base.get("format") == "glyphs" else (label, "", "")
+        base.get("format") in ("glyphs", "designspace") else (label, "", "")
     for ci, c in enumerate(contours):
         name = f"{label}#{ci}"
         if isinstance(c, Exception):
@@ -534,6 +560,9 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
                              "from: pass template= (or records from one font)")
         template = paths.pop()
     tpath = os.path.abspath(os.fspath(template))  # type: ignore[arg-type]
+    if Path(tpath).suffix.lower() == ".designspace":
+        raise InputError("a designspace is written with its masters: use "
+                         "curvefair.fonts.fair_designspace(path, out_dir, tol)")
     changes = _by_glyph(records, tpath)
     if Path(tpath).suffix.lower() == ".glyphs":
         write_glyphs(path, changes, tpath)
