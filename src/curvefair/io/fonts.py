@@ -18,9 +18,10 @@ and straight segments.
 
 ``name`` is ``"<glyph>#<contour>"``; ``source`` keys: ``glyph``, ``contour`` (0-based index in
 the glyph), ``handle`` (= name), ``master`` (Glyphs sources with several masters: the name is
-then ``"<glyph>@<master>#<contour>"``), ``outline``
-(the contour's points, on-curve flags, smooth flags, closedness, quadratic, integer grid) and
-``index`` (control point of each contour point).
+then ``"<glyph>@<master>#<contour>"``), ``outline`` (the
+:class:`~curvefair.io._outline.Contour`: points, on-curve and smooth flags, closedness,
+quadratic, integer grid) and ``point_index`` (the control point of each contour point: a
+point index reported on the curve maps back to the contour's point through it).
 
 Write
 -----
