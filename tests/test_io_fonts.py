@@ -625,3 +625,65 @@ def test_open_ufo_contour_round_trip(tmp_path):
     check_outlines(a, b, ["s"], 3.0, smooth_from="flags", exact_grid=False)
     pa, pb = a["s"].contours[0].points, b["s"].contours[0].points
     assert (pa[0].x, pa[0].y, pa[-1].x, pa[-1].y) == (pb[0].x, pb[0].y, pb[-1].x, pb[-1].y)
+
+
+def test_check_outlines_kinks_g2_inflections(tmp_path):
+    """A smooth-flagged node turning by 1 degree is a kink of 1 degree; a G2 break's value
+    matches curvatures from finite differences of the Bezier segments; harmonize removes
+    G2 breaks."""
+    from curvefair.fonts import FairFilter, check_outlines
+
+    u = ufoLib2.Font()
+    g = u.newGlyph("k")
+    pen = g.getPointPen()
+    th = np.radians(1.0)
+    pen.beginPath()
+    # a closed blob; node 3 is flagged smooth but its outgoing handle is turned by 1 degree
+    pts = [((0, 0), "curve", True), ((0, 100), None, False), ((100, 200), None, False),
+           ((200, 200), "curve", True),
+           ((float(200 + 100 * np.cos(th)), float(200 - 100 * np.sin(th))), None, False),
+           ((400, 100), None, False), ((400, 0), "curve", True), ((400, -150), None, False),
+           ((0, -150), None, False)]
+    for pt, seg, sm in pts:
+        pen.addPoint(pt, seg, sm)
+    pen.endPath()
+    u.save(tmp_path / "k.ufo")
+    rep = check_outlines(tmp_path / "k.ufo")
+    kinks = [r for r in rep if r["kind"] == "kink"]
+    assert [(r["glyph"], r["contour"], r["point"]) for r in kinks] == [("k", 0, 3)]
+    assert abs(kinks[0]["value"] - th) < 1e-12
+
+    # G2 values against finite differences, on Lobster's smooth nodes
+    def bez(P, t):
+        P = np.asarray(P, float)
+        return ((1 - t) ** 3 * P[0] + 3 * t * (1 - t) ** 2 * P[1] + 3 * t ** 2 * (1 - t) * P[2]
+                + t ** 3 * P[3])
+
+    def kappa(P, t, h=1e-4):
+        d1 = (bez(P, t + h) - bez(P, t - h)) / (2 * h)
+        d2 = (bez(P, t + h) - 2 * bez(P, t) + bez(P, t - h)) / h ** 2
+        return _cross(d1, d2) / np.linalg.norm(d1) ** 3
+
+    rep = check_outlines(LOBSTER)
+    g2 = [r for r in rep if r["kind"] == "g2"]
+    assert len(g2) > 5
+    f = TTFont(LOBSTER)
+    gs = f.getGlyphSet()
+    for r in g2[:10]:
+        P, t, _ = point_contours(gs, r["glyph"])[0][r["contour"]]
+        n, k = len(P), r["point"]
+        left = [P[(k - 3) % n], P[(k - 2) % n], P[(k - 1) % n], P[k]]
+        right = [P[k], P[(k + 1) % n], P[(k + 2) % n], P[(k + 3) % n]]
+        k1, k2 = kappa(left, 1 - 1e-3), kappa(right, 1e-3)  # just inside each segment
+        assert abs(abs(k1 - k2) / max(abs(k1), abs(k2)) - r["value"]) < 0.02, r
+    assert {r["kind"] for r in rep} >= {"g2", "inflection"}
+    # after harmonize=True fewer G2 breaks remain (UFO made from Lobster)
+    from curvefair.fonts import font_to_ufo
+
+    font_to_ufo(LOBSTER, tmp_path / "L.ufo")
+    before = len([r for r in check_outlines(tmp_path / "L.ufo") if r["kind"] == "g2"])
+    h = ufoLib2.Font.open(tmp_path / "L.ufo")
+    FairFilter(tol=2, harmonize=True, grid=False)(h)
+    h.save(tmp_path / "H.ufo")
+    after = len([r for r in check_outlines(tmp_path / "H.ufo") if r["kind"] == "g2"])
+    assert after < before

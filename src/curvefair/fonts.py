@@ -15,6 +15,8 @@
   (or ``ufo2ft.compileOTF(ufo, filters=[FairFilter(tol=2)])``).
 - :func:`font_to_ufo` writes a binary font's outlines as a UFO (smooth flags from the exact
   collinearity of each node's neighbours), to fair a font that has no source.
+- :func:`check_outlines` lists kinks at smooth nodes, G2 breaks and inflections by glyph name
+  and contour point index.
 - :func:`fair_designspace` fairs every master of a designspace document with the same
   options and checks that they still interpolate (fontTools' ``varLib.interpolatable``).
 
@@ -39,7 +41,7 @@ from .io._outline import Contour
 from .io.fonts import glyph_contours, record_points, ufo_contour
 
 __all__ = ["fair_contours", "FairPointPen", "FairFilter", "font_to_ufo",  # noqa: F822
-           "fair_designspace", "interpolation_problems"]
+           "fair_designspace", "interpolation_problems", "check_outlines"]
 
 
 def _check_tol(tol: object) -> float:
@@ -336,3 +338,79 @@ def interpolation_problems(designspace: str | os.PathLike[str]) -> list[dict[str
     glyphsets = [{g.name: g for g in f} for f in fonts]
     problems = interpolatable_test(glyphsets, names=names)
     return [dict(p, glyph=g) for g, ps in problems.items() for p in ps]
+
+
+def _end_curvature(P: FloatArray) -> float:
+    """Signed curvature at the end of the Bezier segment with control points ``P`` (degree
+    ``n = len(P) - 1``): ``(n-1)/n * cross(P_n - P_{n-1}, P_{n-1} - P_{n-2}) / |P_n - P_{n-1}|^3``
+    (e.g. Farin, *Curves and Surfaces for CAGD*, end curvature of a Bezier curve)."""
+    n = len(P) - 1
+    a, b = P[-1] - P[-2], P[-2] - P[-3]
+    la = float(np.hypot(*a))
+    return float((n - 1) / n * -(a[0] * b[1] - a[1] * b[0]) / la ** 3) if la > 0 else np.nan
+
+
+def _piece(c: Contour, k: int, step: int) -> FloatArray:
+    """The Bezier control polygon of the segment before (``step=-1``) or after (``+1``) node
+    ``k``, ordered so that it ends at ``k`` (TrueType: the neighbouring implied on-curve point
+    ends the quadratic piece)."""
+    P, n = np.asarray(c.points, dtype=np.float64), len(c.on)
+    pts = [P[k]]
+    j = (k + step) % n
+    while not c.on[j]:
+        pts.append(P[j])
+        j = (j + step) % n
+    pts.append(P[j])
+    if c.quadratic and len(pts) > 3:
+        pts = [pts[0], pts[1], (pts[1] + pts[2]) / 2]
+    return np.array(pts[::-1])
+
+
+def check_outlines(path: str | os.PathLike[str], *, glyphs: Sequence[str] | str | None = None,
+                   kink_angle: float = 2.0, g2_rel: float = 0.05) -> list[dict[str, Any]]:
+    """Outline problems a type designer looks for, by glyph name and contour point index.
+
+    - ``"kink"``: an on-curve node meant to be smooth (UFO/Glyphs ``smooth`` flag, or turning
+      by at most ``kink_angle`` degrees) whose neighbours are not collinear (turn > 1e-9 rad);
+      ``value`` is the turn in radians;
+    - ``"g2"``: a smooth node between two curve segments whose two end curvatures differ by
+      more than ``g2_rel`` of the larger; ``value`` is that relative difference;
+    - ``"inflection"``: an inflection of the contour (:func:`curvefair.analyze`), ``point``
+      the nearest contour point; ``value`` its parameter on the record's curve.
+
+    Returns a list of dicts ``{"glyph", "contour", "point", "kind", "value", "name"}`` (``name``
+    is the record name, ``"<glyph>#<contour>"``).
+    """
+    from .analysis import analyze
+    from .io import read_curves
+    from .io._outline import smooth_angle
+
+    out: list[dict[str, Any]] = []
+    for r in read_curves(path, glyphs=glyphs, on_unsupported="skip"):
+        c: Contour = r.source["outline"]
+        n = len(c.on)
+        P = np.asarray(c.points, dtype=np.float64)
+        base = {"glyph": r.source["glyph"], "contour": int(r.source["contour"]), "name": r.name}
+        for k in range(n):
+            if not c.on[k]:
+                continue
+            ang = smooth_angle(c, k)
+            if ang is None or (c.on[(k - 1) % n] and c.on[(k + 1) % n]):
+                continue
+            meant = c.smooth[k] or ang <= np.radians(kink_angle)
+            if meant and ang > 1e-9:
+                out.append(dict(base, point=k, kind="kink", value=ang))
+                continue
+            if not meant or c.on[(k - 1) % n] or c.on[(k + 1) % n]:
+                continue
+            k1 = _end_curvature(_piece(c, k, -1))
+            k2 = -_end_curvature(_piece(c, k, 1))  # the outgoing piece, reversed, ends at k
+            big = max(abs(k1), abs(k2))
+            if big > 0 and abs(k1 - k2) > g2_rel * big:
+                out.append(dict(base, point=k, kind="g2", value=abs(k1 - k2) / big))
+        a = analyze(r.curve)
+        for u in np.atleast_1d(a.inflection_params):
+            xy = np.asarray(r.curve(float(u)))
+            k = int(np.argmin(np.linalg.norm(P - xy, axis=1)))
+            out.append(dict(base, point=k, kind="inflection", value=float(u)))
+    return out
