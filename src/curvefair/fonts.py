@@ -164,8 +164,7 @@ def _filter_class() -> type:
     try:
         from ufo2ft.filters import BaseFilter
     except ImportError:  # pragma: no cover - the fonts extra installs it
-        raise MissingDependencyError("FairFilter needs ufo2ft: pip install 'curvefair[fonts]'"
-                                     ) from None
+        raise MissingDependencyError("ufo2ft", "fonts", "FairFilter") from None
 
     class FairFilter(BaseFilter):  # type: ignore[misc,valid-type]
         """ufo2ft filter: fair every glyph's contours within ``tol`` font units.

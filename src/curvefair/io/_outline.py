@@ -98,7 +98,9 @@ def smooth_angle(c: Contour, k: int) -> float | None:
 def _node_kinds(c: Contour) -> tuple[list[int], list[int], list[int]]:
     """(smooth nodes kept exactly smooth, corner nodes, points of straight segments)."""
     n = len(c.on)
-    smooth, corners, line = [], [], set()
+    smooth: list[int] = []
+    corners: list[int] = []
+    line: set[int] = set()
     for k in range(n):
         if not c.on[k]:
             continue

@@ -182,7 +182,7 @@ def _cff_contours(font: Any, name: str) -> list[Contour]:
     return [_binary_contour(np.array(p), o, False) for p, o, _ in walked]
 
 
-def _open_binary(path: object) -> Any:
+def _open_binary(path: Any) -> Any:
     _fonttools("OpenType/TrueType fonts")
     from fontTools.ttLib import TTFont
     try:
@@ -198,7 +198,7 @@ def _open_binary(path: object) -> Any:
     return font
 
 
-def _open_ufo(path: object) -> Any:
+def _open_ufo(path: Any) -> Any:
     ufoLib2 = _ufolib2("UFO sources")
     try:
         return ufoLib2.Font.open(os.fspath(path), lazy=True)  # type: ignore[arg-type]
@@ -206,7 +206,7 @@ def _open_ufo(path: object) -> Any:
         raise FileFormatError(f"not a UFO ufoLib2 can read ({exc})", path) from None
 
 
-def _open_glyphs(path: object) -> Any:
+def _open_glyphs(path: Any) -> Any:
     glyphsLib = lazy_import("glyphsLib", "glyphsLib", "fonts", "Glyphs sources")
     try:
         return glyphsLib.GSFont(os.fspath(path))  # type: ignore[arg-type]
@@ -240,7 +240,7 @@ def glyphs_contour(path: Any) -> Contour:
     return Contour(xy, on, smooth, bool(path.closed), quad, grid=grid)
 
 
-def _designspace_contours(path: object, glyphs: Sequence[str] | None
+def _designspace_contours(path: Any, glyphs: Sequence[str] | None
                           ) -> list[tuple[str, list[Contour]]]:
     """Every source UFO's contours, labelled ``"<glyph>@<source name>"``."""
     _fonttools("designspace documents")
@@ -268,7 +268,7 @@ def _glyph_order(names: Sequence[str], order: Sequence[str] | None) -> list[str]
     return first + sorted(g for g in names if g not in seen)
 
 
-def _select(names: list[str], glyphs: Sequence[str] | None, path: object) -> list[str]:
+def _select(names: list[str], glyphs: Sequence[str] | None, path: Any) -> list[str]:
     if glyphs is None:
         return names
     if isinstance(glyphs, str):
@@ -334,7 +334,7 @@ def glyph_contours(glyph: str, contours: Sequence[Contour | Exception], base: di
                    skip: Any, start: int = 0) -> list[CurveRecord]:
     """Records of one glyph's contours (contours of lines only are not records); ``glyph``
     may be ``"<glyph>@<master>"`` (a Glyphs source with several masters)."""
-    recs = []
+    recs: list[CurveRecord] = []
     label = glyph
     glyph, _, master = label.partition("@") if "@" in label and \
         base.get("format") in ("glyphs", "designspace") else (label, "", "")
@@ -530,7 +530,7 @@ def _cff_rewrite(cmds: list[tuple[str, list[Any]]], walked: list[Any],
     cur = np.zeros(2)
     out = []
 
-    def rel() -> list[int]:
+    def rel() -> list[float | int]:
         nonlocal cur
         p = next(it)
         d = p - cur
