@@ -94,6 +94,9 @@ def _pyplot_axes(n: int = 1, **kw: Any) -> Any:
 
 # Sampling -----------------------------------------------------------------------------------
 def _check_curve(curve: object, name: str) -> PiecewiseCurve:
+    from .interop import as_curve
+
+    curve = as_curve(curve, name)
     if not isinstance(curve, PiecewiseCurve):
         raise InputError(f"{name} must be a curvefair curve (PiecewiseCurve), "
                          f"got {type(curve).__name__}")
@@ -220,6 +223,71 @@ def _auto_scale(max_kappa: float, extent: float) -> float:
     if not np.isfinite(max_kappa) or max_kappa <= 0.0 or extent <= 0.0:
         return 1.0 if extent <= 0.0 else extent
     return 0.2 * extent / max_kappa
+
+
+def _weighted_quantile(values: FloatArray, weights: FloatArray, q: float) -> float:
+    """The ``q`` quantile of ``values`` weighted by ``weights`` (lower value at ties)."""
+    ok = np.isfinite(values) & np.isfinite(weights) & (weights >= 0)
+    v, w = values[ok], weights[ok]
+    if v.size == 0 or not np.any(w > 0):
+        return float(np.quantile(v, q)) if v.size else 0.0
+    order = np.argsort(v, kind="stable")
+    cw = np.cumsum(w[order])
+    i = int(np.searchsorted(cw, q * cw[-1], side="left"))
+    return float(v[order][min(i, v.size - 1)])
+
+
+def _length_weights(s: FloatArray) -> FloatArray:
+    """Arc length each sample stands for (half the gaps to its neighbours)."""
+    s = np.asarray(s, dtype=float).reshape(-1)
+    if s.size < 2:
+        return np.ones_like(s)
+    g = np.abs(np.diff(s))
+    return np.concatenate([[0.5 * g[0]], 0.5 * (g[:-1] + g[1:]), [0.5 * g[-1]]])
+
+
+def typical_curvature(kappas: Sequence[FloatArray], arclengths: Sequence[FloatArray],
+                      q: float = 0.9) -> tuple[float, float]:
+    """``(typical, max)`` of ``|kappa|``: its ``q`` quantile by arc length, and its maximum.
+
+    Weighted by arc length, not by sample, so densely sampled regions (an airfoil's leading
+    edge, where the points cluster) count by their length only.
+    """
+    k = np.concatenate([np.abs(np.asarray(a, dtype=float).reshape(-1)) for a in kappas])
+    w = np.concatenate([_length_weights(s) for s in arclengths])
+    fin = np.isfinite(k)
+    if not np.any(fin):
+        return 0.0, 0.0
+    return _weighted_quantile(k, w, q), float(np.max(k[fin]))
+
+
+#: A curvature peak more than this many times the typical (90 % by arc length) curvature makes
+#: the comb scale robust (clipped hairs) and the curvature axis symmetric-logarithmic.
+PEAK_RATIO = 20.0
+
+
+def robust_comb_scale(kappas: Sequence[FloatArray], arclengths: Sequence[FloatArray],
+                      extent: float) -> tuple[float, float | None]:
+    """Comb scale and hair clip length, robust to a curvature peak.
+
+    Without a dominant peak (``max |kappa| <= PEAK_RATIO`` times the typical curvature, the 90 %
+    quantile by arc length) the longest hair is a fifth of ``extent`` and nothing is clipped.
+    With one, hairs at 3 times the typical curvature are a fifth of ``extent`` and longer hairs
+    are drawn at the clip length ``extent / 5`` (so the leading edge of an airfoil does not
+    shrink the comb of the rest to nothing). Returns ``(scale, clip or None)``.
+    """
+    typical, kmax = typical_curvature(kappas, arclengths)
+    if kmax <= 0.0 or extent <= 0.0 or typical <= 0.0 or kmax <= PEAK_RATIO * typical:
+        return _auto_scale(kmax, extent), None
+    ref = 3.0 * typical
+    return 0.2 * extent / ref, 0.2 * extent
+
+
+def curvature_axis_mode(kappas: Sequence[FloatArray], arclengths: Sequence[FloatArray]) -> str:
+    """``"symlog"`` when the curvature (samples of one or more curves and their arc lengths)
+    has a dominant peak (see :data:`PEAK_RATIO`), else ``"linear"``."""
+    typical, kmax = typical_curvature(kappas, arclengths)
+    return "symlog" if typical > 0.0 and kmax > PEAK_RATIO * typical else "linear"
 
 
 def _extent(points: FloatArray) -> float:
@@ -380,7 +448,7 @@ def _prepare(curves: Sequence[PiecewiseCurve], names: Sequence[str], comb_densit
              markers: bool, n_bad: int) -> list[_Prepared]:
     out = []
     for c, name in zip(curves, names, strict=True):
-        _check_curve(c, name)
+        c = _check_curve(c, name)
         m = c.piecewise.n_segments
         fine = _sample(c, _density(None, m, "samples", _AUTO_SAMPLES, 64))
         comb = _sample(c, _density(comb_density, m, "comb_density", _AUTO_HAIRS, 40))
@@ -732,7 +800,7 @@ def plot_curvature(curve: PiecewiseCurve, ax: Any = None, *, markers: bool = Tru
         ax = _pyplot_axes()
     p = _prepare([curve], ["curve"], None, markers, n_bad)[0]
     _draw_curvature(ax, p, style=_MAIN, label=label, markers=markers)
-    _finish_curvature_axes(ax, curve.dim)
+    _finish_curvature_axes(ax, p.curve.dim)
     return ax
 
 
@@ -798,16 +866,10 @@ def plot_compare(before: PiecewiseCurve, after: PiecewiseCurve, axes: Any = None
 
 
 def _as_curve_list(x: Any, name: str) -> list[PiecewiseCurve]:
-    if isinstance(x, PiecewiseCurve):
-        return [x]
-    try:
-        items = list(x)
-    except TypeError:
-        raise InputError(f"{name} must be a curve or a sequence of curves, "
-                         f"got {type(x).__name__}") from None
-    if not items:
-        raise InputError(f"{name} is an empty sequence of curves")
-    return [_check_curve(c, f"{name}[{i}]") for i, c in enumerate(items)]
+    """One curve-like object (:func:`curvefair.as_curve`) or a list / tuple of them."""
+    from .view import _as_curves
+
+    return _as_curves(x, name)
 
 
 def figure(curve: PiecewiseCurve | Sequence[PiecewiseCurve],
