@@ -135,6 +135,13 @@ def _from_bspline(spl: Any, name: str, closed: bool | None) -> PiecewiseCurve:
     k = int(spl.k)
     c = np.asarray(spl.c, dtype=float)
     n = t.shape[0] - k - 1
+    axis = int(getattr(spl, "axis", 0))
+    if axis != 0 and c.ndim == 2:  # make_splprep: values come out as (dim, m)
+        f = spl
+        spl = BSpline(t, c, k, extrapolate=spl.extrapolate)
+        ref0 = lambda u, f=f: np.moveaxis(np.asarray(f(u), dtype=float), axis, 0)  # noqa: E731
+    else:
+        ref0 = spl
     if c.ndim == 1:
         if k < 1:
             raise InputError(f"{name}: a scalar spline of degree 0 is not a curve")
@@ -142,7 +149,7 @@ def _from_bspline(spl: Any, name: str, closed: bool | None) -> PiecewiseCurve:
         spl2 = BSpline(t, c2, k, extrapolate=spl.extrapolate)
         ref = _graph_reference(spl)
     elif c.ndim == 2 and c.shape[1] in (2, 3):
-        spl2, ref = spl, spl
+        spl2, ref = spl, ref0
     else:
         raise InputError(f"{name}: the spline's coefficients have shape {c.shape}; a curve "
                          "needs (n, 2) or (n, 3) (or (n,) for a graph y = f(x))")
@@ -194,6 +201,12 @@ def _from_ppoly(pp: Any, name: str, closed: bool | None) -> PiecewiseCurve:
 
     x = np.asarray(pp.x, dtype=float)
     c = np.asarray(pp.c, dtype=float)
+    if x.shape[0] >= 2 and np.all(np.diff(x) >= 0) and np.any(np.diff(x) == 0):
+        # empty intervals (PPoly.from_spline keeps the repeated end knots): no part of the curve
+        keep = np.diff(x) > 0
+        x = np.r_[x[:-1][keep], x[-1]]
+        c = c[:, keep]
+        pp = PPoly(c, x, extrapolate=pp.extrapolate)
     if x.shape[0] < 2 or np.any(np.diff(x) <= 0):
         raise InputError(f"{name}: the breakpoints must be strictly increasing")
     ref = pp
@@ -232,7 +245,13 @@ def _from_ppoly(pp: Any, name: str, closed: bool | None) -> PiecewiseCurve:
         raise InputError(f"{name}: the piecewise polynomial jumps at breakpoint {j} "
                          f"(x = {x[j]!r}); a curve must be continuous")
     xs = x
-    vals = [pp(xs, nu) for nu in range(min(k, 2) + 1)]
+    # data at the breakpoints: the power coefficients c_{k-nu} nu! of each segment's start
+    # (exact), and the last segment evaluated at its end
+    vals = []
+    for nu in range(min(k, 2) + 1):
+        start = c[k - nu] * float(np.prod(np.arange(1, nu + 1)))
+        end = _poly_derivative(c[:, -1], nu, x[-1] - x[-2])
+        vals.append(np.vstack([start, end[None, :]]))
     if closed is None:
         closed = bool(np.all([np.max(np.abs(v[0] - v[-1])) * (x[-1] - x[0])**nu <= 1e-12 * size
                               for nu, v in enumerate(vals[:max(1, k)])]))
