@@ -711,7 +711,8 @@ def plot_cmd(infile: str, other: str | None, out: str, comb_scale: float | None,
 
     corner = _corner(corner_angle, no_corners)
     with _user_errors():
-        curves = [r.curve for r in _read(infile, corner, strict, quiet)]
+        recs = _read(infile, corner, strict, quiet)
+        curves = [r.curve for r in recs]
         others = None if other is None else [r.curve for r in _read(other, corner, strict,
                                                                       quiet)]
     _check_comb(curves + (others or []), comb_scale, comb_density, no_comb)
@@ -720,6 +721,8 @@ def plot_cmd(infile: str, other: str | None, out: str, comb_scale: float | None,
         fig = figure(curves, compare=others, labels=labels, tol=tol, comb=not no_comb,
                      comb_scale=comb_scale, comb_density=comb_density, markers=not no_markers,
                      projection=projection,  # type: ignore[arg-type]
+                     names=[_record_label(r, i) for i, r in enumerate(recs)],
+                     y_down=_format_of(infile) == "svg",
                      title=title if title is not None else
                      (f"{labels[0]} vs {labels[1]}" if other else labels[0]))
         _save_figure(fig, out)
