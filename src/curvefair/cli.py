@@ -768,9 +768,13 @@ def view_cmd(infile: str, other: str | None, out: str, tol: float | None,
             report = json.loads(Path(report_path).read_text(encoding="utf-8"))
         except (OSError, UnicodeDecodeError, ValueError) as exc:
             raise InputFailure(f"--report {report_path!r}: not a JSON file ({exc})") from None
-        if tol is None and isinstance(report, dict) and isinstance(report.get("tol"),
-                                                                    (int, float)):
-            tol = float(report["tol"]) if report["tol"] > 0 else None
+        if tol is None and isinstance(report, dict):
+            # a run report (curvefair fair --report) holds it in "options", a fair() report
+            # at the top
+            opts = report.get("options")
+            t = report.get("tol", opts.get("tol") if isinstance(opts, dict) else None)
+            if isinstance(t, (int, float)) and not isinstance(t, bool) and t > 0:
+                tol = float(t)
     with _user_errors():
         recs = _read(infile, corner, strict, quiet)
         others = None if other is None else [r.curve for r in _read(other, corner, strict,
