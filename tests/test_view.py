@@ -126,3 +126,47 @@ def test_repr_html_small_for_large_curves():
     r = fair(c, tol=0.01)
     hr = r._repr_html_()
     assert repr(r.report["max_deviation"]) in hr and "<svg" in hr
+
+
+DATA = __import__("pathlib").Path(__file__).parent / "data" / "real"
+
+
+def _circumcurvature(p):
+    """Curvature of the circle through each three consecutive points (independent of any
+    spline): 4 * area / (a b c)."""
+    a = np.linalg.norm(p[1:-1] - p[:-2], axis=1)
+    b = np.linalg.norm(p[2:] - p[1:-1], axis=1)
+    c = np.linalg.norm(p[2:] - p[:-2], axis=1)
+    u, v = p[1:-1] - p[:-2], p[2:] - p[:-2]
+    area2 = np.abs(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0])
+    return 2 * area2 / (a * b * c), 0.5 * (a + b)
+
+
+def test_real_airfoil_leading_edge_gets_log_axis_and_clipped_comb():
+    from curvefair import read_curves
+    from curvefair.plot import typical_curvature
+
+    recs = read_curves(DATA / "uiuc" / "e387.dat")
+    k, w = _circumcurvature(np.asarray(recs[0].points))
+    # independent: the nose curvature is far above the typical (length-weighted) curvature
+    order = np.argsort(k)
+    cw = np.cumsum(w[order])
+    k90 = k[order][np.searchsorted(cw, 0.9 * cw[-1])]
+    assert k.max() > 20 * k90
+    assert typical_curvature([k], [np.cumsum(w)])[1] == k.max()
+    d = page_data(recs)
+    assert d["kappa_mode"] == "symlog"
+    assert d["comb_clip"] is not None
+
+
+@pytest.mark.filterwarnings("ignore:.*unsupported Arc segment")
+def test_cli_view_real_svg_is_y_down(tmp_path):
+    from curvefair import read_curves
+
+    src = DATA / "svgpathtools" / "test.svg"
+    n = len(read_curves(src, on_unsupported="skip"))
+    page = tmp_path / "svg.html"
+    res = CliRunner().invoke(main, ["view", str(src), "-o", str(page), "-q"])
+    assert res.exit_code == 0, res.output
+    d = _page_json(page.read_text())
+    assert d["y_down"] is True and len(d["curves"]) == n

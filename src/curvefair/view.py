@@ -648,10 +648,13 @@ function drawPlots(){
   if (mode === "symlog") {
     for (const sgn of [-1, 1]) for (let e = -12; e <= 12; e++) {
       const k = sgn * Math.pow(10, e); const v = f(k);
-      if (v >= ylo && v <= yhi && Math.abs(k) >= scale) ticks.push([v, (sgn < 0 ? "-" : "") + "1e" + e]);
+      if (v >= ylo && v <= yhi && Math.abs(k) >= scale)
+        ticks.push([v, (sgn < 0 ? "-" : "") + "1e" + e]);
     }
     ticks.push([0, "0"]);
-  } else { for (let j = 0; j <= 4; j++) { const v = ylo + (yhi - ylo) * j / 4; ticks.push([v, fmt(v)]); } }
+  } else {
+    for (let j = 0; j <= 4; j++) { const v = ylo + (yhi - ylo) * j / 4; ticks.push([v, fmt(v)]); }
+  }
   axes(kp, W, H, L, B, [0, smax], [ylo, yhi],
        "curvature κ" + (D.dim === 2 ? " (signed)" : "") +
        (mode === "symlog" ? ", symmetric log (linear below " + fmt(scale) + ")" :
@@ -673,7 +676,8 @@ function drawPlots(){
   const sm = ds[ds.length - 1] || 1;
   const dt = []; for (let j = 0; j <= 4; j++) dt.push([dtop * j / 4, fmt(dtop * j / 4)]);
   axes(dp, W, H2, L, B, [0, sm], [0, dtop],
-       (dv.parametric ? "deviation |after(t) − before(t)|" : "distance to the nearest point of before"),
+       (dv.parametric ? "deviation |after(t) − before(t)|"
+                      : "distance to the nearest point of before"),
        "arc length s (after)", dt);
   polyline(dp, ds, dv.d, [0, sm], [0, dtop], W, H2, L, B,
            {"class": "dcurve", stroke: "#1f4e79", "stroke-width": 1.4});
@@ -684,7 +688,8 @@ function drawPlots(){
   }
   const mx = L + (W - 8 - L) * dv.max_s / sm;
   el("circle", {id: "dev-max", cx: mx, cy: yof(dv.max), r: 4.5, fill: "#c92a2a"}, dp);
-  const lab = el("text", {id: "dev-max-label", x: Math.min(mx + 8, W - 260), y: Math.max(yof(dv.max) + 4, 22),
+  const lab = el("text", {id: "dev-max-label", x: Math.min(mx + 8, W - 260),
+                          y: Math.max(yof(dv.max) + 4, 22),
                           "class": "tick", fill: "#c92a2a"}, dp);
   lab.textContent = "max " + exact(dv.max) + " at s = " + fmt(dv.max_s);
   cap.textContent = "max deviation " + exact(dv.max) +
@@ -693,13 +698,15 @@ function drawPlots(){
 }
 function setFocus(i){
   focus = i;
-  list.querySelectorAll("li").forEach((li) => li.classList.toggle("focus", +li.dataset.curve === i));
+  list.querySelectorAll("li").forEach(
+    (li) => li.classList.toggle("focus", +li.dataset.curve === i));
   drawPlots();
 }
 // ---- report
 const rep = document.getElementById("report");
 if (D.report) rep.textContent = JSON.stringify(D.report, null, 1);
-else rep.textContent = JSON.stringify(C.map((c) => Object.assign({name: c.name}, c.summary)), null, 1);
+else rep.textContent = JSON.stringify(
+  C.map((c) => Object.assign({name: c.name}, c.summary)), null, 1);
 fitView(); setFocus(0);
 document.body.dataset.ready = "1";
 })();
