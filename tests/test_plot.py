@@ -314,7 +314,7 @@ def test_figure_several_curves_share_axes():
     x = np.linspace(0, 3, 10)
     c1 = interpolate_cubic(np.c_[x, np.sin(x)])
     c2 = interpolate_cubic(np.c_[x + 4, np.cos(x)])
-    fig = cfplot.figure([c1, c2])
+    fig = cfplot.figure([c1, c2], panels="overlay")
     ax_c, ax_k = fig.axes
     assert len(collections_with_gid(ax_c, "curvefair-comb-hairs")) == 2
     lines = lines_with_gid(ax_k, "curvefair-curvature")
@@ -338,3 +338,124 @@ def test_missing_matplotlib_raises_missing_dependency(monkeypatch):
         cfplot.plot_curve(c)
     # the comb itself needs no matplotlib
     assert cfplot.curvature_comb(c).base.shape[1] == 2
+
+
+# issue 17: panels per curve, robust comb, curvature axis, orientation, exact labels ----------
+def _airfoil_like(n=61):
+    """A NACA 0012-like closed section with points clustered at the leading edge: its
+    curvature there (about 1 / (1.1 t^2) for the rounded nose) is ~100x that of the rest."""
+    beta = np.linspace(0.0, np.pi, n)
+    x = 0.5 * (1 - np.cos(beta))
+    t = 0.12
+    y = 5 * t * (0.2969 * np.sqrt(x) - 0.126 * x - 0.3516 * x**2 + 0.2843 * x**3
+                 - 0.1036 * x**4)
+    upper = np.c_[x[::-1], y[::-1]]
+    lower = np.c_[x[1:], -y[1:]]
+    return np.vstack([upper, lower])
+
+
+def test_grid_one_cell_per_curve_with_titles():
+    x = np.linspace(0, 3, 10)
+    cs = [interpolate_cubic(np.c_[x + 4 * i, np.sin(x + i)]) for i in range(5)]
+    fig = cfplot.figure(cs, names=[f"station {i}" for i in range(5)])
+    assert len(fig.axes) == 2 * 5
+    curve_axes = [a for a in fig.axes if lines_with_gid(a, "curvefair-curve")]
+    assert len(curve_axes) == 5
+    assert [a.get_title(loc="left") for a in curve_axes] == [f"station {i}" for i in range(5)]
+    # each panel shows its own curve: x limits hold that curve's x range only
+    for i, a in enumerate(curve_axes):
+        lo, hi = a.get_xlim()
+        assert lo <= 4 * i + 0.0 and hi >= 4 * i + 3.0
+        assert hi - lo < 6.0
+    fig2 = cfplot.figure(cs, compare=cs, tol=0.1)
+    assert len(fig2.axes) == 3 * 5
+    assert len(cfplot.figure(cs, panels="overlay").axes) == 2
+
+
+def test_leading_edge_curvature_axis_symlog_and_robust_comb():
+    c = interpolate_cubic(_airfoil_like())
+    _, ax = new_ax()
+    cfplot.plot_curvature(c, ax)
+    assert ax.get_yscale() == "symlog"
+    # the peak (independent estimate: finite differences on the data, ~ 1 / nose radius)
+    # is more than PEAK_RATIO times the curvature over most of the length
+    t0, t1 = c.domain
+    u = np.linspace(t0, t1, 20001)
+    k_fd = np.linalg.norm(fd_kappa_vector(c, u[1:-1], h=1e-6 * (t1 - t0)), axis=1)
+    assert k_fd.max() > cfplot.PEAK_RATIO * np.quantile(k_fd, 0.5)
+    lin = ax.yaxis.get_transform().linthresh
+    assert 0 < lin < k_fd.max() / 10
+    # a circle: linear axis
+    tt = np.linspace(0, np.pi, 20)
+    _, ax2 = new_ax()
+    cfplot.plot_curvature(interpolate_cubic(np.c_[np.cos(tt), np.sin(tt)]), ax2)
+    assert ax2.get_yscale() == "linear"
+    _, ax3 = new_ax()
+    cfplot.plot_curvature(c, ax3, kappa_scale="clip")
+    assert ax3.get_ylim()[1] < k_fd.max() / 5
+    # robust comb: hairs clipped at a fifth of the extent, most hairs still visible
+    _, ax4 = new_ax()
+    cfplot.plot_curve(c, ax4, markers=False)
+    segs = collections_with_gid(ax4, "curvefair-comb-hairs")[0].get_segments()
+    length = np.array([np.linalg.norm(s[1] - s[0]) for s in segs])
+    extent = np.ptp(c.sample(4000), axis=0).max()
+    assert length.max() <= 0.2 * extent * (1 + 1e-4)
+    # scaled by the maximum curvature, the typical hair would be 0.2 extent median(k) / max(k)
+    assert np.median(length) > 3 * 0.2 * extent * np.median(k_fd) / k_fd.max()
+    assert any("clipped at" in t.get_text() for t in ax4.texts)
+
+
+def test_exact_text_never_hides_digits():
+    assert cfplot.exact_text(1.0013e-4) == "0.00010013"
+    assert cfplot.exact_text(1.0000001e-4, 1e-4) != "0.0001"
+    assert float(cfplot.exact_text(1.0000001e-4, 1e-4)) > 1e-4
+    assert float(cfplot.exact_text(0.99999999e-4, 1e-4)) < 1e-4
+    assert cfplot.exact_text(1e-4, 1e-4) == "0.0001"
+
+
+def test_deviation_label_is_exact():
+    pts = example1()
+    moved = pts.copy()
+    moved[3] += (0.0, 1.0013e-4)
+    a = interpolate_cubic(pts)
+    b = interpolate_cubic(moved, param=a.params)  # same parameters: parametric deviation
+    fig = cfplot.figure(a, compare=b, tol=1e-4)
+    ax_d = fig.axes[2]
+    t0, t1 = a.domain
+    u = np.linspace(t0, t1, 200001)
+    brute = np.linalg.norm(b(u) - a(u), axis=1).max()
+    texts = [t.get_text() for t in ax_d.texts] + [t.get_text() for t in ax_d.get_children()
+                                                   if hasattr(t, "get_text")]
+    label = next(t for t in texts if t.startswith("max deviation"))
+    shown = float(label.split()[-1])
+    assert shown == pytest.approx(brute, rel=1e-4)
+    assert shown > 1e-4  # above the tolerance, and the text says so
+    assert ax_d.get_legend().get_texts()[0].get_text() == "tolerance 0.0001"
+
+
+def test_svg_y_down_and_3d_stations_face_on():
+    x = np.linspace(0, 3, 10)
+    c = interpolate_cubic(np.c_[x, np.sin(x)])
+    _, ax = new_ax()
+    cfplot.plot_curve(c, ax, y_down=True)
+    assert ax.yaxis_inverted()
+    _, ax = new_ax()
+    cfplot.plot_curve(c, ax)
+    assert not ax.yaxis_inverted()
+    # hull stations: planar sections x = const, spread along x; seen along x (face-on)
+    th = np.linspace(-1.4, 1.4, 15)
+    stations = [interpolate_cubic(np.c_[np.full(th.size, xs), (1 + 0.1 * xs) * np.sin(th),
+                                        -np.cos(th) * (1 + 0.05 * xs)])
+                for xs in np.linspace(0.0, 30.0, 6)]
+    fig = cfplot.figure(stations, panels="overlay", markers=False, comb=False)
+    ax_c = fig.axes[0]
+    drawn = lines_with_gid(ax_c, "curvefair-curve")
+    # face-on: each drawn station is congruent with its y-z section (same area-like extents);
+    # edge-on it would collapse to a line
+    for ln, st in zip(drawn, stations, strict=True):
+        xy = ln.get_xydata()
+        yz = st.sample(xy.shape[0])[:, 1:]
+        assert np.ptp(xy, axis=0).min() > 0.5 * np.ptp(yz, axis=0).min()
+        d_drawn = np.linalg.norm(xy[0] - xy[-1])
+        d_true = np.linalg.norm(yz[0] - yz[-1])
+        assert d_drawn == pytest.approx(d_true, rel=1e-9)

@@ -30,6 +30,7 @@ from .analysis import (Analysis, Deviation, analyze, curvature,  # noqa: I001
 from . import steps  # noqa: I001
 from .fairing import FairingResult, fair  # noqa: I001
 from .fairing.pipeline import PointFairingResult, fair_points  # noqa: I001
+from .interop import as_curve  # noqa: I001
 
 __all__ = [
     "energy",
@@ -43,6 +44,7 @@ __all__ = [
     "fair",
     "FairingResult",
     "fair_points",
+    "as_curve",
     "PointFairingResult",
     "steps",
     "read_curves",

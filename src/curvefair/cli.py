@@ -46,6 +46,7 @@ Examples:
   curvefair analyze profile.csv
   curvefair analyze part.dxf --json > analysis.json
   curvefair plot profile.csv --compare profile_faired.csv -o compare.svg
+  curvefair view profile.csv --compare profile_faired.csv -o compare.html
   curvefair methods
 """
 
@@ -712,7 +713,8 @@ def plot_cmd(infile: str, other: str | None, out: str, comb_scale: float | None,
 
     corner = _corner(corner_angle, no_corners)
     with _user_errors():
-        curves = [r.curve for r in _read(infile, corner, strict, quiet)]
+        recs = _read(infile, corner, strict, quiet)
+        curves = [r.curve for r in recs]
         others = None if other is None else [r.curve for r in _read(other, corner, strict,
                                                                       quiet)]
     _check_comb(curves + (others or []), comb_scale, comb_density, no_comb)
@@ -721,9 +723,73 @@ def plot_cmd(infile: str, other: str | None, out: str, comb_scale: float | None,
         fig = figure(curves, compare=others, labels=labels, tol=tol, comb=not no_comb,
                      comb_scale=comb_scale, comb_density=comb_density, markers=not no_markers,
                      projection=projection,  # type: ignore[arg-type]
+                     names=[_record_label(r, i) for i, r in enumerate(recs)],
+                     y_down=_format_of(infile) == "svg",
                      title=title if title is not None else
                      (f"{labels[0]} vs {labels[1]}" if other else labels[0]))
         _save_figure(fig, out)
+    if not quiet:
+        click.echo(f"wrote {out}")
+
+
+# ------------------------------------------------------------------------------------------
+# view
+# ------------------------------------------------------------------------------------------
+@main.command("view")
+@click.argument("infile", metavar="IN", type=click.Path(exists=True, dir_okay=False))
+@click.option("--compare", "other", metavar="OTHER",
+              type=click.Path(exists=True, dir_okay=False),
+              help="A second file with as many curves (e.g. the faired one): before/after "
+                   "toggle and the deviation along each curve.")
+@click.option("-o", "--output", "out", metavar="PAGE.html", required=True,
+              help="The HTML page to write (self-contained: opens from disk, no network).")
+@click.option("--tol", type=click.FloatRange(0, min_open=True), metavar="T",
+              help="Tolerance shown on the deviation plot [default: the report's tol].")
+@click.option("--report", "report_path", metavar="REPORT.json",
+              type=click.Path(exists=True, dir_okay=False),
+              help="A fairing report (curvefair fair --report) shown on the page.")
+@click.option("--title", help="Page title [default: the file name(s)].")
+@_reading_options
+@_quiet_option
+def view_cmd(infile: str, other: str | None, out: str, tol: float | None,
+             report_path: str | None, title: str | None, corner_angle: float,
+             no_corners: bool, strict: bool, quiet: bool) -> None:
+    """Write an interactive HTML page of the curves of IN: combs, curvature, deviation."""
+    _check_outputs([(infile, "IN")] + ([(other, "--compare")] if other else [])
+                   + ([(report_path, "--report")] if report_path else []),
+                   [(out, "-o/--output")])
+    if Path(out).suffix.lower() not in (".html", ".htm"):
+        raise click.BadParameter(f"{out!r}: the page is HTML; give a .html file name",
+                                 param_hint="-o/--output")
+    from .view import write_html
+
+    corner = _corner(corner_angle, no_corners)
+    report = None
+    if report_path is not None:
+        try:
+            report = json.loads(Path(report_path).read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, ValueError) as exc:
+            raise InputFailure(f"--report {report_path!r}: not a JSON file ({exc})") from None
+        if tol is None and isinstance(report, dict):
+            # a run report (curvefair fair --report) holds it in "options", a fair() report
+            # at the top
+            opts = report.get("options")
+            t = report.get("tol", opts.get("tol") if isinstance(opts, dict) else None)
+            if isinstance(t, (int, float)) and not isinstance(t, bool) and t > 0:
+                tol = float(t)
+    with _user_errors():
+        recs = _read(infile, corner, strict, quiet)
+        others = None if other is None else [r.curve for r in _read(other, corner, strict,
+                                                                      quiet)]
+        if others is not None and len(others) != len(recs):
+            raise InputFailure(f"--compare {other!r} has {len(others)} curves but {infile!r} "
+                               f"has {len(recs)}; they are paired in order")
+        labels = (Path(infile).name, Path(other).name if other else "")
+        write_html(out, [r.curve for r in recs], others,
+                   names=[_record_label(r, i) for i, r in enumerate(recs)], tol=tol,
+                   report=report, y_down=_format_of(infile) == "svg",
+                   title=title if title is not None else
+                   (f"{labels[0]} vs {labels[1]}" if other else labels[0]))
     if not quiet:
         click.echo(f"wrote {out}")
 

@@ -94,6 +94,9 @@ def _pyplot_axes(n: int = 1, **kw: Any) -> Any:
 
 # Sampling -----------------------------------------------------------------------------------
 def _check_curve(curve: object, name: str) -> PiecewiseCurve:
+    from .interop import as_curve
+
+    curve = as_curve(curve, name)
     if not isinstance(curve, PiecewiseCurve):
         raise InputError(f"{name} must be a curvefair curve (PiecewiseCurve), "
                          f"got {type(curve).__name__}")
@@ -222,6 +225,71 @@ def _auto_scale(max_kappa: float, extent: float) -> float:
     return 0.2 * extent / max_kappa
 
 
+def _weighted_quantile(values: FloatArray, weights: FloatArray, q: float) -> float:
+    """The ``q`` quantile of ``values`` weighted by ``weights`` (lower value at ties)."""
+    ok = np.isfinite(values) & np.isfinite(weights) & (weights >= 0)
+    v, w = values[ok], weights[ok]
+    if v.size == 0 or not np.any(w > 0):
+        return float(np.quantile(v, q)) if v.size else 0.0
+    order = np.argsort(v, kind="stable")
+    cw = np.cumsum(w[order])
+    i = int(np.searchsorted(cw, q * cw[-1], side="left"))
+    return float(v[order][min(i, v.size - 1)])
+
+
+def _length_weights(s: FloatArray) -> FloatArray:
+    """Arc length each sample stands for (half the gaps to its neighbours)."""
+    s = np.asarray(s, dtype=float).reshape(-1)
+    if s.size < 2:
+        return np.ones_like(s)
+    g = np.abs(np.diff(s))
+    return np.concatenate([[0.5 * g[0]], 0.5 * (g[:-1] + g[1:]), [0.5 * g[-1]]])
+
+
+def typical_curvature(kappas: Sequence[FloatArray], arclengths: Sequence[FloatArray],
+                      q: float = 0.9) -> tuple[float, float]:
+    """``(typical, max)`` of ``|kappa|``: its ``q`` quantile by arc length, and its maximum.
+
+    Weighted by arc length, not by sample, so densely sampled regions (an airfoil's leading
+    edge, where the points cluster) count by their length only.
+    """
+    k = np.concatenate([np.abs(np.asarray(a, dtype=float).reshape(-1)) for a in kappas])
+    w = np.concatenate([_length_weights(s) for s in arclengths])
+    fin = np.isfinite(k)
+    if not np.any(fin):
+        return 0.0, 0.0
+    return _weighted_quantile(k, w, q), float(np.max(k[fin]))
+
+
+#: A curvature peak more than this many times the typical (90 % by arc length) curvature makes
+#: the comb scale robust (clipped hairs) and the curvature axis symmetric-logarithmic.
+PEAK_RATIO = 20.0
+
+
+def robust_comb_scale(kappas: Sequence[FloatArray], arclengths: Sequence[FloatArray],
+                      extent: float) -> tuple[float, float | None]:
+    """Comb scale and hair clip length, robust to a curvature peak.
+
+    Without a dominant peak (``max |kappa| <= PEAK_RATIO`` times the typical curvature, the 90 %
+    quantile by arc length) the longest hair is a fifth of ``extent`` and nothing is clipped.
+    With one, hairs at 3 times the typical curvature are a fifth of ``extent`` and longer hairs
+    are drawn at the clip length ``extent / 5`` (so the leading edge of an airfoil does not
+    shrink the comb of the rest to nothing). Returns ``(scale, clip or None)``.
+    """
+    typical, kmax = typical_curvature(kappas, arclengths)
+    if kmax <= 0.0 or extent <= 0.0 or typical <= 0.0 or kmax <= PEAK_RATIO * typical:
+        return _auto_scale(kmax, extent), None
+    ref = 3.0 * typical
+    return 0.2 * extent / ref, 0.2 * extent
+
+
+def curvature_axis_mode(kappas: Sequence[FloatArray], arclengths: Sequence[FloatArray]) -> str:
+    """``"symlog"`` when the curvature (samples of one or more curves and their arc lengths)
+    has a dominant peak (see :data:`PEAK_RATIO`), else ``"linear"``."""
+    typical, kmax = typical_curvature(kappas, arclengths)
+    return "symlog" if typical > 0.0 and kmax > PEAK_RATIO * typical else "linear"
+
+
 def _extent(points: FloatArray) -> float:
     pts = points[np.all(np.isfinite(points), axis=1)]
     if pts.size == 0:
@@ -317,6 +385,40 @@ def _s_at(curve: PiecewiseCurve, smp: _Samples, u: FloatArray) -> FloatArray:
 
 
 # Projection ---------------------------------------------------------------------------------
+#: Curves whose best-fit planes are this flat (smallest / largest singular value) and whose
+#: normals agree to within this angle are drawn in their common plane.
+_PLANAR = 1e-3
+_PARALLEL_DEG = 10.0
+
+
+def _common_normal(dense_points: list[FloatArray]) -> FloatArray | None:
+    """The mean normal of several planar 3-D curves lying in parallel planes, else None.
+
+    Each curve's plane is its least-squares plane (SVD of its centred samples); it is planar
+    when its smallest singular value is at most ``_PLANAR`` times its largest. With two or more
+    curves, all planar and all normals within ``_PARALLEL_DEG`` degrees, their mean normal is
+    the viewing direction (hull stations, each in its own plane x = const, are seen face-on,
+    rather than edge-on as the best-fit plane of all of them together would show them).
+    """
+    if len(dense_points) < 2:
+        return None
+    normals = []
+    for p in dense_points:
+        p = p[np.all(np.isfinite(p), axis=1)]
+        if p.shape[0] < 3:
+            return None
+        _, sv, vt = np.linalg.svd(p - p.mean(axis=0), full_matrices=False)
+        if sv.size < 3 or not sv[0] > 0 or sv[2] > _PLANAR * sv[0] or sv[1] <= _PLANAR * sv[0]:
+            return None
+        normals.append(vt[2])
+    n0 = normals[0]
+    aligned = np.array([n if n @ n0 >= 0 else -n for n in normals])
+    if np.min(aligned @ n0) < math.cos(math.radians(_PARALLEL_DEG)):
+        return None
+    m = aligned.mean(axis=0)
+    return m / np.linalg.norm(m)
+
+
 class _Projector:
     """Maps 2-D or 3-D points to plot coordinates."""
 
@@ -342,7 +444,13 @@ class _Projector:
         pts = np.vstack(dense_points)
         pts = pts[np.all(np.isfinite(pts), axis=1)]
         self.origin = pts.mean(axis=0)
-        _, _, vt = np.linalg.svd(pts - self.origin, full_matrices=False)
+        normal = _common_normal(dense_points)
+        if normal is not None:  # parallel planar curves (hull stations): seen face-on
+            flat = (pts - self.origin) - np.outer((pts - self.origin) @ normal, normal)
+            _, _, vt = np.linalg.svd(flat, full_matrices=False)
+            vt = np.vstack([vt[0], np.cross(normal, vt[0])])
+        else:
+            _, _, vt = np.linalg.svd(pts - self.origin, full_matrices=False)
         e1, e2 = vt[0], vt[1]
         # deterministic orientation: largest component of e1 positive, normal towards +z (or +x)
         e1 = e1 * np.sign(e1[np.argmax(np.abs(e1))])
@@ -351,7 +459,9 @@ class _Projector:
             e2 = -e2
         self.basis = np.column_stack([e1, e2])
         self.labels = ("u (best-fit plane)", "v (best-fit plane)")
-        self.note = "3-D curve, projected onto its best-fit plane"
+        self.note = ("3-D curves, seen along their planes' common normal "
+                     f"({', '.join(f'{v:.3g}' for v in np.cross(e1, e2))})"
+                     if normal is not None else "3-D curve, projected onto its best-fit plane")
 
     def __call__(self, pts: FloatArray) -> FloatArray:
         if self.dim == 2:
@@ -380,7 +490,7 @@ def _prepare(curves: Sequence[PiecewiseCurve], names: Sequence[str], comb_densit
              markers: bool, n_bad: int) -> list[_Prepared]:
     out = []
     for c, name in zip(curves, names, strict=True):
-        _check_curve(c, name)
+        c = _check_curve(c, name)
         m = c.piecewise.n_segments
         fine = _sample(c, _density(None, m, "samples", _AUTO_SAMPLES, 64))
         comb = _sample(c, _density(comb_density, m, "comb_density", _AUTO_HAIRS, 40))
@@ -390,12 +500,16 @@ def _prepare(curves: Sequence[PiecewiseCurve], names: Sequence[str], comb_densit
 
 
 def _joint_scale(prepared: list[_Prepared], comb_scale: object) -> float:
+    return _joint_scale_clip(prepared, comb_scale)[0]
+
+
+def _joint_scale_clip(prepared: list[_Prepared], comb_scale: object) -> tuple[float, float | None]:
+    """``(scale, clip)``: the given scale (no clip), or :func:`robust_comb_scale`."""
     if comb_scale is not None:
-        return float(as_positive(comb_scale, "comb_scale", window=True))  # type: ignore[arg-type]
-    kmax = max((float(np.nanmax(np.abs(p.comb.kappa))) for p in prepared
-                if np.any(np.isfinite(p.comb.kappa))), default=0.0)
+        return float(as_positive(comb_scale, "comb_scale", window=True)), None  # type: ignore
     extent = _extent(np.vstack([p.fine.flat("r") for p in prepared]))
-    return _auto_scale(kmax, extent)
+    return robust_comb_scale([p.comb.flat("kappa") for p in prepared],
+                             [p.comb.flat("s") for p in prepared], extent)
 
 
 def _projector(prepared: list[_Prepared], projection: str) -> _Projector:
@@ -405,7 +519,7 @@ def _projector(prepared: list[_Prepared], projection: str) -> _Projector:
 # Drawing ------------------------------------------------------------------------------------
 def _draw_curve(ax: Any, p: _Prepared, proj: _Projector, *, comb: bool, scale: float,
                 markers: bool, style: dict[str, str], label: str | None, points: bool,
-                ref: bool = False, bad_labels: bool = True) -> None:
+                ref: bool = False, bad_labels: bool = True, clip: float | None = None) -> None:
     mpl = _mpl()
     LineCollection = mpl.collections.LineCollection
     xy = proj(p.fine.flat("r"))
@@ -413,7 +527,12 @@ def _draw_curve(ax: Any, p: _Prepared, proj: _Projector, *, comb: bool, scale: f
             ls="--" if ref else "-", label=label, zorder=3 if ref else 4, gid=_GID_CURVE)
     if comb:
         base = proj(p.comb.r)  # (m, k, 2)
-        tip = base - scale * proj.vec(p.comb.kvec)
+        hair = -scale * proj.vec(p.comb.kvec)
+        if clip is not None:  # longer hairs drawn at the clip length
+            ln = np.linalg.norm(hair, axis=-1)
+            over = ln > clip
+            hair[over] *= (clip / ln[over])[..., None]
+        tip = base + hair
         fin = np.all(np.isfinite(tip), axis=-1)
         segs = np.stack([base[fin], tip[fin]], axis=1)
         ax.add_collection(LineCollection(segs, colors=style["hair"], linewidths=0.6,
@@ -489,9 +608,13 @@ def _prime(order: int) -> str:
 
 
 def _finish_curve_axes(ax: Any, prepared: list[_Prepared], proj: _Projector, scale: float,
-                       comb: bool, markers: bool, extra_handles: list[Any] | None = None) -> None:
+                       comb: bool, markers: bool, extra_handles: list[Any] | None = None,
+                       clip: float | None = None, y_down: bool = False,
+                       legend: bool = True) -> None:
     ax.set_aspect("equal", adjustable="datalim")
     ax.autoscale_view()
+    if y_down and proj.dim == 2 and not ax.yaxis_inverted():
+        ax.invert_yaxis()
     ax.set_xlabel(proj.labels[0])
     ax.set_ylabel(proj.labels[1])
     ax.grid(True, lw=0.4, alpha=0.4)
@@ -504,11 +627,14 @@ def _finish_curve_axes(ax: Any, prepared: list[_Prepared], proj: _Projector, sca
             "bad": any(p.feats.bad for p in prepared),
             "bad_order": _common_order(prepared),
         })
-    if handles:
+    if handles and legend:
         ax.legend(handles=handles, loc="best", fontsize=8, framealpha=0.85)
     notes = []
     if comb:
-        notes.append(f"comb: hair = {scale:.3g} × κ")
+        notes.append(f"comb: hair = {scale:.3g} × κ"
+                     + (f", clipped at {clip:.3g}" if clip is not None else ""))
+    if y_down and proj.dim == 2:
+        notes.append("y axis down (as in the file)")
     if proj.note:
         notes.append(proj.note)
     if notes:
@@ -549,10 +675,45 @@ def _kappa_at(curve: PiecewiseCurve, u: FloatArray) -> FloatArray:
     return np.asarray(curvature(curve, u), dtype=float).reshape(-1)
 
 
-def _finish_curvature_axes(ax: Any, dim: int) -> None:
+KappaScale = Literal["auto", "linear", "symlog", "clip"]
+KAPPA_SCALES = ("auto", "linear", "symlog", "clip")
+
+
+def _set_kappa_scale(ax: Any, prepared: Sequence[_Prepared], mode: str) -> str:
+    """Apply the curvature axis scale; returns the mode used.
+
+    ``"auto"``: :func:`curvature_axis_mode`. ``"symlog"``: matplotlib's symmetric log scale,
+    linear within the median ``|kappa|`` (by arc length). ``"clip"``: the axis limited to
+    1.5 times the 95 % quantile of ``|kappa|`` by arc length (the peak runs off the axis; the
+    label gives its value).
+    """
+    choice(mode, KAPPA_SCALES, "kappa_scale")
+    ks = [p.fine.flat("kappa") for p in prepared]
+    ss = [p.fine.flat("s") for p in prepared]
+    if mode == "auto":
+        mode = curvature_axis_mode(ks, ss)
+    if mode == "symlog":
+        med, kmax = typical_curvature(ks, ss, 0.5)
+        lin = med if med > 0 else (kmax / 1e3 if kmax > 0 else 1.0)
+        ax.set_yscale("symlog", linthresh=lin)
+    elif mode == "clip":
+        q95, kmax = typical_curvature(ks, ss, 0.95)
+        lim = 1.5 * q95
+        if lim > 0 and kmax > lim:
+            signed = bool(np.nanmin(np.concatenate(ks)) < 0)
+            ax.set_ylim(-lim if signed else -0.05 * lim, lim)
+            ax.text(0.99, 0.98, f"clipped at ±{lim:.3g} (max |κ| {kmax:.4g})",
+                    transform=ax.transAxes, ha="right", va="top", fontsize=7.5, color="0.35")
+    return mode
+
+
+def _finish_curvature_axes(ax: Any, dim: int, prepared: Sequence[_Prepared] = (),
+                           kappa_scale: str = "linear") -> None:
     ax.axhline(0.0, color="0.6", lw=0.7, zorder=1)
     ax.set_xlabel("arc length s")
-    ax.set_ylabel("curvature κ (signed)" if dim == 2 else "curvature κ")
+    mode = _set_kappa_scale(ax, prepared, kappa_scale) if prepared else "linear"
+    ylab = "curvature κ (signed)" if dim == 2 else "curvature κ"
+    ax.set_ylabel(ylab + (", symlog" if mode == "symlog" else ""))
     ax.grid(True, lw=0.4, alpha=0.4)
     ax.margins(x=0.01)
     if ax.get_legend_handles_labels()[0]:
@@ -588,8 +749,27 @@ def _nearest_distance(q: FloatArray, other: PiecewiseCurve) -> FloatArray:
     return best
 
 
+def exact_text(value: float, ref: float | None = None, digits: int = 5) -> str:
+    """``value`` with ``digits`` significant digits, or more until the text compares with
+    ``ref`` (a tolerance) as the value does and differs from it when the value does
+    (1.0013e-4 is never printed as 0.0001, a value just above the tolerance never as the
+    tolerance); at most the 17 digits of float64's round trip."""
+    v = float(value)
+    if not math.isfinite(v):
+        return repr(v)
+    for d in range(digits, 18):
+        text = f"{v:.{d}g}"
+        shown = float(text)
+        if ref is None:
+            return text
+        r = float(ref)
+        if (shown <= r) == (v <= r) and (shown == r) == (v == r):
+            return text
+    return repr(v)
+
+
 def _draw_deviation(ax: Any, before: _Prepared, after: _Prepared, *, offset: float = 0.0,
-                    annotate: bool = True) -> tuple[float, bool]:
+                    annotate: bool = True, tol: float | None = None) -> tuple[float, bool]:
     """Plot the deviation of ``after`` from ``before`` against the arc length of ``after``.
 
     Curves on the same parameter domain (a curve and its faired version): ``|after(t) -
@@ -615,7 +795,8 @@ def _draw_deviation(ax: Any, before: _Prepared, after: _Prepared, *, offset: flo
     ax.plot(s, dev, color=_MAIN["curve"], lw=1.3, gid=_GID_DEVIATION, zorder=3)
     if annotate:
         ax.plot([smax], [dmax], marker="v", color=_BAD, ms=6, zorder=5, ls="none")
-        ax.annotate(f"max {dmax:.3g} at s = {smax:.3g}", (smax, dmax), xytext=(6, -2),
+        ax.annotate(f"max {exact_text(dmax, tol)} at s = {smax:.4g}", (smax, dmax),
+                    xytext=(6, -2),
                     textcoords="offset points", fontsize=8, color=_BAD, va="top")
     return dmax, parametric
 
@@ -623,12 +804,16 @@ def _draw_deviation(ax: Any, before: _Prepared, after: _Prepared, *, offset: flo
 def _finish_deviation_axes(ax: Any, tol: float | None, dmax: float, parametric: bool,
                            labels: tuple[str, str]) -> None:
     if tol is not None:
-        ax.axhline(tol, color=_BAD, lw=1.0, ls="--", label=f"tolerance {tol:.3g}", zorder=4)
+        ax.axhline(tol, color=_BAD, lw=1.0, ls="--", label=f"tolerance {float(tol)!r}",
+                   zorder=4)
         ax.legend(loc="upper right", fontsize=8, framealpha=0.85)
     top = max(dmax, tol or 0.0)
     ax.set_ylim(0.0, 1.2 * top if top > 0 else 1.0)
     ax.set_xlabel("arc length s")
     ax.set_ylabel("deviation")
+    if dmax > 0:
+        ax.text(0.01, 0.97, f"max deviation {exact_text(dmax, tol)}", transform=ax.transAxes,
+                ha="left", va="top", fontsize=8, color=_BAD, gid="curvefair-max-deviation")
     what = (f"deviation |{labels[1]}(t) - {labels[0]}(t)|" if parametric else
             f"distance of {labels[1]} to the nearest point of {labels[0]}")
     ax.set_title(what, fontsize=9, loc="left")
@@ -640,7 +825,8 @@ def _finish_deviation_axes(ax: Any, tol: float | None, dmax: float, parametric: 
 def plot_curve(curve: PiecewiseCurve, ax: Any = None, comb: bool = True,
                comb_scale: float | None = None, comb_density: int | None = None,
                markers: bool = True, *, points: bool = True, label: str | None = None,
-               projection: ProjectionName = "plane", n_bad: int = 3) -> Any:
+               projection: ProjectionName = "plane", n_bad: int = 3,
+               y_down: bool = False) -> Any:
     """Draw ``curve`` with its curvature comb and markers.
 
     Parameters
@@ -667,10 +853,18 @@ def plot_curve(curve: PiecewiseCurve, ax: Any = None, comb: bool = True,
         For 3-D curves: the best-fit plane (default) or a coordinate plane. Ignored in 2-D.
     n_bad : int
         How many bad points to mark.
+    y_down : bool
+        The data's y axis points down (SVG coordinates): the axes are drawn that way up.
 
     Returns
     -------
     matplotlib Axes
+
+    Notes
+    -----
+    The default comb scale is robust (:func:`robust_comb_scale`): with a dominant curvature
+    peak (an airfoil's leading edge) hairs longer than a fifth of the drawing are drawn at that
+    length, and the note on the axes says so.
 
     Examples
     --------
@@ -687,15 +881,16 @@ def plot_curve(curve: PiecewiseCurve, ax: Any = None, comb: bool = True,
         ax = _pyplot_axes()
     prepared = _prepare([curve], ["curve"], comb_density, markers, n_bad)
     proj = _projector(prepared, projection)
-    scale = _joint_scale(prepared, comb_scale)
+    scale, clip = _joint_scale_clip(prepared, comb_scale)
     _draw_curve(ax, prepared[0], proj, comb=comb, scale=scale, markers=markers, style=_MAIN,
-                label=label, points=points)
-    _finish_curve_axes(ax, prepared, proj, scale, comb, markers)
+                label=label, points=points, clip=clip)
+    _finish_curve_axes(ax, prepared, proj, scale, comb, markers, clip=clip, y_down=y_down)
     return ax
 
 
 def plot_curvature(curve: PiecewiseCurve, ax: Any = None, *, markers: bool = True,
-                   label: str | None = None, n_bad: int = 3) -> Any:
+                   label: str | None = None, n_bad: int = 3,
+                   kappa_scale: KappaScale = "auto") -> Any:
     """Plot the curvature of ``curve`` against its arc length.
 
     Parameters
@@ -708,6 +903,10 @@ def plot_curvature(curve: PiecewiseCurve, ax: Any = None, *, markers: bool = Tru
         vertical lines with their rank).
     label : str, optional
     n_bad : int
+    kappa_scale : {"auto", "linear", "symlog", "clip"}
+        Curvature axis: ``"auto"`` is symmetric-logarithmic when the curvature has a dominant
+        peak (:func:`curvature_axis_mode`), else linear; ``"clip"`` limits the axis to 1.5
+        times the 95 % quantile of ``|kappa|`` by arc length.
 
     Returns
     -------
@@ -732,7 +931,7 @@ def plot_curvature(curve: PiecewiseCurve, ax: Any = None, *, markers: bool = Tru
         ax = _pyplot_axes()
     p = _prepare([curve], ["curve"], None, markers, n_bad)[0]
     _draw_curvature(ax, p, style=_MAIN, label=label, markers=markers)
-    _finish_curvature_axes(ax, curve.dim)
+    _finish_curvature_axes(ax, p.curve.dim, [p], kappa_scale)
     return ax
 
 
@@ -785,29 +984,27 @@ def plot_compare(before: PiecewiseCurve, after: PiecewiseCurve, axes: Any = None
     prepared = (_prepare([before], ["before"], comb_density, False, n_bad)
                 + _prepare([after], ["after"], comb_density, markers, n_bad))
     proj = _projector(prepared, projection)
-    scale = _joint_scale(prepared, comb_scale)
+    scale, clip = _joint_scale_clip(prepared, comb_scale)
     tol = None if tol is None else as_positive(tol, "tol", window=True)
     _draw_curve(ax_c, prepared[0], proj, comb=comb, scale=scale, markers=markers, style=_REF,
-                label=labels[0], points=True, ref=True, bad_labels=False)
+                label=labels[0], points=True, ref=True, bad_labels=False, clip=clip)
     _draw_curve(ax_c, prepared[1], proj, comb=comb, scale=scale, markers=markers, style=_MAIN,
-                label=labels[1], points=True)
-    _finish_curve_axes(ax_c, prepared, proj, scale, comb, markers)
-    dmax, parametric = _draw_deviation(ax_d, prepared[0], prepared[1])
+                label=labels[1], points=True, clip=clip)
+    _finish_curve_axes(ax_c, prepared, proj, scale, comb, markers, clip=clip)
+    dmax, parametric = _draw_deviation(ax_d, prepared[0], prepared[1], tol=tol)
     _finish_deviation_axes(ax_d, tol, dmax, parametric, labels)
     return ax_c, ax_d
 
 
 def _as_curve_list(x: Any, name: str) -> list[PiecewiseCurve]:
-    if isinstance(x, PiecewiseCurve):
-        return [x]
-    try:
-        items = list(x)
-    except TypeError:
-        raise InputError(f"{name} must be a curve or a sequence of curves, "
-                         f"got {type(x).__name__}") from None
-    if not items:
-        raise InputError(f"{name} is an empty sequence of curves")
-    return [_check_curve(c, f"{name}[{i}]") for i, c in enumerate(items)]
+    """One curve-like object (:func:`curvefair.as_curve`) or a list / tuple of them."""
+    from .view import _as_curves
+
+    return _as_curves(x, name)
+
+
+#: ``figure(panels="auto")`` draws one panel per curve for 2 .. this many curves.
+MAX_PANELS = 64
 
 
 def figure(curve: PiecewiseCurve | Sequence[PiecewiseCurve],
@@ -815,18 +1012,21 @@ def figure(curve: PiecewiseCurve | Sequence[PiecewiseCurve],
            labels: tuple[str, str] | None = None, tol: float | None = None,
            comb: bool = True, comb_scale: float | None = None, comb_density: int | None = None,
            markers: bool = True, projection: ProjectionName = "plane", n_bad: int = 3,
-           title: str | None = None, figsize: tuple[float, float] | None = None) -> Any:
+           title: str | None = None, figsize: tuple[float, float] | None = None,
+           panels: Literal["auto", "overlay", "grid"] = "auto",
+           names: Sequence[str | None] | None = None, kappa_scale: KappaScale = "auto",
+           y_down: bool = False) -> Any:
     """The standard curvefair figure: curve and comb above, curvature against arc length below.
 
     With ``compare`` the second curve (e.g. the faired one) is drawn over ``curve`` with its own
     comb at the same scale, both curvature plots share the lower panel, and a third panel shows
-    the deviation of ``compare`` from ``curve``.
+    the deviation of ``compare`` from ``curve``, its maximum printed with enough digits to tell
+    it from the tolerance (:func:`exact_text`).
 
     Parameters
     ----------
     curve : PiecewiseCurve or sequence of them
-        Several curves (e.g. every curve of a file) are drawn together; their curvature plots
-        follow one another along a common arc-length axis, separated by grey lines.
+        Anything :func:`curvefair.as_curve` accepts, or a list of them.
     compare : PiecewiseCurve or sequence, optional
         As many curves as ``curve``, paired in order.
     labels : (str, str), optional
@@ -835,10 +1035,24 @@ def figure(curve: PiecewiseCurve | Sequence[PiecewiseCurve],
     tol : float, optional
         Tolerance line on the deviation panel.
     comb, comb_scale, comb_density, markers, projection, n_bad
-        As for :func:`plot_curve`.
+        As for :func:`plot_curve`. The default comb scale is robust
+        (:func:`robust_comb_scale`).
     title : str, optional
     figsize : (float, float), optional
-        Inches; default 9 wide, the height following the curve's aspect ratio.
+        Inches; default 9 wide, the height following the curve's aspect ratio (grid: about
+        4.2 inches per column).
+    panels : {"auto", "overlay", "grid"}
+        ``"grid"``: one cell per curve (its curve panel above its curvature panel, and its
+        deviation panel with ``compare``), each with its own comb scale, curvature axis and
+        (3-D) best-fit plane, so each curve is readable. ``"overlay"``: all curves in one
+        panel, their curvature plots following one another along a common arc-length axis,
+        separated by grey lines. ``"auto"``: grid for 2 to :data:`MAX_PANELS` curves.
+    names : sequence of str, optional
+        Grid cell titles (default ``curve 0``, ``curve 1``, ...).
+    kappa_scale : {"auto", "linear", "symlog", "clip"}
+        Curvature axis, as for :func:`plot_curvature`.
+    y_down : bool
+        The data's y axis points down (SVG coordinates): 2-D curve panels are drawn that way.
 
     Returns
     -------
@@ -861,9 +1075,20 @@ def figure(curve: PiecewiseCurve | Sequence[PiecewiseCurve],
     if others is not None and len(others) != len(curves):
         raise InputError(f"compare has {len(others)} curves but curve has {len(curves)}; "
                          "they are paired in order")
+    choice(panels, ("auto", "overlay", "grid"), "panels")
+    choice(kappa_scale, KAPPA_SCALES, "kappa_scale")
+    if names is not None:
+        names = list(names)
+        if len(names) != len(curves):
+            raise InputError(f"names has {len(names)} entries for {len(curves)} curves")
     if labels is None:
         labels = ("curve", "compare")
     tol = None if tol is None else as_positive(tol, "tol", window=True)
+    if panels == "grid" or (panels == "auto" and 2 <= len(curves) <= MAX_PANELS):
+        return _grid_figure(mpl, curves, others, labels=labels, tol=tol, comb=comb,
+                            comb_scale=comb_scale, comb_density=comb_density, markers=markers,
+                            projection=projection, n_bad=n_bad, title=title, figsize=figsize,
+                            names=names, kappa_scale=kappa_scale, y_down=y_down)
     prep = _prepare(curves, [f"curve[{i}]" for i in range(len(curves))], comb_density,
                     markers and others is None, n_bad)
     prep_o = ([] if others is None else
@@ -871,7 +1096,7 @@ def figure(curve: PiecewiseCurve | Sequence[PiecewiseCurve],
                        markers, n_bad))
     everything = prep + prep_o
     proj = _projector(everything, projection)
-    scale = _joint_scale(everything, comb_scale)
+    scale, clip = _joint_scale_clip(everything, comb_scale)
 
     # layout: curve panel height from the data's aspect ratio
     xy = [proj(p.fine.flat("r")) for p in everything]
@@ -896,13 +1121,14 @@ def figure(curve: PiecewiseCurve | Sequence[PiecewiseCurve],
         lab = labels[0] if i == 0 else None
         if others is None:
             _draw_curve(ax_c, p, proj, comb=comb, scale=scale, markers=markers, style=_MAIN,
-                        label=lab if multi else None, points=True)
+                        label=lab if multi else None, points=True, clip=clip)
         else:
             _draw_curve(ax_c, p, proj, comb=comb, scale=scale, markers=markers, style=_REF,
-                        label=lab, points=True, ref=True, bad_labels=False)
+                        label=lab, points=True, ref=True, bad_labels=False, clip=clip)
             _draw_curve(ax_c, prep_o[i], proj, comb=comb, scale=scale, markers=markers,
-                        style=_MAIN, label=labels[1] if i == 0 else None, points=True)
-    _finish_curve_axes(ax_c, everything, proj, scale, comb, markers)
+                        style=_MAIN, label=labels[1] if i == 0 else None, points=True,
+                        clip=clip)
+    _finish_curve_axes(ax_c, everything, proj, scale, comb, markers, clip=clip, y_down=y_down)
 
     offset = 0.0
     dmax = 0.0
@@ -918,18 +1144,72 @@ def figure(curve: PiecewiseCurve | Sequence[PiecewiseCurve],
                             markers=markers, ref=True, offset=offset)
             _draw_curvature(ax_k, q, style=_MAIN, label=labels[1] if i == 0 else None,
                             markers=markers, offset=offset)
-            dm, parametric = _draw_deviation(axs[2], p, q, offset=offset, annotate=not multi)
+            dm, parametric = _draw_deviation(axs[2], p, q, offset=offset, annotate=not multi,
+                                             tol=tol)
             dmax = max(dmax, dm)
             length = max(p.length, q.length)
         offset += length
         if multi and i < len(prep) - 1:
             for ax in axs[1:]:
                 ax.axvline(offset, color="0.5", lw=1.0, ls="-", alpha=0.6)
-    _finish_curvature_axes(ax_k, proj.dim)
+    _finish_curvature_axes(ax_k, proj.dim, everything, kappa_scale)
     if others is not None:
         _finish_deviation_axes(axs[2], tol, dmax, parametric, labels)
     if multi:
         ax_k.set_xlabel("arc length s (curves one after another)")
+    if title:
+        fig.suptitle(title, fontsize=11)
+    return fig
+
+
+def _grid_figure(mpl: Any, curves: list[PiecewiseCurve], others: list[PiecewiseCurve] | None,
+                 *, labels: tuple[str, str], tol: float | None, comb: bool,
+                 comb_scale: float | None, comb_density: int | None, markers: bool,
+                 projection: str, n_bad: int, title: str | None,
+                 figsize: tuple[float, float] | None, names: list[str | None] | None,
+                 kappa_scale: str, y_down: bool) -> Any:
+    """One cell per curve: curve panel, curvature panel (and deviation panel)."""
+    n = len(curves)
+    ncols = min(4, math.ceil(math.sqrt(n)))
+    nrows = math.ceil(n / ncols)
+    rows = [2.6, 1.5] + ([1.2] if others is not None else [])
+    if figsize is None:
+        figsize = (4.2 * ncols, nrows * sum(rows) + (0.4 if title else 0.0))
+    fig = mpl.figure.Figure(figsize=figsize, layout="constrained")
+    outer = fig.add_gridspec(nrows, ncols)
+    for i, c in enumerate(curves):
+        cell = outer[i // ncols, i % ncols].subgridspec(len(rows), 1, height_ratios=rows)
+        axs = [fig.add_subplot(cell[j]) for j in range(len(rows))]
+        p = _prepare([c], [f"curve[{i}]"], comb_density, markers and others is None, n_bad)
+        q = ([] if others is None else
+             _prepare([others[i]], [f"compare[{i}]"], comb_density, markers, n_bad))
+        both = p + q
+        proj = _projector(both, projection)
+        scale, clip = _joint_scale_clip(both, comb_scale)
+        if others is None:
+            _draw_curve(axs[0], p[0], proj, comb=comb, scale=scale, markers=markers,
+                        style=_MAIN, label=None, points=True, clip=clip)
+            _draw_curvature(axs[1], p[0], style=_MAIN, label=None, markers=markers)
+        else:
+            _draw_curve(axs[0], p[0], proj, comb=comb, scale=scale, markers=markers,
+                        style=_REF, label=labels[0], points=True, ref=True,
+                        bad_labels=False, clip=clip)
+            _draw_curve(axs[0], q[0], proj, comb=comb, scale=scale, markers=markers,
+                        style=_MAIN, label=labels[1], points=True, clip=clip)
+            _draw_curvature(axs[1], p[0], style=_REF, label=None, markers=markers, ref=True)
+            _draw_curvature(axs[1], q[0], style=_MAIN, label=None, markers=markers)
+            dmax, parametric = _draw_deviation(axs[2], p[0], q[0], tol=tol)
+            _finish_deviation_axes(axs[2], tol, dmax, parametric, labels)
+            axs[2].set_title("")
+        _finish_curve_axes(axs[0], both, proj, scale, comb, markers, clip=clip,
+                           y_down=y_down, legend=(i == 0))
+        _finish_curvature_axes(axs[1], proj.dim, both, kappa_scale)
+        name = names[i] if names is not None and names[i] else f"curve {i}"
+        axs[0].set_title(name, fontsize=9, loc="left")
+        for ax in axs:
+            ax.tick_params(labelsize=7)
+            ax.xaxis.label.set_size(8)
+            ax.yaxis.label.set_size(8)
     if title:
         fig.suptitle(title, fontsize=11)
     return fig

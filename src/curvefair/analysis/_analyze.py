@@ -10,6 +10,7 @@ import numpy as np
 from .._typing import FloatArray
 from .._validate import as_positive
 from ..curves.piecewise import PiecewiseCurve, readonly
+from ..interop import as_curve
 from ._core import bounding_diagonal, check_curve, falling, fields_to_dict
 from ._energy import segment_energies
 from ._sampling import QUAD_RTOL, sample_curve, scan_sign_changes
@@ -279,7 +280,7 @@ def analyze(curve: object, *, quad_rtol: float = QUAD_RTOL) -> Analysis:
     >>> a.max_jump_index is not None and a.energy2 > 0
     True
     """
-    c = check_curve(curve)
+    c = check_curve(as_curve(curve, "curve"))  # scipy splines too (curvefair.interop)
     rtol = as_positive(quad_rtol, "quad_rtol")
     assert rtol is not None
     pp = c.piecewise

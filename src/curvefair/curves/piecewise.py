@@ -186,6 +186,12 @@ class PiecewiseCurve(abc.ABC):
             st[k] = v
         self.__dict__.update(st)
 
+    def _repr_html_(self) -> str:
+        """Notebook display: a small inline SVG with the comb (:func:`curvefair.view.curve_svg`)."""
+        from ..view import curve_repr_html
+
+        return curve_repr_html(self)
+
     @cached_property
     def piecewise(self) -> PiecewisePolynomial:
         """The local power form (cached; the curve is immutable; refused if it overflows)."""

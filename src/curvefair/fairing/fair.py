@@ -21,6 +21,7 @@ import numpy as np
 from .._typing import FloatArray
 from ..curves.piecewise import PiecewiseCurve, readonly
 from ..errors import InputError
+from ..interop import as_curve as _as_curve
 
 __all__ = [
     "MethodSpec",
@@ -185,6 +186,10 @@ class FairingResult:
     curve: PiecewiseCurve
     report: dict[str, Any]
     history: FairingHistory
+
+    def _repr_html_(self) -> str:  # notebook display: curvefair.view.result_repr_html
+        from ..view import result_repr_html
+        return result_repr_html(self)
 
     def __repr__(self) -> str:
         r = self.report
@@ -504,6 +509,7 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
     True
     """
     t_start = time.perf_counter()
+    curve = _as_curve(curve, "curve")  # scipy splines too (curvefair.interop.as_curve)
     if not isinstance(curve, PiecewiseCurve):
         raise InputError(f"curve must be a curvefair curve, got {type(curve).__name__}")
     if method is None:
