@@ -166,10 +166,17 @@ def fair_many(paths: Sequence[str], out: str | None, in_place: bool, options: di
         if scheduler is not None:
             client = stack.enter_context(_dask_client(scheduler))
         show = not quiet and sys.stderr.isatty()
-        with _progress(show, len(jobs_list)) as event:
-            reports = _batch.run_jobs(jobs_list, options, jobs_n=jobs, client=client,
-                                      dry_run=dry_run, resume=resume, in_format=fmt,
-                                      on_event=event)
+        try:
+            with _progress(show, len(jobs_list)) as event:
+                reports = _batch.run_jobs(jobs_list, options, jobs_n=jobs, client=client,
+                                          dry_run=dry_run, resume=resume, in_format=fmt,
+                                          on_event=event)
+        except (_batch._Terminated, KeyboardInterrupt) as exc:
+            signum = exc.args[0] if isinstance(exc, _batch._Terminated) else 2
+            click.echo(f"Error: stopped by signal {signum}; the outputs already written are "
+                       "complete, the others were not written (run again with --resume)",
+                       err=True)
+            raise SystemExit(128 + int(signum)) from None
         run = _batch.run_report(jobs_list, reports, options, t0, dry_run)
         run_path = None
         if not dry_run and not (single or to_stdout):
