@@ -222,3 +222,43 @@ def test_pre_commit_hook_definition():
         for e in exts:
             assert pat.search("drawings/part" + e) and pat.search("PART" + e.upper())
     assert not pat.search("README.md") and not pat.search("a.csv.bak")
+
+
+def test_g2_breaks_of_a_real_svg_match_svgpathtools(tmp_path: Path):
+    """trimesh's MIL.svg (Inkscape, cubic chains that are G1 but not G2): every
+    tangent-continuous join whose curvature vector jumps by more than 5 % (computed here from
+    svgpathtools' own parse and derivatives) is a g2-break finding with the same value."""
+    svgpathtools = pytest.importorskip("svgpathtools")
+    from curvefair import read_curves
+    from curvefair._check import check_records
+
+    path = Path(__file__).parent / "data/real/trimesh/MIL.svg"
+
+    def kvec(d1: complex, d2: complex) -> np.ndarray:
+        a, b = np.array([d1.real, d1.imag]), np.array([d2.real, d2.imag])
+        t = a / np.linalg.norm(a)
+        return (b - (b @ t) * t) / (a @ a)
+
+    want = []
+    paths, _ = svgpathtools.svg2paths(str(path))
+    for p in paths:
+        for sub in p.continuous_subpaths():
+            segs, L = list(sub), sub.length()
+            pairs = list(zip(segs[:-1], segs[1:], strict=True))
+            if sub.isclosed():
+                pairs.append((segs[-1], segs[0]))
+            for a, b in pairs:
+                da, db = a.derivative(1), b.derivative(0)
+                z = da.conjugate() * db
+                if math.degrees(abs(math.atan2(z.imag, z.real))) > 0.05:
+                    continue  # a kink or a corner, not a G1 join
+                kl, kr = kvec(da, a.derivative(1, 2)), kvec(db, b.derivative(0, 2))
+                rel = np.linalg.norm(kr - kl) / max(np.linalg.norm(kl), np.linalg.norm(kr),
+                                                    1.0 / L)
+                if rel > 0.05:
+                    want.append(rel)
+    found = check_records(read_curves(path), str(path),
+                          {"max_bad": None, "wiggle": None}, top=10**6)
+    got = sorted(f.value for f in found if f.rule == "g2-break")
+    assert len(want) > 50
+    np.testing.assert_allclose(got, sorted(want), rtol=1e-6)

@@ -28,7 +28,8 @@ are reported, each against a threshold:
 Joins where one side has zero speed (a degenerate control polygon) have no tangent and are
 skipped.
 
-A threshold of None switches its finding off.
+A threshold of None switches its finding off. Each curve reports at most ``top`` findings per
+kind (the worst), each saying how many the curve had.
 """
 
 from __future__ import annotations
@@ -43,7 +44,7 @@ from typing import Any
 import numpy as np
 
 from ._version import __version__
-from .errors import CurvefairError
+from .errors import CurvefairError, FileFormatError
 
 __all__ = ["THRESHOLDS", "RULES", "check_records", "check_file", "to_sarif", "Finding"]
 
@@ -144,8 +145,9 @@ def check_records(records: Sequence[Any], file: str = "",
 
     th = dict(THRESHOLDS)
     th.update(thresholds or {})
-    out: list[Finding] = []
+    found: list[Finding] = []
     for i, rec in enumerate(records):
+        out: list[Finding] = []
         curve = rec.curve
         label = rec.name if rec.name else f"curve {i}"
         pp = curve.piecewise
@@ -210,7 +212,7 @@ def check_records(records: Sequence[Any], file: str = "",
             regular = np.array([_regular(d1l[(j - 1) % m], d1r[j % m], width, L)
                                 for j in np.asarray(a.jump_indices, dtype=int)], dtype=bool)
             z = np.where(regular & np.isfinite(z), z, 0.0)
-            order = np.argsort(-z, kind="stable")[:top]
+            order = np.argsort(-z, kind="stable")
             for j in order:
                 if z[j] > th["max_bad"]:
                     u = float(ju[j])
@@ -218,6 +220,28 @@ def check_records(records: Sequence[Any], file: str = "",
                                        f"bad point: |Δ dκ/ds| / (κ² + 1/L²) = {z[j]:.4g} at "
                                        f"break {int(a.jump_indices[j])}", float(z[j]),
                                        th["max_bad"], u, at(u)))
+        found += _worst(out, top)
+    return found
+
+
+#: Which way is worse, per rule (a smaller gap between inflections is a worse wiggle).
+_WORSE_LOW = {"extra-inflection"}
+
+
+def _worst(findings: list[Finding], top: int) -> list[Finding]:
+    """At most ``top`` findings per rule of one curve, the worst first; the kept ones say how
+    many the curve had (``n_on_curve``) so a noisy curve is one short entry, not hundreds."""
+    by_rule: dict[str, list[Finding]] = {}
+    for f in findings:
+        by_rule.setdefault(f.rule, []).append(f)
+    out: list[Finding] = []
+    for rule, group in by_rule.items():
+        group.sort(key=lambda f: f.value if rule in _WORSE_LOW else -f.value)
+        for f in group[:top]:
+            f.extra["n_on_curve"] = len(group)
+            if len(group) > top:
+                f.message += f" (worst {top} of {len(group)} on this curve)"
+            out.append(f)
     return out
 
 
@@ -237,6 +261,8 @@ def check_file(path: str, thresholds: Mapping[str, float | None] | None = None, 
             recs = read_curves(path, corner_angle=corner_angle,
                                on_unsupported="raise" if strict else "skip")
     except (CurvefairError, OSError) as exc:
+        if isinstance(exc, FileFormatError) and "no curves in the" in str(exc):
+            return [], 0  # a drawing without curves has nothing unfair in it
         msg = str(exc) if isinstance(exc, CurvefairError) else f"{exc.strerror or exc}"
         return [Finding(path, -1, "", "unreadable", msg, float("nan"), None)], 0
     sel = [r for r in recs if select is None or selected(r, select)]
