@@ -15,7 +15,6 @@ import time
 from pathlib import Path
 
 import numpy as np
-import pytest
 from click.testing import CliRunner
 
 from curvefair import interpolate_bspline, read_curves, write_curves
@@ -99,8 +98,8 @@ def test_folder_to_output_folder_reports_and_same_bytes_as_single_file(tmp_path:
 
 def test_glob_keeps_paths_below_the_glob_base_and_no_match_is_a_usage_error(tmp_path: Path):
     _tree(tmp_path)
-    r = _run(["fair", "in/**/*.json", "in/*.csv", "-o", "g", "--tol", str(TOL), "-q", "-j", "1"],
-             tmp_path)
+    r = _run(["fair", "in/**/*.json", "in/*.csv", "-o", "g", "--tol", str(TOL), "-q",
+              "-j", "1"], tmp_path)
     assert r.exit_code == 0, r.output
     assert (tmp_path / "g/sub/b.json").is_file() and (tmp_path / "g/ex1.csv").is_file()
     assert not (tmp_path / "g/sub/naca2412.dat").exists()
@@ -332,3 +331,22 @@ def test_sigterm_mid_run_leaves_complete_outputs_and_no_temporary_files(tmp_path
         assert f.read_bytes() == (tmp_path / "ref" / f.name).read_bytes()
     leftovers = [q for q in (tmp_path / "out").rglob(".*") if q.is_file()]
     assert leftovers == [], leftovers
+
+
+def test_one_file_into_a_folder_and_in_place_over_a_folder(tmp_path: Path):
+    src = _tree(tmp_path)
+    (tmp_path / "o").mkdir()
+    r = _run(["fair", "in/ex1.csv", "-o", "o/", "--tol", str(TOL), "-q"], tmp_path)
+    assert r.exit_code == 0, r.output
+    assert (tmp_path / "o/ex1.csv").is_file()
+    r = _run(["fair", "in/ex1.csv", "-o", "o", "--tol", str(TOL)], tmp_path)
+    assert r.exit_code == 2 and "o/ to write into the folder" in r.output
+    before = _pts(src / "sub/b.json")[0]
+    os.symlink("sub/b.json", src / "link.json")  # the same file twice: faired once
+    r = _run(["fair", "in", "--in-place", "--tol", str(TOL), "-j", "1"], tmp_path)
+    assert r.exit_code == 0, r.output
+    after = _pts(src / "sub/b.json")[0]
+    assert 0 < np.max(np.linalg.norm(after - before, axis=1)) <= TOL
+    assert os.path.islink(src / "link.json")
+    assert (src / ".curvefair/ex1.csv.json").is_file()
+    assert "3 file(s)" in r.output

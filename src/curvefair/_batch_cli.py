@@ -40,7 +40,9 @@ def wants_batch(paths: Sequence[str], out: str | None, method: str | None,
         return True
     if not os.path.exists(p) and _batch._GLOB_CHARS.search(p):
         return True
-    if out is not None and (out == "-" or os.path.isdir(out) or out.endswith(("/", os.sep))):
+    # one file and -o naming an existing folder stays a usage error (a file name was likely
+    # meant); a trailing slash asks for the folder
+    if out is not None and (out == "-" or out.endswith(("/", os.sep))):
         return True
     if method is not None and "=" in method:
         return True
@@ -423,7 +425,8 @@ def check_cmd(paths: tuple[str, ...], out_format: str, kink_angle: str | None,
     else:
         lines = []
         for x in findings:
-            where = "" if x.point is None else " at (" + ", ".join(f"{v:.6g}" for v in x.point) + ")"
+            where = ("" if x.point is None
+                     else " at (" + ", ".join(f"{v:.6g}" for v in x.point) + ")")
             who = f"curve {x.curve} ({x.label})" if x.curve >= 0 else "file"
             lines.append(f"{x.file}: {who}: {x.rule}: {x.message}{where}")
         lines.append(f"{len(files)} file(s), {n_curves} curve(s) checked: "

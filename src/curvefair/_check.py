@@ -160,7 +160,7 @@ def check_records(records: Sequence[Any], file: str = "",
         if curve.closed:
             joins.append((0, m - 1, 0))
 
-        def at(u: float) -> list[float]:
+        def at(u: float, pp: Any = pp) -> list[float]:
             return [float(v) for v in pp.evaluate(np.array([u]))[0]]
 
         width = float(br[-1] - br[0])

@@ -590,8 +590,6 @@ def up_to_date(job: Job, options: Mapping[str, Any], out_format: str | None = No
                in_format: str | None = None) -> dict[str, Any] | None:
     """The recorded report when ``job``'s output exists and matches (see the module
     docstring), else None."""
-    from .io import detect_format
-
     if job.report is None or not os.path.isfile(job.report) or not os.path.isfile(job.output):
         return None
     try:

@@ -94,7 +94,9 @@ def _check_outputs(inputs: Sequence[tuple[str, str]], outputs: Sequence[tuple[st
         if not p.strip():
             raise click.BadParameter("the file name is empty", param_hint=opt)
         if os.path.isdir(p):
-            raise click.BadParameter(f"{p!r} is a folder; give a file name", param_hint=opt)
+            raise click.BadParameter(f"{p!r} is a folder; give a file name"
+                                     + (f" (or {p.rstrip('/')}/ to write into the folder)"
+                                        if opt == "-o/--output" else ""), param_hint=opt)
         key = _file_key(p)
         for kin, pin, what in keys_in:
             if key == kin and not (in_place and k == 0 and what == "IN"):
