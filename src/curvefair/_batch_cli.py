@@ -288,12 +288,12 @@ def _print_summary(jobs: Sequence[_batch.Job], reports: Sequence[Mapping[str, An
 # ------------------------------------------------------------------------------------------
 def _selection_options(f: Any) -> Any:
     f = click.option("--layer", multiple=True, metavar="PATTERN",
-                     help="Fair only curves on a layer matching PATTERN (glob, repeatable: "
-                          "any matches); the others are written back untouched.")(f)
+                     help="Only the curves on a layer matching PATTERN (glob, repeatable: "
+                          "any matches); fair writes the others back untouched.")(f)
     f = click.option("--name", multiple=True, metavar="PATTERN",
-                     help="Fair only curves whose name matches PATTERN (glob, repeatable).")(f)
+                     help="Only the curves whose name matches PATTERN (glob, repeatable).")(f)
     f = click.option("--handle", "--id", "handle", multiple=True, metavar="PATTERN",
-                     help="Fair only curves whose DXF handle, Rhino object id or SVG element "
+                     help="Only the curves whose DXF handle, Rhino object id or SVG element "
                           "id matches PATTERN (glob, repeatable).")(f)
     return f
 

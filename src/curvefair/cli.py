@@ -902,6 +902,10 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
     against IN's (the figure is printed and in the report). Farther than --tol: SVG rounding
     to the file's decimals is undone, point data get smaller moves; otherwise OUT is not
     written (exit 1).
+
+    IN... may be several files, folders and glob patterns (quote them), or '-' for stdin;
+    then OUT is a folder and every file is faired on its own (--jobs processes, or Dask
+    workers with --scheduler); one failing file does not stop the others (exit 1).
     """
     from ._batch_cli import fair_many, wants_batch
 
