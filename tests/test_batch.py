@@ -15,6 +15,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+import pytest
 from click.testing import CliRunner
 
 from curvefair import interpolate_bspline, read_curves, write_curves
@@ -350,3 +351,45 @@ def test_one_file_into_a_folder_and_in_place_over_a_folder(tmp_path: Path):
     assert os.path.islink(src / "link.json")
     assert (src / ".curvefair/ex1.csv.json").is_file()
     assert "3 file(s)" in r.output
+
+
+def _pool_workers(pid: int) -> list[int]:
+    """Pids of the spawn workers of process ``pid`` (Linux /proc), not its resource tracker."""
+    out = []
+    for task in Path(f"/proc/{pid}/task").iterdir():
+        for c in (task / "children").read_text().split():
+            cmd = Path(f"/proc/{c}/cmdline").read_bytes().replace(b"\0", b" ")
+            if b"spawn_main" in cmd and b"resource_tracker" not in cmd:
+                out.append(int(c))
+    return out
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not Path("/proc/self/task").is_dir(), reason="needs Linux /proc")
+def test_a_killed_pool_worker_loses_nothing(tmp_path: Path):
+    src = tmp_path / "in"
+    src.mkdir()
+    for k in range(4):
+        write_curves(src / f"w{k}.json", [interpolate_bspline(_wavy(seed=k))])
+    ref = _run(["fair", "in", "-o", "ref", "--tol", str(TOL), "-j", "1", "-q"], tmp_path)
+    assert ref.exit_code == 0
+    env = _env()
+    env["CURVEFAIR_TEST_FILE_DELAY"] = "1.5"
+    p = subprocess.Popen([sys.executable, "-m", "curvefair", "fair", "in", "-o", "out",
+                          "--tol", str(TOL), "-j", "2"], cwd=tmp_path, env=env,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    deadline = time.time() + 60
+    workers: list[int] = []
+    while time.time() < deadline and len(workers) < 2:
+        time.sleep(0.1)
+        workers = _pool_workers(p.pid)
+    assert workers, "no pool worker seen"
+    time.sleep(1.0)  # the workers are inside their first files
+    os.kill(workers[0], signal.SIGKILL)
+    so, se = p.communicate(timeout=120)
+    assert p.returncode == 0, se
+    out = tmp_path / "out"
+    assert {f.name: f.read_bytes() for f in out.glob("w*.json")} == {
+        f.name: f.read_bytes() for f in (tmp_path / "ref").glob("w*.json")}
+    assert len(list(out.glob("w*.json"))) == 4
+    assert [q for q in out.rglob(".*") if q.is_file()] == []
