@@ -453,6 +453,28 @@ def fair_file(infile: str, outfile: str | None, options: Mapping[str, Any] | Non
               in_format: str | None = None, out_format: str | None = None) -> dict[str, Any]:
     """Fair one file; return its report (a JSON-serialisable dict); never raise for bad input.
 
+    An unexpected error (a bug, or a library failing on a file) is a ``failed`` report naming
+    the exception too, so one file never stops a run; nothing is written for it.
+    """
+
+    _options(options or {})  # unknown options: the caller's error, raised
+    try:
+        return _fair_file(infile, outfile, options, report=report, dry_run=dry_run,
+                          progress=progress, in_format=in_format, out_format=out_format)
+    except (KeyboardInterrupt, SystemExit, _Terminated):
+        raise
+    except Exception as exc:  # noqa: BLE001 - reported per file, see the docstring
+        return {"curvefair": __version__, "input": infile, "output": outfile,
+                "status": "failed", "dry_run": bool(dry_run),
+                "error": f"unexpected {type(exc).__name__}: {exc}"}
+
+
+def _fair_file(infile: str, outfile: str | None, options: Mapping[str, Any] | None = None, *,
+               report: str | None = None, dry_run: bool = False,
+               progress: Callable[[str, Any], None] | None = None,
+               in_format: str | None = None, out_format: str | None = None) -> dict[str, Any]:
+    """The work of :func:`fair_file`; ``fair_file``'s contract, except that it may raise.
+
     ``outfile`` None or ``dry_run``: nothing is written (the report says what would change).
     ``report``: also write the report there (atomically). ``progress(event, value)`` is called
     with ``("curves", n)`` once the file is read and ``("curve", 1)`` after each curve.
@@ -727,7 +749,12 @@ def run_jobs(jobs: Sequence[Job], options: Mapping[str, Any], *, jobs_n: int | N
                 index = {f.key: k for f, k in zip(futs, todo, strict=True)}
                 for fut in as_completed(futs):
                     k = index[fut.key]
-                    reports[k] = fut.result()
+                    try:
+                        reports[k] = fut.result()
+                    except Exception as exc:  # noqa: BLE001 - e.g. KilledWorker: one file
+                        reports[k] = {"input": jobs[k].input, "output": jobs[k].output,
+                                      "status": "failed",
+                                      "error": f"{type(exc).__name__}: {exc}"}
                     if on_event:
                         on_event(jobs[k].display, "file", 1)
             elif n <= 1 or len(todo) <= 1:
@@ -778,7 +805,7 @@ def _run_pool(jobs: Sequence[Job], todo: Sequence[int], options: Mapping[str, An
                 k = futs[f]
                 try:
                     reports[k] = f.result()
-                except Exception as exc:  # a worker died (BrokenProcessPool): redo here
+                except cf.process.BrokenProcessPool as exc:  # a worker died: redo it here
                     reports[k] = fair_file(jobs[k].input, jobs[k].output, options,
                                            report=jobs[k].report, dry_run=dry_run,
                                            in_format=in_format)
@@ -850,7 +877,7 @@ def fair_files(paths: str | Sequence[str], out_dir: str | os.PathLike[str], clie
     if isinstance(paths, (str, os.PathLike)):
         paths = [os.fspath(paths)]
     out = os.fspath(out_dir)
-    plan = plan_inputs(list(paths), out)
+    plan = plan_inputs([os.fspath(p) for p in paths], out)
     if any(j.input == "-" for j in plan):
         raise InputError("fair_files: '-' (stdin) is for the command line only")
     reps = run_jobs(plan, options, jobs_n=jobs, client=client, dry_run=dry_run, resume=resume)
