@@ -287,6 +287,7 @@ def test_dry_run_writes_nothing_and_says_what_a_run_changes(tmp_path: Path):
         assert f"moved {moved}/{n} points (largest move {d.max():.6g})" in out, out
 
 
+@pytest.mark.slow
 def test_jobs_give_the_bytes_of_one_process(tmp_path: Path):
     _tree(tmp_path)
     for k in range(3):
@@ -307,6 +308,7 @@ def _env() -> dict[str, str]:
     return env
 
 
+@pytest.mark.slow
 def test_sigterm_mid_run_leaves_complete_outputs_and_no_temporary_files(tmp_path: Path):
     src = tmp_path / "in"
     src.mkdir()
