@@ -96,7 +96,9 @@ def _check_outputs(inputs: Sequence[tuple[str, str]], outputs: Sequence[tuple[st
             raise click.BadParameter("the file name is empty", param_hint=opt)
         if os.path.isdir(p) and not (opt == "-o/--output" and p.lower().rstrip("/\\")
                                      .endswith(".ufo")):  # a UFO font is a folder
-            raise click.BadParameter(f"{p!r} is a folder; give a file name", param_hint=opt)
+            raise click.BadParameter(f"{p!r} is a folder; give a file name"
+                                     + (f" (or {p.rstrip('/')}/ to write into the folder)"
+                                        if opt == "-o/--output" else ""), param_hint=opt)
         key = _file_key(p)
         for kin, pin, what in keys_in:
             if key == kin and not (in_place and k == 0 and what == "IN"):
@@ -881,12 +883,38 @@ def _summary_table(rows: list[dict[str, Any]]) -> Any:
     return t
 
 
+def _batch_options(f: Any) -> Any:
+    """The many-files options of ``curvefair fair`` (see :mod:`curvefair._batch_cli`)."""
+    from ._batch_cli import batch_options
+
+    return batch_options(f)
+
+
+def _batch_fair_options(method: str | None, tol: float | None, eps: float | None,
+                        max_steps: int | None, clamp: str, protect: str | None, mode: str,
+                        method_option: tuple[str, ...], decimals: int | None, history: bool,
+                        corner_angle: float, no_corners: bool, strict: bool,
+                        batch: dict[str, Any]) -> dict[str, Any]:
+    """The options of :func:`curvefair.batch.fair_file`, checked as for one file."""
+    options = _parse_method_options(method_option)
+    _check_option_values(method if method and "=" not in method else None, options)
+    return {"method": method, "tol": tol, "eps": eps, "max_steps": max_steps, "clamp": clamp,
+            "protect": tuple(_parse_protect(protect)), "mode": mode, "method_options": options,
+            "decimals": decimals, "history": history,
+            "corner_angle": _corner(corner_angle, no_corners), "strict": strict,
+            "layer": batch["layer"], "name": batch["name"], "handle": batch["handle"],
+            "hold_shared": batch["hold_shared"], "shared_distance": batch["shared_distance"]}
+
+
 @main.command("fair", epilog="Default method per curve type: " + _default_methods_text()
               + ". List all with 'curvefair methods'.")
-@click.argument("infile", metavar="IN", type=click.Path(exists=True, dir_okay=True))
+@click.argument("paths", metavar="IN...", nargs=-1, required=True)
 @click.option("-o", "--output", "out", metavar="OUT",
               help="Output file; its extension picks the format (default: IN's format). "
-                   "Required unless --in-place.")
+                   "Required unless --in-place. With several inputs, a folder or a glob: the "
+                   "output folder (inputs keep their paths relative to the folder or glob "
+                   "base; per-file JSON reports and the run report go to OUT/.curvefair/). "
+                   "'-': stdout.")
 @click.option("--in-place", is_flag=True, help="Allow OUT to be IN (or omit -o to replace IN).")
 @click.option("--method", "-m", metavar="M",
               help="Fairing method (see 'curvefair methods'); default: the best general method "
@@ -923,15 +951,16 @@ def _summary_table(rows: list[dict[str, Any]]) -> Any:
               help="Write a before/after figure (.png, .svg or .pdf).")
 @click.option("--glyphs", metavar="A,B,...",
               help="Fonts (.ufo, .ttf, .otf): fair only these glyphs (names, comma separated).")
+@_batch_options
 @_reading_options
 @_quiet_option
-def fair_cmd(infile: str, out: str | None, in_place: bool, method: str | None,
+def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: str | None,
              tol: float | None, eps: float | None, max_steps: int | None, clamp: str,
              protect: str | None, mode: str, method_option: tuple[str, ...],
              decimals: int | None, report: str | None,
              history: bool,
              plot_path: str | None, corner_angle: float, no_corners: bool,
-             strict: bool, quiet: bool, glyphs: str | None = None) -> None:
+             strict: bool, quiet: bool, glyphs: str | None = None, **batch: Any) -> None:
     """Fair every curve in IN and write them to OUT.
 
     Prints a before/after table: strain energy, largest third-derivative jump, inflections,
@@ -943,7 +972,28 @@ def fair_cmd(infile: str, out: str | None, in_place: bool, method: str | None,
     against IN's (the figure is printed and in the report). Farther than --tol: SVG rounding
     to the file's decimals is undone, point data get smaller moves; otherwise OUT is not
     written (exit 1).
+
+    IN... may be several files, folders and glob patterns (quote them), or '-' for stdin;
+    then OUT is a folder and every file is faired on its own (--jobs processes, or Dask
+    workers with --scheduler); one failing file does not stop the others (exit 1).
     """
+    from ._batch_cli import fair_many, wants_batch
+
+    if wants_batch(paths, out, method, batch):
+        if glyphs:
+            raise click.BadParameter("--glyphs works on one font file (IN, -o OUT)",
+                                     param_hint="--glyphs")
+        fair_many(paths, out, in_place, _batch_fair_options(
+            method, tol, eps, max_steps, clamp, protect, mode, method_option, decimals,
+            history, corner_angle, no_corners, strict, batch), jobs=batch["jobs"],
+            resume=batch["resume"], dry_run=batch["dry_run"], diff=batch["diff"],
+            scheduler=batch["scheduler"], report=report, fmt=batch["in_format"], quiet=quiet,
+            plot_path=plot_path)
+        return
+    infile = paths[0]
+    if not (os.path.isfile(infile) or (os.path.isdir(infile)
+                                       and infile.rstrip("/\\").lower().endswith(".ufo"))):
+        raise click.BadParameter(f"file {infile!r} does not exist", param_hint="IN")
     from .io import detect_format
 
     if out is None:
@@ -1078,6 +1128,10 @@ def fair_cmd(infile: str, out: str | None, in_place: bool, method: str | None,
                        err=True)
         raise SystemExit(EXIT_INPUT)
 
+
+from ._batch_cli import check_cmd as _check_cmd  # noqa: E402  (curvefair check)
+
+main.add_command(_check_cmd)
 
 if __name__ == "__main__":  # pragma: no cover
     main()

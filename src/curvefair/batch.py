@@ -1,0 +1,905 @@
+"""Fairing many files: input expansion, per-file work, reports, resuming, processes and Dask.
+
+The unit of work is one file, :func:`fair_file`: read it with :func:`curvefair.read_curves`,
+fair the selected curves with :func:`curvefair.fair`, write the result through
+:func:`curvefair.io._verify.write_checked` (temporary file, read back, measured against the
+input, moved onto the output only when every curve is within ``tol``) and write a per-file
+JSON report. The same function runs in this process, in a pool of processes
+(:func:`fair_files` with ``jobs``) or on Dask distributed workers (``client``); its result
+depends only on the input file's bytes and the options, so all three give the same bytes.
+
+Resuming
+--------
+A per-file report records ``input_sha256`` (the input's bytes), ``options_sha256`` (the
+canonical JSON of every option that changes the output, the output format and the curvefair
+version) and ``output_sha256`` (the bytes written). With ``resume=True`` a file is skipped
+when its report says ``status: "ok"``, both hashes equal today's and the output on disk still
+has the recorded hash: the output is exactly what this run would write.
+
+Selection
+---------
+``layer``, ``name`` and ``handle`` are lists of glob patterns (:func:`fnmatch.fnmatchcase`)
+matched against a record's ``source["layer"]``, ``name`` and ``source["handle"]`` or
+``source["id"]`` (DXF handles, Rhino GUIDs, SVG element ids). A record is selected when, for
+every option given, one of its patterns matches; a record without the field is not selected.
+Unselected curves are written back untouched (their record unchanged).
+
+Hull networks
+-------------
+``hold_shared=True`` protects every point (data points of point lists, control points of
+splines) that lies within ``shared_distance`` of a point of another curve of the same file
+(default ``1e-9`` times the drawing's bounding-box diagonal): station / longitudinal
+intersections of an offsets table stay where they are in both curves, so the network stays
+connected.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import fnmatch
+import glob as _glob
+import hashlib
+import json
+import os
+import re
+import signal
+import sys
+import tempfile
+import time
+import warnings
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ._version import __version__
+from .errors import CurvefairError, InputError
+
+__all__ = ["fair_files", "fair_file", "plan_inputs", "Job", "file_sha256", "options_digest",
+           "parse_methods", "REPORT_DIR"]
+
+#: Folder (inside the output folder) holding the per-file reports and the run report.
+REPORT_DIR = ".curvefair"
+#: Options that change what is written (hashed for ``resume``).
+OUTPUT_OPTIONS = ("method", "tol", "eps", "max_steps", "clamp", "protect", "mode",
+                  "method_options", "decimals", "corner_angle", "strict", "layer", "name",
+                  "handle", "hold_shared", "shared_distance", "format")
+_DEFAULTS: dict[str, Any] = {"method": None, "tol": None, "eps": None, "max_steps": None,
+                             "clamp": "g0", "protect": (), "mode": "spline",
+                             "method_options": {}, "decimals": None, "corner_angle": 60.0,
+                             "strict": False, "layer": (), "name": (), "handle": (),
+                             "hold_shared": False, "shared_distance": None, "history": False,
+                             "format": None}
+_GLOB_CHARS = re.compile(r"[*?\[]")
+
+
+# ------------------------------------------------------------------------------------------
+# options
+# ------------------------------------------------------------------------------------------
+def parse_methods(value: str | Mapping[str, str] | None) -> dict[str, str | None]:
+    """``"bspline=global,points=poliakoff"`` -> ``{"bspline": "global", "points":
+    "poliakoff"}``; a plain ``"NAME"`` -> ``{"*": "NAME"}``; None -> ``{"*": None}``.
+
+    Keys are record kinds (:data:`curvefair.io.KINDS`) or ``*`` (every other kind); values
+    method names of :data:`curvefair.fairing.METHODS`.
+    """
+    from .fairing import METHODS
+    from .io import KINDS
+
+    if value is None:
+        return {"*": None}
+    if isinstance(value, Mapping):
+        items = list(value.items())
+    elif "=" not in value:
+        items = [("*", value.strip())]
+    else:
+        items = []
+        for tok in value.split(","):
+            tok = tok.strip()
+            if not tok:
+                continue
+            k, sep, v = tok.partition("=")
+            if not sep:
+                k, v = "*", tok
+            items.append((k.strip(), v.strip()))
+    out: dict[str, str | None] = {"*": None}
+    for k, v in items:
+        if k not in KINDS and k != "*":
+            raise InputError(f"method: {k!r} is not a curve kind; valid: *, " + ", ".join(KINDS))
+        if v not in METHODS:
+            raise InputError(f"method: unknown method {v!r} for {k!r}; valid: "
+                             + ", ".join(METHODS))
+        out[k] = v
+    return out
+
+
+def _options(options: Mapping[str, Any]) -> dict[str, Any]:
+    bad = sorted(set(options) - set(_DEFAULTS))
+    if bad:
+        raise InputError(f"fair_files: unknown option {bad[0]!r}; valid: "
+                         + ", ".join(sorted(_DEFAULTS)))
+    opts = dict(_DEFAULTS)
+    opts.update(options)
+    for key in ("protect", "layer", "name", "handle"):
+        v = opts[key]
+        opts[key] = (v,) if isinstance(v, (str, int)) else tuple(v or ())
+    opts["methods"] = parse_methods(opts["method"])
+    return opts
+
+
+def _jsonable(v: Any) -> Any:
+    if isinstance(v, Mapping):
+        return {str(k): _jsonable(x) for k, x in sorted(v.items(), key=lambda kv: str(kv[0]))}
+    if isinstance(v, (list, tuple)):
+        return [_jsonable(x) for x in v]
+    if isinstance(v, float) and not np.isfinite(v):
+        return repr(v)
+    if v is None or isinstance(v, (bool, int, float, str)):
+        return v
+    return repr(v)
+
+
+def options_digest(options: Mapping[str, Any], out_format: str | None = None) -> str:
+    """SHA-256 of the canonical JSON of the output-changing options, the output format and the
+    curvefair version (what ``resume`` compares)."""
+    opts = _options({k: v for k, v in options.items() if k != "methods"})
+    sel = {k: opts[k] for k in OUTPUT_OPTIONS}
+    sel["method"] = opts["methods"]
+    blob = json.dumps({"options": _jsonable(sel), "out_format": out_format,
+                       "curvefair": __version__}, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(blob.encode()).hexdigest()
+
+
+def file_sha256(path: str | os.PathLike[str]) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for chunk in iter(lambda: f.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()
+
+
+# ------------------------------------------------------------------------------------------
+# inputs and outputs
+# ------------------------------------------------------------------------------------------
+@dataclass
+class Job:
+    """One file to fair: where it is read, where its output and report go."""
+
+    input: str
+    output: str
+    report: str | None
+    rel: str = ""
+    display: str = ""
+    meta: dict[str, Any] = field(default_factory=dict)
+
+
+def _known_exts() -> tuple[str, ...]:
+    from .io import FORMATS
+
+    return tuple(e for exts in FORMATS.values() for e in exts)
+
+
+def _file_key(path: str) -> tuple[Any, ...]:
+    real = os.path.realpath(path)
+    try:
+        st = os.stat(real)
+    except OSError:
+        return ("path", os.path.normcase(real))
+    return ("inode", st.st_dev, st.st_ino)
+
+
+def _glob_base(pattern: str) -> str:
+    parts = Path(pattern).parts
+    base: list[str] = []
+    for part in parts:
+        if _GLOB_CHARS.search(part):
+            break
+        base.append(part)
+    return str(Path(*base)) if base else "."
+
+
+def _walk(folder: str, skip: set[tuple[Any, ...]]) -> Iterator[str]:
+    """Files with a known extension under ``folder``, sorted, hidden files and folders (and
+    the folders in ``skip``, e.g. the output folder) left out."""
+    exts = _known_exts()
+    for root, dirs, files in os.walk(folder, followlinks=False):
+        dirs[:] = sorted(d for d in dirs if not d.startswith(".")
+                         and _file_key(os.path.join(root, d)) not in skip)
+        for f in sorted(files):
+            if not f.startswith(".") and f.lower().endswith(exts):
+                yield os.path.join(root, f)
+
+
+def expand_inputs(paths: Sequence[str], skip_dirs: Sequence[str] = ()) -> list[tuple[str, str]]:
+    """``(file, path relative to where it was found)`` for every input: files as given,
+    folders walked (known extensions), glob patterns (``**`` recursive) expanded. ``-`` is
+    kept as is (stdin). The same file named twice (any spelling) is kept once.
+
+    Raises
+    ------
+    InputError
+        A path that does not exist and matches nothing.
+    """
+    skip = {_file_key(d) for d in skip_dirs if os.path.isdir(d)}
+    out: list[tuple[str, str]] = []
+    seen: set[tuple[Any, ...]] = set()
+
+    def add(p: str, rel: str) -> None:
+        if p == "-":
+            out.append((p, rel))
+            return
+        k = _file_key(p)
+        if k not in seen:
+            seen.add(k)
+            out.append((p, rel))
+
+    for p in paths:
+        if p == "-":
+            add(p, "-")
+        elif os.path.isdir(p):
+            for f in _walk(p, skip):
+                add(f, os.path.relpath(f, p))
+        elif os.path.exists(p):
+            add(p, os.path.basename(p))
+        elif _GLOB_CHARS.search(p):
+            hits = sorted(h for h in _glob.glob(p, recursive=True) if os.path.isfile(h))
+            if not hits:
+                raise InputError(f"{p!r}: no file matches")
+            base = _glob_base(p)
+            for h in hits:
+                add(h, os.path.relpath(h, base))
+        else:
+            raise InputError(f"{p!r} does not exist")
+    return out
+
+
+def plan_inputs(paths: Sequence[str], out_dir: str | None, *, in_place: bool = False,
+                stdin_format: str | None = None) -> list[Job]:
+    """The jobs for ``paths``: one per file, output ``out_dir/<relative path>`` (or the input
+    itself with ``in_place``), per-file report ``<out folder>/.curvefair/<relative>.json``.
+
+    Raises
+    ------
+    InputError
+        An input that does not exist, two inputs with one output, an output that is an input
+        (same inode, any spelling or link) without ``in_place``.
+    """
+    if out_dir is None and not in_place:
+        raise InputError("an output folder is needed (or in_place=True)")
+    found = expand_inputs(paths, [out_dir] if out_dir else [])
+    if not found:
+        raise InputError("no input files")
+    jobs: list[Job] = []
+    for p, rel in found:
+        if p == "-":
+            ext = _stdin_ext(stdin_format)
+            rel = "stdin" + ext
+        if in_place:
+            if p == "-":
+                raise InputError("'-' (stdin) cannot be faired in place")
+            folder = os.path.dirname(os.path.abspath(p))
+            rep = os.path.join(folder, REPORT_DIR, os.path.basename(p) + ".json")
+            jobs.append(Job(p, p, rep, os.path.basename(p), p))
+        else:
+            assert out_dir is not None
+            jobs.append(Job(p, os.path.join(out_dir, rel),
+                            os.path.join(out_dir, REPORT_DIR, rel + ".json"), rel,
+                            "<stdin>" if p == "-" else p))
+    ins = {_file_key(j.input): j.input for j in jobs if j.input != "-"}
+    seen: dict[tuple[Any, ...], str] = {}
+    for j in jobs:
+        for what, path in (("output", j.output), ("report", j.report)):
+            if path is None:
+                continue
+            k = _file_key(path)
+            if k in ins and not (in_place and what == "output" and ins[k] == j.input):
+                raise InputError(f"the {what} {path!r} is the input file {ins[k]!r}")
+            if k in seen:
+                raise InputError(f"{seen[k]!r} and {j.display!r} would both be written to "
+                                 f"{path!r}")
+            seen[k] = j.display
+    return jobs
+
+
+def _stdin_ext(fmt: str | None) -> str:
+    from .io import FORMATS
+
+    if fmt is None:
+        raise InputError("'-' (stdin) has no file name: give its format (format=, --format); "
+                         "one of " + ", ".join(FORMATS))
+    if fmt not in FORMATS:
+        raise InputError(f"format {fmt!r} unknown; valid: " + ", ".join(FORMATS))
+    return FORMATS[fmt][0]
+
+
+# ------------------------------------------------------------------------------------------
+# selection and shared points
+# ------------------------------------------------------------------------------------------
+def _handle_of(rec: Any) -> str | None:
+    for key in ("handle", "id"):
+        v = rec.source.get(key)
+        if v is not None:
+            return str(v)
+    return None
+
+
+def selected(rec: Any, opts: Mapping[str, Any]) -> bool:
+    """Whether ``rec`` passes the ``layer`` / ``name`` / ``handle`` glob filters."""
+    for key, value in (("layer", rec.source.get("layer")), ("name", rec.name),
+                       ("handle", _handle_of(rec))):
+        pats = opts.get(key) or ()
+        if not pats:
+            continue
+        if value is None or not any(fnmatch.fnmatchcase(str(value), p) for p in pats):
+            return False
+    return True
+
+
+def _movable_points(rec: Any) -> np.ndarray | None:
+    """What ``protect`` indexes for ``rec``: data points of point kinds (``rec.points``),
+    else the curve's control points (B-spline) or points (Hermite)."""
+    if rec.points is not None:
+        return np.asarray(rec.points)
+    for attr in ("control_points", "points"):
+        v = getattr(rec.curve, attr, None)
+        if v is not None:
+            return np.asarray(v)
+    return None
+
+
+def _curve_points(curve: Any) -> np.ndarray | None:
+    """The points a method moves: control points of a B-spline, else the curve's points."""
+    for attr in ("control_points", "points"):
+        v = getattr(curve, attr, None)
+        if v is not None:
+            return np.asarray(v)
+    return None
+
+
+def shared_points(records: Sequence[Any], distance: float | None = None) -> list[list[int]]:
+    """For every record, the indices of its points (see :func:`_movable_points`) within
+    ``distance`` of a point of another record (default: ``1e-9`` times the bounding-box
+    diagonal of all points)."""
+    from scipy.spatial import cKDTree
+
+    pts = [_movable_points(r) for r in records]
+    have = [p for p in pts if p is not None and len(p)]
+    if len(have) < 2:
+        return [[] for _ in records]
+    dims = {p.shape[1] for p in have}
+    dim = max(dims)
+    pad = [np.c_[p, np.zeros((len(p), dim - p.shape[1]))] if p.shape[1] < dim else p
+           for p in have]
+    allp = np.vstack(pad)
+    owner = np.concatenate([np.full(len(p), k) for k, p in enumerate(pad)])
+    if distance is None:
+        span = float(np.linalg.norm(allp.max(axis=0) - allp.min(axis=0)))
+        distance = 1e-9 * span
+    tree = cKDTree(allp)
+    out: list[list[int]] = []
+    k = 0
+    for p in pts:
+        if p is None or not len(p):
+            out.append([])
+            continue
+        mine = pad[k]
+        hits = tree.query_ball_point(mine, r=distance)
+        out.append([i for i, h in enumerate(hits) if any(owner[j] != k for j in h)])
+        k += 1
+    return out
+
+
+# ------------------------------------------------------------------------------------------
+# one file
+# ------------------------------------------------------------------------------------------
+def _nothing_to_fair(rec: Any) -> bool:
+    pts = rec.points
+    if pts is None:
+        return False
+    return len(pts) - (1 if getattr(rec.curve, "closed", False) else 0) <= 2
+
+
+def _local_protect(rec: Any, user: Sequence[int]) -> list[int]:
+    idx = rec.source.get("indices")
+    if idx is not None and user:
+        pos = {int(fi): k for k, fi in enumerate(idx)}
+        mine = [pos[i] for i in user if i in pos]
+    else:
+        mine = list(user)
+    return sorted(set(mine) | set(rec.corners))
+
+
+def _label(rec: Any, i: int) -> str:
+    return rec.name if rec.name else f"curve {i}"
+
+
+def _change(before: Any, after: Any) -> dict[str, Any]:
+    """Points moved between two records of one curve: count and largest move."""
+    a, b = _curve_points(before.curve), _curve_points(after.curve)
+    if a is None or b is None or a.shape != b.shape:
+        return {"points": None if a is None else int(len(a)), "moved": None,
+                "max_move": None}
+    d = np.linalg.norm(b - a, axis=1)
+    return {"points": int(len(a)), "moved": int(np.count_nonzero(d)),
+            "max_move": float(d.max()) if d.size else 0.0}
+
+
+def _read(path: str, opts: Mapping[str, Any], notes: list[str] | None = None,
+          fmt: str | None = None) -> list[Any]:
+    from . import read_curves
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        recs = read_curves(path, corner_angle=opts["corner_angle"], format=fmt,
+                           on_unsupported="raise" if opts["strict"] else "skip")
+    if notes is not None:
+        notes.extend(dict.fromkeys(str(w.message) for w in caught))
+    return recs
+
+
+def _test_delay() -> None:
+    """Test hook: ``CURVEFAIR_TEST_FILE_DELAY`` seconds of sleep before each file's write (the
+    worker-killed-mid-run test needs files that take long enough to be caught running)."""
+    d = os.environ.get("CURVEFAIR_TEST_FILE_DELAY")
+    if d:
+        time.sleep(float(d))
+
+
+def fair_file(infile: str, outfile: str | None, options: Mapping[str, Any] | None = None, *,
+              report: str | None = None, dry_run: bool = False,
+              progress: Callable[[str, Any], None] | None = None,
+              in_format: str | None = None, out_format: str | None = None) -> dict[str, Any]:
+    """Fair one file; return its report (a JSON-serialisable dict); never raise for bad input.
+
+    An unexpected error (a bug, or a library failing on a file) is a ``failed`` report naming
+    the exception too, so one file never stops a run; nothing is written for it.
+    """
+
+    _options(options or {})  # unknown options: the caller's error, raised
+    try:
+        return _fair_file(infile, outfile, options, report=report, dry_run=dry_run,
+                          progress=progress, in_format=in_format, out_format=out_format)
+    except (KeyboardInterrupt, SystemExit, _Terminated):
+        raise
+    except Exception as exc:  # noqa: BLE001 - reported per file, see the docstring
+        return {"curvefair": __version__, "input": infile, "output": outfile,
+                "status": "failed", "dry_run": bool(dry_run),
+                "error": f"unexpected {type(exc).__name__}: {exc}"}
+
+
+def _fair_file(infile: str, outfile: str | None, options: Mapping[str, Any] | None = None, *,
+               report: str | None = None, dry_run: bool = False,
+               progress: Callable[[str, Any], None] | None = None,
+               in_format: str | None = None, out_format: str | None = None) -> dict[str, Any]:
+    """The work of :func:`fair_file`; ``fair_file``'s contract, except that it may raise.
+
+    ``outfile`` None or ``dry_run``: nothing is written (the report says what would change).
+    ``report``: also write the report there (atomically). ``progress(event, value)`` is called
+    with ``("curves", n)`` once the file is read and ``("curve", 1)`` after each curve.
+    ``status`` is ``"ok"``, ``"failed"`` (nothing written: unreadable input, every selected
+    curve failed, or the written file would not read back within ``tol``), ``"partial"`` (some
+    curves failed: written with those unchanged) or ``"dry-run"``.
+    """
+    from . import fair
+    from .io import detect_format
+
+    opts = _options(options or {})
+    t0 = time.perf_counter()
+    rep: dict[str, Any] = {"curvefair": __version__, "input": infile, "output": outfile,
+                           "status": "failed", "dry_run": bool(dry_run)}
+    try:
+        fmt_in = detect_format(infile, in_format)
+        fmt_out = out_format or (fmt_in if outfile is None
+                                 else _out_format(infile, outfile, in_format))
+        rep.update(format=fmt_out, input_sha256=file_sha256(infile),
+                   options=_jsonable({k: opts[k] for k in OUTPUT_OPTIONS}),
+                   options_sha256=options_digest(options or {}, fmt_out))
+        read_notes: list[str] = []
+        records = _read(infile, opts, read_notes, fmt_in)
+        if read_notes:
+            rep["read_warnings"] = read_notes
+    except (CurvefairError, OSError) as exc:
+        rep["error"] = _err(exc)
+        rep["time_s"] = time.perf_counter() - t0
+        return _finish(rep, report, dry_run)
+    if progress is not None:
+        progress("curves", len(records))
+    shared = (shared_points(records, opts["shared_distance"]) if opts["hold_shared"]
+              else [[] for _ in records])
+    rows: list[dict[str, Any]] = []
+    faired = []
+    for i, rec in enumerate(records):
+        row: dict[str, Any] = {"index": i, "label": _label(rec, i), "name": rec.name,
+                               "kind": rec.kind, "layer": rec.source.get("layer"),
+                               "handle": _handle_of(rec)}
+        method = opts["methods"].get(rec.kind, opts["methods"]["*"])
+        if not selected(rec, opts):
+            row["status"] = "not selected"
+            faired.append(rec)
+        elif _nothing_to_fair(rec):
+            row["status"] = "nothing to fair"
+            faired.append(rec)
+        else:
+            notes: list[str] = []
+            prot = sorted(set(_local_protect(rec, opts["protect"])) | set(shared[i]))
+            if shared[i]:
+                row["shared_points_held"] = len(shared[i])
+            try:
+                with warnings.catch_warnings(record=True) as caught:
+                    warnings.simplefilter("always")
+                    res = fair(rec.curve, method, tol=opts["tol"], eps=opts["eps"],
+                               max_steps=opts["max_steps"], clamp=opts["clamp"], protect=prot,
+                               mode=opts["mode"], **dict(opts["method_options"]))
+                notes = list(dict.fromkeys(str(w.message) for w in caught))
+            except CurvefairError as exc:
+                row.update(status="failed", error=str(exc))
+                faired.append(rec)
+            else:
+                new = rec.with_curve(res.curve)
+                row.update(status="ok", report=_jsonable(res.report), change=_change(rec, new))
+                if notes:
+                    row["warnings"] = notes
+                if opts["history"]:
+                    row["history"] = _jsonable(res.history.to_dict())
+                faired.append(new)
+        rows.append(row)
+        if progress is not None:
+            progress("curve", 1)
+    failed = [r for r in rows if r["status"] == "failed"]
+    tried = [r for r in rows if r["status"] in ("ok", "failed")]
+    rep.update(n_curves=len(rows), n_selected=len(tried), n_failed=len(failed), curves=rows)
+    if dry_run or outfile is None:
+        rep["status"] = "dry-run"
+    elif tried and len(failed) == len(tried):
+        rep["error"] = "every selected curve failed; nothing written"
+    else:
+        _test_delay()
+        try:
+            check = _write(outfile, faired, records, infile, fmt_in, fmt_out, opts,
+                           in_place=_file_key(outfile) == _file_key(infile))
+        except (CurvefairError, OSError) as exc:
+            rep["error"] = _err(exc)
+        else:
+            for row, d, kind in zip(rows, check.deviations, check.kinds, strict=True):
+                if row["status"] == "ok":
+                    row["report"]["on_disk_deviation"] = d
+                    row["report"]["on_disk_deviation_kind"] = kind
+            rep["output_check"] = _jsonable(check.to_dict())
+            rep["output_sha256"] = file_sha256(outfile)
+            rep["status"] = "partial" if failed else "ok"
+    rep["time_s"] = time.perf_counter() - t0
+    return _finish(rep, report, dry_run)
+
+
+def _err(exc: BaseException) -> str:
+    if isinstance(exc, OSError) and not isinstance(exc, CurvefairError):
+        where = f"{exc.filename}: " if getattr(exc, "filename", None) else ""
+        return f"{where}{exc.strerror or exc}"
+    return str(exc)
+
+
+def _write(outfile: str, faired: list[Any], records: list[Any], infile: str, fmt_in: str,
+           fmt_out: str, opts: Mapping[str, Any], in_place: bool) -> Any:
+    from .io._verify import write_checked
+
+    folder = os.path.dirname(os.path.abspath(outfile))
+    os.makedirs(folder, exist_ok=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return write_checked(outfile, faired, records, tol=opts["tol"],
+                             reader=lambda p: _read(p, opts, None, fmt_out),
+                             template=infile if fmt_out == fmt_in else None, format=fmt_out,
+                             overwrite=in_place, decimals=opts["decimals"])
+
+
+def _finish(rep: dict[str, Any], report: str | None, dry_run: bool) -> dict[str, Any]:
+    if report is not None and not dry_run:
+        from .io import atomic_write
+
+        try:
+            os.makedirs(os.path.dirname(os.path.abspath(report)), exist_ok=True)
+            atomic_write(report, json.dumps(rep, indent=2, allow_nan=False) + "\n")
+        except (CurvefairError, OSError, ValueError) as exc:
+            rep.setdefault("error", f"report {report!r} not written: {_err(exc)}")
+            if rep["status"] == "ok":
+                rep["status"] = "failed"
+    return rep
+
+
+def up_to_date(job: Job, options: Mapping[str, Any], out_format: str | None = None,
+               in_format: str | None = None) -> dict[str, Any] | None:
+    """The recorded report when ``job``'s output exists and matches (see the module
+    docstring), else None."""
+    if job.report is None or not os.path.isfile(job.report) or not os.path.isfile(job.output):
+        return None
+    try:
+        with open(job.report, encoding="utf-8") as f:
+            old = json.load(f)
+        fmt = out_format or _out_format(job.input, job.output, in_format)
+        if (old.get("status") == "ok"
+                and old.get("input_sha256") == file_sha256(job.input)
+                and old.get("options_sha256") == options_digest(options, fmt)
+                and old.get("output_sha256") == file_sha256(job.output)):
+            return old
+    except (OSError, ValueError, CurvefairError):
+        return None
+    return None
+
+
+def _out_format(infile: str, outfile: str, in_format: str | None = None) -> str:
+    from .io import detect_format
+
+    try:
+        return detect_format(outfile)
+    except CurvefairError:
+        return detect_format(infile, in_format)
+
+
+# ------------------------------------------------------------------------------------------
+# many files
+# ------------------------------------------------------------------------------------------
+def _sweep_temps(paths: Iterable[str | None]) -> int:
+    """Remove temporary files an atomic write left next to ``paths`` (a worker killed with
+    SIGKILL cannot delete its own): ``.<name>.<8 random characters><suffix>``, the names
+    :func:`tempfile.mkstemp` gives in :func:`curvefair.io.atomic_path`. Only called when no
+    job of the run is still writing."""
+    n = 0
+    for p in paths:
+        if p is None:
+            continue
+        dest = Path(os.path.realpath(p)) if os.path.islink(p) else Path(p)
+        pat = re.compile(re.escape("." + dest.name + ".") + r"[A-Za-z0-9_]{8}"
+                         + r"(\.[A-Za-z0-9]+)?$")
+        with contextlib.suppress(OSError):
+            for e in os.scandir(dest.parent if str(dest.parent) else "."):
+                if pat.match(e.name) and e.is_file(follow_symlinks=False):
+                    with contextlib.suppress(OSError):
+                        os.unlink(e.path)
+                        n += 1
+    return n
+
+
+def _run_one(job: Job, options: Mapping[str, Any], dry_run: bool, in_format: str | None,
+             queue: Any = None) -> dict[str, Any]:
+    """Top-level (picklable) per-file call for process pools and Dask workers."""
+    prog = None
+    if queue is not None:
+        def prog(event: str, value: Any) -> None:
+            with contextlib.suppress(Exception):
+                queue.put((job.display, event, value))
+    rep = fair_file(job.input, job.output, options, report=job.report, dry_run=dry_run,
+                    progress=prog, in_format=in_format)
+    if queue is not None:
+        with contextlib.suppress(Exception):
+            queue.put((job.display, "file", 1))
+    return rep
+
+
+def _summary(job: Job, rep: Mapping[str, Any]) -> dict[str, Any]:
+    return {"input": job.display, "output": job.output, "report": job.report,
+            "status": rep.get("status"), "error": rep.get("error"),
+            "n_curves": rep.get("n_curves"), "n_selected": rep.get("n_selected"),
+            "n_failed": rep.get("n_failed"), "time_s": rep.get("time_s")}
+
+
+class _Terminated(Exception):
+    pass
+
+
+@contextlib.contextmanager
+def _signals_raise() -> Iterator[None]:
+    """SIGTERM / SIGHUP in the main thread raise :class:`_Terminated` (so ``finally`` blocks
+    stop the workers and remove temporary files), instead of killing the process outright."""
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    old: dict[int, Any] = {}
+
+    def handler(signum: int, frame: Any) -> None:
+        raise _Terminated(signum)
+
+    for name in ("SIGTERM", "SIGHUP"):
+        sig = getattr(signal, name, None)
+        if sig is not None:
+            with contextlib.suppress(ValueError, OSError):
+                old[sig] = signal.signal(sig, handler)
+    try:
+        yield
+    finally:
+        for sig, h in old.items():
+            with contextlib.suppress(ValueError, OSError, TypeError):
+                signal.signal(sig, h)
+
+
+def run_jobs(jobs: Sequence[Job], options: Mapping[str, Any], *, jobs_n: int | None = None,
+             client: Any = None, dry_run: bool = False, resume: bool = False,
+             in_format: str | None = None,
+             on_event: Callable[[str, str, Any], None] | None = None
+             ) -> list[dict[str, Any]]:
+    """Run ``jobs`` (in this process, a process pool of ``jobs_n`` or on a Dask ``client``);
+    one report per job, in the order of ``jobs``. ``on_event(file, event, value)`` gets the
+    progress events (``"curves"``, ``"curve"``, ``"file"``, ``"skipped"``)."""
+    _options(options)  # refuse unknown options before any work
+    reports: list[dict[str, Any] | None] = [None] * len(jobs)
+    todo: list[int] = []
+    for k, job in enumerate(jobs):
+        old = up_to_date(job, options, in_format=in_format) if resume and not dry_run else None
+        if old is not None:
+            rep = dict(old)
+            rep["status"] = "ok"
+            rep["skipped"] = "up to date (input, options and output match the report)"
+            reports[k] = rep
+            if on_event:
+                on_event(job.display, "skipped", 1)
+        else:
+            todo.append(k)
+    n = jobs_n if jobs_n is not None else (os.cpu_count() or 1)
+    try:
+        with _signals_raise():
+            if client is not None:
+                futs = client.map(_run_one, [jobs[k] for k in todo],
+                                  [options] * len(todo), [dry_run] * len(todo),
+                                  [in_format] * len(todo), pure=False)
+                from distributed import as_completed
+
+                index = {f.key: k for f, k in zip(futs, todo, strict=True)}
+                for fut in as_completed(futs):
+                    k = index[fut.key]
+                    try:
+                        reports[k] = fut.result()
+                    except Exception as exc:  # noqa: BLE001 - e.g. KilledWorker: one file
+                        reports[k] = {"input": jobs[k].input, "output": jobs[k].output,
+                                      "status": "failed",
+                                      "error": f"{type(exc).__name__}: {exc}"}
+                    if on_event:
+                        on_event(jobs[k].display, "file", 1)
+            elif n <= 1 or len(todo) <= 1:
+                for k in todo:
+                    def ev(event: str, value: Any, _d: str = jobs[k].display) -> None:
+                        if on_event:
+                            on_event(_d, event, value)
+                    reports[k] = fair_file(jobs[k].input, jobs[k].output, options,
+                                           report=jobs[k].report, dry_run=dry_run,
+                                           progress=ev, in_format=in_format)
+                    if on_event:
+                        on_event(jobs[k].display, "file", 1)
+            else:
+                _run_pool(jobs, todo, options, min(n, len(todo)), dry_run, in_format,
+                          reports, on_event)
+    finally:
+        if not dry_run:
+            _sweep_temps([j.output for j in jobs] + [j.report for j in jobs])
+    return [r if r is not None else {"status": "failed", "error": "not run"} for r in reports]
+
+
+def _run_pool(jobs: Sequence[Job], todo: Sequence[int], options: Mapping[str, Any], n: int,
+              dry_run: bool, in_format: str | None, reports: list[Any],
+              on_event: Callable[[str, str, Any], None] | None) -> None:
+    import concurrent.futures as cf
+    import multiprocessing as mp
+    import queue as _queue
+
+    ctx = mp.get_context("spawn")
+    manager = ctx.Manager() if on_event else None
+    q = manager.Queue() if manager is not None else None
+    pool = cf.ProcessPoolExecutor(max_workers=n, mp_context=ctx)
+    try:
+        futs = {pool.submit(_run_one, jobs[k], options, dry_run, in_format, q): k
+                for k in todo}
+        pending = set(futs)
+        while pending:
+            done, pending = cf.wait(pending, timeout=0.1, return_when=cf.FIRST_COMPLETED)
+            if q is not None:
+                while True:
+                    try:
+                        name, event, value = q.get_nowait()
+                    except (_queue.Empty, OSError, EOFError):
+                        break
+                    assert on_event is not None
+                    on_event(name, event, value)
+            for f in done:
+                k = futs[f]
+                try:
+                    reports[k] = f.result()
+                except cf.process.BrokenProcessPool as exc:  # a worker died: redo it here
+                    reports[k] = fair_file(jobs[k].input, jobs[k].output, options,
+                                           report=jobs[k].report, dry_run=dry_run,
+                                           in_format=in_format)
+                    reports[k].setdefault("notes", []).append(f"redone after {exc!r}")
+    except BaseException:
+        for p in list(getattr(pool, "_processes", {}).values()):
+            with contextlib.suppress(Exception):
+                p.terminate()  # SIGTERM: the worker's handler deletes its temporary files
+        for p in list(getattr(pool, "_processes", {}).values()):
+            with contextlib.suppress(Exception):
+                p.join(5)
+        pool.shutdown(wait=False, cancel_futures=True)
+        raise
+    else:
+        pool.shutdown(wait=True)
+    finally:
+        if manager is not None:
+            manager.shutdown()
+
+
+def run_report(jobs: Sequence[Job], reports: Sequence[Mapping[str, Any]],
+               options: Mapping[str, Any], t0: float, dry_run: bool) -> dict[str, Any]:
+    """The run's report: options, counts and one summary per file."""
+    files = [_summary(j, r) for j, r in zip(jobs, reports, strict=True)]
+    for f, r in zip(files, reports, strict=True):
+        if r.get("skipped"):
+            f["skipped"] = r["skipped"]
+    opts = _options(options)
+    return {"curvefair": __version__, "dry_run": dry_run,
+            "options": _jsonable({k: opts[k] for k in OUTPUT_OPTIONS}),
+            "n_files": len(files),
+            "n_ok": sum(f["status"] == "ok" and not f.get("skipped") for f in files),
+            "n_skipped": sum(bool(f.get("skipped")) for f in files),
+            "n_partial": sum(f["status"] == "partial" for f in files),
+            "n_failed": sum(f["status"] == "failed" for f in files),
+            "n_dry_run": sum(f["status"] == "dry-run" for f in files),
+            "time_s": time.perf_counter() - t0, "files": files}
+
+
+def fair_files(paths: str | Sequence[str], out_dir: str | os.PathLike[str], client: Any = None,
+               *, jobs: int | None = None, resume: bool = False, dry_run: bool = False,
+               report: str | None = None, **options: Any) -> dict[str, Any]:
+    """Fair every file of ``paths`` (files, folders, glob patterns) into ``out_dir``.
+
+    Parameters
+    ----------
+    paths : str or sequence of str
+    out_dir : path-like
+        Outputs go to ``out_dir/<path relative to the folder or glob base>``; per-file reports
+        to ``out_dir/.curvefair/<relative path>.json``; the run report to
+        ``out_dir/.curvefair/run.json`` (or ``report``).
+    client : distributed.Client, optional
+        Run the per-file work on this Dask cluster (the workers must see the same file
+        system); None: local processes (``jobs``, default the core count).
+    jobs, resume, dry_run
+        See the module docstring; ``dry_run`` writes nothing at all.
+    **options
+        ``method`` (a name or ``"kind=name,..."``), ``tol``, ``eps``, ``max_steps``, ``clamp``,
+        ``protect``, ``mode``, ``method_options`` (dict), ``decimals``, ``corner_angle``,
+        ``strict``, ``layer``, ``name``, ``handle``, ``hold_shared``, ``shared_distance``,
+        ``history``.
+
+    Returns
+    -------
+    dict
+        The run report (``files``: one summary per file; ``n_failed`` > 0 when any failed).
+    """
+    t0 = time.perf_counter()
+    if isinstance(paths, (str, os.PathLike)):
+        paths = [os.fspath(paths)]
+    out = os.fspath(out_dir)
+    plan = plan_inputs([os.fspath(p) for p in paths], out)
+    if any(j.input == "-" for j in plan):
+        raise InputError("fair_files: '-' (stdin) is for the command line only")
+    reps = run_jobs(plan, options, jobs_n=jobs, client=client, dry_run=dry_run, resume=resume)
+    run = run_report(plan, reps, options, t0, dry_run)
+    if not dry_run:
+        from .io import atomic_write
+
+        dest = report or os.path.join(out, REPORT_DIR, "run.json")
+        os.makedirs(os.path.dirname(os.path.abspath(dest)), exist_ok=True)
+        atomic_write(dest, json.dumps(run, indent=2, allow_nan=False) + "\n")
+        run["run_report"] = dest
+    return run
+
+
+def spool_stdin(fmt: str | None, folder: str) -> str:
+    """Copy stdin into ``folder/stdin.<ext>`` (the readers take file names)."""
+    path = os.path.join(folder, "stdin" + _stdin_ext(fmt))
+    data = sys.stdin.buffer.read()
+    with open(path, "wb") as f:
+        f.write(data)
+    return path
+
+
+def temp_folder() -> tempfile.TemporaryDirectory[str]:
+    return tempfile.TemporaryDirectory(prefix="curvefair-")

@@ -1,0 +1,264 @@
+"""`curvefair check`: findings measured against independent computations (the tangent legs
+and end curvature of Bezier control polygons, a dense sampling of the signed curvature),
+the exit code, the SARIF 2.1.0 structure and the pre-commit hook definition."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from curvefair import BSplineCurve, interpolate_cubic, write_curves
+from curvefair.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _run(args: list[str], cwd: Path):
+    old = os.getcwd()
+    os.chdir(cwd)
+    try:
+        return CliRunner().invoke(main, args, catch_exceptions=False)
+    finally:
+        os.chdir(old)
+
+
+def _two_beziers(left: np.ndarray, right: np.ndarray) -> BSplineCurve:
+    """Two cubic Bezier pieces joined at left[3] == right[0] (a C0 knot of multiplicity 3)."""
+    assert np.array_equal(left[3], right[0])
+    P = np.vstack([left, right[1:]])
+    knots = [0, 0, 0, 0, 1, 1, 1, 2, 2, 2, 2]
+    return BSplineCurve(P, knots, 3)
+
+
+def _leg_angle(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> float:
+    u, v = b - a, c - b
+    return math.degrees(math.atan2(abs(u[0] * v[1] - u[1] * v[0]), float(u @ v)))
+
+
+def _end_curvature(p0: np.ndarray, p1: np.ndarray, p2: np.ndarray) -> float:
+    """Curvature of a cubic Bezier at its end p0 (p1, p2 the next control points):
+    kappa = (n-1)/n |(p1-p0) x (p2-p1)| / |p1-p0|^3 with n = 3."""
+    d1, d2 = p1 - p0, p2 - p1
+    return 2.0 / 3.0 * abs(d1[0] * d2[1] - d1[1] * d2[0]) / np.linalg.norm(d1) ** 3
+
+
+def test_kink_value_is_the_control_polygon_angle(tmp_path: Path):
+    t = math.radians(3.0)
+    J = np.array([3.0, 0.0])
+    left = np.array([[0.0, 0.0], [1.0, 0.3], [2.0, 0.0], J])
+    right = np.array([J, J + [math.cos(t), math.sin(t)], J + [2.0, 1.0], J + [3.0, 0.5]])
+    write_curves(tmp_path / "kink.json", [_two_beziers(left, right)])
+    r = _run(["check", "kink.json", "--format", "json"], tmp_path)
+    assert r.exit_code == 1, r.output
+    found = json.loads(r.output)["findings"]
+    kinks = [f for f in found if f["rule"] == "kink"]
+    assert len(kinks) == 1
+    want = _leg_angle(left[2], J, right[1])
+    assert abs(want - 3.0) < 1e-12
+    assert abs(kinks[0]["value"] - want) < 1e-9
+    np.testing.assert_allclose(kinks[0]["point"], J, atol=1e-12)
+    # above the corner angle it is a corner drawn on purpose; with the kink threshold off: none
+    r = _run(["check", "kink.json", "--corner-angle", "2", "--format", "json"], tmp_path)
+    assert not [f for f in json.loads(r.output)["findings"] if f["rule"] == "kink"]
+
+
+def test_g2_break_value_is_the_bezier_end_curvature_jump(tmp_path: Path):
+    J = np.array([3.0, 0.0])
+    left = np.array([[0.0, 0.0], [1.0, 0.5], [2.0, 0.0], J])
+    right = np.array([J, [4.0, 0.0], [5.0, 1.0], [6.0, 1.0]])
+    write_curves(tmp_path / "g2.json", [_two_beziers(left, right)])
+    r = _run(["check", "g2.json", "--format", "json", "--max-bad", "off", "--wiggle", "off"],
+             tmp_path)
+    assert r.exit_code == 1, r.output
+    (f,) = json.loads(r.output)["findings"]
+    assert f["rule"] == "g2-break"
+    kl = _end_curvature(J, left[2], left[1])   # 1/3, bending the same way as the right side
+    kr = _end_curvature(J, right[1], right[2])  # 2/3
+    assert abs(f["value"] - abs(kr - kl) / max(kl, kr)) < 1e-9
+    # the threshold above the jump: no finding, exit 0
+    r = _run(["check", "g2.json", "--g2-rel", "0.6", "--max-bad", "off"], tmp_path)
+    assert r.exit_code == 0 and "0 finding(s)" in r.output
+
+
+def _signed_curvature(c, n: int = 20001) -> tuple[np.ndarray, np.ndarray]:
+    pp = c.piecewise
+    u = np.linspace(pp.breaks[0], pp.breaks[-1], n)
+    d1, d2, r = pp.evaluate(u, 1), pp.evaluate(u, 2), pp.evaluate(u)
+    k = (d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]) / np.linalg.norm(d1, axis=1) ** 3
+    s = np.concatenate([[0], np.cumsum(np.linalg.norm(np.diff(r, axis=0), axis=1))])
+    return s, k
+
+
+def test_clean_curve_passes_and_an_s_wiggle_is_found(tmp_path: Path):
+    t = np.linspace(0.0, 0.5 * np.pi, 40)
+    arc = interpolate_cubic(np.c_[np.cos(t), np.sin(t)], "chord", "natural")
+    write_curves(tmp_path / "arc.json", [arc])
+    r = _run(["check", "arc.json"], tmp_path)
+    assert r.exit_code == 0, r.output
+    assert "1 curve(s) checked: 0 finding(s)" in r.output
+    x = np.linspace(0.0, 10.0, 41)
+    y = 0.1 * x**2 / 10
+    y[20] += 0.01  # a small bump on a convex curve: an S-wiggle
+    bumpy = interpolate_cubic(np.c_[x, y], "chord", "natural")
+    write_curves(tmp_path / "bump.json", [bumpy])
+    s, k = _signed_curvature(bumpy)
+    big = np.abs(k) > 1e-9 * np.abs(k).max()
+    sk, kk = s[big], np.sign(k[big])
+    flips = sk[1:][np.diff(kk) != 0]
+    gaps = np.diff(flips) / s[-1]
+    assert gaps.size and gaps.min() < 0.05  # independently: two inflections close together
+    r = _run(["check", "bump.json", "--format", "json", "--wiggle", "0.05"], tmp_path)
+    assert r.exit_code == 1
+    wig = [f for f in json.loads(r.output)["findings"] if f["rule"] == "extra-inflection"]
+    assert wig and all(4.0 < f["point"][0] < 6.0 for f in wig)
+    assert abs(min(f["value"] for f in wig) - gaps.min()) < 1e-3
+
+
+def test_unreadable_file_is_a_finding_and_folders_are_walked(tmp_path: Path):
+    (tmp_path / "d").mkdir()
+    t = np.linspace(0.0, 0.5 * np.pi, 40)
+    write_curves(tmp_path / "d/arc.json", [interpolate_cubic(np.c_[np.cos(t), np.sin(t)],
+                                                             "chord", "natural")])
+    (tmp_path / "d/bad.csv").write_text("x,y\n1,2\nno,number\n")
+    r = _run(["check", "d"], tmp_path)
+    assert r.exit_code == 1 and "Traceback" not in r.output
+    assert "bad.csv: file: unreadable" in r.output and "bad.csv:3" in r.output
+    r = _run(["check", "d/nothing*.json"], tmp_path)
+    assert r.exit_code == 2
+
+
+# SARIF 2.1.0: the parts of the OASIS schema (sarif-schema-2.1.0.json) a log of ours uses, with
+# their required properties, types and enums. Set CURVEFAIR_SARIF_SCHEMA to the full schema's
+# path to validate against it as well.
+_MESSAGE = {"type": "object", "required": ["text"], "properties": {"text": {"type": "string"}}}
+_SARIF_SUBSET = {
+    "type": "object", "required": ["version", "runs"],
+    "properties": {
+        "$schema": {"type": "string", "format": "uri"},
+        "version": {"enum": ["2.1.0"]},
+        "runs": {"type": "array", "items": {
+            "type": "object", "required": ["tool"],
+            "properties": {
+                "tool": {"type": "object", "required": ["driver"], "properties": {
+                    "driver": {"type": "object", "required": ["name"], "properties": {
+                        "name": {"type": "string"}, "version": {"type": "string"},
+                        "rules": {"type": "array", "uniqueItems": True, "items": {
+                            "type": "object", "required": ["id"], "properties": {
+                                "id": {"type": "string"}, "shortDescription": _MESSAGE,
+                                "defaultConfiguration": {"type": "object", "properties": {
+                                    "level": {"enum": ["none", "note", "warning",
+                                                       "error"]}}}}}}}}}},
+                "results": {"type": "array", "items": {
+                    "type": "object", "required": ["message"],
+                    "properties": {
+                        "ruleId": {"type": "string"},
+                        "ruleIndex": {"type": "integer", "minimum": -1},
+                        "level": {"enum": ["none", "note", "warning", "error"]},
+                        "message": _MESSAGE,
+                        "locations": {"type": "array", "items": {
+                            "type": "object", "properties": {
+                                "physicalLocation": {"type": "object", "properties": {
+                                    "artifactLocation": {"type": "object", "properties": {
+                                        "uri": {"type": "string", "format": "uri-reference"}}}}},
+                                "logicalLocations": {"type": "array", "items": {
+                                    "type": "object", "properties": {
+                                        "name": {"type": "string"},
+                                        "fullyQualifiedName": {"type": "string"},
+                                        "kind": {"type": "string"}}}}}}},
+                        "properties": {"type": "object"}}}}}}},
+    },
+}
+
+
+def test_sarif_log_structure(tmp_path: Path):
+    jsonschema = pytest.importorskip("jsonschema")
+    J = np.array([3.0, 0.0])
+    left = np.array([[0.0, 0.0], [1.0, 0.5], [2.0, 0.0], J])
+    right = np.array([J, [4.0, 0.0], [5.0, 1.0], [6.0, 1.0]])
+    (tmp_path / "sub").mkdir()
+    write_curves(tmp_path / "sub/g2.json", [_two_beziers(left, right)])
+    (tmp_path / "sub/bad.csv").write_text("x,y\n1,2\nno,number\n")
+    r = _run(["check", "sub", "--format", "sarif", "-o", "out.sarif"], tmp_path)
+    assert r.exit_code == 1
+    log = json.loads((tmp_path / "out.sarif").read_text())
+    jsonschema.validate(log, _SARIF_SUBSET)
+    full = os.environ.get("CURVEFAIR_SARIF_SCHEMA")
+    if full:
+        jsonschema.validate(log, json.loads(Path(full).read_text()))
+    (run,) = log["runs"]
+    rules = run["tool"]["driver"]["rules"]
+    for res in run["results"]:
+        assert rules[res["ruleIndex"]]["id"] == res["ruleId"]
+        uri = res["locations"][0]["physicalLocation"]["artifactLocation"]["uri"]
+        assert (tmp_path / uri).is_file() and not uri.startswith("/")
+    got = {(res["ruleId"], res["locations"][0]["physicalLocation"]["artifactLocation"]["uri"])
+           for res in run["results"]}
+    assert ("g2-break", "sub/g2.json") in got and ("unreadable", "sub/bad.csv") in got
+
+
+def test_pre_commit_hook_definition():
+    yaml = pytest.importorskip("yaml")
+    # the formats read_curves had when the hook was written (a new reader's extensions are
+    # added to the hook's pattern with it)
+    formats = {"points": (".csv", ".txt", ".xyz", ".pts"), "airfoil": (".dat",),
+               "json": (".json",), "dxf": (".dxf",), "3dm": (".3dm",), "svg": (".svg",),
+               "iges": (".igs", ".iges"), "step": (".stp", ".step")}
+    hooks = yaml.safe_load((ROOT / ".pre-commit-hooks.yaml").read_text())
+    (hook,) = [h for h in hooks if h["id"] == "curvefair-check"]
+    for key in ("id", "name", "entry", "language"):  # pre-commit's required manifest keys
+        assert isinstance(hook[key], str) and hook[key]
+    assert hook["language"] == "python"
+    prog, sub = hook["entry"].split()
+    assert prog == "curvefair" and sub in main.commands
+    pat = re.compile(hook["files"])
+    for exts in formats.values():
+        for e in exts:
+            assert pat.search("drawings/part" + e) and pat.search("PART" + e.upper())
+    assert not pat.search("README.md") and not pat.search("a.csv.bak")
+
+
+def test_g2_breaks_of_a_real_svg_match_svgpathtools(tmp_path: Path):
+    """trimesh's MIL.svg (Inkscape, cubic chains that are G1 but not G2): every
+    tangent-continuous join whose curvature vector jumps by more than 5 % (computed here from
+    svgpathtools' own parse and derivatives) is a g2-break finding with the same value."""
+    svgpathtools = pytest.importorskip("svgpathtools")
+    from curvefair import read_curves
+    from curvefair._check import check_records
+
+    path = Path(__file__).parent / "data/real/trimesh/MIL.svg"
+
+    def kvec(d1: complex, d2: complex) -> np.ndarray:
+        a, b = np.array([d1.real, d1.imag]), np.array([d2.real, d2.imag])
+        t = a / np.linalg.norm(a)
+        return (b - (b @ t) * t) / (a @ a)
+
+    want = []
+    paths, _ = svgpathtools.svg2paths(str(path))
+    for p in paths:
+        for sub in p.continuous_subpaths():
+            segs, L = list(sub), sub.length()
+            pairs = list(zip(segs[:-1], segs[1:], strict=True))
+            if sub.isclosed():
+                pairs.append((segs[-1], segs[0]))
+            for a, b in pairs:
+                da, db = a.derivative(1), b.derivative(0)
+                z = da.conjugate() * db
+                if math.degrees(abs(math.atan2(z.imag, z.real))) > 0.05:
+                    continue  # a kink or a corner, not a G1 join
+                kl, kr = kvec(da, a.derivative(1, 2)), kvec(db, b.derivative(0, 2))
+                rel = np.linalg.norm(kr - kl) / max(np.linalg.norm(kl), np.linalg.norm(kr),
+                                                    1.0 / L)
+                if rel > 0.05:
+                    want.append(rel)
+    found = check_records(read_curves(path), str(path),
+                          {"max_bad": None, "wiggle": None}, top=10**6)
+    got = sorted(f.value for f in found if f.rule == "g2-break")
+    assert len(want) > 50
+    np.testing.assert_allclose(got, sorted(want), rtol=1e-6)
