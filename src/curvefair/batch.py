@@ -207,6 +207,9 @@ def _walk(folder: str, skip: set[tuple[Any, ...]]) -> Iterator[str]:
     for root, dirs, files in os.walk(folder, followlinks=False):
         dirs[:] = sorted(d for d in dirs if not d.startswith(".")
                          and _file_key(os.path.join(root, d)) not in skip)
+        fonts = [d for d in dirs if d.lower().endswith(".ufo")]  # a UFO font is a folder
+        dirs[:] = [d for d in dirs if d not in fonts]
+        yield from (os.path.join(root, d) for d in fonts)
         for f in sorted(files):
             if not f.startswith(".") and f.lower().endswith(exts):
                 yield os.path.join(root, f)
