@@ -269,7 +269,7 @@ def method_options(name: str) -> dict[str, Any]:
     --------
     >>> from curvefair.fairing.fair import method_options
     >>> method_options("eck-hadenfeld")["schedule"]
-    'ranking'
+    'sweep'
     """
     return dict(_driver_options(_method_spec(name))[0])
 

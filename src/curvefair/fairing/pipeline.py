@@ -1,6 +1,6 @@
 """Fair a point sequence directly: the fairest spline passing within ``tol`` of every point.
 
-:func:`fair_points` solves, for data points ``p_i`` at parameters ``u_i``,
+:func:`fair_points` solves, for data points ``p_i`` at parameters ``u_i``::
 
     minimise  E_l(C) = int |C^(l)(u)|^2 du   subject to   |C(u_i) - p_i| <= tol  for every i,
 

@@ -71,7 +71,7 @@ class CurveRecord:
     source : mapping
         Read-only, format specific; always ``"format"``, ``"path"`` (absolute, or None for
         curves not read from a file) and ``"index"`` (0-based position of the record in the
-        file). See :doc:`docs/formats.md <formats>` for the keys of each format.
+        file). See :doc:`docs/formats.md </formats>` for the keys of each format.
     points : ndarray, shape (m, dim), or None
         The raw data points of point kinds (``points``, ``airfoil``, ``polyline``,
         ``fit_points``), in file order; ``curve.points`` starts as exactly these (plus the first

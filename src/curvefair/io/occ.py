@@ -61,7 +61,6 @@ from ._common import (
     CurveRecord,
     Unsupported,
     atomic_path,
-    atomic_write,
     bspline_of,
     is_clamped,
     joined_points,
@@ -454,8 +453,8 @@ def _num(v: float, exp: str = "E") -> str:
 def _orig_curve(edge: Any) -> tuple[Any, Any, Any]:
     """(local Geom_BSplineCurve, edge location gp_Trsf, local curve) of a free edge."""
     from OCP.BRep import BRep_Tool
-    from OCP.GeomAdaptor import GeomAdaptor_Curve
     from OCP.GeomAbs import GeomAbs_CurveType
+    from OCP.GeomAdaptor import GeomAdaptor_Curve
     from OCP.TopLoc import TopLoc_Location
 
     loc = TopLoc_Location()
