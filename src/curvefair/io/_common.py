@@ -394,7 +394,7 @@ def drop_duplicates(pts: FloatArray, path: object, lines: Sequence[int | None] |
     more = f" and {drop.size - 5} more" if drop.size > 5 else ""
     import warnings
 
-    warnings.warn(f"{os.fspath(path) if path is not None else '<data>'}: dropped "  # type: ignore[arg-type]
+    warnings.warn(f"{os.fspath(path) if path is not None else '<data>'}: dropped "  # type: ignore[call-overload]
                   f"{drop.size} exactly repeated consecutive {what}(s) ({at}{more}); they are "
                   "written back with the value of the point they repeat", UserWarning,
                   stacklevel=3)
@@ -710,7 +710,7 @@ def is_clamped(knots: FloatArray, degree: int) -> bool:
 def same_path(a: object, b: object) -> bool:
     """True when two paths name the same existing file."""
     try:
-        return os.path.samefile(os.fspath(a), os.fspath(b))  # type: ignore[arg-type]
+        return os.path.samefile(os.fspath(a), os.fspath(b))  # type: ignore[call-overload]
     except (OSError, TypeError):
         return False
 

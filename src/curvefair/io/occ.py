@@ -76,7 +76,7 @@ def _occ(what: str) -> Any:
 
 
 def _fmt_of(path: object) -> str:
-    ext = os.path.splitext(os.fspath(path))[1].lower()  # type: ignore[arg-type]
+    ext = os.path.splitext(os.fspath(path))[1].lower()  # type: ignore[call-overload]
     return "iges" if ext in (".igs", ".iges") else "step"
 
 
@@ -107,7 +107,7 @@ def _read_shape(path: object, fmt: str, what: str) -> Any:
     from OCP.IGESControl import IGESControl_Reader
     from OCP.STEPControl import STEPControl_Reader
 
-    p = os.fspath(path)  # type: ignore[arg-type]
+    p = os.fspath(path)  # type: ignore[call-overload]
     try:
         if os.path.getsize(p) == 0:
             raise FileFormatError(f"empty {fmt.upper()} file", path)

@@ -82,7 +82,7 @@ def _rhino(what: str) -> Any:
 
 def _load(path: object, what: str) -> Any:
     rh = _rhino(what)
-    p = os.fspath(path)  # type: ignore[arg-type]
+    p = os.fspath(path)  # type: ignore[call-overload]
     try:
         size = os.path.getsize(p)
     except OSError as exc:
