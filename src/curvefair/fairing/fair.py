@@ -337,6 +337,8 @@ def normalize_clamp(clamp: object) -> tuple[str, str]:
     if isinstance(clamp, str):
         pair: tuple[object, object] = (clamp, clamp)
     else:
+        left: object
+        right: object
         try:
             left, right = clamp  # type: ignore[misc]
         except (TypeError, ValueError):

@@ -98,7 +98,7 @@ def _energy_weights(l: Any, degree: int) -> dict[int, float]:  # noqa: E741
 
 def _gram(curve: BSplineCurve, w: dict[int, float]) -> sp.csr_matrix:
     """``sum_k w_k G_k`` (exact Gram matrices of the k-th derivatives of the basis)."""
-    G = None
+    G: Any = None
     for k, v in w.items():
         Gk = curve.gram_matrix(k) * v
         G = Gk if G is None else G + Gk
