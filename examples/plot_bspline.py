@@ -4,8 +4,9 @@ A B-spline with a disturbed control point: Eck & Hadenfeld
 
 A cubic B-spline whose control points lie on a circular arc, with one control point pushed
 outwards. Eck & Hadenfeld's local method moves one control point at a time to the position
-that minimises the curve's energy locally, subject to the tolerance; the disturbed point
-returns towards the arc and the curvature becomes nearly constant again.
+that minimises the curve's energy locally, each point staying within the tolerance of where it
+was; the curvature spike the disturbed point made is removed, and the whole curve stays within
+``tol`` of the original.
 """
 
 import numpy as np
