@@ -27,8 +27,6 @@ pytest.importorskip("numpydoc")
 pytest.importorskip("myst_parser")
 pytest.importorskip("sphinx_gallery")
 
-pytestmark = pytest.mark.slow
-
 
 @pytest.fixture(scope="module")
 def html(tmp_path_factory: pytest.TempPathFactory) -> Path:
