@@ -39,7 +39,7 @@ def html(tmp_path_factory: pytest.TempPathFactory) -> Path:
            # run every example again even if sphinx-gallery has its output from an earlier build
            "-D", "sphinx_gallery_conf.run_stale_examples=True",
            str(DOCS), str(out)]
-    proc = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=ROOT, timeout=600)
+    proc = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=ROOT, timeout=1800)
     assert proc.returncode == 0, f"sphinx-build failed:\n{proc.stdout}\n{proc.stderr}"
     assert "WARNING" not in proc.stderr and "ERROR" not in proc.stderr, proc.stderr
     return out
