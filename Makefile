@@ -4,7 +4,7 @@ VENV   ?= .venv
 PY     := $(VENV)/bin/python
 PIP    := $(VENV)/bin/pip
 
-.PHONY: demo test bench bench-quality clean venv venv-test
+.PHONY: demo test docs lint bench bench-quality clean venv venv-test
 
 $(VENV)/.stamp-base: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -32,6 +32,16 @@ demo: $(VENV)/.stamp-base
 test: $(VENV)/.stamp-test
 	$(PY) -m pytest -q
 
+## docs: the HTML documentation in docs/_build/html (API reference, formats, benchmarks, the
+## gallery of examples/plot_*.py run at build time); any Sphinx warning is an error
+docs: $(VENV)/.stamp-test
+	$(PY) -m sphinx -W --keep-going -q -b html docs docs/_build/html
+
+## lint: ruff over src and tests, mypy over the package (settings in pyproject.toml)
+lint: $(VENV)/.stamp-test
+	$(VENV)/bin/ruff check src tests
+	$(PY) -m mypy src/curvefair
+
 ## bench: speed benchmarks (figures quoted in README.md)
 bench: $(VENV)/.stamp-bench
 	$(PY) benchmarks/run_all.py
@@ -41,4 +51,4 @@ bench-quality: $(VENV)/.stamp-bench
 	$(PY) benchmarks/quality/run.py
 
 clean:
-	rm -rf $(VENV) demo_out .pytest_cache .hypothesis
+	rm -rf $(VENV) demo_out .pytest_cache .hypothesis docs/_build docs/auto_examples

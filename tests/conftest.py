@@ -4,6 +4,9 @@
 properties. CI runs them a second time under another instruction set (``NUMBA_CPU_NAME=generic``
 and numpy's wide SIMD paths disabled) and once with ``NUMBA_BOUNDSCHECK=1`` (see ``.ci/run``);
 ``pytest -m compiled`` selects them.
+
+``slow``: tests that take more than ~20 s on the 2-core CI machine with a warm kernel cache
+(still run by ``make test``; ``pytest -m "not slow"`` leaves them out while working).
 """
 
 from __future__ import annotations
@@ -28,6 +31,12 @@ COMPILED_FILES = frozenset({
     "test_reproducible.py",
 })
 
+#: test files whose tests each take more than ~20 s (marked ``slow``); measured with
+#: ``pytest --durations=30``
+SLOW_FILES = frozenset({
+    "test_docs.py",  # one Sphinx build with the gallery (~25 s)
+})
+
 
 def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line("markers", "compiled: exercises the numba kernels (run again by CI "
@@ -39,3 +48,5 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     for item in items:
         if item.path.name in COMPILED_FILES:
             item.add_marker(pytest.mark.compiled)
+        if item.path.name in SLOW_FILES:
+            item.add_marker(pytest.mark.slow)

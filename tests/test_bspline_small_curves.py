@@ -13,8 +13,8 @@ CASES = {
     "closed-minimal": "cf.BSplineCurve([[0,0],[1,0],[1,1],[0,1]], [0,1,2,3,4], 3, closed=True)",
     "single-span": "cf.BSplineCurve([[0,0],[1,1],[2,1],[3,0]], [0,0,0,0,1,1,1,1], 3)",
     "two-span": "cf.BSplineCurve([[0,0],[1,1],[2,1],[3,0],[4,1]], [0,0,0,0,.5,1,1,1,1], 3)",
-    "quartic-3d": "cf.BSplineCurve(np.c_[np.arange(5.), np.sin(np.arange(5.)), np.cos(np.arange(5.))],"
-                  " [0,0,0,0,0,1,1,1,1,1], 4)",
+    "quartic-3d": "cf.BSplineCurve(np.c_[np.arange(5.), np.sin(np.arange(5.)),"
+                  " np.cos(np.arange(5.))], [0,0,0,0,0,1,1,1,1,1], 4)",
 }
 
 

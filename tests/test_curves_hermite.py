@@ -73,7 +73,8 @@ def test_interpolate_cubic_bcs():
 @pytest.mark.parametrize("dim", [2, 3])
 def test_interpolate_periodic_closes_and_is_smooth_across_seam(dim):
     s = np.linspace(0, 2 * np.pi, 13)[:-1]
-    pts = np.column_stack([np.cos(s), 0.6 * np.sin(s)] + ([0.1 * np.sin(2 * s)] if dim == 3 else []))
+    pts = np.column_stack([np.cos(s), 0.6 * np.sin(s)]
+                          + ([0.1 * np.sin(2 * s)] if dim == 3 else []))
     for build, order in ((cf.interpolate_cubic, 2), (cf.interpolate_quintic, 4)):
         c = build(pts, bc="periodic")
         assert c.closed and c.n_points == 13

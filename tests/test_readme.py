@@ -23,11 +23,11 @@ def test_readme_example_matches_its_comments():
     printed = buf.getvalue().strip().splitlines()
     assert len(printed) == len(expected)
     num = re.compile(r"-?\d+(?:\.\d+)?(?:e-?\d+)?")
-    for got, want in zip(printed, expected):
+    for got, want in zip(printed, expected, strict=True):
         want_nums = [float(x) for x in num.findall(want)]
         got_nums = [float(x) for x in num.findall(got.replace("[", " ").replace("]", " "))]
         assert len(got_nums) == len(want_nums), (got, want)
-        for g, w in zip(got_nums, want_nums):
+        for g, w in zip(got_nums, want_nums, strict=True):
             digits = len(str(w).split(".")[1]) if "." in str(w) else 0
             assert np.isclose(g, w, rtol=0, atol=0.51 * 10.0**-digits), (got, want)
         want_words = re.sub(num, "", want).split()

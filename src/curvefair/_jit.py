@@ -59,7 +59,7 @@ def _source_hash() -> str:
     """sha256 over every ``.py`` file of the package (relative path and bytes, sorted) and the
     versions and options that change compiled code."""
     h = hashlib.sha256()
-    files = []
+    files: list[str] = []
     for root, dirs, names in os.walk(_PKG_DIR):
         dirs[:] = sorted(d for d in dirs if d != "__pycache__")
         files.extend(os.path.join(root, n) for n in names if n.endswith(".py"))

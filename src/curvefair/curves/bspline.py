@@ -28,8 +28,7 @@ from scipy.sparse import csr_matrix
 
 from .._jit import njit
 from .._typing import ArrayLike, FloatArray
-from .._validate import (_as_float, as_count, as_params, as_points, magnitude,
-                         check_steps)
+from .._validate import _as_float, as_count, as_params, as_points, check_steps, magnitude
 from ..errors import InputError
 from .parameterize import parameterize
 from .piecewise import PiecewiseCurve, PiecewisePolynomial, readonly

@@ -42,13 +42,16 @@ class HermiteSpline(PiecewiseCurve):
               closed: bool) -> None:
         pts = as_points(points, "points", min_points=2)
         n, dim = pts.shape
-        ders = [as_vectors(d, (n, dim), name) for d, name in zip(derivs, self._deriv_names)]
+        ders = [as_vectors(d, (n, dim), name)
+                for d, name in zip(derivs, self._deriv_names, strict=True)]
         t = as_params(params, n, "params")
         closed = bool(closed)
         if closed:
             if n < 3:
-                raise InputError(f"a closed curve needs at least 3 points (first repeated last), got {n}")
-            _check_closed(type(self).__name__, [("points", pts)] + list(zip(self._deriv_names, ders)))
+                raise InputError("a closed curve needs at least 3 points (first repeated last), "
+                                 f"got {n}")
+            _check_closed(type(self).__name__,
+                          [("points", pts)] + list(zip(self._deriv_names, ders, strict=True)))
         self._points = readonly(pts)
         self._derivs = [readonly(d) for d in ders]
         self._params = readonly(t)
@@ -87,8 +90,9 @@ class HermiteSpline(PiecewiseCurve):
 
     def replace(self, **changes: Any) -> "HermiteSpline":
         """A new curve with some data replaced (``points=``, derivative arrays, ``params=``)."""
-        kw: dict[str, Any] = {"points": self._points, "params": self._params, "closed": self._closed}
-        kw.update(dict(zip(self._deriv_names, self._derivs)))
+        kw: dict[str, Any] = {"points": self._points, "params": self._params,
+                              "closed": self._closed}
+        kw.update(dict(zip(self._deriv_names, self._derivs, strict=True)))
         unknown = set(changes) - set(kw)
         if unknown:
             raise InputError(f"replace() got unknown fields {sorted(unknown)}; valid: {sorted(kw)}")
@@ -149,7 +153,8 @@ class CubicHermite(HermiteSpline):
 
     def _make_piecewise(self) -> PiecewisePolynomial:
         return PiecewisePolynomial(np.array(self._params),
-                                   cubic_hermite_coefficients(self._points, self.tangents, self._params))
+                                   cubic_hermite_coefficients(self._points, self.tangents,
+                                                              self._params))
 
 
 class QuinticHermite(HermiteSpline):

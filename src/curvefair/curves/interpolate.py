@@ -157,7 +157,8 @@ def interpolate_cubic(points: ArrayLike, param: str | ArrayLike = "chord", bc: A
         left, right = _bc_pair(bc, pts.shape[1], (2,), end_tangents)
         scipy_bc = tuple("not-a-knot" if c == "not-a-knot" else c[0] for c in (left, right))
         if pts.shape[0] < 4 and "not-a-knot" in scipy_bc and scipy_bc != ("not-a-knot",) * 2:
-            raise InputError("a not-a-knot end needs at least 4 points unless both ends are not-a-knot")
+            raise InputError("a not-a-knot end needs at least 4 points unless both ends are "
+                             "not-a-knot")
         spl = CubicSpline(t, pts, bc_type=scipy_bc, axis=0)
     tangents = spl(t, 1)
     if periodic:

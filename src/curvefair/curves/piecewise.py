@@ -106,7 +106,8 @@ class PiecewisePolynomial:
         return np.diff(self.breaks)
 
     def segment_of(self, u: FloatArray) -> np.ndarray:
-        """Index of the segment containing each parameter (right-continuous, last segment closed)."""
+        """Index of the segment containing each parameter (right-continuous, last segment
+        closed)."""
         i = np.searchsorted(self.breaks, u, side="right") - 1
         return np.clip(i, 0, self.n_segments - 1)
 
@@ -128,7 +129,8 @@ class PiecewisePolynomial:
         return out.reshape(shape + (self.dim,))
 
     def evaluate_local(self, s: FloatArray, nu: int = 0) -> FloatArray:
-        """Evaluate every segment at local offsets ``s`` (shape ``(k,)``): result ``(m, k, dim)``."""
+        """Evaluate every segment at local offsets ``s`` (shape ``(k,)``): result
+        ``(m, k, dim)``."""
         c = derivative_coefficients(self.coeffs, nu)
         s = np.asarray(s, dtype=float)
         out = np.broadcast_to(c[:, -1:, :], (c.shape[0], s.shape[0], c.shape[2])).copy()
@@ -138,7 +140,8 @@ class PiecewisePolynomial:
         return out
 
     def segment_values(self, frac: FloatArray, nu: int = 0) -> FloatArray:
-        """Evaluate segment ``i`` at ``breaks[i] + frac * width_i`` for each ``frac``: ``(m, k, dim)``."""
+        """Evaluate segment ``i`` at ``breaks[i] + frac * width_i`` for each ``frac``:
+        ``(m, k, dim)``."""
         c = derivative_coefficients(self.coeffs, nu)
         s = self.widths[:, None] * np.asarray(frac, dtype=float)[None, :]
         out = np.repeat(c[:, -1:, :], s.shape[1], axis=1)

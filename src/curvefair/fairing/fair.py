@@ -274,7 +274,7 @@ def method_options(name: str) -> dict[str, Any]:
     --------
     >>> from curvefair.fairing.fair import method_options
     >>> method_options("eck-hadenfeld")["schedule"]
-    'ranking'
+    'sweep'
     """
     return dict(_driver_options(_method_spec(name))[0])
 
@@ -342,6 +342,8 @@ def normalize_clamp(clamp: object) -> tuple[str, str]:
     if isinstance(clamp, str):
         pair: tuple[object, object] = (clamp, clamp)
     else:
+        left: object
+        right: object
         try:
             left, right = clamp  # type: ignore[misc]
         except (TypeError, ValueError):

@@ -451,7 +451,8 @@ _REASONS = ("max_steps", "tolerance", "eps", "no_decrease")
 #: Relative rounding floor of the Sapidis-Farin loop: a jump at or below ``ROUNDING_FLOOR``
 #: times the largest initial jump counts as zero (the loop stops there as at ``eps``), and a step
 #: must lower the tracked sum by more than that much (else ``no_decrease``). ``2**-40`` is about
-#: 4000 ulps: far above the rounding of the jumps, far below any jump that shows in a curvature plot.
+#: 4000 ulps: far above the rounding of the jumps, far below any jump that shows in a
+#: curvature plot.
 ROUNDING_FLOOR = 2.0 ** -40
 
 

@@ -1,6 +1,6 @@
 """Fair a point sequence directly: the fairest spline passing within ``tol`` of every point.
 
-:func:`fair_points` solves, for data points ``p_i`` at parameters ``u_i``,
+:func:`fair_points` solves, for data points ``p_i`` at parameters ``u_i``::
 
     minimise  E_l(C) = int |C^(l)(u)|^2 du   subject to   |C(u_i) - p_i| <= tol  for every i,
 
@@ -98,7 +98,7 @@ def _energy_weights(l: Any, degree: int) -> dict[int, float]:  # noqa: E741
 
 def _gram(curve: BSplineCurve, w: dict[int, float]) -> sp.csr_matrix:
     """``sum_k w_k G_k`` (exact Gram matrices of the k-th derivatives of the basis)."""
-    G = None
+    G: Any = None
     for k, v in w.items():
         Gk = curve.gram_matrix(k) * v
         G = Gk if G is None else G + Gk

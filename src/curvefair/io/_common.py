@@ -72,7 +72,7 @@ class CurveRecord:
     source : mapping
         Read-only, format specific; always ``"format"``, ``"path"`` (absolute, or None for
         curves not read from a file) and ``"index"`` (0-based position of the record in the
-        file). See :doc:`docs/formats.md <formats>` for the keys of each format.
+        file). See :doc:`docs/formats.md </formats>` for the keys of each format.
     points : ndarray, shape (m, dim), or None
         The raw data points of point kinds (``points``, ``airfoil``, ``polyline``,
         ``fit_points``), in file order; ``curve.points`` starts as exactly these (plus the first
@@ -426,7 +426,7 @@ def drop_duplicates(pts: FloatArray, path: object, lines: Sequence[int | None] |
     more = f" and {drop.size - 5} more" if drop.size > 5 else ""
     import warnings
 
-    warnings.warn(f"{os.fspath(path) if path is not None else '<data>'}: dropped "  # type: ignore[arg-type]
+    warnings.warn(f"{os.fspath(path) if path is not None else '<data>'}: dropped "  # type: ignore[call-overload]
                   f"{drop.size} exactly repeated consecutive {what}(s) ({at}{more}); they are "
                   "written back with the value of the point they repeat", UserWarning,
                   stacklevel=3)
@@ -742,7 +742,7 @@ def is_clamped(knots: FloatArray, degree: int) -> bool:
 def same_path(a: object, b: object) -> bool:
     """True when two paths name the same existing file."""
     try:
-        return os.path.samefile(os.fspath(a), os.fspath(b))  # type: ignore[arg-type]
+        return os.path.samefile(os.fspath(a), os.fspath(b))  # type: ignore[call-overload]
     except (OSError, TypeError):
         return False
 

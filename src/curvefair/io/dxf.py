@@ -201,7 +201,7 @@ def _polyline_record(e: Any, base: dict[str, Any], path: object,
 def _load(path: object, what: str) -> Any:
     ezdxf = _ezdxf(what)
     try:
-        return ezdxf.readfile(os.fspath(path))  # type: ignore[arg-type]
+        return ezdxf.readfile(os.fspath(path))  # type: ignore[call-overload]
     except OSError as exc:
         raise FileFormatError(f"not a readable DXF file ({exc})", path) from None
     except Exception as exc:  # ezdxf raises its own DXFStructureError, ValueError, ...

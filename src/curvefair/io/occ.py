@@ -61,7 +61,6 @@ from ._common import (
     CurveRecord,
     Unsupported,
     atomic_path,
-    atomic_write,
     bspline_of,
     is_clamped,
     joined_points,
@@ -77,7 +76,7 @@ def _occ(what: str) -> Any:
 
 
 def _fmt_of(path: object) -> str:
-    ext = os.path.splitext(os.fspath(path))[1].lower()  # type: ignore[arg-type]
+    ext = os.path.splitext(os.fspath(path))[1].lower()  # type: ignore[call-overload]
     return "iges" if ext in (".igs", ".iges") else "step"
 
 
@@ -108,7 +107,7 @@ def _read_shape(path: object, fmt: str, what: str) -> Any:
     from OCP.IGESControl import IGESControl_Reader
     from OCP.STEPControl import STEPControl_Reader
 
-    p = os.fspath(path)  # type: ignore[arg-type]
+    p = os.fspath(path)  # type: ignore[call-overload]
     try:
         if os.path.getsize(p) == 0:
             raise FileFormatError(f"empty {fmt.upper()} file", path)
@@ -454,8 +453,8 @@ def _num(v: float, exp: str = "E") -> str:
 def _orig_curve(edge: Any) -> tuple[Any, Any, Any]:
     """(local Geom_BSplineCurve, edge location gp_Trsf, local curve) of a free edge."""
     from OCP.BRep import BRep_Tool
-    from OCP.GeomAdaptor import GeomAdaptor_Curve
     from OCP.GeomAbs import GeomAbs_CurveType
+    from OCP.GeomAdaptor import GeomAdaptor_Curve
     from OCP.TopLoc import TopLoc_Location
 
     loc = TopLoc_Location()

@@ -82,7 +82,7 @@ def _rhino(what: str) -> Any:
 
 def _load(path: object, what: str) -> Any:
     rh = _rhino(what)
-    p = os.fspath(path)  # type: ignore[arg-type]
+    p = os.fspath(path)  # type: ignore[call-overload]
     try:
         size = os.path.getsize(p)
     except OSError as exc:
@@ -334,7 +334,8 @@ def _geometry_key(g: Any) -> tuple[Any, ...]:
 
 def _same_key(a: tuple[Any, ...], b: tuple[Any, ...]) -> bool:
     return len(a) == len(b) and all(
-        np.array_equal(x, y) if isinstance(x, np.ndarray) else x == y for x, y in zip(a, b))
+        np.array_equal(x, y) if isinstance(x, np.ndarray) else x == y
+        for x, y in zip(a, b, strict=True))
 
 
 def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,

@@ -288,7 +288,7 @@ def _path_elements(text: str, path: object) -> list[ET.Element]:
 
 def _read_text(path: object) -> str:
     try:
-        with open(os.fspath(path), "rb") as f:  # type: ignore[arg-type]
+        with open(os.fspath(path), "rb") as f:  # type: ignore[call-overload]
             raw = f.read()
     except OSError as exc:
         raise FileFormatError(f"cannot read the file: {exc.strerror or exc}", path) from None

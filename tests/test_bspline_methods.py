@@ -1,4 +1,4 @@
-"""Audit of issue 3 (B-spline fairing): tests for the bullets the other test files left weak.
+"""B-spline curve type and B-spline fairing methods against independent computations.
 
 Every check compares against a computation that does not use the code under test:
 
