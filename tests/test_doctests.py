@@ -43,6 +43,12 @@ def test_doctests_were_found() -> None:
 def test_docstring_examples(test: doctest.DocTest) -> None:
     out: list[str] = []
     runner = doctest.DocTestRunner(optionflags=doctest.ELLIPSIS, verbose=False)
-    runner.run(test, out=out.append, clear_globs=True)
+    try:
+        runner.run(test, out=out.append, clear_globs=True)
+    finally:  # an example that draws on pyplot's current figure must not leave it to others
+        import sys
+
+        if "matplotlib.pyplot" in sys.modules:
+            sys.modules["matplotlib.pyplot"].close("all")
     result = runner.summarize(verbose=False)
     assert result.failed == 0, "".join(out)
