@@ -201,8 +201,8 @@ def violations(c: Any, res: Any, tol: float, clamp: tuple[str, str], protect: li
     # the report prints exactly np.linalg.norm(moved - original) of the points that moved
     m = len(d0) - 1 if (c.closed and hasattr(c, "points")) else len(d0)  # distinct points
     idx = np.flatnonzero(np.any(d1[:m] != d0[:m], axis=1))
-    if (res.report["moved"]["indices"] != idx.tolist()
-            or res.report["moved"]["displacement"] != vec[idx].tolist()):
+    if (not np.array_equal(res.report["moved"]["indices"], idx)
+            or not np.array_equal(res.report["moved"]["displacement"], vec[idx])):
         bad.append("report 'moved' differs from np.linalg.norm(moved - original, axis=1)")
     # protected points: bitwise
     for i in protect:
