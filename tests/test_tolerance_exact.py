@@ -52,7 +52,7 @@ from threadpoolctl import threadpool_limits
 
 import curvefair as cf
 
-N_CASES = int(os.environ.get("CURVEFAIR_TOL_CASES", "2000"))
+N_CASES = int(os.environ.get("CURVEFAIR_TOL_CASES", "1500"))
 OFFSETS = (0.0, 3e3, 1e6, 1e12)
 EPS = np.finfo(float).eps
 
