@@ -509,8 +509,9 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
     The loop is Wang & Cao 2006's steps 1-6: rank the points, fair the worst, re-interpolate,
     repeat. The report holds ``method``, ``steps``, ``stop_reason``, ``moved`` (arrays of the
     indices and their final displacement from the original), ``energy_before/after``
-    (``int |r''|^2``), ``max_jump_before/after`` (third derivative, seed 001), ``max_top_jump_before/after`` (jump
-    of the ``degree``-th derivative: the meaningful one for a C4 quintic),
+    (``int |r''|^2``), ``max_jump_before/after`` (third derivative, seed 001),
+    ``max_top_jump_before/after`` (jump of the ``degree``-th derivative: the meaningful one for
+    a C4 quintic),
     ``energy3_before/after``, ``sapidis_sum_before/after``, ``dkds_energy_before/after``
     (``int (dkappa/ds)^2 ds``), ``inflections_before/after``, ``extrema_before/after``,
     ``max_point_displacement`` (+ ``max_point_index``; ``np.linalg.norm(moved - original)``),
