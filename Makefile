@@ -42,9 +42,10 @@ lint: $(VENV)/.stamp-test
 	$(VENV)/bin/ruff check src tests
 	$(PY) -m mypy src/curvefair
 
-## bench: speed benchmarks (figures quoted in README.md)
+## bench: speed benchmarks (figures quoted in README.md); sizes as a parameter:
+##   make bench SIZES=1e3,1e6   (ONLY=bench_call_cost to run some scripts only)
 bench: $(VENV)/.stamp-bench
-	$(PY) benchmarks/run_all.py
+	$(PY) benchmarks/run_all.py $(if $(SIZES),--sizes $(SIZES)) $(if $(ONLY),--only $(ONLY))
 
 ## bench-quality: fairing quality benchmark (all methods and peers); regenerates docs/benchmarks.md
 bench-quality: $(VENV)/.stamp-bench

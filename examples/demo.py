@@ -85,7 +85,7 @@ def main() -> int:
               f"{r['extrema_before']:>2}->{r['extrema_after']:<2} "
               f"{r['max_point_displacement']:>9.4f} {r['max_deviation']:>8.4f}")
         results[label] = {"method": method, "param": param, "options": kw,
-                          "faired_points": res.curve.points.tolist(), "report": r}
+                          "faired_points": res.curve.points.tolist(), "report": r.to_dict()}
     atomic_write_json({"example": "Wang & Cao 2006, Example 1", "input": str(args.input),
                        "points": pts.tolist(), "runs": results}, args.out)
     print("* top jump: jump of the degree-th derivative at the data points (r''' for cubics,"

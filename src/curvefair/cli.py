@@ -153,7 +153,18 @@ def _arrow(a: Any, b: Any, digits: int = 4) -> str:
 def _write_json(path: str, obj: Any) -> None:
     from .io import atomic_write
 
-    atomic_write(path, json.dumps(obj, indent=2, allow_nan=False) + "\n")
+    # a fair() report keeps its per-point arrays (FairingReport); they become lists only here
+    atomic_write(path, json.dumps(obj, indent=2, allow_nan=False, default=_json_array) + "\n")
+
+
+def _json_array(obj: Any) -> Any:
+    import numpy as np
+
+    from .fairing.fair import _jsonable
+
+    if isinstance(obj, np.ndarray):
+        return _jsonable(obj)
+    raise TypeError(f"Object of type {type(obj).__name__} is not JSON serializable")
 
 
 def _save_figure(fig: Any, path: str) -> None:

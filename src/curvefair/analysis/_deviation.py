@@ -164,6 +164,115 @@ def _norms(b: FloatArray) -> FloatArray:
     return np.sqrt(np.sum(b * b, axis=-1))
 
 
+@njit(cache=True, error_model="numpy")
+def _norm_row(v):  # type: ignore[no-untyped-def]
+    """``sqrt(sum(v * v))`` summed in index order (as :func:`_norms` rounds it)."""
+    acc = v[0] * v[0]
+    for c in range(1, v.shape[0]):
+        acc += v[c] * v[c]
+    return np.sqrt(acc)
+
+
+@njit(cache=True, error_model="numpy")
+def _branch_and_bound(cb, lo, hi, best, best_t, ub, rtol, atol, levels, cap):  # type: ignore[no-untyped-def]
+    """The levels of :func:`deviation`'s branch-and-bound in one compiled pass.
+
+    Per level, for the pieces left (Bernstein control points ``cb`` (k, q, dim) on
+    ``[lo, hi]``): halve each piece (de Casteljau at 1/2: left halves first, then right
+    halves), sample every child at its midpoint and the split points, keep the children whose
+    bound ``max_i |b_i|`` exceeds ``best + rtol best + atol``; the bounds of the others raise
+    ``ub``. The same operations in the same order as the array code it replaces (bitwise the
+    same figures). Stops early, before a level, when more than ``cap`` pieces are left (the
+    caller trims them) and returns ``(cb, lo, hi, best, best_t, ub, levels done)``.
+    """
+    q = cb.shape[1]
+    dim = cb.shape[2]
+    cur = np.empty((q, dim))
+    done = 0
+    for _ in range(levels):
+        k = cb.shape[0]
+        if k == 0 or k > cap:
+            break
+        k2 = 2 * k
+        nb = np.empty((k2, q, dim))
+        nlo = np.empty(k2)
+        nhi = np.empty(k2)
+        for i in range(k):
+            for j in range(q):
+                for c in range(dim):
+                    cur[j, c] = cb[i, j, c]
+            for c in range(dim):
+                nb[i, 0, c] = cur[0, c]
+                nb[k + i, q - 1, c] = cur[q - 1, c]
+            for r in range(1, q):
+                for j in range(q - r):
+                    for c in range(dim):
+                        cur[j, c] = 0.5 * (cur[j, c] + cur[j + 1, c])
+                for c in range(dim):
+                    nb[i, r, c] = cur[0, c]
+                    nb[k + i, q - 1 - r, c] = cur[q - 1 - r, c]
+            mid = 0.5 * (lo[i] + hi[i])
+            nlo[i] = lo[i]
+            nhi[i] = mid
+            nlo[k + i] = mid
+            nhi[k + i] = hi[i]
+        # each child's midpoint: de Casteljau at 1/2 of its control points
+        sbest = -1.0
+        skk = 0
+        for i in range(k2):
+            for j in range(q):
+                for c in range(dim):
+                    cur[j, c] = nb[i, j, c]
+            for r in range(1, q):
+                for j in range(q - r):
+                    for c in range(dim):
+                        cur[j, c] = 0.5 * (cur[j, c] + cur[j + 1, c])
+            v = _norm_row(cur[0])
+            if v > sbest:
+                sbest = v
+                skk = i
+        if sbest > best:
+            best = sbest
+            best_t = 0.5 * (nlo[skk] + nhi[skk])
+        # the split points: the last control point of each left child
+        ebest = -1.0
+        ekk = 0
+        for i in range(k):
+            v = _norm_row(nb[i, q - 1])
+            if v > ebest:
+                ebest = v
+                ekk = i
+        if ebest > best:
+            best = ebest
+            best_t = nhi[ekk]
+        thr = best + (rtol * best + atol)
+        U = np.empty(k2)
+        n_keep = 0
+        for i in range(k2):
+            u = -1.0
+            for j in range(q):
+                v = _norm_row(nb[i, j])
+                if v > u:
+                    u = v
+            U[i] = u
+            if u > thr:
+                n_keep += 1
+            elif u > ub:
+                ub = u
+        cb = np.empty((n_keep, q, dim))
+        lo = np.empty(n_keep)
+        hi = np.empty(n_keep)
+        w = 0
+        for i in range(k2):
+            if U[i] > thr:
+                cb[w] = nb[i]
+                lo[w] = nlo[i]
+                hi[w] = nhi[i]
+                w += 1
+        done += 1
+    return cb, lo, hi, best, best_t, ub, done
+
+
 def deviation(curve_a: object, curve_b: object,
               kind: Literal["auto", "parametric", "geometric"] = "auto") -> Deviation:
     """Maximum distance between two curves: ``max_t |a(t) - b(t)|``, or geometric.
@@ -282,7 +391,15 @@ def deviation(curve_a: object, curve_b: object,
     sel = np.flatnonzero(U > best + tol())
     ub = float(np.max(U)) if sel.size == 0 else float(np.max(np.where(U > best + tol(), 0.0, U)))
     cb, lo, hi = to_bernstein(d[sel], w[sel]), starts[sel], ends[sel]
-    for _ in range(_MAX_LEVELS):
+    levels = _MAX_LEVELS
+    if cb.shape[0]:
+        cb, lo, hi, best, best_t, ub, done = _branch_and_bound(
+            np.ascontiguousarray(cb, dtype=np.float64), np.ascontiguousarray(lo, dtype=np.float64),
+            np.ascontiguousarray(hi, dtype=np.float64), float(best), float(best_t), float(ub),
+            DEVIATION_RTOL, float(atol), _MAX_LEVELS, _MAX_CANDIDATES)
+        best, best_t, ub = float(best), float(best_t), float(ub)
+        levels -= int(done)
+    for _ in range(levels):  # only when more than _MAX_CANDIDATES pieces are left
         if cb.shape[0] == 0:
             break
         if cb.shape[0] > _MAX_CANDIDATES:

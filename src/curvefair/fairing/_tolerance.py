@@ -35,7 +35,7 @@ import numpy as np
 
 from .._distance import exceeds, point_distances
 from .._typing import FloatArray
-from ..curves.bspline import BSplineCurve, basis_derivatives
+from ..curves.bspline import BSplineCurve, _power_form_kernel
 from ..curves.hermite import (
     CubicHermite,
     QuinticHermite,
@@ -114,14 +114,14 @@ class _PowerForm(PiecewiseCurve):
 def _difference_form(a: PiecewiseCurve, delta: dict[str, FloatArray]) -> PiecewisePolynomial:
     """Power form of the curve with ``a``'s knots / parameters and data ``delta``."""
     if isinstance(a, BSplineCurve):
+        # the compiled pass of BSplineCurve's own power form, on the differences:
+        # c[m, k] = sum_a N_{s-p+a}^(k)(t_s) delta_{s-p+a} / k!
         p = a.degree
-        t = np.asarray(a.knots)
-        s = np.asarray(a.spans)
-        ders = basis_derivatives(t, p, s, t[s], p)
-        idx = a.control_index(s[:, None] - p + np.arange(p + 1)[None, :])
-        local = delta["control_points"][idx]
-        fact = np.cumprod(np.r_[1.0, np.arange(1, p + 1, dtype=float)])
-        coeffs = np.einsum("mka,mad->mkd", ders, local) / fact[None, :, None]
+        t = np.ascontiguousarray(a.knots)
+        s = np.ascontiguousarray(a.spans, dtype=np.int64)
+        d = np.ascontiguousarray(delta["control_points"], dtype=np.float64)
+        coeffs = np.empty((s.size, p + 1, d.shape[1]))
+        _power_form_kernel(t, p, s, d, bool(a.closed), coeffs)
         return PiecewisePolynomial(np.append(t[s], t[s[-1] + 1]), coeffs)
     params = np.asarray(a.params)  # type: ignore[attr-defined]
     if isinstance(a, QuinticHermite):

@@ -28,6 +28,7 @@ __all__ = [
     "DriverOutput",
     "FairingHistory",
     "FairingResult",
+    "FairingReport",
     "METHODS",
     "register_method",
     "available_methods",
@@ -169,6 +170,22 @@ class MethodSpec:
     accepts: Callable[[Any], bool] | None = None
 
 
+class FairingReport(dict):  # type: ignore[type-arg]
+    """The report of :func:`fair`: a ``dict`` whose per-point entries stay numpy arrays.
+
+    Every entry is a plain Python value (``float``, ``int``, ``str``, ``bool``, ``None``,
+    lists and dicts of them; non-finite floats are ``None``) except ``report["moved"]``,
+    whose ``"indices"`` (int64) and ``"displacement"`` (float64) are read-only arrays with one
+    entry per moved data point: on a curve of a million points, a million Python objects would
+    cost more than the fairing itself. :meth:`to_dict` gives the whole report as plain Python
+    values (what ``json.dumps`` needs).
+    """
+
+    def to_dict(self) -> dict[str, Any]:
+        """A JSON-ready copy: arrays become lists, non-finite floats ``None``."""
+        return _jsonable(self)  # type: ignore[no-any-return]
+
+
 @dataclass(frozen=True, eq=False)
 class FairingResult:
     """Result of :func:`fair`.
@@ -177,14 +194,15 @@ class FairingResult:
     ----------
     curve : PiecewiseCurve
         The faired curve.
-    report : dict
-        JSON-serialisable summary (see :func:`fair`).
+    report : FairingReport
+        Summary (see :func:`fair`): a ``dict`` of plain values whose per-point ``"moved"``
+        entries are numpy arrays; :meth:`FairingReport.to_dict` makes it JSON-ready.
     history : FairingHistory
         One entry per step.
     """
 
     curve: PiecewiseCurve
-    report: dict[str, Any]
+    report: FairingReport
     history: FairingHistory
 
     def _repr_html_(self) -> str:  # notebook display: curvefair.view.result_repr_html
@@ -310,6 +328,13 @@ def _jsonable(obj: Any) -> Any:
     if isinstance(obj, (list, tuple)):
         return [_jsonable(v) for v in obj]
     if isinstance(obj, np.ndarray):
+        if obj.dtype.kind in "iub":
+            return obj.tolist()  # plain ints / bools: no per-element conversion needed
+        if obj.dtype.kind == "f" and obj.ndim == 1:
+            vals = obj.astype(np.float64, copy=False).tolist()
+            if bool(np.isfinite(obj).all()):
+                return vals
+            return [_finite_or_none(v) for v in vals]
         return _jsonable(obj.tolist())
     if isinstance(obj, (np.bool_, bool)):
         return bool(obj)
@@ -476,7 +501,9 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
     Returns
     -------
     FairingResult
-        ``.curve``, ``.report`` (JSON-serialisable dict, no NaN) and ``.history``.
+        ``.curve``, ``.report`` (a :class:`FairingReport`: a dict without NaN whose
+        per-point ``"moved"`` entries are numpy arrays; ``.report.to_dict()`` is JSON-ready)
+        and ``.history``.
 
     Raises
     ------
@@ -487,10 +514,11 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
     Notes
     -----
     The loop is Wang & Cao 2006's steps 1-6: rank the points, fair the worst, re-interpolate,
-    repeat. The report holds ``method``, ``steps``, ``stop_reason``, ``moved`` (indices and
-    their final displacement from the original), ``energy_before/after`` (``int |r''|^2``),
-    ``max_jump_before/after`` (third derivative, seed 001), ``max_top_jump_before/after`` (jump
-    of the ``degree``-th derivative: the meaningful one for a C4 quintic),
+    repeat. The report holds ``method``, ``steps``, ``stop_reason``, ``moved`` (arrays of the
+    indices and their final displacement from the original), ``energy_before/after``
+    (``int |r''|^2``), ``max_jump_before/after`` (third derivative, seed 001),
+    ``max_top_jump_before/after`` (jump of the ``degree``-th derivative: the meaningful one for
+    a C4 quintic),
     ``energy3_before/after``, ``sapidis_sum_before/after``, ``dkds_energy_before/after``
     (``int (dkappa/ds)^2 ds``), ``inflections_before/after``, ``extrema_before/after``,
     ``max_point_displacement`` (+ ``max_point_index``; ``np.linalg.norm(moved - original)``),
@@ -636,4 +664,10 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
     for k, v in out.extra.items():
         report.setdefault(k, v)
     report["time_s"] = time.perf_counter() - t_start
-    return FairingResult(new, _jsonable(report), history)
+    # everything plain Python except the per-point arrays (FairingReport): converting a
+    # million of them is what to_dict() does when a JSON file is asked for
+    report["moved"] = None
+    rep = FairingReport(_jsonable(report))
+    rep["moved"] = {"indices": readonly(np.asarray(moved_idx, dtype=np.int64)),
+                    "displacement": readonly(np.asarray(disp, dtype=np.float64))}
+    return FairingResult(new, rep, history)

@@ -339,6 +339,7 @@ def prepare(curve: HermiteSpline, *, method: str, tol: float | None, eps: float 
             K0, pe, q, fixed, Hinv, _W0[degree], _WMAX, _THR, measure, values, tv, ti,
             blocked, block_measure)
     return {"args": args, "extra": extra, "held": held, "eligible": eligible, "m0": m0,
+            "floor0": 8.0 * np.finfo(float).eps * scale,
             "P0": P.copy(), "D0": D.copy(),
             "eps": eps_eff, "max_steps": max_eff, "n_elig": n_elig, "measure": measure,
             "P": P, "D": D, "spline": spline, "degree": degree, "nd": nd, "Hinv": Hinv}
@@ -346,6 +347,32 @@ def prepare(curve: HermiteSpline, *, method: str, tol: float | None, eps: float 
 
 _CURVE_TOL_RERUNS = 2
 _SHRINK = 0.98
+# the entries of prepare()'s "args" that drive() modifies in place: P, D, measure, values, tv,
+# ti, blocked, block_measure
+_DRIVE_STATE = (0, 1, 22, 23, 24, 25, 26, 27)
+
+
+def _copy_state(st: dict[str, Any]) -> dict[str, Any]:
+    """A copy of :func:`prepare`'s result whose in-place loop state is fresh."""
+    args = list(st["args"])
+    for k in _DRIVE_STATE:
+        args[k] = args[k].copy()
+    out = dict(st)
+    out["args"] = tuple(args)
+    out["P"], out["D"], out["measure"] = args[0], args[1], args[22]
+    out["extra"] = dict(st["extra"])
+    return out
+
+
+def _retarget(snap: dict[str, Any], tol: float) -> dict[str, Any]:
+    """:func:`prepare`'s result for another point tolerance, from a pristine copy ``snap``:
+    only ``tol`` and the move floor depend on it (no ``O(n)`` setup repeated)."""
+    st = _copy_state(snap)
+    args = list(st["args"])
+    args[10] = float(tol)
+    args[13] = max(snap["floor0"], 1e-9 * tol)
+    st["args"] = tuple(args)
+    return st
 
 
 def _curve_deviation(curve: HermiteSpline, P: FloatArray, D: FloatArray) -> float:
@@ -415,8 +442,14 @@ def hermite_driver(curve: HermiteSpline, *, method: str, tol: float | None, eps:
     t0 = time.perf_counter()
     kw = dict(method=method, eps=eps, max_steps=max_steps, clamp=clamp, protect=protect, mode=mode)
     point_tol = tol
+    snap = None
     for attempt in range(_CURVE_TOL_RERUNS + 1):
-        st = prepare(curve, tol=point_tol, **kw)
+        if snap is None:
+            st = prepare(curve, tol=point_tol, **kw)
+            if tol is not None and tol_on == "curve":
+                snap = _copy_state(st)  # a re-run starts from this state
+        else:
+            st = _retarget(snap, point_tol)
         (steps, stop, h_idx, h_meas, h_disp, blocked, n_trunc, n_skip,
          max_window) = _k.drive(*st["args"])
         if tol is None or tol_on == "points":
