@@ -3,9 +3,10 @@
 Unknowns interleaved: B-spline coefficient ``j`` (of the natural cubic, after the two end
 conditions are eliminated), coordinate ``a`` is unknown ``j dim + a``. The Newton matrix is
 
-    M = kron(K, I_dim) + sum_i A_i^T B_i A_i,
+    M = K + sum_i A_i^T B_i A_i,
 
-``K`` banded with half-bandwidth 4 (given by ``Kb[j, o] = K[j + o, j]``, ``o = 0 .. 4``), the
+``K`` the interleaved energy matrix, banded with ``dim x dim`` blocks of block half-bandwidth
+4 (given by its lower band ``L0``), the
 collocation ``A`` tridiagonal (``A[i, i - 1 + s] = Aw[i, s]``) and one symmetric
 ``dim x dim`` block ``B_i`` per data point. Lower band storage ``L[r, k] = M[r + k, r]`` with
 ``kd = 5 dim - 1``, as :func:`curvefair.fairing._global_kernels.band_cholesky` takes it.
@@ -19,17 +20,12 @@ from .._jit import njit
 
 
 @njit(cache=True)
-def assemble_newton(Kb, Aw, B, dim, L):  # type: ignore[no-untyped-def]
-    """Fill ``L`` (shape ``(N dim, 5 dim)``, zeroed here) with the lower band of ``M``."""
-    N = Kb.shape[0]
+def assemble_newton(L0, Aw, B, dim, L):  # type: ignore[no-untyped-def]
+    """``L = L0 + band(sum_i A_i^T B_i A_i)``: ``L0`` the lower band of the (interleaved)
+    energy matrix, ``L`` of the same shape ``(N dim, 5 dim)``."""
+    N = Aw.shape[0]
     kd = L.shape[1] - 1
-    L[:, :] = 0.0
-    for j in range(N):
-        for o in range(5):
-            if j + o < N:
-                v = Kb[j, o]
-                for a in range(dim):
-                    L[j * dim + a, o * dim] += v
+    L[:, :] = L0
     for i in range(N):
         for s2 in range(3):
             j2 = i - 1 + s2

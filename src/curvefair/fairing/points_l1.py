@@ -185,15 +185,16 @@ def _tube_qp(K: sp.csr_matrix, A: sp.csr_matrix, x0: FloatArray, pts: FloatArray
     N, dim = x0.shape
     m = pts.shape[0]
     x = np.array(x0)
-    E0 = float(np.sum(x * (K @ x)))
+    xf = x.reshape(-1)
+    E0 = float(xf @ (K @ xf))
     if not E0 > 0:
         return x, np.zeros(m), 0, "zero_energy"
     Ks = K * (2.0 / E0)
-    Kb = _band_lower(Ks, 4)
+    kd = 5 * dim - 1
+    L0 = _band_lower(Ks, kd)
     Aw = _tridiag(A)
     AT = A.T.tocsr()
     t2 = rad * rad
-    kd = 5 * dim - 1
     L = np.zeros((N * dim, kd + 1))
     eye = np.eye(dim)
     lam = np.ones(m)
@@ -202,7 +203,7 @@ def _tube_qp(K: sp.csr_matrix, A: sp.csr_matrix, x0: FloatArray, pts: FloatArray
               ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
         v = A @ x - pts
         fi = 0.5 * (np.sum(v * v, axis=1) / t2 - 1.0)
-        rd = Ks @ x + AT @ (lam[:, None] * v / t2[:, None])
+        rd = (Ks @ x.reshape(-1)).reshape(N, dim) + AT @ (lam[:, None] * v / t2[:, None])
         rc = -lam * fi - tinv
         return rd, rc, fi, v
 
@@ -224,7 +225,7 @@ def _tube_qp(K: sp.csr_matrix, A: sp.csr_matrix, x0: FloatArray, pts: FloatArray
         ww = lam / (-fi)
         B = ((lam / t2)[:, None, None] * eye
              + ww[:, None, None] * a[:, :, None] * a[:, None, :])
-        _pk.assemble_newton(Kb, Aw, B, dim, L)
+        _pk.assemble_newton(L0, Aw, B, dim, L)
         rhs = -rd - AT @ (a * (rc / fi)[:, None])
         if _gk.band_cholesky(L, N * dim) != 0:
             reason = "converged" if eta < 1e-6 else "numerical"
@@ -267,22 +268,51 @@ def _tube_qp(K: sp.csr_matrix, A: sp.csr_matrix, x0: FloatArray, pts: FloatArray
 # ------------------------------------------------------------------------------------------
 # the method
 # ------------------------------------------------------------------------------------------
-def _jump_norms(ops: NaturalOperators, x: FloatArray) -> FloatArray:
+def _jump_norms(ops: NaturalOperators, x: FloatArray, P: FloatArray | None = None
+                ) -> FloatArray:
+    """``|J_k|``, or ``|P_k J_k|`` with the per-jump projections ``P`` (shape (k, dim, dim))."""
     J = ops.Jm @ x
+    if P is not None:
+        J = np.einsum("kab,kb->ka", P, J)
     return np.sqrt(np.sum(J * J, axis=1))
 
 
-def _energy_matrix(ops: NaturalOperators, w: FloatArray, beta: float) -> sp.csr_matrix:
+def _normal_projections(q: FloatArray) -> FloatArray:
+    """``I - t_k t_k^T`` at every interior point, ``t_k`` the unit central chord direction."""
+    d = q[2:] - q[:-2]
+    t = d / np.maximum(np.linalg.norm(d, axis=1), 1e-300)[:, None]
+    dim = q.shape[1]
+    return np.eye(dim)[None] - t[:, :, None] * t[:, None, :]
+
+
+def _energy_matrix(ops: NaturalOperators, w: FloatArray, beta: float, P: FloatArray,
+                   tau: float) -> sp.csr_matrix:
+    """Interleaved ``sum_k J_k^T W_k J_k + beta sum_k h_k g_k^T g_k`` with
+    ``W_k = w_k (P_k + tau (I - P_k))`` (``P_k`` the projection on the normal space)."""
+    dim = P.shape[1]
     h = np.diff(ops.u)
-    K = ops.Jm.T @ sp.diags(w) @ ops.Jm
+    eye = np.eye(dim)
+    Wk = w[:, None, None] * (P + tau * (eye[None] - P))
+    Wb = _block_diag(Wk)
+    JI = sp.kron(ops.Jm, sp.identity(dim), format="csr")
+    K = JI.T @ Wb @ JI
     if beta > 0:
-        K = K + beta * (ops.G.T @ sp.diags(h) @ ops.G)
+        GI = sp.kron(ops.G, sp.identity(dim), format="csr")
+        K = K + beta * (GI.T @ sp.diags(np.repeat(h, dim)) @ GI)
     return K.tocsr()
 
 
+def _block_diag(W: FloatArray) -> sp.csr_matrix:
+    k, dim, _ = W.shape
+    base = np.arange(k)[:, None, None] * dim
+    r = np.broadcast_to(base + np.arange(dim)[None, :, None], W.shape).reshape(-1)
+    c = np.broadcast_to(base + np.arange(dim)[None, None, :], W.shape).reshape(-1)
+    return sp.csr_matrix((W.reshape(-1), (r, c)), shape=(k * dim, k * dim))
+
+
 def points_l1(points: ArrayLike, tol: float, *, hold: ArrayLike = (), rounds: int = 5,
-              delta: float = 1e-3, beta: float = 1e-6, reparam: int = 2,
-              max_steps: int = 80) -> PointsL1Result:
+              delta: float = 1e-5, beta: float = 1e-6, tau: float = 1e-2,
+              reparam: int = 2, max_steps: int = 80) -> PointsL1Result:
     """The natural cubic through moved points with the sparsest third-derivative jumps.
 
     Parameters
@@ -346,14 +376,15 @@ def points_l1(points: ArrayLike, tol: float, *, hold: ArrayLike = (), rounds: in
         b = beta * jj / e3 if e3 > 0 and jj > 0 else beta
         x = xp
         floor = None
+        Pn = _normal_projections(q)
         for r in range(max(1, int(rounds))):
-            K = _energy_matrix(ops, w, b)
+            K = _energy_matrix(ops, w, b, Pn, tau)
             # strictly feasible start: the interpolant of p pulled toward the last solution
             x0 = xp + 0.9 * (x - xp) if r > 0 else xp
             x, _, st, reason = _tube_qp(K, ops.A, x0, pts, rad, max_steps=max_steps)
             newton += st
             rounds_done += 1
-            jn = _jump_norms(ops, x)
+            jn = _jump_norms(ops, x, Pn)
             if floor is None:
                 floor = delta * float(jn.max()) if jn.size and jn.max() > 0 else 1.0
             w = 1.0 / (jn + floor)
