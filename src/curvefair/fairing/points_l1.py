@@ -312,7 +312,8 @@ def _block_diag(W: FloatArray) -> sp.csr_matrix:
 
 def points_l1(points: ArrayLike, tol: float, *, hold: ArrayLike = (), rounds: int = 5,
               delta: float = 1e-5, beta: float = 1e-6, tau: float = 1e-2,
-              reparam: int = 2, max_steps: int = 80) -> PointsL1Result:
+              reparam: int = 2, max_steps: int = 80, curve_tol: bool = True
+              ) -> PointsL1Result:
     """The natural cubic through moved points with the sparsest third-derivative jumps.
 
     Parameters
@@ -335,6 +336,12 @@ def points_l1(points: ArrayLike, tol: float, *, hold: ArrayLike = (), rounds: in
         Solves at updated chord-length parameters (>= 1).
     max_steps : int
         Interior-point iteration cap per solve.
+    curve_tol : bool
+        Also keep the rebuilt curve within ``tol`` of the input's natural cubic interpolant
+        as a curve (Hausdorff distance, :func:`curvefair.deviation`), as the read-back check
+        of a written point file measures it: when the first solution strays farther between
+        the points, the radii are scaled by ``0.98 tol / distance`` and the problem solved
+        again (at most 4 times).
 
     Returns
     -------
@@ -357,46 +364,65 @@ def points_l1(points: ArrayLike, tol: float, *, hold: ArrayLike = (), rounds: in
         held[i] = True
     margin = min(0.25 * tolv, 1e-9 * tolv + 64.0 * np.finfo(float).eps * float(np.abs(pts).max()))
     rad = np.where(held, 1e-4 * tolv, tolv - margin)
-    q = np.array(pts)
     newton = 0
-    reason = "converged"
     j_before = None
     rounds_done = 0
-    for rp in range(max(1, int(reparam))):
-        u = parameterize(q, "chord")
-        ops = natural_operators(u)
-        xp = _solve_tri(ops.A, pts)  # the interpolant of the input at these parameters
-        if j_before is None:
-            j_before = float(_jump_norms(ops, xp).sum())
-        w = np.ones(N - 2)
-        jn0 = _jump_norms(ops, xp)
-        h = np.diff(u)
-        e3 = float(np.sum(h[:, None] * (ops.G @ xp) ** 2))
-        jj = float(np.sum(jn0 * jn0))
-        b = beta * jj / e3 if e3 > 0 and jj > 0 else beta
-        x = xp
-        floor = None
-        Pn = _normal_projections(q)
-        for r in range(max(1, int(rounds))):
-            K = _energy_matrix(ops, w, b, Pn, tau)
-            # strictly feasible start: the interpolant of p pulled toward the last solution
-            x0 = xp + 0.9 * (x - xp) if r > 0 else xp
-            x, _, st, reason = _tube_qp(K, ops.A, x0, pts, rad, max_steps=max_steps)
-            newton += st
-            rounds_done += 1
-            jn = _jump_norms(ops, x, Pn)
-            if floor is None:
-                floor = delta * float(jn.max()) if jn.size and jn.max() > 0 else 1.0
-            w = 1.0 / (jn + floor)
-            w *= (N - 2) / float(w.sum())
-        q = ops.A @ x
-        q[held] = pts[held]
-    # float64 tolerance: pull back anything rounding put outside (along its move)
+    attempts = 0
+    curve_dev = None
+    ref = interpolate_cubic(pts, "chord", "natural") if curve_tol else None
     from ._tolerance import _pull_back
 
-    q, pulled = _pull_back(pts, q, tolv)
-    q = np.array(q)
-    curve = interpolate_cubic(q, "chord", "natural")
+    while True:
+        attempts += 1
+        q = np.array(pts)
+        reason = "converged"
+        for rp in range(max(1, int(reparam))):
+            u = parameterize(q, "chord")
+            ops = natural_operators(u)
+            xp = _solve_tri(ops.A, pts)  # the interpolant of the input at these parameters
+            if j_before is None:
+                j_before = float(_jump_norms(ops, xp).sum())
+            w = np.ones(N - 2)
+            jn0 = _jump_norms(ops, xp)
+            h = np.diff(u)
+            e3 = float(np.sum(h[:, None] * (ops.G @ xp) ** 2))
+            jj = float(np.sum(jn0 * jn0))
+            b = beta * jj / e3 if e3 > 0 and jj > 0 else beta
+            x = xp
+            floor = None
+            Pn = _normal_projections(q)
+            for r in range(max(1, int(rounds))):
+                K = _energy_matrix(ops, w, b, Pn, tau)
+                # strictly feasible start: the interpolant of p pulled toward the last solution
+                x0 = xp + 0.9 * (x - xp) if r > 0 else xp
+                x, _, st, reason = _tube_qp(K, ops.A, x0, pts, rad, max_steps=max_steps)
+                newton += st
+                rounds_done += 1
+                jn = _jump_norms(ops, x, Pn)
+                if floor is None:
+                    floor = delta * float(jn.max()) if jn.size and jn.max() > 0 else 1.0
+                w = 1.0 / (jn + floor)
+                w *= (N - 2) / float(w.sum())
+            q = ops.A @ x
+            q[held] = pts[held]
+        # float64 tolerance: pull back anything rounding put outside (along its move)
+        q, pulled = _pull_back(pts, q, tolv)
+        q = np.array(q)
+        curve = interpolate_cubic(q, "chord", "natural")
+        if ref is None or attempts > 4:
+            break
+        # the rebuilt curve between the points: the read-back check of a point file measures
+        # the (Hausdorff) distance between the input's interpolant and the rebuilt one; if it
+        # exceeds tol, the radii are shrunk by the excess and the problem solved again
+        from ..analysis import deviation
+        from ..analysis._deviation import geometric_upper_bound
+
+        curve_dev = float(geometric_upper_bound(ref, curve))
+        if curve_dev > tolv:
+            curve_dev = float(deviation(ref, curve).max_distance)
+        if curve_dev <= tolv:
+            break
+        rad = np.where(held, rad, rad * (0.98 * tolv / curve_dev))
     u1 = parameterize(q, "chord")
     ops1 = natural_operators(u1)
     x1 = _solve_tri(ops1.A, q)
@@ -405,7 +431,8 @@ def points_l1(points: ArrayLike, tol: float, *, hold: ArrayLike = (), rounds: in
               "n_active": int(np.sum(dev > (1.0 - 1e-6) * tolv)),
               "jumps_l1_before": j_before,
               "jumps_l1_after": float(_jump_norms(ops1, x1).sum()),
-              "pulled_back": int(pulled)}
+              "pulled_back": int(pulled), "attempts": attempts,
+              "curve_deviation": curve_dev}
     q.setflags(write=False)
     return PointsL1Result(q, curve, report)
 
