@@ -96,7 +96,7 @@ def test_tube_qp_matches_scipy_minimize_and_kkt() -> None:
 def test_points_l1_tolerance_and_rebuilt_curve() -> None:
     p = _noisy_arc(60, 1e-3, seed=7)
     tol = 4e-3
-    res = points_l1(p, tol, hold=[0, 59])
+    res = points_l1(p, tol, hold=[0, 59], curve_tol=False)
     q = np.asarray(res.points)
     assert all(np.linalg.norm(q[i] - p[i]) <= tol for i in range(len(p)))
     assert np.array_equal(q[[0, -1]], p[[0, -1]])
@@ -124,3 +124,31 @@ def test_fair_method_registered_and_refusals() -> None:
     loop = np.c_[np.cos(np.linspace(0, 2 * np.pi, 30)), np.sin(np.linspace(0, 2 * np.pi, 30))]
     with pytest.raises(InputError):
         fair(interpolate_cubic(loop, "chord", "periodic"), "points-l1", tol=tol)
+
+
+def test_points_l1_curve_within_tol_of_input_interpolant() -> None:
+    """curve_tol: the rebuilt curve stays within tol of the input's interpolant (dense
+    sampling of both, nearest-point distances both ways with scipy's cKDTree)."""
+    from scipy.spatial import cKDTree
+
+    p = _noisy_arc(50, 1e-3, seed=11)
+    tol = 4e-3
+    res = points_l1(p, tol, hold=[0, 49])
+    a = CubicSpline(_chord(p), p, bc_type="natural")(np.linspace(0, _chord(p)[-1], 40001))
+    q = np.asarray(res.points)
+    b = CubicSpline(_chord(q), q, bc_type="natural")(np.linspace(0, _chord(q)[-1], 40001))
+    h = max(cKDTree(b).query(a)[0].max(), cKDTree(a).query(b)[0].max())
+    spacing = np.linalg.norm(np.diff(a, axis=0), axis=1).max()
+    assert h <= tol + spacing
+    assert np.max(np.linalg.norm(q - p, axis=1)) <= tol
+    before = analyze(interpolate_cubic(p)).extrema
+    assert analyze(res.curve).extrema < before
+
+
+@pytest.mark.parametrize("tol", [1e-300, 1e-14, 1e300, np.finfo(float).max])
+def test_points_l1_extreme_tolerances(tol: float) -> None:
+    p = _noisy_arc(12, 1e-2, seed=5) * 1e3
+    res = points_l1(p, tol, hold=[0, 11])
+    q = np.asarray(res.points)
+    assert np.all(np.isfinite(q))
+    assert all(np.linalg.norm(q[i] - p[i]) <= tol for i in range(len(p)))

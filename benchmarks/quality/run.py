@@ -65,6 +65,9 @@ BASELINE = "interpolant"  # natural cubic interpolating spline of the input: "be
 VARIANTS: dict[str, list[tuple[str, dict[str, Any]]]] = {
     "eck-hadenfeld": [("l3+eps0", {"l": 3, "eps": 0.0}), ("sweep", {"schedule": "sweep"})],
     "global": [("l3", {"l": 3})],
+    # points-l1 bounds the data points only (as the peers are tuned), not also the rebuilt
+    # curve's distance from the input interpolant between the points
+    "points-l1": [("points", {"curve_tol": False})],
 }
 
 

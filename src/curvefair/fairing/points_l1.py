@@ -362,6 +362,21 @@ def points_l1(points: ArrayLike, tol: float, *, hold: ArrayLike = (), rounds: in
         if not -N <= i < N:
             raise InputError(f"hold index {i} out of range for {N} points")
         held[i] = True
+    # solved on centred, unit-size data (conditioning; a tol of 1e300 or 1e-300 must not
+    # overflow): a radius beyond 1e6 sizes binds nothing, one below 1e-12 moves nothing
+    p_in = pts
+    centre = 0.5 * (pts.max(axis=0) + pts.min(axis=0))
+    size = float(np.ptp(pts, axis=0).max())
+    if not size > 0 or tolv < 1e-12 * size:
+        curve0 = interpolate_cubic(p_in, "chord", "natural")
+        q0 = np.array(p_in)
+        q0.setflags(write=False)
+        return PointsL1Result(q0, curve0, {"rounds": 0, "newton_steps": 0,
+                                           "stop_reason": "tolerance", "n_active": 0,
+                                           "attempts": 0, "pulled_back": 0})
+    pts = (pts - centre) / size
+    tol_out = tolv
+    tolv = min(tolv / size, 1e6)
     margin = min(0.25 * tolv, 1e-9 * tolv + 64.0 * np.finfo(float).eps * float(np.abs(pts).max()))
     rad = np.where(held, 1e-4 * tolv, tolv - margin)
     newton = 0
@@ -369,7 +384,7 @@ def points_l1(points: ArrayLike, tol: float, *, hold: ArrayLike = (), rounds: in
     rounds_done = 0
     attempts = 0
     curve_dev = None
-    ref = interpolate_cubic(pts, "chord", "natural") if curve_tol else None
+    ref = interpolate_cubic(p_in, "chord", "natural") if curve_tol else None
     from ._tolerance import _pull_back
 
     while True:
@@ -405,10 +420,13 @@ def points_l1(points: ArrayLike, tol: float, *, hold: ArrayLike = (), rounds: in
                 w *= (N - 2) / float(w.sum())
             q = ops.A @ x
             q[held] = pts[held]
-        # float64 tolerance: pull back anything rounding put outside (along its move)
-        q, pulled = _pull_back(pts, q, tolv)
-        q = np.array(q)
-        curve = interpolate_cubic(q, "chord", "natural")
+        # back to the data's units; float64 tolerance: pull back anything rounding put
+        # outside (along its move)
+        q_out = centre + size * q
+        q_out[held] = p_in[held]
+        q_out, pulled = _pull_back(p_in, q_out, tol_out)
+        q_out = np.array(q_out)
+        curve = interpolate_cubic(q_out, "chord", "natural")
         if ref is None or attempts > 4:
             break
         # the rebuilt curve between the points: the read-back check of a point file measures
@@ -418,23 +436,23 @@ def points_l1(points: ArrayLike, tol: float, *, hold: ArrayLike = (), rounds: in
         from ..analysis._deviation import geometric_upper_bound
 
         curve_dev = float(geometric_upper_bound(ref, curve))
-        if curve_dev > tolv:
+        if curve_dev > tol_out:
             curve_dev = float(deviation(ref, curve).max_distance)
-        if curve_dev <= tolv:
+        if curve_dev <= tol_out:
             break
-        rad = np.where(held, rad, rad * (0.98 * tolv / curve_dev))
-    u1 = parameterize(q, "chord")
+        rad = np.where(held, rad, rad * min(0.98 * tol_out / curve_dev, 0.98))
+    u1 = parameterize(q_out, "chord")
     ops1 = natural_operators(u1)
-    x1 = _solve_tri(ops1.A, q)
-    dev = np.sqrt(np.sum((q - pts) ** 2, axis=1))
+    x1 = _solve_tri(ops1.A, q_out)
+    dev = np.sqrt(np.sum((q_out - p_in) ** 2, axis=1))
     report = {"rounds": rounds_done, "newton_steps": newton, "stop_reason": reason,
-              "n_active": int(np.sum(dev > (1.0 - 1e-6) * tolv)),
-              "jumps_l1_before": j_before,
+              "n_active": int(np.sum(dev > (1.0 - 1e-6) * tol_out)),
+              "jumps_l1_before": None if j_before is None else j_before / size ** 2,
               "jumps_l1_after": float(_jump_norms(ops1, x1).sum()),
               "pulled_back": int(pulled), "attempts": attempts,
               "curve_deviation": curve_dev}
-    q.setflags(write=False)
-    return PointsL1Result(q, curve, report)
+    q_out.setflags(write=False)
+    return PointsL1Result(q_out, curve, report)
 
 
 def _solve_tri(A: sp.csr_matrix, rhs: FloatArray) -> FloatArray:
@@ -459,7 +477,7 @@ def _accepts(curve: Any) -> bool:
 
 def _driver(curve: CubicHermite, *, tol: float | None, eps: float | None,
             max_steps: int | None, clamp: Any, protect: Any, rounds: int = 5,
-            delta: float = 1e-3, reparam: int = 2) -> Any:
+            delta: float = 1e-5, reparam: int = 2, curve_tol: bool = True) -> Any:
     from .fair import DriverOutput, FairingHistory
 
     if curve.closed:
@@ -481,7 +499,7 @@ def _driver(curve: CubicHermite, *, tol: float | None, eps: float | None,
         return DriverOutput(curve=curve, steps=0, stop_reason="max_steps",
                             history=FairingHistory.empty(), curve_within_tol=False)
     res = points_l1(p0, tol, hold=sorted(hold), rounds=rounds, delta=delta, reparam=reparam,
-                    max_steps=steps)
+                    max_steps=steps, curve_tol=curve_tol)
     p1 = np.asarray(res.points)
     moved = np.flatnonzero(np.any(p0 != p1, axis=1))
     disp = np.sqrt(np.sum((p1[moved] - p0[moved]) ** 2, axis=1))
@@ -507,6 +525,7 @@ def _register() -> None:
         source="convex problem over the data points of the natural cubic interpolant; "
                "reweighted L1 (Candes, Wakin & Boyd 2008); interior point (Boyd & "
                "Vandenberghe sec. 11.7)",
+        default=True,
         accepts=_accepts,
     ))
 
