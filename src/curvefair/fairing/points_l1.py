@@ -484,7 +484,14 @@ def _driver(curve: CubicHermite, *, tol: float | None, eps: float | None,
         raise InputError("method 'points-l1' handles open curves only (a closed point list: "
                          "use 'poliakoff' or 'wang-cao')")
     if tol is None:
-        raise InputError("method 'points-l1' needs tol (the largest move of a data point)")
+        # no bound on the moves: the convex problem has no tube to work in (its minimiser
+        # would be a straight line); the local Poliakoff loop is run instead, and said so
+        from .fair import METHODS
+
+        out = METHODS["poliakoff"].driver(curve, tol=None, eps=eps, max_steps=max_steps,
+                                          clamp=clamp, protect=protect, mode="spline")
+        out.extra["points_l1"] = "no tol given: the poliakoff loop was run instead"
+        return out
     n = curve.n_points
     if n < 4:
         raise InputError(f"method 'points-l1' needs at least 4 points, got {n}")
