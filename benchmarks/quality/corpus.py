@@ -450,6 +450,82 @@ def ground_truth_cases(instances: int = 3, levels: tuple[float, ...] = NOISE_LEV
 
 
 # ---------------------------------------------------------------------------------------------
+# point files: five curve families that the ground-truth corpus does not have
+# ---------------------------------------------------------------------------------------------
+POINT_FILE_FAMILIES = ("logspiral", "sine", "cardioid", "lemniscate", "cycloid")
+
+
+def _point_file_curve(family: str, rng: np.random.Generator) -> TrueCurve:
+    """Open arcs; the true extrema / inflection counts come from dense evaluation
+    (:attr:`TrueCurve.extrema`), not from closed forms."""
+    if family == "logspiral":  # r = e^(b theta): curvature monotone, 0 extrema
+        b = rng.uniform(0.1, 0.3)
+        span = rng.uniform(3.0, 5.0)
+
+        def fn(t):
+            r = np.exp(b * t)
+            return np.column_stack([r * np.cos(t), r * np.sin(t)])
+
+        return TrueCurve(family, fn, 0.0, span, False, params={"b": b})
+    if family == "sine":
+        a = rng.uniform(0.15, 0.35)
+        x1 = rng.uniform(1.1, 1.7)
+
+        def fn(t):
+            return np.column_stack([t, a * np.sin(2 * np.pi * t)])
+
+        return TrueCurve(family, fn, 0.0, x1, False, params={"a": a})
+    if family == "cardioid":
+        e = rng.uniform(2.2, 2.8)
+
+        def fn(t):
+            r = 1.0 + np.cos(t)
+            return np.column_stack([r * np.cos(t), r * np.sin(t)])
+
+        return TrueCurve(family, fn, -e, e, False, params={"e": e})
+    if family == "lemniscate":  # Bernoulli, one lobe and a bit, away from the node
+        e = rng.uniform(0.5, 0.7)
+
+        def fn(t):
+            d = 1.0 + np.sin(t) ** 2
+            return np.column_stack([np.cos(t) / d, np.sin(t) * np.cos(t) / d])
+
+        return TrueCurve(family, fn, -np.pi / 2 + e, np.pi / 2 - e + 0.3, False,
+                         params={"e": e})
+    e = rng.uniform(0.4, 0.8)  # cycloid arch, away from the cusps
+
+    def fn(t):
+        return np.column_stack([t - np.sin(t), 1.0 - np.cos(t)])
+
+    return TrueCurve("cycloid", fn, e, 2 * np.pi - e * rng.uniform(0.8, 1.2), False,
+                     params={"e": e})
+
+
+def point_file_cases(instances: int = 2, levels: tuple[float, ...] = NOISE_LEVELS,
+                     seed: int = 20261202, n_range: tuple[int, int] = (40, 100)) -> list[Case]:
+    """``5 families x instances x levels`` noisy point lists (30 with the defaults),
+    ``tol = TOL_FACTOR sigma``; sampled like :func:`ground_truth_cases`."""
+    cases = []
+    for fi, fam in enumerate(POINT_FILE_FAMILIES):
+        for inst in range(instances):
+            rng = np.random.default_rng([seed, fi, inst])
+            tc = _point_file_curve(fam, rng)
+            n = int(rng.integers(n_range[0], n_range[1] + 1))
+            clean = sample_true_curve(tc, n, rng)
+            poly = tc.polyline()
+            diag = float(np.linalg.norm(poly.max(axis=0) - poly.min(axis=0)))
+            spacing = float(np.median(np.linalg.norm(np.diff(clean, axis=0), axis=1)))
+            n_ext = tc.resolvable_extrema(spacing)
+            for li, lev in enumerate(levels):
+                nrng = np.random.default_rng([seed, fi, inst, li, 7])
+                pts = clean + nrng.normal(0.0, lev * diag, clean.shape)
+                cases.append(Case("point-files", fam, f"{fam}-{inst}@{lev:g}", pts, False,
+                                  TOL_FACTOR * lev * diag, diag, lev, tc, clean, n_ext,
+                                  tc.inflections))
+    return cases
+
+
+# ---------------------------------------------------------------------------------------------
 # airfoils from the aerosandbox wheel (UIUC database)
 # ---------------------------------------------------------------------------------------------
 

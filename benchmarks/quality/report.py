@@ -16,7 +16,7 @@ from typing import Any
 import corpus as C
 import numpy as np
 
-CORPORA = ("ground-truth", "airfoils", "glyphs")
+CORPORA = ("ground-truth", "airfoils", "glyphs", "point-files")
 BASELINE = "interpolant"
 
 
@@ -202,6 +202,69 @@ def table_real(t: Table) -> list[str]:
 
 
 # ---------------------------------------------------------------------------------------------
+_RB_KEYS = ("extrema", "inflections", "E2", "E3", "dkds", "n_segments", "truth_dist",
+            "hit_extrema", "hit_inflections")
+
+
+def rebuilt_rows(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """The rows with every curve metric taken from the curve rebuilt from the written points
+    (the ``*_rb`` columns of ``run.py``)."""
+    out = []
+    for r in rows:
+        x = dict(r)
+        for k in _RB_KEYS:
+            x.pop(k, None)
+            if k + "_rb" in r:
+                x[k] = r[k + "_rb"]
+        out.append(x)
+    return out
+
+
+def goal_lines(tabs_rb: dict[str, "Table"], tool: str = "cf:points-l1") -> list[str]:
+    """Issue 13's goals, measured on the rebuilt curves, for ``tool`` and the best peer."""
+    L: list[str] = []
+    gt, af, gl, pf = (tabs_rb[k] for k in CORPORA)
+    if tool not in set(gt.tools) | set(af.tools) | set(gl.tools) | set(pf.tools):
+        return L
+    if gt.cases and tool in gt.tools:
+        h, n = gt.hits(tool)
+        hi, _ = gt.hits(tool, "hit_inflections")
+        n_inf = sum(1 for c in gt.cases if gt.by.get((c, BASELINE), {}).get("true_inflections")
+                    not in ("", None))
+        bp = best_tool(gt, "peer:")
+        hp = gt.hits(bp)[0] if bp else 0
+        d = _q([_f(r["truth_dist"]) / _f(r["tol"]) for r in gt.ok_rows(tool)], 0.5)
+        dp = _q([_f(r["truth_dist"]) / _f(r["tol"]) for r in gt.ok_rows(bp)], 0.5) if bp else \
+            math.nan
+        L += [f"- Ground truth, rebuilt curves: `{_tool_label(tool)}` reaches the true extrema "
+              f"count on {h}/{n} (goal >= 55; best peer `{_tool_label(bp)}` {hp}/{n}), the "
+              f"true inflection count on {hi}/{n_inf} (goal >= 66); median distance to the "
+              f"true curve {_fmt(d)} tol (best peer {_fmt(dp)}). Closed curves are n/a for "
+              "this method and count as misses.", ""]
+    for name, t, goal in (("Airfoils", af, "median <= 0.35, p90 <= 0.7"),
+                          ("Glyph runs", gl, "median <= 0.2")):
+        if t.cases and tool in t.tools:
+            r = t.ratio(tool, "extrema")
+            bp = best_real_tool(t, "peer:")
+            rp = t.ratio(bp, "extrema") if bp else []
+            L += [f"- {name}, rebuilt curves: extrema ratio to the input median / p90 "
+                  f"{_fmt(_q(r, 0.5))} / {_fmt(_q(r, 0.9))} over {len(r)} open curves (goal "
+                  f"{goal}); best peer `{_tool_label(bp)}` {_fmt(_q(rp, 0.5))} / "
+                  f"{_fmt(_q(rp, 0.9))}.", ""]
+    if pf.cases and tool in pf.tools:
+        ex = [_f(r["extrema"]) - _f(r["true_extrema"]) for r in pf.ok_rows(tool)]
+        bp = min((x for x in pf.tools if x.startswith("peer:")),
+                 key=lambda x: _q([_f(r["extrema"]) - _f(r["true_extrema"])
+                                   for r in pf.ok_rows(x)] or [math.inf], 0.5), default=None)
+        exp = [_f(r["extrema"]) - _f(r["true_extrema"]) for r in pf.ok_rows(bp)] if bp else []
+        L += [f"- Point files of five families ({len(pf.cases)} curves), rebuilt curves: median "
+              f"excess of extrema over the true curve {_fmt(_q(ex, 0.5))} for "
+              f"`{_tool_label(tool)}` (goal <= 2); best peer `{_tool_label(bp)}` "
+              f"{_fmt(_q(exp, 0.5))}.", ""]
+    return L
+
+
+# ---------------------------------------------------------------------------------------------
 def best_tool(t: Table, prefix: str) -> str | None:
     """The tool with ``prefix`` reaching the true extrema count most often (ties: smaller
     median excess)."""
@@ -274,6 +337,8 @@ def write_page(rows: list[dict[str, Any]], cases: list[C.Case], info: dict[str, 
     by_name = {c.name: c for c in cases}
     tabs = {k: Table(rows, k) for k in CORPORA}
     gt, af, gl = tabs["ground-truth"], tabs["airfoils"], tabs["glyphs"]
+    rrows = rebuilt_rows(rows)
+    tabs_rb = {k: Table(rrows, k) for k in CORPORA}
     rel_img = os.path.relpath(img, out.parent)
 
     L: list[str] = []
@@ -346,6 +411,8 @@ def write_page(rows: list[dict[str, Any]], cases: list[C.Case], info: dict[str, 
                   f"{len(af.violations(ba))} tolerance violations."
                   + (f" Best peer by the same measure: `{_tool_label(bpa)}`, median ratio "
                      f"{_fmt(_q(af.ratio(bpa, 'extrema'), 0.5))}." if bpa else ""), ""]
+
+    L += goal_lines(tabs_rb)
 
     # corpus ---------------------------------------------------------------------------------
     L += ["## Corpus", "",
@@ -450,6 +517,24 @@ def write_page(rows: list[dict[str, Any]], cases: list[C.Case], info: dict[str, 
         L += table_real(af) + [""]
     if gl.cases:
         L += ["## Glyph outlines (DejaVu)", ""] + table_real(gl) + [""]
+    if any(t.cases for t in tabs_rb.values()):
+        L += ["## Counted on the curve rebuilt from the written points", "",
+              "A point file stores only points: the curve a reader rebuilds is the chord-length "
+              "natural (closed: periodic) cubic through the written points (each tool's curve "
+              "at the input's parameters; a Hermite result's own data points). Every curve "
+              "metric below is that of the rebuilt curve; deviations are those of the written "
+              "points. 'point files' are five curve families not in the ground truth "
+              "(log spiral, sine, cardioid, lemniscate, cycloid arcs; noise and tol as there).",
+              ""]
+        for key, title, fn in (("ground-truth", "Ground truth, rebuilt", table_ground_truth),
+                               ("point-files", "Point files (five families), rebuilt",
+                                table_ground_truth),
+                               ("airfoils", "Airfoils, rebuilt", table_real),
+                               ("glyphs", "Glyph runs, rebuilt", table_real)):
+            if tabs_rb[key].cases:
+                L += [f"### {title}", ""] + fn(tabs_rb[key]) + [""]
+                if key in ("ground-truth", "point-files"):
+                    L += table_share_by(tabs_rb[key], "family") + [""]
 
     # violations -----------------------------------------------------------------------------
     if viol_all:

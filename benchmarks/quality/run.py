@@ -51,8 +51,9 @@ import corpus as C  # noqa: E402
 import peers as P  # noqa: E402
 
 import curvefair as cf  # noqa: E402
+from curvefair.fairing.fair import METHODS as REGISTERED_METHODS  # noqa: E402
 
-HERMITE_CUBIC = ("kjellander", "poliakoff", "wang-cao")
+HERMITE_CUBIC = ("kjellander", "poliakoff", "wang-cao", "points-l1")
 HERMITE_QUINTIC = ("wang-quintic",)
 BSPLINE = ("eck-hadenfeld", "knot-removal", "cheng-yu", "global")
 METHODS = HERMITE_CUBIC + HERMITE_QUINTIC + BSPLINE
@@ -64,6 +65,9 @@ BASELINE = "interpolant"  # natural cubic interpolating spline of the input: "be
 VARIANTS: dict[str, list[tuple[str, dict[str, Any]]]] = {
     "eck-hadenfeld": [("l3+eps0", {"l": 3, "eps": 0.0}), ("sweep", {"schedule": "sweep"})],
     "global": [("l3", {"l": 3})],
+    # points-l1 bounds the data points only (as the peers are tuned), not also the rebuilt
+    # curve's distance from the input interpolant between the points
+    "points-l1": [("points", {"curve_tol": False})],
 }
 
 
@@ -172,6 +176,37 @@ def metrics(case: C.Case, curve: cf.PiecewiseCurve) -> dict[str, Any]:
     return row
 
 
+def written_points(curve: cf.PiecewiseCurve, u: np.ndarray, n: int) -> np.ndarray:
+    """The ``n`` points a point file would hold after fairing: a Hermite curve's data points
+    (its own parameters), else the curve at the input's parameters ``u``."""
+    if isinstance(curve, (cf.CubicHermite, cf.QuinticHermite)):
+        return np.asarray(curve.points)[:n]
+    return np.asarray(curve(u[:n]))
+
+
+def result_deviation(curve: cf.PiecewiseCurve, pts: np.ndarray, u: np.ndarray
+                     ) -> tuple[float, int]:
+    """``max_i |w_i - p_i|`` over the written points ``w`` (:func:`written_points`): at the
+    input's parameters, or a Hermite result's own data points (``points-l1`` re-interpolates
+    at the chord lengths of the moved points)."""
+    w = written_points(curve, u, len(pts))
+    d = np.linalg.norm(w - pts, axis=1)
+    i = int(np.argmax(d))
+    return float(d[i]), i
+
+
+def rebuilt_metrics(case: C.Case, curve: cf.PiecewiseCurve, u: np.ndarray) -> dict[str, Any]:
+    """:func:`metrics` (suffix ``_rb``) of the curve rebuilt from the written point file: the
+    chord-length natural (closed: periodic) cubic through :func:`written_points`, as curvefair's
+    point-file reader builds it."""
+    w = written_points(curve, u, len(case.points))
+    if case.closed:
+        rb = cf.interpolate_cubic(np.vstack([w, w[:1]]), "chord", "periodic")
+    else:
+        rb = cf.interpolate_cubic(w, "chord", "natural")
+    return {k + "_rb": v for k, v in metrics(case, rb).items()}
+
+
 def _base_row(case: C.Case, tool: str) -> dict[str, Any]:
     return {"corpus": case.corpus, "family": case.family, "case": case.name, "tool": tool,
             "n_points": int(len(case.points)), "closed": int(case.closed), "tol": case.tol,
@@ -197,6 +232,7 @@ def run_case(case: C.Case, tools: list[str] | None = None) -> list[dict[str, Any
         d, i = P.data_deviation(c0, pts, u)
         row.update(dev=d, dev_index=i, dev_over_tol=d / case.tol)
         row.update(metrics(case, c0))
+        row.update(rebuilt_metrics(case, c0, u))
     except Exception as exc:  # noqa: BLE001
         row.update(ok=0, error=repr(exc)[:300])
     rows.append(row)
@@ -212,15 +248,21 @@ def run_case(case: C.Case, tools: list[str] | None = None) -> list[dict[str, Any
                 rep = dict(rep, steps=rep["iterations"])
             else:
                 c0, u = initial_curve(method, pts, case.closed)
+                spec = REGISTERED_METHODS[method]
+                if spec.accepts is not None and not spec.accepts(c0):
+                    row.update(ok=0, na=1, error=f"{method} does not handle this curve")
+                    rows.append(row)
+                    continue
                 res = cf.fair(c0, method, tol=case.tol, **kw)
                 curve, rep = res.curve, res.report
             dt = time.perf_counter() - t0
-            d, i = P.data_deviation(curve, pts, u)
+            d, i = result_deviation(curve, pts, u)
             row.update(ok=1, time_s=dt, dev=d, dev_index=i, dev_over_tol=d / case.tol,
                        violation=int(d > case.tol * (1 + 1e-9)),
                        steps=rep.get("steps"), stop_reason=rep.get("stop_reason"),
                        curve_dev=rep.get("max_deviation"))
             row.update(metrics(case, curve))
+            row.update(rebuilt_metrics(case, curve, u))
         except Exception as exc:  # noqa: BLE001
             row.update(ok=0, error=(repr(exc) + " " + traceback.format_exc(limit=-1))[:300])
         rows.append(row)
@@ -243,6 +285,7 @@ def run_case(case: C.Case, tools: list[str] | None = None) -> list[dict[str, Any
                            violation=int(r.dev > case.tol * (1 + 1e-9)),
                            converged=int(r.converged), param=r.param, steps=r.evaluations)
                 row.update(metrics(case, r.curve))
+                row.update(rebuilt_metrics(case, r.curve, P.chord_params(pts, case.closed)))
         except Exception as exc:  # noqa: BLE001
             row.update(ok=0, error=repr(exc)[:300])
         rows.append(row)
@@ -253,11 +296,14 @@ def run_case(case: C.Case, tools: list[str] | None = None) -> list[dict[str, Any
 _CASES: list[C.Case] = []
 
 
+_TOOLS: list[str] | None = None
+
+
 def _work(i: int, tools: list[str] | None = None) -> list[dict[str, Any]]:
     import warnings
 
     warnings.simplefilter("ignore")
-    return run_case(_CASES[i], tools)
+    return run_case(_CASES[i], tools if tools is not None else _TOOLS)
 
 
 def _isolated(ctx: Any, i: int) -> list[dict[str, Any]]:
@@ -286,14 +332,16 @@ def _isolated(ctx: Any, i: int) -> list[dict[str, Any]]:
     return rows
 
 
-def run_all(cases: list[C.Case], jobs: int) -> list[dict[str, Any]]:
+def run_all(cases: list[C.Case], jobs: int, tools: list[str] | None = None
+            ) -> list[dict[str, Any]]:
     """All tools on all cases, ``jobs`` worker processes (fork), biggest cases first. A worker
     that dies does not stop the run: the unfinished cases are re-run in isolation."""
     from concurrent.futures import ProcessPoolExecutor, as_completed
     from concurrent.futures.process import BrokenProcessPool
 
-    global _CASES
+    global _CASES, _TOOLS
     _CASES = cases
+    _TOOLS = tools
     order = sorted(range(len(cases)), key=lambda i: -len(cases[i].points))
     rows: list[dict[str, Any]] = []
     done: set[int] = set()
@@ -357,6 +405,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--glyphs", type=int, default=None, help="number of glyph runs")
     ap.add_argument("--instances", type=int, default=None,
                     help="ground-truth instances per family and noise level")
+    ap.add_argument("--only", nargs="+", default=None,
+                    choices=("ground-truth", "airfoils", "glyphs", "point-files"),
+                    help="run these corpora only (a partial page)")
+    ap.add_argument("--tools", nargs="+", default=None,
+                    help="run these tools only (names as in the tables, e.g. cf:points-l1 "
+                         "peer:scipy-splprep; the input interpolant always runs)")
     args = ap.parse_args(argv)
 
     t_start = time.perf_counter()
@@ -364,14 +418,22 @@ def main(argv: list[str] | None = None) -> int:
         gt = C.ground_truth_cases(instances=args.instances or 1, levels=(1e-3,))
         af = C.airfoil_cases(args.airfoils or 6)
         gl = C.glyph_cases(args.glyphs or 6)
+        pf = C.point_file_cases(instances=1, levels=(1e-3,))
     else:
         gt = C.ground_truth_cases(instances=args.instances or 4)
         af = C.airfoil_cases(args.airfoils or 240)
         gl = C.glyph_cases(args.glyphs or 80)
-    cases = gt + af + gl
-    print(f"corpus: {len(gt)} ground-truth, {len(af)} airfoils, {len(gl)} glyph runs; "
+        pf = C.point_file_cases()
+    if args.only:
+        keep = set(args.only)
+        gt, af, gl, pf = [c if n in keep else [] for n, c in
+                          (("ground-truth", gt), ("airfoils", af), ("glyphs", gl),
+                           ("point-files", pf))]
+    cases = gt + af + gl + pf
+    print(f"corpus: {len(gt)} ground-truth, {len(af)} airfoils, {len(gl)} glyph runs, "
+          f"{len(pf)} point files; "
           f"{len(all_tools())} tools; {args.jobs} processes", flush=True)
-    rows = run_all(cases, args.jobs)
+    rows = run_all(cases, args.jobs, args.tools)
     elapsed = time.perf_counter() - t_start
     args.csv.parent.mkdir(parents=True, exist_ok=True)
     write_csv(rows, args.csv)

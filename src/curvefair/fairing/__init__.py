@@ -38,6 +38,7 @@ METHOD_MODULES = [
     "knot_removal",
     "global_fair",
     "cheng_yu",
+    "points_l1",
 ]
 
 for _name in METHOD_MODULES:

@@ -149,7 +149,11 @@ def difference_deviation(a: PiecewiseCurve, b: PiecewiseCurve) -> tuple[float, f
         d = deviation(_PowerForm(pp, a.closed), _PowerForm(zero, a.closed))
     else:
         d = deviation(a, b)
-    return float(d.max_distance), float(d.upper_bound), float(d.param)
+    # a geometric deviation (other parameter domains, e.g. point data re-interpolated at
+    # new chord lengths) may come without an upper bound or parameter
+    ub = float("inf") if d.upper_bound is None else float(d.upper_bound)
+    par = float("nan") if d.param is None else float(d.param)
+    return float(d.max_distance), ub, par
 
 
 def _rebuild(template: PiecewiseCurve, fields: dict[str, FloatArray]) -> PiecewiseCurve:

@@ -410,6 +410,15 @@ def normalize_protect(protect: object, curve: PiecewiseCurve) -> frozenset[int]:
 
 
 def _default_method(curve: PiecewiseCurve) -> MethodSpec:
+    # a default with an ``accepts`` condition that holds is more specific than one without
+    # (e.g. 'points-l1' for open cubic Hermite point data, 'poliakoff' for the closed ones)
+    for spec in METHODS.values():
+        if (spec.default and isinstance(curve, spec.curve_types) and spec.accepts is not None
+                and spec.accepts(curve)):
+            return spec
+    for spec in METHODS.values():
+        if spec.default and isinstance(curve, spec.curve_types) and spec.accepts is None:
+            return spec
     for spec in METHODS.values():
         if spec.default and isinstance(curve, spec.curve_types):
             return spec

@@ -1,0 +1,155 @@
+"""points-l1: the natural cubic through moved points, checked against independent computations
+(scipy's CubicSpline for the operators and the rebuilt curve, scipy.optimize for the convex
+problem, the KKT conditions, dense sampling)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.interpolate import CubicSpline
+from scipy.optimize import NonlinearConstraint, minimize
+
+from curvefair import analyze, fair, interpolate_cubic
+from curvefair.errors import InputError
+from curvefair.fairing.points_l1 import (
+    _energy_matrix,
+    _normal_projections,
+    _solve_tri,
+    _tube_qp,
+    natural_operators,
+    points_l1,
+)
+
+
+def _chord(p: np.ndarray) -> np.ndarray:
+    return np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))]
+
+
+def _noisy_arc(n: int, sigma: float, seed: int = 0) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    t = np.sort(rng.uniform(0.0, 2.5, n))
+    t[0], t[-1] = 0.0, 2.5
+    return np.c_[np.cos(t), 0.6 * np.sin(t)] + rng.normal(0.0, sigma, (n, 2))
+
+
+def test_operators_match_scipy_natural_spline() -> None:
+    p = _noisy_arc(15, 1e-2, seed=3)
+    u = _chord(p)
+    ops = natural_operators(u)
+    x = _solve_tri(ops.A, p)
+    cs = CubicSpline(u, p, bc_type="natural")
+    assert np.allclose(ops.A @ x, p, atol=1e-14)
+    mid = 0.5 * (u[1:] + u[:-1])
+    g = ops.G @ x
+    assert np.allclose(g, cs(mid, 3), rtol=1e-9, atol=1e-9 * np.abs(g).max())
+    # jumps of the third derivative at the interior parameters, from scipy's pieces
+    jumps = cs(u[1:-1] + 1e-9 * 0, 3)  # right-continuous value at the knot
+    left = cs.c[0, :-1] * 6.0  # S''' on span k = 6 * leading coefficient
+    right = cs.c[0, 1:] * 6.0
+    assert np.allclose(ops.Jm @ x, right - left, rtol=1e-8, atol=1e-8 * np.abs(left).max())
+    del jumps
+    # the B-spline form is the natural spline everywhere (dense sampling)
+    from scipy.interpolate import BSpline
+
+    uu = np.linspace(u[0], u[-1], 2001)
+    assert np.allclose(BSpline(ops.t, ops.E @ x, 3)(uu), cs(uu), atol=1e-12)
+
+
+def test_tube_qp_matches_scipy_minimize_and_kkt() -> None:
+    p = _noisy_arc(9, 2e-2, seed=1)
+    N, dim = p.shape
+    u = _chord(p)
+    ops = natural_operators(u)
+    w = np.linspace(0.5, 2.0, N - 2)
+    K = _energy_matrix(ops, w, 1e-3, _normal_projections(p), 0.1)
+    tol = 0.03
+    rad = np.full(N, tol)
+    x0 = _solve_tri(ops.A, p)
+    x, lam, steps, reason = _tube_qp(K, ops.A, x0, p, rad, gap=1e-12)
+    assert reason == "converged"
+    Kd = K.toarray()
+    A = ops.A.toarray()
+
+    def f(z: np.ndarray) -> float:
+        return float(z @ Kd @ z)
+
+    def cons(z: np.ndarray) -> np.ndarray:
+        return np.sum((A @ z.reshape(N, dim) - p) ** 2, axis=1)
+
+    ref = minimize(f, x0.reshape(-1), jac=lambda z: 2 * Kd @ z, method="trust-constr",
+                   constraints=[NonlinearConstraint(cons, -np.inf, tol * tol)],
+                   options={"gtol": 1e-12, "xtol": 1e-14, "maxiter": 5000})
+    fx, fr = f(x.reshape(-1)), f(ref.x)
+    assert fx <= fr * (1 + 1e-5) + 1e-12
+    assert np.all(cons(ref.x) <= tol * tol * (1 + 1e-6))
+    # KKT: 2 K x + sum_i mu_i A_i^T (A_i x - p_i) = 0 with mu_i >= 0, mu_i = 0 off the ball
+    v = A @ x - p
+    E0 = float(x0.reshape(-1) @ Kd @ x0.reshape(-1))
+    mu = lam * E0 / (tol * tol)
+    grad = 2 * (Kd @ x.reshape(-1)).reshape(N, dim) + A.T @ (mu[:, None] * v)
+    assert np.abs(grad).max() <= 1e-5 * np.abs(2 * Kd @ x0.reshape(-1)).max()
+    assert np.all(mu >= 0)
+    off = np.linalg.norm(v, axis=1) < 0.99 * tol
+    assert np.all(mu[off] <= 1e-6 * max(mu.max(), 1e-300))
+
+
+def test_points_l1_tolerance_and_rebuilt_curve() -> None:
+    p = _noisy_arc(60, 1e-3, seed=7)
+    tol = 4e-3
+    res = points_l1(p, tol, hold=[0, 59], curve_tol=False)
+    q = np.asarray(res.points)
+    assert all(np.linalg.norm(q[i] - p[i]) <= tol for i in range(len(p)))
+    assert np.array_equal(q[[0, -1]], p[[0, -1]])
+    # the curve is the chord-length natural cubic through q (what a reader rebuilds)
+    cs = CubicSpline(_chord(q), q, bc_type="natural")
+    uu = np.linspace(0.0, _chord(q)[-1], 5001)
+    assert np.allclose(res.curve(uu), cs(uu), atol=1e-12)
+    before = analyze(interpolate_cubic(p)).extrema
+    after = analyze(res.curve).extrema
+    assert after < before / 3
+
+
+def test_fair_method_registered_and_refusals() -> None:
+    p = _noisy_arc(40, 1e-3, seed=2)
+    tol = 4e-3
+    res = fair(interpolate_cubic(p), "points-l1", tol=tol)
+    q = np.asarray(res.curve.points)
+    assert np.max(np.linalg.norm(q - p, axis=1)) <= tol
+    assert res.report["extrema_after"] < res.report["extrema_before"]
+    assert res.report["method"] == "points-l1"
+    # without tol there is no tube: the Poliakoff loop runs instead (said in the report)
+    r0 = fair(interpolate_cubic(p), "points-l1", max_steps=20)
+    assert "poliakoff" in r0.report["points_l1"]
+    with pytest.raises(InputError, match="tangent"):
+        fair(interpolate_cubic(p), "points-l1", tol=tol, clamp="g1")
+    loop = np.c_[np.cos(np.linspace(0, 2 * np.pi, 30)), np.sin(np.linspace(0, 2 * np.pi, 30))]
+    with pytest.raises(InputError):
+        fair(interpolate_cubic(loop, "chord", "periodic"), "points-l1", tol=tol)
+
+
+def test_points_l1_curve_within_tol_of_input_interpolant() -> None:
+    """curve_tol: the rebuilt curve stays within tol of the input's interpolant (dense
+    sampling of both, nearest-point distances both ways with scipy's cKDTree)."""
+    from scipy.spatial import cKDTree
+
+    p = _noisy_arc(50, 1e-3, seed=11)
+    tol = 4e-3
+    res = points_l1(p, tol, hold=[0, 49])
+    a = CubicSpline(_chord(p), p, bc_type="natural")(np.linspace(0, _chord(p)[-1], 40001))
+    q = np.asarray(res.points)
+    b = CubicSpline(_chord(q), q, bc_type="natural")(np.linspace(0, _chord(q)[-1], 40001))
+    h = max(cKDTree(b).query(a)[0].max(), cKDTree(a).query(b)[0].max())
+    spacing = np.linalg.norm(np.diff(a, axis=0), axis=1).max()
+    assert h <= tol + spacing
+    assert np.max(np.linalg.norm(q - p, axis=1)) <= tol
+    before = analyze(interpolate_cubic(p)).extrema
+    assert analyze(res.curve).extrema < before
+
+
+@pytest.mark.parametrize("tol", [1e-300, 1e-14, 1e300, np.finfo(float).max])
+def test_points_l1_extreme_tolerances(tol: float) -> None:
+    p = _noisy_arc(12, 1e-2, seed=5) * 1e3
+    res = points_l1(p, tol, hold=[0, 11])
+    q = np.asarray(res.points)
+    assert np.all(np.isfinite(q))
+    assert all(np.linalg.norm(q[i] - p[i]) <= tol for i in range(len(p)))
