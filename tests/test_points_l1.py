@@ -11,6 +11,7 @@ from scipy.optimize import NonlinearConstraint, minimize
 
 from curvefair import analyze, fair, interpolate_cubic
 from curvefair.errors import InputError
+from curvefair.fairing.fair import available_methods
 from curvefair.fairing.points_l1 import (
     _energy_matrix,
     _normal_projections,
@@ -153,3 +154,22 @@ def test_points_l1_extreme_tolerances(tol: float) -> None:
     q = np.asarray(res.points)
     assert np.all(np.isfinite(q))
     assert all(np.linalg.norm(q[i] - p[i]) <= tol for i in range(len(p)))
+
+
+def test_default_only_for_natural_chord_point_data_up_to_the_size_limit():
+    # points-l1 returns the chord-length natural cubic through the moved points: it is the
+    # default only where the input is that kind of curve (point data), and up to
+    # DEFAULT_MAX_POINTS; elsewhere the Poliakoff loop, which keeps the input's tangents
+    from curvefair.fairing import points_l1 as pl
+    from curvefair.fairing.fair import _default_method
+
+    t = np.linspace(0.0, 3.0, 40)
+    P = np.c_[t, np.sin(t)]
+    assert _default_method(interpolate_cubic(P)).name == "points-l1"
+    clamped = interpolate_cubic(P, bc="clamped", end_tangents=([1.0, 0.0], [1.0, 0.0]))
+    assert _default_method(clamped).name == "poliakoff"
+    assert _default_method(interpolate_cubic(P, param="uniform")).name == "poliakoff"
+    big = np.linspace(0.0, 3.0, pl.DEFAULT_MAX_POINTS + 1)
+    assert _default_method(interpolate_cubic(np.c_[big, np.sin(big)])).name == "poliakoff"
+    # an explicit request is honoured whatever the size or kind
+    assert "points-l1" in available_methods(clamped)

@@ -14,8 +14,6 @@ collocation ``A`` tridiagonal (``A[i, i - 1 + s] = Aw[i, s]``) and one symmetric
 
 from __future__ import annotations
 
-import numpy as np
-
 from .._jit import njit
 
 

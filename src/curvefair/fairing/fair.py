@@ -158,6 +158,10 @@ class MethodSpec:
         ``accepts(curve) -> bool``: a further condition on curves of ``curve_types`` (e.g.
         cubic B-splines only); :func:`available_methods` lists the method for a curve only if
         it holds. ``fair`` still calls the driver, which explains a refusal.
+    prefer : callable or None
+        ``prefer(curve) -> bool``, for a ``default`` method: the curves it is the default for
+        (e.g. open point data up to a size); where it does not hold, the default of the curve
+        type without such a condition is used. None: ``accepts`` decides.
     """
 
     name: str
@@ -168,6 +172,7 @@ class MethodSpec:
     default: bool = False
     modes: tuple[str, ...] = ("spline",)
     accepts: Callable[[Any], bool] | None = None
+    prefer: Callable[[Any], bool] | None = None
 
 
 class FairingReport(dict):  # type: ignore[type-arg]
@@ -413,11 +418,13 @@ def _default_method(curve: PiecewiseCurve) -> MethodSpec:
     # a default with an ``accepts`` condition that holds is more specific than one without
     # (e.g. 'points-l1' for open cubic Hermite point data, 'poliakoff' for the closed ones)
     for spec in METHODS.values():
-        if (spec.default and isinstance(curve, spec.curve_types) and spec.accepts is not None
-                and spec.accepts(curve)):
+        cond = spec.prefer if spec.prefer is not None else spec.accepts
+        if (spec.default and isinstance(curve, spec.curve_types) and cond is not None
+                and cond(curve)):
             return spec
     for spec in METHODS.values():
-        if spec.default and isinstance(curve, spec.curve_types) and spec.accepts is None:
+        if (spec.default and isinstance(curve, spec.curve_types) and spec.accepts is None
+                and spec.prefer is None):
             return spec
     for spec in METHODS.values():
         if spec.default and isinstance(curve, spec.curve_types):

@@ -391,7 +391,7 @@ def points_l1(points: ArrayLike, tol: float, *, hold: ArrayLike = (), rounds: in
         attempts += 1
         q = np.array(pts)
         reason = "converged"
-        for rp in range(max(1, int(reparam))):
+        for _rp in range(max(1, int(reparam))):
             u = parameterize(q, "chord")
             ops = natural_operators(u)
             xp = _solve_tri(ops.A, pts)  # the interpolant of the input at these parameters
@@ -475,6 +475,38 @@ def _accepts(curve: Any) -> bool:
     return isinstance(curve, CubicHermite) and not curve.closed and curve.n_points >= 4
 
 
+#: the largest point count for which ``points-l1`` is the default (its interior point is
+#: O(n) but not yet compiled end to end: about 1.5 ms per point on the 2-core benchmark
+#: machine, see docs/benchmarks.md); longer point lists default to ``poliakoff``
+DEFAULT_MAX_POINTS = 20_000
+
+
+def _is_natural_chord_interpolant(curve: CubicHermite) -> bool:
+    """Whether ``curve`` is the chord-length natural cubic through its points (what a point
+    file is read as), up to an affine change of parameter: only then is the curve rebuilt
+    from the written points the same kind of curve as the input."""
+    from ..curves.interpolate import interpolate_cubic
+
+    try:
+        ref = interpolate_cubic(curve.points, "chord", "natural")
+    except InputError:
+        return False
+    t, r = np.asarray(curve.params), np.asarray(ref.params)
+    st, sr = t[-1] - t[0], r[-1] - r[0]
+    if not (st > 0 and sr > 0):
+        return False
+    if not np.allclose((t - t[0]) / st, (r - r[0]) / sr, rtol=0.0, atol=1e-9):
+        return False
+    d, dr = np.asarray(curve.tangents) * st, np.asarray(ref.tangents) * sr
+    scale = max(float(np.max(np.abs(dr))), 1e-300)
+    return bool(np.max(np.abs(d - dr)) <= 1e-7 * scale)
+
+
+def _prefer(curve: Any) -> bool:
+    return (_accepts(curve) and curve.n_points <= DEFAULT_MAX_POINTS
+            and _is_natural_chord_interpolant(curve))
+
+
 def _driver(curve: CubicHermite, *, tol: float | None, eps: float | None,
             max_steps: int | None, clamp: Any, protect: Any, rounds: int = 5,
             delta: float = 1e-5, reparam: int = 2, curve_tol: bool = True) -> Any:
@@ -536,6 +568,7 @@ def _register() -> None:
                "Vandenberghe sec. 11.7)",
         default=True,
         accepts=_accepts,
+        prefer=_prefer,
     ))
 
 
