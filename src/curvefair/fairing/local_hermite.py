@@ -237,14 +237,37 @@ def _end_second_derivative_kept(curve: HermiteSpline, clamp: tuple[str, str]) ->
     return out
 
 
+_MEASURE_REPORT = {"jump": "third_derivative_jump", "energy": "energy_drop",
+                   "sapidis": "dkappa_ds_jump", "move": "step_length"}
+MEASURES = {3: ("jump", "energy", "sapidis", "move"), 5: ("energy", "move")}
+"""``measure=`` values per degree; the first is the papers' (the default)."""
+_MEASURE_CODE = {"jump": _k.M_DEFAULT, "energy": _k.M_ENERGY, "sapidis": _k.M_SAPIDIS,
+                 "move": _k.M_MOVE}
+
+
+def measure_code(measure: str | None, degree: int, method: str) -> tuple[str, int]:
+    """``(name, kernel code)`` of a ``measure=`` option (``None``: the method's published
+    measure); InputError naming the valid values otherwise."""
+    valid = MEASURES[degree]
+    if measure is None:
+        return valid[0], _k.M_DEFAULT
+    if not isinstance(measure, str) or measure not in valid:
+        raise InputError(f"unknown measure {measure!r} for method {method!r}; valid values "
+                         "are: " + ", ".join(repr(m) for m in valid))
+    if degree == 5 and measure == "energy":
+        return measure, _k.M_DEFAULT
+    return measure, _MEASURE_CODE[measure]
+
+
 def prepare(curve: HermiteSpline, *, method: str, tol: float | None, eps: float | None,
             max_steps: int | None, clamp: tuple[str, str], protect: frozenset[int],
-            mode: str = "spline") -> dict[str, Any]:
+            mode: str = "spline", measure: str | None = None) -> dict[str, Any]:
     """Validate and set up everything the compiled loop needs (``O(n)``); see
     :func:`hermite_driver`. Returns a dict with the kernel arguments under ``"args"`` (in the
     order of :func:`_hermite_kernels.drive`) and bookkeeping entries."""
     degree = curve.degree
     code = _METHOD_CODE[method]
+    mname, mcode = measure_code(measure, degree, method)
     spline = mode == "spline"
     P, D, h = distinct_data(curve)
     nd, dim = P.shape
@@ -318,10 +341,11 @@ def prepare(curve: HermiteSpline, *, method: str, tol: float | None, eps: float 
         D = D_new
 
     # -- ranking and defaults
-    measure, values, tv, ti, blocked, block_measure = _k.drive_setup(
-        P, D, h, closed, degree, spline, eligible)
-    m0 = float(measure[eligible].max()) if eligible.any() else 0.0
-    rel = 1e-2 if degree == 3 else 1e-4
+    meas, values, tv, ti, blocked, block_measure = _k.drive_setup(
+        P, D, h, closed, degree, spline, eligible, code, hstep, mcode)
+    m0 = float(meas[eligible].max()) if eligible.any() else 0.0
+    # 1 % in amplitude: an energy is quadratic in the move, the other measures linear
+    rel = 1e-4 if mname == "energy" else 1e-2
     eps_eff = rel * m0 if eps is None else float(eps)
     n_elig = int(eligible.sum())
     max_eff = 20 * n_elig + 1000 if max_steps is None else int(max_steps)
@@ -336,11 +360,12 @@ def prepare(curve: HermiteSpline, *, method: str, tol: float | None, eps: float 
         Hinv = _dense_inverse(nd, nb, h, degree)
     args = (P, D, h, P.copy(), closed, degree, code, spline, hstep, eligible,
             -1.0 if tol is None else float(tol), eps_eff, max_eff, floor,
-            K0, pe, q, fixed, Hinv, _W0[degree], _WMAX, _THR, measure, values, tv, ti,
-            blocked, block_measure)
+            K0, pe, q, fixed, Hinv, _W0[degree], _WMAX, _THR, meas, values, tv, ti,
+            blocked, block_measure, mcode)
     return {"args": args, "extra": extra, "held": held, "eligible": eligible, "m0": m0,
+            "measure_name": mname,
             "P0": P.copy(), "D0": D.copy(),
-            "eps": eps_eff, "max_steps": max_eff, "n_elig": n_elig, "measure": measure,
+            "eps": eps_eff, "max_steps": max_eff, "n_elig": n_elig, "measure": meas,
             "P": P, "D": D, "spline": spline, "degree": degree, "nd": nd, "Hinv": Hinv}
 
 
@@ -400,12 +425,17 @@ def _enforce_curve_tol(curve: HermiteSpline, st: dict[str, Any], tol: float,
 
 def hermite_driver(curve: HermiteSpline, *, method: str, tol: float | None, eps: float | None,
                    max_steps: int | None, clamp: tuple[str, str], protect: frozenset[int],
-                   mode: str = "spline", tol_on: str = "curve", **options: Any) -> DriverOutput:
+                   mode: str = "spline", tol_on: str = "curve", measure: str | None = None,
+                   **options: Any) -> DriverOutput:
     """Driver of the four Hermite methods (see the module docstring); called by :func:`fair`.
 
     ``tol_on="curve"`` (default) keeps the whole output curve within ``tol`` of the input
     (step 6 of the module docstring); ``tol_on="points"`` bounds only the data points, as the
     papers' loop does, and the curve may then bulge past ``tol`` between them.
+
+    ``measure`` chooses how the loop ranks the points (module docstring, "Bad-point
+    measures"); ``None`` is the method's published measure, and ``"jump"`` (cubic) or
+    ``"energy"`` (quintic) name it explicitly (bit-identical results).
     """
     if options:
         raise InputError(f"method {method!r} got unknown options {sorted(options)}")
@@ -413,7 +443,8 @@ def hermite_driver(curve: HermiteSpline, *, method: str, tol: float | None, eps:
 
     choice(tol_on, ("curve", "points"), "tol_on")
     t0 = time.perf_counter()
-    kw = dict(method=method, eps=eps, max_steps=max_steps, clamp=clamp, protect=protect, mode=mode)
+    kw = dict(method=method, eps=eps, max_steps=max_steps, clamp=clamp, protect=protect, mode=mode,
+              measure=measure)
     point_tol = tol
     for attempt in range(_CURVE_TOL_RERUNS + 1):
         st = prepare(curve, tol=point_tol, **kw)
@@ -463,7 +494,8 @@ def hermite_driver(curve: HermiteSpline, *, method: str, tol: float | None, eps:
     # re-interpolation, a changed curve reported as "0 steps")
     new = curve if int(steps) == 0 else rebuild(curve, P, D)
     extra.update({
-        "measure": "third_derivative_jump" if degree == 3 else
+        "measure": _MEASURE_REPORT[st["measure_name"]] if degree == 3 or
+                   st["measure_name"] != "energy" else
                    ("energy_drop_position" if spline else "energy_drop"),
         "measure_max_before": m0,
         "measure_max_after": float(measure[eligible].max()) if n_elig else 0.0,
