@@ -1099,7 +1099,6 @@ def _register() -> None:
                 "schedule=ranking: the paper's ranking list",
         source="Eck & Hadenfeld, Local energy fairing of B-spline curves, eqs. (12)-(16); "
                "ranking list as in ERRATA",
-        default=True,
     ))
 
 

@@ -156,6 +156,12 @@ class MethodSpec:
         ``accepts(curve) -> bool``: a further condition on curves of ``curve_types`` (e.g.
         cubic B-splines only); :func:`available_methods` lists the method for a curve only if
         it holds. ``fair`` still calls the driver, which explains a refusal.
+    default_options : dict or callable
+        Options :func:`fair` passes when it chooses this method as the default (``method``
+        not given), or ``default_options(curve) -> dict``; options the caller gives win.
+        E.g. ``{"l": 3}`` for ``global`` on curves of degree >= 3.
+    default_reason : str
+        Why it is the default: one line with the benchmark figure (``curvefair methods``).
     """
 
     name: str
@@ -166,6 +172,9 @@ class MethodSpec:
     default: bool = False
     modes: tuple[str, ...] = ("spline",)
     accepts: Callable[[Any], bool] | None = None
+    default_options: dict[str, Any] | Callable[[Any], dict[str, Any]] = field(
+        default_factory=dict)
+    default_reason: str = ""
 
 
 @dataclass(frozen=True, eq=False)
@@ -421,7 +430,10 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
         (with a B-spline method registered).
     method : str, optional
         A name from :func:`available_methods`; default: the curve type's default
-        (``"poliakoff"`` for cubic, ``"wang-quintic"`` for quintic Hermite splines).
+        (``"poliakoff"`` for cubic, ``"wang-quintic"`` for quintic Hermite splines,
+        ``"global"`` with ``l=3`` for B-splines: the fairest method of the quality benchmark
+        that keeps the B-spline's degree, knots and number of control points), with that
+        method's ``default_options`` under the caller's own options.
     tol : float > 0, optional
         Neither the output curve nor any data point ends farther than ``tol`` from the input.
         Each step is clamped onto the ball of radius ``tol`` around the ORIGINAL point (ERRATA,
@@ -508,6 +520,8 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
         raise InputError(f"curve must be a curvefair curve, got {type(curve).__name__}")
     if method is None:
         spec = _default_method(curve)
+        dflt = spec.default_options
+        options = {**(dflt(curve) if callable(dflt) else dflt), **options}
     else:
         spec = _method_spec(method)
     if not isinstance(curve, spec.curve_types):
