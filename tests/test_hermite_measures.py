@@ -171,3 +171,18 @@ def test_methods_command_says_the_default_and_why():
     rows = {r["name"]: r for r in json.loads(js)}
     assert rows["global"]["default"] and "l=3" in rows["global"]["default_options"]
     assert not rows["eck-hadenfeld"]["default"]
+
+
+def test_structure_free_removes_knots_within_tol():
+    pts = _noisy(120, 7)
+    b = interpolate_bspline(pts, 3)
+    r = fair(b, tol=4e-3, structure="free")
+    st = r.report["structure"]
+    assert r.curve.n_ctrl < b.n_ctrl and st["knots_removed"] == b.n_ctrl - r.curve.n_ctrl
+    assert r.curve.degree == 3 and set(np.asarray(r.curve.knots)) <= set(np.asarray(b.knots))
+    # independent check of the tolerance: dense sampling at equal parameter
+    u = np.linspace(*b.domain, 20001)
+    assert np.linalg.norm(r.curve(u) - b(u), axis=1).max() <= 4e-3
+    assert r.report["extrema_before"] == fair(b, tol=4e-3).report["extrema_before"]
+    with pytest.raises(InputError, match="structure"):
+        fair(b, tol=4e-3, structure="new")

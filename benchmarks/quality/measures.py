@@ -11,7 +11,7 @@ Usage (from the repository root)::
 Rows: every Hermite method (``kjellander``, ``poliakoff``, ``wang-cao``, ``wang-quintic``)
 with every value of ``fair(..., measure=...)`` it accepts, each with the method's default
 ``eps`` and with ``eps=0``; the B-spline methods that keep the structure (``global``,
-``eck-hadenfeld``), and ``global`` with ``structure="free"``. Prints a Markdown summary per
+``eck-hadenfeld``) and the B-spline default (``fair(curve)`` without a method). Prints a Markdown summary per
 corpus (ground truth: true extrema / inflection counts reached, extrema - true; airfoils and
 glyphs: median / p90 of the extrema ratio to the input) and writes the per-case rows to
 ``measures.csv`` next to this file (not committed).
@@ -56,7 +56,6 @@ def tools(only: str | None) -> list[tuple[str, str, dict[str, Any]]]:
         out += [("eck-hadenfeld", "eck-hadenfeld", {}),
                 ("global", "global", {}),
                 ("global/l3", "global", {"l": 3}),
-                ("global/l3+free", "global", {"l": 3, "structure": "free"}),
                 ("default(bspline)", None, {})]
     return out
 

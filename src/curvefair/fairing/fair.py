@@ -420,7 +420,8 @@ def _analysis_block(curve: PiecewiseCurve) -> dict[str, Any]:
 def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None = None,
          eps: float | None = None, max_steps: int | None = None, clamp: Any = "g0",
          protect: Iterable[int] = (), mode: str = "spline", joins: str = "keep",
-         g1_angle: float | None = None, guard: bool = True, **options: Any) -> FairingResult:
+         g1_angle: float | None = None, guard: bool = True, structure: str = "keep",
+         **options: Any) -> FairingResult:
     """Fair a curve automatically: repeatedly apply a local step at the worst point.
 
     Parameters
@@ -473,6 +474,11 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
         input (curvefair's own counts, :func:`curvefair.analyze`), the largest fraction of the
         move (1/2, 1/4, 1/8) that does not is returned instead, or else the input itself;
         ``report["guard"]`` says what was kept and why. False: the method's result as it is.
+    structure : {"keep", "free"}
+        B-splines: ``"keep"`` (default) keeps the degree, knot vector and number of control
+        points; ``"free"`` accepts fewer knots (:mod:`curvefair.fairing.structure`: the fewest
+        knots whose least-squares refit stays within ``tol / 2``, then the method under the
+        rest of the tolerance; ``report["structure"]``). Other curves: no effect.
     **options
         Passed to the method's driver; :func:`method_options` lists each method's options and
         their defaults (e.g. ``schedule="sweep"`` for ``"eck-hadenfeld"``). An unknown name
@@ -518,6 +524,16 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
     t_start = time.perf_counter()
     if not isinstance(curve, PiecewiseCurve):
         raise InputError(f"curve must be a curvefair curve, got {type(curve).__name__}")
+    if structure not in ("keep", "free"):
+        raise InputError(f"unknown structure {structure!r}; valid values are: 'keep', 'free'")
+    if structure == "free" and hasattr(curve, "control_points"):
+        from .._validate import as_positive as _pos
+        from .structure import fair_new_structure
+
+        return fair_new_structure(
+            curve, method, _pos(tol, "tol", allow_none=True, window=True), fair, eps=eps,
+            max_steps=max_steps, clamp=clamp, protect=protect, mode=mode, joins=joins,
+            g1_angle=g1_angle, guard=guard, **options)
     if method is None:
         spec = _default_method(curve)
         dflt = spec.default_options

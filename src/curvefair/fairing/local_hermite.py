@@ -558,6 +558,17 @@ _SPECS = [
      "Wang 2005 (seed 000), eqs. (3)-(5), H x = -C solved exactly (ERRATA)"),
 ]
 
+_MEASURE_RUN = ("python benchmarks/quality/measures.py --only hermite --instances 2 "
+                "--airfoils 120 --glyphs 40")
+_DEFAULT_REASON = {
+    "poliakoff": "ranked by measure=move: airfoil extrema ratio median 0.75 (the papers' jump "
+                 "0.952, kjellander 1.14, wang-cao with move 0.73), glyph runs 0.58 [" +
+                 _MEASURE_RUN + "]",
+    "wang-quintic": "the only method for quintic Hermite splines; airfoil extrema ratio "
+                    "median 1 (0.927 with eps=0), glyph runs 0.515 [" + _MEASURE_RUN + "]",
+}
+
 for _name, _types, _default, _summary, _source in _SPECS:
     register_method(MethodSpec(_name, _types, partial(hermite_driver, method=_name), _summary,
-                               _source, default=_default, modes=("spline", "hermite")))
+                               _source, default=_default, modes=("spline", "hermite"),
+                               default_reason=_DEFAULT_REASON.get(_name, "")))
