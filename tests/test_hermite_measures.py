@@ -65,7 +65,9 @@ def _kappa(d1, d2):
 @pytest.mark.parametrize("dim", [2, 3])
 def test_sapidis_is_the_jump_of_dkappa_ds_by_finite_differences(dim):
     rng = np.random.default_rng(11 + dim)
-    c = _cubic(rng, dim=dim)
+    u = np.cumsum(rng.uniform(0.2, 1.0, 10))
+    pts = np.c_[u, np.sin(u), np.cos(0.7 * u)][:, :dim] + rng.normal(0, 0.05, (10, dim))
+    c = interpolate_cubic(pts, u)  # non-uniform, noisy, curvature of order 1
     t, P, T = np.asarray(c.params), np.asarray(c.points), np.asarray(c.tangents)
     for k in range(1, 8):
         sides = []

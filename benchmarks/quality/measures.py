@@ -11,7 +11,8 @@ Usage (from the repository root)::
 Rows: every Hermite method (``kjellander``, ``poliakoff``, ``wang-cao``, ``wang-quintic``)
 with every value of ``fair(..., measure=...)`` it accepts, each with the method's default
 ``eps`` and with ``eps=0``; the B-spline methods that keep the structure (``global``,
-``eck-hadenfeld``) and the B-spline default (``fair(curve)`` without a method). Prints a Markdown summary per
+``eck-hadenfeld``), the B-spline default (``fair(curve)`` without a method) and ``global``
+with ``structure="free"`` (``--only structure``: only the last two). Prints a Markdown summary per
 corpus (ground truth: true extrema / inflection counts reached, extrema - true; airfoils and
 glyphs: median / p90 of the extrema ratio to the input) and writes the per-case rows to
 ``measures.csv`` next to this file (not committed).
@@ -57,6 +58,10 @@ def tools(only: str | None) -> list[tuple[str, str, dict[str, Any]]]:
                 ("global", "global", {}),
                 ("global/l3", "global", {"l": 3}),
                 ("default(bspline)", None, {})]
+    if only in (None, "bspline", "structure"):
+        out += [("global/l3" if only == "structure" else "", "global", {"l": 3}),
+                ("global/l3+free", "global", {"l": 3, "structure": "free"})]
+        out = [o for o in out if o[0]]
     return out
 
 
@@ -136,7 +141,7 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--jobs", type=int, default=min(2, os.cpu_count() or 1))
-    ap.add_argument("--only", choices=("hermite", "bspline"), default=None)
+    ap.add_argument("--only", choices=("hermite", "bspline", "structure"), default=None)
     ap.add_argument("--csv", type=Path, default=HERE / "measures.csv")
     ap.add_argument("--airfoils", type=int, default=240)
     ap.add_argument("--glyphs", type=int, default=80)
