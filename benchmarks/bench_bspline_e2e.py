@@ -122,6 +122,11 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--bisect", type=int, default=40, help="csaps bisection steps")
     ap.add_argument("--no-global", action="store_true")
+    ap.add_argument("--global-l", type=int, nargs="+", default=[2],
+                    help="energies E_l of the global rows (2 and/or 3)")
+    ap.add_argument("--default-call", action="store_true",
+                    help="also time the whole fair(curve, tol=tol) call with the B-spline "
+                         "default method (analysis and report included)")
     ap.add_argument("--no-eh", action="store_true", help="skip the Eck-Hadenfeld rows")
     ap.add_argument("--schedules", nargs="+", default=["ranking", "sweep"],
                     choices=["ranking", "sweep"],
@@ -167,11 +172,23 @@ def main() -> None:
                 f"{r.stop_reason}; interp {t_interp:.2f}s")
     if not args.no_global:
         global_fair(interpolate_bspline(pts[:200], param=t[:200]), tol=args.tol)  # warm-up
-        t_g, gl = best_of(lambda cc: global_fair(cc, tol=args.tol, l=2), fresh_curve)
-        t_gl = t_g + t_interp
-        rows["curvefair global"] = (t_gl, bspline_metrics(gl.curve, t, pts),
-                                    f"{gl.iterations} Newton iterations, {gl.stop_reason}; "
-                                    f"interp {t_interp:.2f}s; threads {_gf._THREADS}")
+        for lv in args.global_l:
+            t_g, gl = best_of(lambda cc, lv=lv: global_fair(cc, tol=args.tol, l=lv),
+                              fresh_curve)
+            t_gl = t_g + t_interp
+            rows["curvefair global" + ("" if lv == 2 else f" l={lv}")] = (
+                t_gl, bspline_metrics(gl.curve, t, pts),
+                f"{gl.iterations} Newton iterations, {gl.stop_reason}; "
+                f"interp {t_interp:.2f}s; threads {_gf._THREADS}")
+    if args.default_call:
+        from curvefair import fair
+
+        fair(interpolate_bspline(pts[:200], param=t[:200]), tol=args.tol)  # warm-up
+        t_d, rd = best_of(lambda cc: fair(cc, tol=args.tol), fresh_curve)
+        rows["fair(curve, tol) default"] = (
+            t_d + t_interp, bspline_metrics(rd.curve, t, pts),
+            f"method {rd.report['method']} l={rd.report.get('l')}, whole call {t_d:.2f}s "
+            f"(analysis, joins, guard, report); interp {t_interp:.2f}s")
 
     peers = {}
     for name in list(rows)[1:]:

@@ -26,6 +26,7 @@ COMPILED_FILES = frozenset({
     "test_bspline_small_curves.py",
     "test_cheng_yu_driver.py",
     "test_steps_local.py",
+    "test_hermite_measures.py",
     "test_analysis_deviation.py",
     "test_bspline_fairing_properties.py",
     "test_jit_cache.py",

@@ -130,7 +130,7 @@ def test_registered_in_fair():
     c = interpolate_bspline(np.c_[x, np.sin(x) + 0.03 * rng.normal(size=40)])
     names = available_methods(c)
     assert {"eck-hadenfeld", "knot-removal", "global"} <= set(names)
-    assert fair(c, tol=0.02).report["method"] == "eck-hadenfeld"  # the default for B-splines
+    assert fair(c, tol=0.02).report["method"] == "global"  # the default for B-splines (l=3)
     for m, opts in [("eck-hadenfeld", {"l": 3}), ("knot-removal", {"variant": "least-squares"}),
                     ("global", {"l": (1.0, 0.1)})]:
         res = fair(c, m, tol=0.02, clamp="g1", protect=[20], **opts)

@@ -136,7 +136,7 @@ def test_hermite_mode_replays_with_public_steps(method, interp, fn):
 
 def test_loop_picks_the_largest_third_derivative_jump():
     c = interpolate_cubic(_example1())
-    res = fair(c, "poliakoff", eps=0.0, max_steps=1)
+    res = fair(c, "poliakoff", eps=0.0, max_steps=1, measure="jump")  # the papers' measure
     pp = c.piecewise
     t = c.params[1:-1]
     i = np.arange(1, 6)

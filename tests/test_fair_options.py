@@ -58,7 +58,7 @@ def test_method_options_contents():
                   "schedule": "sweep"}
     assert method_options("knot-removal")["variant"] == "one-point"
     assert method_options("global") == {"l": 2}
-    assert method_options("poliakoff") == {"tol_on": "curve"}  # 'method' is bound by partial
+    assert method_options("poliakoff") == {"tol_on": "curve", "measure": None}  # method: partial
     for name in METHODS:
         opts = method_options(name)
         assert not {"tol", "eps", "max_steps", "clamp", "protect", "mode", "curve"} & set(opts)

@@ -502,8 +502,19 @@ def _method_rows(raw_defaults: bool = False) -> list[dict[str, Any]]:
     return [{"name": s.name, "curve_types": [t.__name__ for t in s.curve_types],
              "default": bool(s.default), "modes": list(s.modes), "summary": s.summary,
              "source": s.source,
-             "options": {k: conv(v) for k, v in method_options(s.name).items()}}
+             "options": {k: conv(v) for k, v in method_options(s.name).items()},
+             "default_options": _default_options_text(s),
+             "default_reason": s.default_reason if s.default else ""}
             for s in METHODS.values()]
+
+
+def _default_options_text(spec: Any) -> str:
+    """The options a default method gets when chosen by default, as ``-O`` text."""
+    d = spec.default_options
+    if callable(d):
+        doc = (getattr(d, "__doc__", "") or "").strip().splitlines()
+        return doc[0] if doc else "chosen per curve"
+    return " ".join(f"{k}={v}" for k, v in d.items())
 
 
 def _default_methods_text() -> str:
@@ -511,7 +522,8 @@ def _default_methods_text() -> str:
         rows = _method_rows()
     except Exception:  # pragma: no cover - help must always render
         return "the registry's default for the curve type"
-    pairs = [f"{t}: {r['name']}" for r in rows if r["default"] for t in r["curve_types"]]
+    pairs = [f"{t}: {r['name']}" + (f" ({r['default_options']})" if r["default_options"] else "")
+             for r in rows if r["default"] for t in r["curve_types"]]
     return "; ".join(pairs) if pairs else "the first method accepting the curve type"
 
 
@@ -537,6 +549,11 @@ def methods_cmd(as_json: bool) -> None:
         table.add_row(r["name"] + (" *" if r["default"] else ""), ", ".join(r["curve_types"]),
                       r["summary"], r["source"], opts)
     _console().print(table)
+    for r in rows:
+        if r["default"]:
+            extra = f" ({r['default_options']})" if r["default_options"] else ""
+            why = r["default_reason"] or "the registered default for its type"
+            click.echo(f"default for {', '.join(r['curve_types'])}: {r['name']}{extra}: {why}")
 
 
 # ------------------------------------------------------------------------------------------

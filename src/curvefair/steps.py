@@ -32,7 +32,8 @@ from .fairing.cheng_yu import cheng_yu  # noqa: F401  (Cheng & Yu, cubic B-splin
 from .fairing.eck_hadenfeld import eck_hadenfeld  # noqa: F401  (Eck & Hadenfeld, B-splines)
 from .fairing.knot_removal import knot_removal  # noqa: F401  (Farin, B-splines)
 
-__all__ = ["kjellander", "poliakoff", "wang_cao", "wang_quintic", "uniform_spacing"]
+__all__ = ["kjellander", "poliakoff", "wang_cao", "wang_quintic", "uniform_spacing",
+           "bad_point_measure"]
 
 
 # ----------------------------------------------------------------------------------------------
@@ -248,3 +249,43 @@ def wang_quintic(curve: QuinticHermite, k: int) -> QuinticHermite:
     D[kd, 0] += eta
     D[kd, 1] += xi
     return rebuild(curve, P, D)  # type: ignore[return-value]
+
+
+# ----------------------------------------------------------------------------------------------
+# bad-point measures
+# ----------------------------------------------------------------------------------------------
+_MEASURE_METHODS = {"kjellander": _k.KJELLANDER, "poliakoff": _k.POLIAKOFF,
+                    "wang-cao": _k.WANG_CAO, "wang-quintic": _k.WANG_QUINTIC}
+
+
+def bad_point_measure(curve: HermiteSpline, k: int, method: str = "poliakoff",
+                      measure: str | None = None, mode: str = "hermite") -> float:
+    """The value by which ``fair(curve, method, measure=measure)`` ranks point ``k``.
+
+    ``measure``: ``"jump"`` (cubic; the papers', ``|r'''(t_k+) - r'''(t_k-)|``, seed 001),
+    ``"energy"`` (the exact drop of ``int |r''|^2`` the method's unclamped step achieves on the
+    current Hermite data; the quintic's is Wang 2005's ``C^T H^-1 C / 2``, position part only
+    in ``mode="spline"``), ``"sapidis"`` (cubic; the jump of ``dkappa/ds``, Sapidis & Farin),
+    ``"move"`` (the length of the position change of the method's unclamped step); ``None``:
+    the method's published measure. Index rules as for the steps (module docstring).
+    """
+    from .fairing.local_hermite import measure_code
+
+    if method not in _MEASURE_METHODS:
+        raise InputError(f"unknown method {method!r}; valid methods are: "
+                         + ", ".join(repr(m) for m in _MEASURE_METHODS))
+    cls = QuinticHermite if method == "wang-quintic" else CubicHermite
+    _need(curve, cls, "bad_point_measure")
+    if mode not in ("spline", "hermite"):
+        raise InputError(f"unknown mode {mode!r}; valid values are: 'spline', 'hermite'")
+    kd = check_step_index(curve, k)
+    _, code = measure_code(measure, curve.degree, method)
+    P, D, h = distinct_data(curve)
+    hstep = 0.0
+    if method == "kjellander":
+        hs = uniform_spacing(np.asarray(curve.params))
+        if hs is None:
+            raise InputError("method 'kjellander' needs uniformly spaced params")
+        hstep = hs
+    return float(_k.measure_at(P, D, h, kd, curve.degree, mode == "spline",
+                               _MEASURE_METHODS[method], hstep, code))

@@ -264,11 +264,164 @@ def cubic_jump(P, D, h, k):  # type: ignore[no-untyped-def]
     return 6.0 * np.sqrt(s)
 
 
+# bad-point measures (``fair(..., measure=...)``); 0 is each method's published measure
+M_DEFAULT = 0  # cubic: third-derivative jump (seed 001); quintic: energy drop of the Wang step
+M_ENERGY = 1   # exact drop of int |r''|^2 that the method's (unclamped) step achieves
+M_SAPIDIS = 2  # jump of dkappa/ds (Sapidis & Farin 1990), cubic only
+M_MOVE = 3     # length of the (unclamped) move the method's step wants
+
+
+@njit(cache=True, inline="always")
+def _cubic_step_coord(P, D, h, k, method, hstep, c):  # type: ignore[no-untyped-def]
+    """``(delta_c, eta_c, delta_poliakoff_c)`` of :func:`cubic_step`, one coordinate, no
+    allocation (the same formulas)."""
+    nd = P.shape[0]
+    km = (k - 1) % nd
+    kp = (k + 1) % nd
+    D0 = h[km]
+    D1 = h[k]
+    al2, al3 = _cubic_a23(P, D, h, km, c)
+    ar2, ar3 = _cubic_a23(P, D, h, k, c)
+    dpol = -(ar3 - al3) / (2.0 / D1**3 + 2.0 / D0**3)
+    if method == KJELLANDER:
+        d = (0.5 * (P[km, c] + P[kp, c]) + 0.25 * hstep * (D[km, 0, c] - D[kp, 0, c])
+             - P[k, c])
+        return d, 0.0, dpol
+    if method == POLIAKOFF:
+        return dpol, 0.0, dpol
+    J = al3 - ar3
+    G = ar2 - al2 - 3.0 * al3 * D0
+    f = D1 * D0 / (D1 + D0) ** 3
+    d = f * D1 * D0 * (2.0 * D1 * D0 * J + (D1 - D0) * G)
+    e = f * (3.0 * D1 * D0 * (D1 - D0) * J + 2.0 * (D1 * D1 - D1 * D0 + D0 * D0) * G)
+    return d, e, dpol
+
+
 @njit(cache=True)
-def measure_at(P, D, h, k, degree, spline):  # type: ignore[no-untyped-def]
-    """Ranking measure of point ``k``: cubic -> third-derivative jump; quintic -> energy drop
-    of the Wang step (hermite mode: whole step; spline mode: the part due to the position)."""
+def cubic_energy_drop(P, D, h, k, method, hstep):  # type: ignore[no-untyped-def]
+    """Exact drop of ``int |r''|^2 dt`` over the two segments at ``k`` when the method's
+    unclamped step (derivatives as the step leaves them) is applied.
+
+    In the Hermite data of point ``k`` the energy is quadratic with the Hessian
+    ``Hpp = 24 (1/D0^3 + 1/D1^3)``, ``Hpd = 12 (1/D1^2 - 1/D0^2)``, ``Hdd = 8 (1/D0 + 1/D1)``
+    (twice the cubic Hermite stiffness matrices of the two segments). Poliakoff's step is the
+    minimiser over ``r_k`` and Wang-Cao's over ``(r_k, r'_k)``, so their drop is
+    ``x^T H x / 2``; Kjellander's is not, and its drop is ``-(g . delta + Hpp |delta|^2 / 2)``
+    with the gradient ``g = -Hpp delta_Poliakoff`` (it can be negative).
+    """
+    nd = P.shape[0]
+    D0 = h[(k - 1) % nd]
+    D1 = h[k]
+    Hpp = 24.0 * (1.0 / D0**3 + 1.0 / D1**3)
+    Hpd = 12.0 * (1.0 / D1**2 - 1.0 / D0**2)
+    Hdd = 8.0 * (1.0 / D0 + 1.0 / D1)
+    out = 0.0
+    for c in range(P.shape[1]):
+        d, e, dpol = _cubic_step_coord(P, D, h, k, method, hstep, c)
+        if method == KJELLANDER:
+            out += Hpp * (dpol * d - 0.5 * d * d)
+        else:
+            out += 0.5 * (Hpp * d * d + 2.0 * Hpd * d * e + Hdd * e * e)
+    return out
+
+
+@njit(cache=True)
+def cubic_move(P, D, h, k, method, hstep):  # type: ignore[no-untyped-def]
+    """Length of the position change the method's unclamped step wants at ``k``."""
+    s = 0.0
+    for c in range(P.shape[1]):
+        d, e, dpol = _cubic_step_coord(P, D, h, k, method, hstep, c)
+        s += d * d
+    return np.sqrt(s)
+
+
+@njit(cache=True, inline="always")
+def _dkds(r1, r2, r3, dim):  # type: ignore[no-untyped-def]
+    """``dkappa/ds`` from the first three derivatives (plane: signed curvature; space: the
+    derivative of ``|r1 x r2| / |r1|^3``, and ``|r1 x r3| / |r1|^4`` where ``r1 x r2 = 0``)."""
+    v2 = 0.0
+    dot12 = 0.0
+    for c in range(dim):
+        v2 += r1[c] * r1[c]
+        dot12 += r1[c] * r2[c]
+    if v2 == 0.0 or dim == 1:
+        return 0.0
+    v = np.sqrt(v2)
+    if dim == 2:
+        c12 = r1[0] * r2[1] - r1[1] * r2[0]
+        c13 = r1[0] * r3[1] - r1[1] * r3[0]
+        return (c13 / (v2 * v) - 3.0 * c12 * dot12 / (v2 * v2 * v)) / v
+    ax = r1[1] * r2[2] - r1[2] * r2[1]
+    ay = r1[2] * r2[0] - r1[0] * r2[2]
+    az = r1[0] * r2[1] - r1[1] * r2[0]
+    bx = r1[1] * r3[2] - r1[2] * r3[1]
+    by = r1[2] * r3[0] - r1[0] * r3[2]
+    bz = r1[0] * r3[1] - r1[1] * r3[0]
+    na = np.sqrt(ax * ax + ay * ay + az * az)
+    if na <= 1e-300:
+        return np.sqrt(bx * bx + by * by + bz * bz) / (v2 * v2)
+    kt = (ax * bx + ay * by + az * bz) / (na * v2 * v) - 3.0 * na * dot12 / (v2 * v2 * v)
+    return kt / v
+
+
+@njit(cache=True)
+def cubic_sapidis(P, D, h, k):  # type: ignore[no-untyped-def]
+    """``|kappa_s(t_k+) - kappa_s(t_k-)|``, the jump of ``dkappa/ds`` at point ``k``
+    (Sapidis & Farin 1990; seed 004), each side from its own segment (first three
+    coordinates of a curve in more than three dimensions)."""
+    nd = P.shape[0]
+    dim = P.shape[1]
+    km = (k - 1) % nd
+    D0 = h[km]
+    m = 3 if dim > 3 else dim
+    l1 = np.zeros(3)
+    l2 = np.zeros(3)
+    l3 = np.zeros(3)
+    q1 = np.zeros(3)
+    q2 = np.zeros(3)
+    q3 = np.zeros(3)
+    for c in range(m):
+        al2, al3 = _cubic_a23(P, D, h, km, c)
+        ar2, ar3 = _cubic_a23(P, D, h, k, c)
+        l1[c] = D[k, 0, c]
+        l2[c] = 2.0 * al2 + 6.0 * al3 * D0
+        l3[c] = 6.0 * al3
+        q1[c] = D[k, 0, c]
+        q2[c] = 2.0 * ar2
+        q3[c] = 6.0 * ar3
+    return abs(_dkds(q1, q2, q3, m) - _dkds(l1, l2, l3, m))
+
+
+@njit(cache=True)
+def quintic_move(P, D, h, k):  # type: ignore[no-untyped-def]
+    """Length of the position change of the unclamped Wang step at ``k``."""
+    nd = P.shape[0]
+    H00, H01, H02, H11, H22 = _quintic_H(h[(k - 1) % nd], h[k])
+    S = H00 - H01 * H01 / H11 - H02 * H02 / H22
+    s = 0.0
+    for c in range(P.shape[1]):
+        C1, C2, C3 = _quintic_C(P, D, h, k, c)
+        d = -(C1 - H01 * C2 / H11 - H02 * C3 / H22) / S
+        s += d * d
+    return np.sqrt(s)
+
+
+@njit(cache=True)
+def measure_at(P, D, h, k, degree, spline, method=POLIAKOFF, hstep=0.0, mcode=M_DEFAULT):  # type: ignore[no-untyped-def]
+    """Ranking measure of point ``k``. ``mcode`` ``M_DEFAULT`` (the papers'): cubic ->
+    third-derivative jump; quintic -> energy drop of the Wang step (hermite mode: whole step;
+    spline mode: the part due to the position). ``M_ENERGY``: the energy drop of the method's
+    step (the quintic's is ``M_DEFAULT``); ``M_SAPIDIS``: jump of dkappa/ds (cubic);
+    ``M_MOVE``: length of the move the step wants."""
+    if mcode == M_MOVE:
+        if degree == 3:
+            return cubic_move(P, D, h, k, method, hstep)
+        return quintic_move(P, D, h, k)
     if degree == 3:
+        if mcode == M_ENERGY:
+            return cubic_energy_drop(P, D, h, k, method, hstep)
+        if mcode == M_SAPIDIS:
+            return cubic_sapidis(P, D, h, k)
         return cubic_jump(P, D, h, k)
     return quintic_measure(P, D, h, k, spline)
 
@@ -484,11 +637,12 @@ def _is_blocked(mv, clamped, want, move_floor):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def drive_setup(P, D, h, closed, degree, spline, eligible):  # type: ignore[no-untyped-def]
+def drive_setup(P, D, h, closed, degree, spline, eligible, method=POLIAKOFF, hstep=0.0,
+                mcode=M_DEFAULT):  # type: ignore[no-untyped-def]
     """Initial state of the loop (``O(n)``): ``(measure, values, tv, ti, blocked,
     block_measure)`` -- measures, tree leaves, the tree, block flags and measures at blocking."""
     nd = P.shape[0]
-    measure = all_measures(P, D, h, closed, degree, spline)
+    measure = all_measures(P, D, h, closed, degree, spline, method, hstep, mcode)
     values = np.full(nd, -np.inf)
     for i in range(nd):
         if eligible[i]:
@@ -500,7 +654,7 @@ def drive_setup(P, D, h, closed, degree, spline, eligible):  # type: ignore[no-u
 @njit(cache=True)
 def drive(P, D, h, orig, closed, degree, method, spline, hstep, eligible, tol, eps,
           max_steps, move_floor, K0, pe, q, fixed, Hinv, w0, wmax, thr,
-          measure, values, tv, ti, blocked, block_measure):  # type: ignore[no-untyped-def]
+          measure, values, tv, ti, blocked, block_measure, mcode=M_DEFAULT):  # type: ignore[no-untyped-def]
     """Seed 001's steps 2-6 on the distinct data (``P``, ``D`` and the state from
     :func:`drive_setup` are modified in place; no ``O(n)`` work or allocation here).
 
@@ -679,7 +833,7 @@ def drive(P, D, h, orig, closed, degree, method, spline, hstep, eligible, tol, e
                 b = nd - 2
         for vv in range(a, b + 1):
             i = vv % nd if closed else vv
-            m_new = measure_at(P, D, h, i, degree, spline)
+            m_new = measure_at(P, D, h, i, degree, spline, method, hstep, mcode)
             measure[i] = m_new
             if not eligible[i]:
                 values[i] = -np.inf
@@ -712,11 +866,12 @@ def drive(P, D, h, orig, closed, degree, method, spline, hstep, eligible, tol, e
 
 
 @njit(cache=True)
-def all_measures(P, D, h, closed, degree, spline):  # type: ignore[no-untyped-def]
+def all_measures(P, D, h, closed, degree, spline, method=POLIAKOFF, hstep=0.0,
+                 mcode=M_DEFAULT):  # type: ignore[no-untyped-def]
     """Ranking measure of every point (0 at the ends of an open curve)."""
     nd = P.shape[0]
     out = np.zeros(nd)
     for i in range(nd):
         if closed or (i >= 1 and i <= nd - 2):
-            out[i] = measure_at(P, D, h, i, degree, spline)
+            out[i] = measure_at(P, D, h, i, degree, spline, method, hstep, mcode)
     return out

@@ -1100,6 +1100,9 @@ def _register() -> None:
         source="Eck & Hadenfeld, Local energy fairing of B-spline curves, eqs. (12)-(16); "
                "ranking list as in ERRATA",
         default=True,
+        default_reason="default above 200,000 control points (global_fair.DEFAULT_MAX_CTRL), "
+                       "where 'global' l=3 costs ~30x one csaps fit: the sweep's whole call is "
+                       "a few csaps fits at 1e6 [benchmarks/bench_call_cost.py]",
     ))
 
 

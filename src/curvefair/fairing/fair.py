@@ -162,6 +162,12 @@ class MethodSpec:
         ``prefer(curve) -> bool``, for a ``default`` method: the curves it is the default for
         (e.g. open point data up to a size); where it does not hold, the default of the curve
         type without such a condition is used. None: ``accepts`` decides.
+    default_options : dict or callable
+        Options :func:`fair` passes when it chooses this method as the default (``method``
+        not given), or ``default_options(curve) -> dict``; options the caller gives win.
+        E.g. ``{"l": 3}`` for ``global`` on curves of degree >= 3.
+    default_reason : str
+        Why it is the default: one line with the benchmark figure (``curvefair methods``).
     """
 
     name: str
@@ -173,6 +179,9 @@ class MethodSpec:
     modes: tuple[str, ...] = ("spline",)
     accepts: Callable[[Any], bool] | None = None
     prefer: Callable[[Any], bool] | None = None
+    default_options: dict[str, Any] | Callable[[Any], dict[str, Any]] = field(
+        default_factory=dict)
+    default_reason: str = ""
 
 
 class FairingReport(dict):  # type: ignore[type-arg]
@@ -459,7 +468,8 @@ def _analysis_block(curve: PiecewiseCurve) -> dict[str, Any]:
 def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None = None,
          eps: float | None = None, max_steps: int | None = None, clamp: Any = "g0",
          protect: Iterable[int] = (), mode: str = "spline", joins: str = "keep",
-         g1_angle: float | None = None, guard: bool = True, **options: Any) -> FairingResult:
+         g1_angle: float | None = None, guard: bool = True, structure: str = "keep",
+         **options: Any) -> FairingResult:
     """Fair a curve automatically: repeatedly apply a local step at the worst point.
 
     Parameters
@@ -469,7 +479,10 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
         (with a B-spline method registered).
     method : str, optional
         A name from :func:`available_methods`; default: the curve type's default
-        (``"poliakoff"`` for cubic, ``"wang-quintic"`` for quintic Hermite splines).
+        (``"poliakoff"`` for cubic, ``"wang-quintic"`` for quintic Hermite splines,
+        ``"global"`` with ``l=3`` for B-splines: the fairest method of the quality benchmark
+        that keeps the B-spline's degree, knots and number of control points), with that
+        method's ``default_options`` under the caller's own options.
     tol : float > 0, optional
         Neither the output curve nor any data point ends farther than ``tol`` from the input.
         Each step is clamped onto the ball of radius ``tol`` around the ORIGINAL point (ERRATA,
@@ -509,6 +522,11 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
         input (curvefair's own counts, :func:`curvefair.analyze`), the largest fraction of the
         move (1/2, 1/4, 1/8) that does not is returned instead, or else the input itself;
         ``report["guard"]`` says what was kept and why. False: the method's result as it is.
+    structure : {"keep", "free"}
+        B-splines: ``"keep"`` (default) keeps the degree, knot vector and number of control
+        points; ``"free"`` accepts fewer knots (:mod:`curvefair.fairing.structure`: the fewest
+        knots whose least-squares refit stays within ``tol / 2``, then the method under the
+        rest of the tolerance; ``report["structure"]``). Other curves: no effect.
     **options
         Passed to the method's driver; :func:`method_options` lists each method's options and
         their defaults (e.g. ``schedule="sweep"`` for ``"eck-hadenfeld"``). An unknown name
@@ -558,8 +576,20 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
     curve = _as_curve(curve, "curve")  # scipy splines too (curvefair.interop.as_curve)
     if not isinstance(curve, PiecewiseCurve):
         raise InputError(f"curve must be a curvefair curve, got {type(curve).__name__}")
+    if structure not in ("keep", "free"):
+        raise InputError(f"unknown structure {structure!r}; valid values are: 'keep', 'free'")
+    if structure == "free" and hasattr(curve, "control_points"):
+        from .._validate import as_positive as _pos
+        from .structure import fair_new_structure
+
+        return fair_new_structure(
+            curve, method, _pos(tol, "tol", allow_none=True, window=True), fair, eps=eps,
+            max_steps=max_steps, clamp=clamp, protect=protect, mode=mode, joins=joins,
+            g1_angle=g1_angle, guard=guard, **options)
     if method is None:
         spec = _default_method(curve)
+        dflt = spec.default_options
+        options = {**(dflt(curve) if callable(dflt) else dflt), **options}
     else:
         spec = _method_spec(method)
     if not isinstance(curve, spec.curve_types):

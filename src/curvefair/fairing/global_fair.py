@@ -1178,7 +1178,36 @@ def _register() -> None:
                 "each within tol of the original (convex QP, interior point, banded solves)",
         source="the problem of Eck & Hadenfeld (seed 003 eq. (12)) solved for all points at "
                "once; deviation bound seed 004 eqs. (8.34)-(8.36)",
+        default=True,
+        prefer=_prefer_default,
+        default_options=_default_options,
+        default_reason=DEFAULT_REASON,
     ))
+
+
+#: the largest control-point count for which ``global`` (l=3) is the B-spline default: its
+#: interior point takes ~30x one csaps fit at 1e6 points (docs/benchmarks.md); larger curves
+#: default to ``eck-hadenfeld`` (sweep), whose whole call stays within a few csaps fits
+DEFAULT_MAX_CTRL = 200_000
+
+
+def _prefer_default(curve: Any) -> bool:
+    return isinstance(curve, BSplineCurve) and curve.n_ctrl <= DEFAULT_MAX_CTRL
+
+
+#: Why ``global`` with ``l = 3`` is the B-spline default (``curvefair methods``).
+DEFAULT_REASON = (
+    "fairest method that keeps degree, knots and control-point count: with l=3 it reaches "
+    "the true curvature-extrema count on 16/84 ground-truth curves (eck-hadenfeld 2/84), "
+    "airfoil extrema ratio median 0.521 (eck-hadenfeld 0.923), glyph runs 0.368 (0.478) "
+    "[make bench-quality, docs/benchmarks.md, 2026-12-01]")
+
+
+def _default_options(curve: BSplineCurve) -> dict[str, Any]:
+    """l=3 on degree >= 3, else l=2
+
+    (E_l needs degree >= l)."""
+    return {"l": 3} if curve.degree >= 3 else {}
 
 
 _register()

@@ -52,9 +52,33 @@ The loop (Wang & Cao 2006, "Algorithm", steps 1-6)
    ``tol`` (the curve's change is linear in the moves; scaling back never raises the strain
    energy above the start's). The report's ``curve_tolerance`` entry says what was done.
 
-Defaults: ``eps`` = 1e-2 x the initial largest measure for the cubic methods (third-derivative
-jump) and 1e-4 x for ``wang-quintic`` (an energy, quadratic in the move: the same 1 % in
-amplitude); ``max_steps`` = 20 x the number of movable points + 1000.
+Defaults: ``eps`` = 1e-2 x the initial largest measure for the linear measures (``jump``,
+``sapidis``, ``move``) and 1e-4 x for the energies (``energy``, ``wang-quintic``'s default;
+quadratic in the move: the same 1 % in amplitude); ``max_steps`` = 20 x the number of movable
+points + 1000.
+
+Bad-point measures (``measure=``)
+---------------------------------
+Step 2 ranks by one of:
+
+* ``"jump"`` (cubic; the papers'): ``|r'''(t_k+) - r'''(t_k-)|`` (seed 001, eq. (7));
+* ``"energy"``: the exact drop of ``int |r''|^2`` over the two segments at ``k`` that the
+  method's unclamped step achieves on the current Hermite data (cubic: ``x^T H x / 2`` with the
+  Hessian of the two segments' energy in ``(r_k, r'_k)``; Kjellander's step is not the
+  minimiser, its drop is ``-(g . delta + Hpp |delta|^2 / 2)``); the quintic's published measure;
+* ``"sapidis"`` (cubic): the jump of ``dkappa/ds`` at ``t_k`` (Sapidis & Farin 1990, the
+  measure of the knot-removal method);
+* ``"move"``: the length ``|delta|`` of the position change the method's unclamped step wants.
+
+The third-derivative jump of noise of amplitude ``sigma`` grows like ``sigma / h^3`` with the
+local spacing ``h`` and the jump of ``dkappa/ds`` with the curvature, so on data whose spacing
+and curvature vary 1:100 (airfoils, clustered at the leading edge) both rank the densest, most
+curved stretch first; the energy drop grows like ``sigma^2 / h^3``. The move is in the data's
+own units, like ``tol``: the same noise ranks the same everywhere. Defaults
+(:data:`DEFAULT_MEASURE`): ``"move"`` for ``poliakoff`` and ``wang-cao``; the published measure
+for ``kjellander`` (on its uniform parameters its step is a fixed multiple of Poliakoff's, so
+jump, move and energy rank alike) and ``wang-quintic`` (``"energy"``; ``"move"`` was not
+fairer overall there). ``measure="jump"`` reproduces the papers' loop exactly.
 
 End conditions (open curves, ``clamp`` per end)
 -----------------------------------------------
@@ -237,14 +261,43 @@ def _end_second_derivative_kept(curve: HermiteSpline, clamp: tuple[str, str]) ->
     return out
 
 
+_MEASURE_REPORT = {"jump": "third_derivative_jump", "energy": "energy_drop",
+                   "sapidis": "dkappa_ds_jump", "move": "step_length"}
+MEASURES = {3: ("jump", "energy", "sapidis", "move"), 5: ("energy", "move")}
+"""``measure=`` values per degree; the first is the papers' (the default)."""
+_MEASURE_CODE = {"jump": _k.M_DEFAULT, "energy": _k.M_ENERGY, "sapidis": _k.M_SAPIDIS,
+                 "move": _k.M_MOVE}
+
+
+#: ``measure=None``: the default measure per method (chosen on the quality benchmark, see
+#: CHANGELOG); a method not listed uses its published one (the first of :data:`MEASURES`).
+DEFAULT_MEASURE = {"poliakoff": "move", "wang-cao": "move"}
+
+
+def measure_code(measure: str | None, degree: int, method: str) -> tuple[str, int]:
+    """``(name, kernel code)`` of a ``measure=`` option (``None``: the method's default,
+    :data:`DEFAULT_MEASURE`, else its published measure); InputError naming the valid
+    values otherwise."""
+    valid = MEASURES[degree]
+    if measure is None:
+        measure = DEFAULT_MEASURE.get(method, valid[0])
+    if not isinstance(measure, str) or measure not in valid:
+        raise InputError(f"unknown measure {measure!r} for method {method!r}; valid values "
+                         "are: " + ", ".join(repr(m) for m in valid))
+    if degree == 5 and measure == "energy":
+        return measure, _k.M_DEFAULT
+    return measure, _MEASURE_CODE[measure]
+
+
 def prepare(curve: HermiteSpline, *, method: str, tol: float | None, eps: float | None,
             max_steps: int | None, clamp: tuple[str, str], protect: frozenset[int],
-            mode: str = "spline") -> dict[str, Any]:
+            mode: str = "spline", measure: str | None = None) -> dict[str, Any]:
     """Validate and set up everything the compiled loop needs (``O(n)``); see
     :func:`hermite_driver`. Returns a dict with the kernel arguments under ``"args"`` (in the
     order of :func:`_hermite_kernels.drive`) and bookkeeping entries."""
     degree = curve.degree
     code = _METHOD_CODE[method]
+    mname, mcode = measure_code(measure, degree, method)
     spline = mode == "spline"
     P, D, h = distinct_data(curve)
     nd, dim = P.shape
@@ -318,10 +371,11 @@ def prepare(curve: HermiteSpline, *, method: str, tol: float | None, eps: float 
         D = D_new
 
     # -- ranking and defaults
-    measure, values, tv, ti, blocked, block_measure = _k.drive_setup(
-        P, D, h, closed, degree, spline, eligible)
-    m0 = float(measure[eligible].max()) if eligible.any() else 0.0
-    rel = 1e-2 if degree == 3 else 1e-4
+    meas, values, tv, ti, blocked, block_measure = _k.drive_setup(
+        P, D, h, closed, degree, spline, eligible, code, hstep, mcode)
+    m0 = float(meas[eligible].max()) if eligible.any() else 0.0
+    # 1 % in amplitude: an energy is quadratic in the move, the other measures linear
+    rel = 1e-4 if mname == "energy" else 1e-2
     eps_eff = rel * m0 if eps is None else float(eps)
     n_elig = int(eligible.sum())
     max_eff = 20 * n_elig + 1000 if max_steps is None else int(max_steps)
@@ -336,12 +390,13 @@ def prepare(curve: HermiteSpline, *, method: str, tol: float | None, eps: float 
         Hinv = _dense_inverse(nd, nb, h, degree)
     args = (P, D, h, P.copy(), closed, degree, code, spline, hstep, eligible,
             -1.0 if tol is None else float(tol), eps_eff, max_eff, floor,
-            K0, pe, q, fixed, Hinv, _W0[degree], _WMAX, _THR, measure, values, tv, ti,
-            blocked, block_measure)
+            K0, pe, q, fixed, Hinv, _W0[degree], _WMAX, _THR, meas, values, tv, ti,
+            blocked, block_measure, mcode)
     return {"args": args, "extra": extra, "held": held, "eligible": eligible, "m0": m0,
             "floor0": 8.0 * np.finfo(float).eps * scale,
+            "measure_name": mname,
             "P0": P.copy(), "D0": D.copy(),
-            "eps": eps_eff, "max_steps": max_eff, "n_elig": n_elig, "measure": measure,
+            "eps": eps_eff, "max_steps": max_eff, "n_elig": n_elig, "measure": meas,
             "P": P, "D": D, "spline": spline, "degree": degree, "nd": nd, "Hinv": Hinv}
 
 
@@ -427,12 +482,17 @@ def _enforce_curve_tol(curve: HermiteSpline, st: dict[str, Any], tol: float,
 
 def hermite_driver(curve: HermiteSpline, *, method: str, tol: float | None, eps: float | None,
                    max_steps: int | None, clamp: tuple[str, str], protect: frozenset[int],
-                   mode: str = "spline", tol_on: str = "curve", **options: Any) -> DriverOutput:
+                   mode: str = "spline", tol_on: str = "curve", measure: str | None = None,
+                   **options: Any) -> DriverOutput:
     """Driver of the four Hermite methods (see the module docstring); called by :func:`fair`.
 
     ``tol_on="curve"`` (default) keeps the whole output curve within ``tol`` of the input
     (step 6 of the module docstring); ``tol_on="points"`` bounds only the data points, as the
     papers' loop does, and the curve may then bulge past ``tol`` between them.
+
+    ``measure`` chooses how the loop ranks the points (module docstring, "Bad-point
+    measures"); ``None`` is the method's published measure, and ``"jump"`` (cubic) or
+    ``"energy"`` (quintic) name it explicitly (bit-identical results).
     """
     if options:
         raise InputError(f"method {method!r} got unknown options {sorted(options)}")
@@ -440,7 +500,8 @@ def hermite_driver(curve: HermiteSpline, *, method: str, tol: float | None, eps:
 
     choice(tol_on, ("curve", "points"), "tol_on")
     t0 = time.perf_counter()
-    kw = dict(method=method, eps=eps, max_steps=max_steps, clamp=clamp, protect=protect, mode=mode)
+    kw = dict(method=method, eps=eps, max_steps=max_steps, clamp=clamp, protect=protect, mode=mode,
+              measure=measure)
     point_tol = tol
     snap = None
     for attempt in range(_CURVE_TOL_RERUNS + 1):
@@ -496,7 +557,8 @@ def hermite_driver(curve: HermiteSpline, *, method: str, tol: float | None, eps:
     # re-interpolation, a changed curve reported as "0 steps")
     new = curve if int(steps) == 0 else rebuild(curve, P, D)
     extra.update({
-        "measure": "third_derivative_jump" if degree == 3 else
+        "measure": _MEASURE_REPORT[st["measure_name"]] if degree == 3 or
+                   st["measure_name"] != "energy" else
                    ("energy_drop_position" if spline else "energy_drop"),
         "measure_max_before": m0,
         "measure_max_after": float(measure[eligible].max()) if n_elig else 0.0,
@@ -529,6 +591,17 @@ _SPECS = [
      "Wang 2005 (seed 000), eqs. (3)-(5), H x = -C solved exactly (ERRATA)"),
 ]
 
+_MEASURE_RUN = ("python benchmarks/quality/measures.py --only hermite --instances 2 "
+                "--airfoils 120 --glyphs 40")
+_DEFAULT_REASON = {
+    "poliakoff": "ranked by measure=move: airfoil extrema ratio median 0.75 (the papers' jump "
+                 "0.952, kjellander 1.14, wang-cao with move 0.73), glyph runs 0.58 [" +
+                 _MEASURE_RUN + "]",
+    "wang-quintic": "the only method for quintic Hermite splines; airfoil extrema ratio "
+                    "median 1 (0.927 with eps=0), glyph runs 0.515 [" + _MEASURE_RUN + "]",
+}
+
 for _name, _types, _default, _summary, _source in _SPECS:
     register_method(MethodSpec(_name, _types, partial(hermite_driver, method=_name), _summary,
-                               _source, default=_default, modes=("spline", "hermite")))
+                               _source, default=_default, modes=("spline", "hermite"),
+                               default_reason=_DEFAULT_REASON.get(_name, "")))
