@@ -89,46 +89,130 @@ def _label(rec: CurveRecord, i: int) -> str:
     return f"curve {i}" + (f" ({rec.name})" if rec.name else "")
 
 
+def _entity(r: CurveRecord) -> tuple[Any, ...] | None:
+    """The source entity of a record (3dm object id, DXF handle, SVG element and subpath)."""
+    src = r.source
+    for k in ("id", "handle"):
+        if src.get(k) is not None:
+            return (k, src[k])
+    if src.get("element") is not None:
+        return ("element", src["element"], src.get("subpath"))
+    return None
+
+
+def _ordered(reference: Sequence[CurveRecord], back: Sequence[CurveRecord]
+             ) -> list[CurveRecord]:
+    """``back`` in the entity order of ``reference`` when every record names its entity and
+    both name the same ones (a writer may move a replaced entity to the end of the file, e.g.
+    a 3dm object whose degree changed), else as read."""
+    ref_keys = [_entity(r) for r in reference]
+    back_keys = [_entity(b) for b in back]
+    if None in ref_keys or None in back_keys or set(ref_keys) != set(back_keys):
+        return list(back)
+    by: dict[Any, list[CurveRecord]] = {}
+    for k, b in zip(back_keys, back, strict=True):
+        by.setdefault(k, []).append(b)
+    out: list[CurveRecord] = []
+    for k in dict.fromkeys(ref_keys):
+        out.extend(by[k])
+    return out
+
+
+def _groups(records: Sequence[CurveRecord]) -> list[list[CurveRecord]]:
+    """Records grouped by source entity: the pieces ``0 .. n_pieces-1`` of a point list split
+    at corners form one group, any other record a group of its own."""
+    out: list[list[CurveRecord]] = []
+    for r in records:
+        piece = r.source.get("piece")
+        if isinstance(piece, int) and piece > 0 and out and \
+                out[-1][-1].source.get("piece") == piece - 1:
+            out[-1].append(r)
+        else:
+            out.append([r])
+    return out
+
+
+def _shapes_agree(ref: Sequence[CurveRecord], back: Sequence[CurveRecord]) -> bool:
+    """Same number of records and, for point data, the same number of points each."""
+    return len(ref) == len(back) and all(
+        r.kind not in POINT_KINDS or b.kind not in POINT_KINDS or r.points is None
+        or b.points is None or np.shape(r.points) == np.shape(b.points)
+        for r, b in zip(ref, back, strict=True))
+
+
 def _matched(reference: Sequence[CurveRecord], back: Sequence[CurveRecord]
              ) -> list[Any] | None:
     """The curves read back, one per reference record, or None when they cannot be paired.
 
-    Same number of records: in order. Otherwise (a point list split at other corners when
-    read back) each reference piece is rebuilt from the points read back at its indices.
+    Per source entity (see :func:`_groups`): the same pieces in order; otherwise (a point
+    list split at other corners when read back, e.g. after moves that made or removed a
+    corner) each reference piece is rebuilt from the points read back at its indices.
     """
-    if len(back) == len(reference):
+    if _shapes_agree(reference, back):
         return [b.curve for b in back]
-    if not all("indices" in r.source for r in list(reference) + list(back)):
-        return None
-    n = {int(r.source["n_points"]) for r in list(reference) + list(back)}
-    if len(n) != 1:
-        return None
-    full = np.full((n.pop(), back[0].points.shape[1]), np.nan)  # type: ignore[union-attr]
-    for b in back:
-        full[np.asarray(b.source["indices"], dtype=int)] = np.asarray(b.points)
-    if np.isnan(full).any():
+    rg, bg = _groups(reference), _groups(back)
+    if len(rg) != len(bg):
         return None
     out = []
-    for r in reference:
-        idx = np.asarray(r.source["indices"], dtype=int)
-        out.append(points_curve(full[idx], bool(r.curve.closed)))
+    for rr, bb in zip(rg, bg, strict=True):
+        if _shapes_agree(rr, bb):
+            out.extend(b.curve for b in bb)
+            continue
+        p0 = rr[0].points if rr[0].points is not None else getattr(rr[0].curve, "points", None)
+        if len(rr) == 1 and "indices" not in rr[0].source and isinstance(p0, np.ndarray) and \
+                all("indices" in b.source and "n_points" in b.source for b in bb):
+            # a bare curve written as points, read back split at corners: the whole list
+            n0 = int(p0.shape[0])
+            if {int(b.source["n_points"]) for b in bb} != {n0}:
+                return None
+            full = np.full((n0, p0.shape[1]), np.nan)
+            for b in bb:
+                full[np.asarray(b.source["indices"], dtype=int)] = np.asarray(b.points)
+            if np.isnan(full).any():
+                return None
+            out.append(points_curve(full, bool(rr[0].curve.closed)))
+            continue
+        if not all("indices" in r.source and "n_points" in r.source for r in rr + bb):
+            return None
+        n = {int(r.source["n_points"]) for r in rr + bb}
+        if len(n) != 1:
+            return None
+        full = np.full((n.pop(), bb[0].points.shape[1]), np.nan)  # type: ignore[union-attr]
+        for b in bb:
+            full[np.asarray(b.source["indices"], dtype=int)] = np.asarray(b.points)
+        if np.isnan(full).any():
+            return None
+        for r in rr:
+            idx = np.asarray(r.source["indices"], dtype=int)
+            out.append(points_curve(full[idx], bool(r.curve.closed)))
     return out
 
 
 def _lost_points(reference: Sequence[CurveRecord], back: Sequence[CurveRecord]) -> str | None:
     """Why the point data read back is not the point data written (points merged or dropped
     on reading, e.g. rounded onto each other), or None."""
-    n_ref = {int(r.source["n_points"]) for r in reference if "n_points" in r.source}
-    n_back = {int(r.source["n_points"]) for r in back if "n_points" in r.source}
-    if len(reference) == len(back):
-        for i, (r, b) in enumerate(zip(reference, back, strict=True)):
-            if r.points is not None and b.points is not None and \
-                    r.points.shape != b.points.shape:
-                return (f"{_label(r, i)} reads back with {b.points.shape[0]} points, "
-                        f"{r.points.shape[0]} were written")
-    elif n_ref and n_back and n_ref != n_back:
-        return (f"the point list reads back with {sorted(n_back)[0]} points, "
-                f"{sorted(n_ref)[0]} were written")
+    if _shapes_agree(reference, back):
+        return None
+    rg, bg = _groups(reference), _groups(back)
+    if len(rg) != len(bg):
+        return None  # reported by _matched
+    for rr, bb in zip(rg, bg, strict=True):
+        if _shapes_agree(rr, bb):
+            continue
+        i = next(k for k, r in enumerate(reference) if r is rr[0])
+        nr = {int(r.source["n_points"]) for r in rr if "n_points" in r.source}
+        nb = {int(b.source["n_points"]) for b in bb if "n_points" in b.source}
+        if nr and nb:
+            if nr != nb:
+                return (f"{_label(rr[0], i)} reads back with {sorted(nb)[0]} points, "
+                        f"{sorted(nr)[0]} were written")
+            continue
+        if len(rr) == len(bb):
+            for r, b in zip(rr, bb, strict=True):
+                if r.points is not None and b.points is not None and \
+                        np.shape(r.points) != np.shape(b.points):
+                    return (f"{_label(r, i)} reads back with {b.points.shape[0]} points, "
+                            f"{r.points.shape[0]} were written")
     return None
 
 
@@ -185,7 +269,7 @@ def write_checked(path: str | os.PathLike[str], records: Sequence[CurveRecord],
                   reference: Sequence[CurveRecord], *, tol: float | None,
                   reader: Callable[[str], list[CurveRecord]], template: object = None,
                   format: str | None = None, overwrite: bool = False,
-                  decimals: int | None = None) -> WriteCheck:
+                  decimals: int | None = None, precision: str = "file") -> WriteCheck:
     """Write ``records`` to ``path`` only if the file read back is within ``tol`` of
     ``reference``; see the module docstring.
 
@@ -201,9 +285,10 @@ def write_checked(path: str | os.PathLike[str], records: Sequence[CurveRecord],
     reader : callable
         ``reader(path) -> records``: how the file is read (the same corner handling as the
         input).
-    template, format, overwrite, decimals
-        As for :func:`curvefair.write_curves`; ``decimals`` given: the rounding asked for is
-        kept, and a file it puts out of tolerance is not written.
+    template, format, overwrite, decimals, precision
+        As for :func:`curvefair.write_curves` (which calls this function; ``overwrite`` is
+        checked there); ``decimals`` given: the rounding asked for is kept, and a file it puts
+        out of tolerance is not written; ``precision="exact"``: exact numbers from the start.
 
     Raises
     ------
@@ -211,22 +296,26 @@ def write_checked(path: str | os.PathLike[str], records: Sequence[CurveRecord],
         The file would not read back, or a curve read back would be farther than ``tol``
         from its input; nothing is written.
     """
-    from . import detect_format, write_curves
+    from . import _template_path, _write_plain, detect_format
 
+    del overwrite  # the destination is checked by write_curves / the CLI; tmp is never an input
     if len(records) != len(reference):
         raise InputError(f"write_checked: {len(records)} records for {len(reference)} "
                          "reference records")
     fmt = detect_format(path, format)
-    precision = "file" if decimals is None else "decimals"
+    if decimals is not None:
+        precision = "decimals"
+    elif precision not in ("file", "exact"):
+        raise InputError(f"precision must be 'file' or 'exact', got {precision!r}")
+    tpath = _template_path(template)
     recs = list(records)
     scale = [1.0] * len(recs)
     notes: list[str] = []
     where = os.fspath(path)
     with atomic_path(path) as tmp:
         for _attempt in range(_MAX_SHRINK + 3):
-            write_curves(tmp, recs, template=template, format=fmt,  # type: ignore[arg-type]
-                         overwrite=overwrite, decimals=decimals,
-                         precision="exact" if precision == "exact" else "file")
+            _write_plain(tmp, recs, fmt, tpath, decimals,
+                         "exact" if precision == "exact" else "file")
             try:
                 back = reader(os.fspath(tmp))
             except CurvefairError as exc:
@@ -240,6 +329,7 @@ def write_checked(path: str | os.PathLike[str], records: Sequence[CurveRecord],
                     else ""
                 raise WriteCheckError(f"{where}: not written: the file would not read back: "
                                       f"{msg}{hint}") from None
+            back = _ordered(reference, back)
             lost = _lost_points(reference, back)
             if lost is not None:
                 hint = f" (--decimals {decimals} rounds too much?)" if decimals is not None \
