@@ -205,3 +205,44 @@ def test_bad_arguments():
     with pytest.raises(InputError, match="reference has 2 curves"):
         write_curves("x.json", [c], reference=[c, c])
     assert not Path("x.json").exists()
+
+
+def test_report_after_figures_describe_the_written_file(tmp_path):
+    """When the moves were scaled for the on-disk tolerance, rescaled_report's after-figures
+    are those of the curve read back from the file: checked against analyze() of the file
+    re-read independently, numpy point moves, and scipy's natural cubic spline through the
+    written points (chord parameters) for the inflection count."""
+    from scipy.interpolate import CubicSpline
+
+    from curvefair import analyze, fair
+    from curvefair.io._verify import rescaled_report
+
+    recs = read_curves(DATA / "clarky.dat")
+    tol = 1e-4
+    res = fair(recs[0].curve, tol=tol, max_steps=5)
+    moved = [_moved_points(recs[0], 0.98 * tol, 7)]
+    out = tmp_path / "c.dat"
+    with pytest.warns(UserWarning, match="scaled down"):
+        check = write_curves(out, moved, tol=tol)
+    s = check.move_scale[0]
+    assert s < 1.0
+    rep = rescaled_report(res.report, recs[0].curve, check.read_back[0], s)
+    back = read_curves(out)[0]
+    a = analyze(back.curve)
+    assert rep["energy_after"] == a.energy2 and rep["extrema_after"] == a.extrema
+    assert rep["energy_before"] == res.report["energy_before"]
+    p0, p1 = np.asarray(recs[0].points), np.asarray(back.points)
+    assert rep["max_point_displacement"] == pytest.approx(
+        np.linalg.norm(p1 - p0, axis=1).max(), rel=1e-12)
+    assert rep["max_point_displacement"] <= 0.98 * tol * s * (1 + 1e-9)
+    assert rep["n_moved"] == int(np.count_nonzero(np.any(p1 != p0, axis=1)))
+    assert rep["max_deviation"] <= tol and rep["move_scale"] == s
+    assert rep["measure_max_after"] is None
+    # inflections of the written curve, independently
+    t = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(p1, axis=0), axis=1))]
+    cs = CubicSpline(t, p1, bc_type="natural")
+    u = np.linspace(t[0], t[-1], 200001)
+    d1, d2 = cs(u, 1), cs(u, 2)
+    k = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]
+    sg = np.sign(k[np.abs(k) > 1e-9 * np.abs(k).max()])
+    assert rep["inflections_after"] == int(np.count_nonzero(sg[1:] != sg[:-1]))

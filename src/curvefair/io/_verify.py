@@ -33,7 +33,7 @@ import numpy as np
 from ..errors import CurvefairError, InputError
 from ._common import CurveRecord, atomic_path, points_curve
 
-__all__ = ["WriteCheck", "WriteCheckError", "write_checked"]
+__all__ = ["WriteCheck", "WriteCheckError", "write_checked", "rescaled_report"]
 
 #: Record kinds whose curve is re-interpolated from data points on reading.
 POINT_KINDS = ("points", "airfoil", "polyline", "fit_points")
@@ -67,6 +67,9 @@ class WriteCheck:
         Per record, the factor ``s`` applied to the moves of point data (1.0: as faired).
     notes : tuple of str
         What was changed to meet the tolerance, one sentence each.
+    read_back : tuple of curves
+        The curves read back from the written file, one per input record (not in
+        :meth:`to_dict`).
     """
 
     max_deviation: float
@@ -76,6 +79,7 @@ class WriteCheck:
     precision: str
     move_scale: tuple[float, ...]
     notes: tuple[str, ...] = field(default_factory=tuple)
+    read_back: tuple[Any, ...] = field(default_factory=tuple, compare=False, repr=False)
 
     def to_dict(self) -> dict[str, Any]:
         return {"max_deviation": self.max_deviation, "deviations": list(self.deviations),
@@ -350,7 +354,7 @@ def write_checked(path: str | os.PathLike[str], records: Sequence[CurveRecord],
             over = [i for i, d in enumerate(devs) if tol is not None and not d <= tol]
             if not over:
                 return WriteCheck(max(devs, default=0.0), tuple(devs), tuple(kinds), mpd,
-                                  precision, tuple(scale), tuple(notes))
+                                  precision, tuple(scale), tuple(notes), tuple(curves))
             if precision == "file" and fmt == "svg":
                 precision = "exact"
                 worst = max(over, key=lambda i: devs[i])
@@ -382,3 +386,50 @@ def write_checked(path: str | os.PathLike[str], records: Sequence[CurveRecord],
         raise WriteCheckError(f"{where}: not written: the curves read back stay farther than "
                               f"tol {tol:g} from the input")
     raise AssertionError("unreachable")  # pragma: no cover
+
+
+def rescaled_report(report: dict[str, Any], original: Any, written: Any,
+                    scale: float) -> dict[str, Any]:
+    """A :func:`curvefair.fair` report whose after-figures describe ``written``, the curve read
+    back from the file, instead of the faired curve whose moves were scaled by ``scale`` to
+    hold the tolerance on disk (point data re-interpolated on reading; see the module
+    docstring, step 2).
+
+    Recomputed: every ``<figure>_after`` of :func:`curvefair.analyze` (energies, jumps,
+    Sapidis sum, inflections, extrema), the data point moves (``moved``, ``n_moved``,
+    ``max_point_displacement``, ``max_point_index``) and the deviation from ``original``
+    (``max_deviation*``, with ``kind="auto"``: geometric, since re-interpolation gives new
+    chord parameters). A method's own after-figure (``measure_max_after``) cannot be
+    recomputed and becomes None. ``move_scale`` and ``after_figures`` say what was done.
+    """
+    from ..analysis import deviation
+    from ..fairing._tolerance import point_report
+    from ..fairing.fair import _analysis_block
+
+    out = dict(report)
+    after = _analysis_block(written)
+    redone = []
+    for k, v in after.items():
+        out[f"{k}_after"] = v
+        redone.append(f"{k}_after")
+    for k in list(out):
+        if k.endswith("_after") and k not in redone:
+            out[k] = None
+    moved_idx, disp, max_disp, max_idx = point_report(original, written)
+    out["moved"] = {"indices": [int(i) for i in moved_idx],
+                    "displacement": [float(x) for x in disp]}
+    out["n_moved"] = int(moved_idx.size)
+    out["max_point_displacement"] = float(max_disp)
+    out["max_point_index"] = None if max_idx is None else int(max_idx)
+    d = deviation(original, written)
+    ub = getattr(d, "upper_bound", None)
+    out["max_deviation"] = float(d.max_distance)
+    out["max_deviation_upper_bound"] = None if ub is None or not np.isfinite(ub) else float(ub)
+    out["max_deviation_param"] = None if d.param is None else float(d.param)
+    out["max_deviation_point"] = None if d.point_a is None else \
+        [float(x) for x in np.asarray(d.point_a).reshape(-1)]
+    out["max_deviation_kind"] = d.kind
+    out["move_scale"] = float(scale)
+    out["after_figures"] = (f"recomputed for the curve read back from the written file: the "
+                            f"faired moves were scaled by {scale:.6g} to hold tol on disk")
+    return out
