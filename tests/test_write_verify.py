@@ -246,3 +246,27 @@ def test_report_after_figures_describe_the_written_file(tmp_path):
     k = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]
     sg = np.sign(k[np.abs(k) > 1e-9 * np.abs(k).max()])
     assert rep["inflections_after"] == int(np.count_nonzero(sg[1:] != sg[:-1]))
+
+
+def test_subset_and_new_curve_into_a_template(tmp_path):
+    """Writing one of a file's curves plus a new curve into the file as template: the
+    template's other curves read back too; the check pairs the written ones by handle and the
+    new one as the appended entity."""
+    pytest.importorskip("ezdxf")
+    src = DATA / "libdxfrw_closed_splines.dxf"  # AC1021
+    recs = read_curves(src)
+    assert len(recs) == 2
+    new = BSplineCurve([[0, 0], [1, 2], [3, 2], [4, 0]], [0, 0, 0, 0, 1, 1, 1, 1], 3)
+    moved = _moved_bspline(recs[1], 0.25)
+    out = tmp_path / "o.dxf"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        check = write_curves(out, [moved, new], template=src, tol=1.0)
+    assert len(check.deviations) == 2 and check.max_deviation <= 1.0
+    back = read_curves(out)
+    assert len(back) == 3
+    got = {b.source["handle"]: b for b in back}
+    d_moved = _dense_distance(recs[1].curve, got[recs[1].source["handle"]].curve)
+    assert d_moved <= check.deviations[0] * (1 + 1e-4) + 1e-15
+    d_new = _dense_distance(new, back[-1].curve)
+    assert d_new <= 1e-9 and check.deviations[1] <= 1e-9

@@ -106,19 +106,38 @@ def _entity(r: CurveRecord) -> tuple[Any, ...] | None:
 
 def _ordered(reference: Sequence[CurveRecord], back: Sequence[CurveRecord]
              ) -> list[CurveRecord]:
-    """``back`` in the entity order of ``reference`` when every record names its entity and
-    both name the same ones (a writer may move a replaced entity to the end of the file, e.g.
-    a 3dm object whose degree changed), else as read."""
+    """The records read back that correspond to ``reference``, in its order.
+
+    Records that name their source entity are paired by it: a writer may move a replaced
+    entity to the end (a 3dm object whose degree changed), and a template's other entities,
+    written back untouched, are read back too (a subset of a file's curves written). Records
+    without one (bare curves written as new entities, appended by the writers) take the last
+    unclaimed records read back, in order. When that cannot be done, ``back`` as read.
+    """
     ref_keys = [_entity(r) for r in reference]
     back_keys = [_entity(b) for b in back]
-    if None in ref_keys or None in back_keys or set(ref_keys) != set(back_keys):
+    if all(k is None for k in ref_keys):
         return list(back)
     by: dict[Any, list[CurveRecord]] = {}
     for k, b in zip(back_keys, back, strict=True):
-        by.setdefault(k, []).append(b)
+        if k is not None:
+            by.setdefault(k, []).append(b)
+    wanted = {k for k in ref_keys if k is not None}
+    if not wanted <= set(by):
+        return list(back)
+    unclaimed = [b for k, b in zip(back_keys, back, strict=True) if k not in wanted]
+    n_bare = sum(k is None for k in ref_keys)
+    if n_bare > len(unclaimed):
+        return list(back)
+    bare = unclaimed[len(unclaimed) - n_bare:]
     out: list[CurveRecord] = []
-    for k in dict.fromkeys(ref_keys):
-        out.extend(by[k])
+    seen: set[Any] = set()
+    for k in ref_keys:
+        if k is None:
+            out.append(bare.pop(0))
+        elif k not in seen:
+            seen.add(k)
+            out.extend(by[k])
     return out
 
 
