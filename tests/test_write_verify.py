@@ -270,3 +270,20 @@ def test_subset_and_new_curve_into_a_template(tmp_path):
     assert d_moved <= check.deviations[0] * (1 + 1e-4) + 1e-15
     d_new = _dense_distance(new, back[-1].curve)
     assert d_new <= 1e-9 and check.deviations[1] <= 1e-9
+
+
+def test_new_curve_into_an_r12_template(tmp_path):
+    """A new SPLINE written into a drawing ezdxf loads as R12 (no $ACADVER): ezdxf refused it
+    (DXFVersionError); the drawing is written as R2000 with a warning, every entity kept."""
+    ezdxf = pytest.importorskip("ezdxf")
+    src = DATA / "real/dxf-parser/splines.dxf"
+    recs = read_curves(src)
+    new = BSplineCurve([[0, 0], [1, 2], [3, 2], [4, 0]], [0, 0, 0, 0, 1, 1, 1, 1], 3)
+    out = tmp_path / "o.dxf"
+    with pytest.warns(UserWarning, match="R2000"):
+        check = write_curves(out, recs + [new], template=src, tol=1e-9)
+    assert check.max_deviation <= 1e-9
+    doc = ezdxf.readfile(str(out))
+    assert doc.dxfversion >= "AC1015"
+    assert sum(e.dxftype() == "SPLINE" for e in doc.modelspace()) == 3
+    assert _dense_distance(new, read_curves(out)[-1].curve, 4000) <= 1e-9

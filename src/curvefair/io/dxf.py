@@ -429,6 +429,13 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
             before[handle] = old
     if before:
         _follow_hatches(doc, before, template)
+    if others and template is not None and doc.dxfversion < "AC1015":
+        # new curves are SPLINE / LWPOLYLINE entities, which R12 cannot hold (ezdxf refuses
+        # to add them): written as R2000, like a template that holds such entities
+        doc.dxfversion = "AC1015"
+        warnings.warn(f"{os.fspath(template)}: read as DXF R12 ({doc.loaded_dxfversion}), which "
+                      "cannot hold the new curves (SPLINE / LWPOLYLINE entities); the output is "
+                      "written as DXF R2000 (AC1015)", UserWarning, stacklevel=3)
     # records from another DXF file that were split into pieces: join them again
     for _key, recs in _group_foreign(others).items():
         if len(recs) > 1 or "indices" in recs[0].source:
