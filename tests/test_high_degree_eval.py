@@ -9,7 +9,6 @@ from fractions import Fraction
 
 import numpy as np
 import pytest
-from scipy.interpolate import BSpline
 
 from curvefair import BSplineCurve, analyze, curvature
 from curvefair.curves.bspline import MAX_DEGREE, POWER_FORM_MAX_DEGREE

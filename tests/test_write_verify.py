@@ -159,14 +159,14 @@ def test_tol_broken_nothing_written(tmp_path):
     assert out.read_bytes() == b"keep me"           # untouched
     assert sorted(os.listdir(tmp_path)) == before     # no temporary file left
     # the independent measure agrees that tol is broken
-    assert max(_dense_distance(r.curve, m.curve) for r, m in zip(recs, moved)) > 1.0
+    assert max(_dense_distance(r.curve, m.curve) for r, m in zip(recs, moved, strict=True)) > 1.0
     # without tol the same write goes through and reports the move (reference: the curves
     # given, so the figure is what the file does to them: nothing)
     check = write_curves(out, moved, template=src)
     assert check.max_deviation <= 1e-12
     # reference= measures from the input explicitly
     check = write_curves(out, moved, template=src, reference=recs, overwrite=False)
-    indep = max(_dense_distance(r.curve, m.curve) for r, m in zip(recs, moved))
+    indep = max(_dense_distance(r.curve, m.curve) for r, m in zip(recs, moved, strict=True))
     assert indep <= check.max_deviation * (1 + 1e-6)
 
 
