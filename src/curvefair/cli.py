@@ -1104,8 +1104,16 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
                                   reader=lambda p: _read(p, corner, strict, True, glyphs),
                                   template=infile if out_fmt == in_fmt else None,
                                   format=out_fmt, overwrite=in_place, decimals=decimals)
-            for row, d, kind in zip(rows, check.deviations, check.kinds, strict=True):
+            from .io._verify import rescaled_report
+
+            for i, (row, d, kind) in enumerate(zip(rows, check.deviations, check.kinds,
+                                                   strict=True)):
                 if row["status"] == "ok":
+                    if check.move_scale[i] != 1.0 and check.read_back:
+                        # what is on disk is not the fair: its after-figures are recomputed
+                        row["report"] = rescaled_report(row["report"], records[i].curve,
+                                                        check.read_back[i],
+                                                        check.move_scale[i])
                     row["report"]["on_disk_deviation"] = d
                     row["report"]["on_disk_deviation_kind"] = kind
             for note in check.notes:

@@ -20,7 +20,11 @@ def _frenet_at(curve: object, u: ArrayLike, side: str, want_torsion: bool = Fals
     pp = c.piecewise
     cg = np.asarray(pp.coeffs)[seg]
     h = pp.widths[seg]
-    r1, r2, r3 = (tuple(r[:, d] for d in range(c.dim)) for r in derivs_at(cg, s, 3))
+    if pp.evaluator is None:
+        rr = derivs_at(cg, s, 3)
+    else:  # high degree: derivatives from the curve's basis (see PiecewisePolynomial.evaluator)
+        rr = [pp.at(seg, s, nu) for nu in (1, 2, 3)]
+    r1, r2, r3 = (tuple(r[:, d] for d in range(c.dim)) for r in rr)
     out = frenet(r1, r2, r3, speed_scale(cg, h, 1), speed_scale(cg, h, 2),
                  want_torsion=want_torsion)
     return out, shape, scalar

@@ -109,10 +109,11 @@ def _plan(degree: int, planar: bool) -> _Plan:
         fits.append(np.ascontiguousarray(pinv.T))  # b = vals @ fit
         # Bernstein coefficients on each gap [x_q, x_{q+1}] of the same polynomial
         S = np.empty((K - 1, K, d + 1))
+        fit_v = np.linalg.pinv(_bernstein_basis(d, v))  # the same for every gap
         for q in range(K - 1):
             vv = x[q] + (x[q + 1] - x[q]) * v
             to_vals = _bernstein_basis(d, vv) @ pinv  # sample values -> values at vv
-            S[q] = (np.linalg.pinv(_bernstein_basis(d, v)) @ to_vals).T
+            S[q] = (fit_v @ to_vals).T
         subs.append(S)
     return _Plan(P=P, K=K, x=x, xk=xk, w7=0.5 * _GK_W7, w4=0.5 * _GK_W4, tab=tab,
                  fit=(fits[0], fits[1]), sub=(subs[0], subs[1]), degs=(d_n, d_e))

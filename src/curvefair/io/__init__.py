@@ -48,7 +48,10 @@ turn between two noisy samples is not a corner. Open airfoils also mark their fi
 points (the trailing edge).
 
 Writing is always atomic (a temporary file in the destination folder, then ``os.replace``) and
-never replaces a file the curves were read from unless ``overwrite=True``.
+never replaces a file the curves were read from unless ``overwrite=True``. By default the
+temporary file is read back and every curve measured against the input before it replaces the
+destination (``tol=``: nothing is written when a curve reads back farther; ``verify=False``
+skips the check).
 
 Examples
 --------
@@ -62,7 +65,9 @@ Examples
 >>> recs = read_curves(src)
 >>> recs[0].kind, recs[0].curve.points.shape
 ('points', (12, 2))
->>> write_curves(os.path.join(d, "wave_faired.csv"), recs)
+>>> check = write_curves(os.path.join(d, "wave_faired.csv"), recs, tol=1e-9)
+>>> check.max_deviation <= 1e-9         # read back and measured before replacing the file
+True
 >>> np.allclose(read_curves(os.path.join(d, "wave_faired.csv"))[0].points, recs[0].points)
 True
 """
@@ -70,16 +75,21 @@ True
 from __future__ import annotations
 
 import os
+import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, Literal
 
-from .._validate import choice
+import numpy as np
+
+from .._validate import as_positive, choice
 from ..curves.piecewise import PiecewiseCurve
 from ..errors import FileFormatError, InputError
 from ._common import KINDS, CurveRecord, atomic_path, atomic_write, curve_kind, same_path
+from ._verify import WriteCheck, WriteCheckError
 
-__all__ = ["read_curves", "write_curves", "CurveRecord", "KINDS", "FORMATS", "detect_format",
+__all__ = ["read_curves", "write_curves", "WriteCheck", "WriteCheckError", "CurveRecord", "KINDS",
+           "FORMATS", "detect_format",
            "atomic_write", "atomic_path"]
 
 FormatName = Literal["points", "airfoil", "json", "dxf", "3dm", "svg", "iges", "step", "ufo",
@@ -257,8 +267,13 @@ def write_curves(path: str | os.PathLike[str], curves: CurveRecord | PiecewiseCu
                  Sequence[CurveRecord | PiecewiseCurve], *, template: object = None,
                  format: FormatName | None = None, overwrite: bool = False,
                  decimals: int | None = None,
-                 precision: Literal["file", "exact"] = "file") -> None:
-    """Write curves (usually faired records from :func:`read_curves`) to a file, atomically.
+                 precision: Literal["file", "exact"] = "file", verify: bool = True,
+                 tol: float | None = None,
+                 reference: CurveRecord | PiecewiseCurve |
+                 Sequence[CurveRecord | PiecewiseCurve] | None = None,
+                 corner_angle: float | None = 60.0) -> WriteCheck | None:
+    """Write curves (usually faired records from :func:`read_curves`) to a file, atomically,
+    and check the file by reading it back.
 
     Parameters
     ----------
@@ -283,12 +298,42 @@ def write_curves(path: str | os.PathLike[str], curves: CurveRecord | PiecewiseCu
         own number of decimals (text point formats keep a token's decimals only where that
         writes the value exactly); ``"exact"`` writes every changed number in the shortest
         form that reads back as exactly the value. Binary and full-precision formats ignore it.
+    verify : bool
+        Default True: write to a temporary file next to ``path``, read it back with
+        :func:`read_curves` and measure every curve read back against its reference curve
+        (:mod:`curvefair.io._verify`: parametric deviation where the parameter domains agree,
+        else the geometric distance -- point files are re-interpolated on reading); only a
+        file within ``tol`` replaces ``path``. False: write without reading back (faster;
+        returns None).
+    tol : float, optional
+        The tolerance the file must hold: every curve read back at most ``tol`` from its
+        reference. When an SVG element's own decimals break it, the element is written with
+        exact numbers instead; when re-interpolated point data breaks it, the moves of the
+        points from the reference are scaled down until it holds (a ``UserWarning`` says so;
+        :attr:`WriteCheck.move_scale`). None: measure and report only.
+    reference : CurveRecord, curve or sequence of them, optional
+        The curves ``tol`` is measured from, one per written curve. Default with ``tol``:
+        records read from a file are compared with that file's curves as it is now (read again
+        before writing, with ``corner_angle``), bare curves with themselves (what the file's
+        rounding does to them). Default without ``tol``: the curves given.
+    corner_angle : float or None
+        The corner angle used to read the written file (and the default reference) back: use
+        the one the records were read with.
+
+    Returns
+    -------
+    WriteCheck or None
+        What the read-back measured (``max_deviation``, per-curve ``deviations``, ``notes``);
+        None with ``verify=False``.
 
     Raises
     ------
     InputError
         Nothing to write, a point count that differs from the source's, ``path`` is an input
         file and ``overwrite`` is False, a curve the format cannot hold.
+    WriteCheckError
+        (an InputError) The file would not read back, or reads back farther than ``tol`` from
+        the reference; nothing was written and ``path`` is untouched.
     MissingDependencyError
         The format's optional library is not installed.
     """
@@ -302,13 +347,81 @@ def write_curves(path: str | os.PathLike[str], curves: CurveRecord | PiecewiseCu
     if decimals is not None and (isinstance(decimals, bool) or not isinstance(decimals, int)
                                  or decimals < 0):
         raise InputError(f"decimals must be an integer >= 0, got {decimals!r}")
+    choice(precision, ("file", "exact"), "precision")
+    if not isinstance(verify, (bool, np.bool_)):
+        raise InputError(f"verify must be True or False, got {verify!r}")
+    tol_f = as_positive(tol, "tol", allow_none=True)
+    if corner_angle is not None:
+        corner_angle = float(corner_angle)
+        if not 0.0 < corner_angle <= 180.0:
+            raise InputError(f"corner_angle must be in (0, 180] degrees or None, got "
+                             f"{corner_angle!r}")
     mod = _module(fmt)
     if fmt in ("points", "airfoil") and tpath is not None and \
             all(r.format != fmt for r in records):
         records = _fill_template(records, mod.read(tpath, corner_angle=None), tpath)
-    choice(precision, ("file", "exact"), "precision")
-    writer: Callable[..., None] = mod.write
-    writer(path, records, template=tpath, decimals=decimals, precision=precision)
+    if not verify:
+        _write_plain(path, records, fmt, tpath, decimals, precision)
+        return None
+    from ._verify import write_checked
+
+    ref = _reference(records, reference, tol_f, corner_angle)
+
+    def reader(p: str) -> list[CurveRecord]:
+        with warnings.catch_warnings():  # the input's skip warnings, again
+            warnings.simplefilter("ignore")
+            return read_curves(p, format=fmt, corner_angle=corner_angle,
+                               on_unsupported="skip")
+
+    check = write_checked(path, records, ref, tol=tol_f, reader=reader, template=tpath,
+                          format=fmt, overwrite=True, decimals=decimals, precision=precision)
+    for note in check.notes:
+        warnings.warn(f"{os.fspath(path)}: {note}", UserWarning, stacklevel=2)
+    return check
+
+
+def _write_plain(path: str | os.PathLike[str], records: Sequence[CurveRecord], fmt: str,
+                 tpath: str | None, decimals: int | None, precision: str) -> None:
+    """The format's writer, without the read-back (records already filled from a point
+    template)."""
+    writer: Callable[..., None] = _module(fmt).write
+    writer(path, list(records), template=tpath, decimals=decimals, precision=precision)
+
+
+def _reference(records: list[CurveRecord], reference: object, tol: float | None,
+               corner_angle: float | None) -> list[CurveRecord]:
+    """The records the written file is measured against (see :func:`write_curves`)."""
+    if reference is not None:
+        ref = _as_records(reference)
+        if len(ref) != len(records):
+            raise InputError(f"reference has {len(ref)} curves for {len(records)} written")
+        return ref
+    if tol is None:
+        return records
+    out: list[CurveRecord] = []
+    cache: dict[str, list[CurveRecord]] = {}
+    for i, r in enumerate(records):
+        src = r.path
+        if src is None or r.format is None or not os.path.isfile(src):
+            out.append(r)  # a bare curve: the file's rounding of it
+            continue
+        if src not in cache:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                cache[src] = read_curves(src, format=r.format,  # type: ignore[arg-type]
+                                         corner_angle=corner_angle, on_unsupported="skip")
+        j = r.source.get("index")
+        got = cache[src]
+        o = got[j] if isinstance(j, int) and 0 <= j < len(got) else None
+        if o is None or o.kind != r.kind or o.name != r.name or \
+                (o.points is not None and r.points is not None
+                 and np.shape(o.points) != np.shape(r.points)):
+            raise InputError(
+                f"write_curves: curves[{i}] ({r.name or r.kind}) does not match curve {j} of "
+                f"its source file {src!r} read again; pass reference= (the records as read) "
+                "or the corner_angle they were read with")
+        out.append(o)
+    return out
 
 
 def _fill_template(records: list[CurveRecord], tmpl: list[CurveRecord],

@@ -33,7 +33,7 @@ import numpy as np
 from ..errors import CurvefairError, InputError
 from ._common import CurveRecord, atomic_path, points_curve
 
-__all__ = ["WriteCheck", "WriteCheckError", "write_checked"]
+__all__ = ["WriteCheck", "WriteCheckError", "write_checked", "rescaled_report"]
 
 #: Record kinds whose curve is re-interpolated from data points on reading.
 POINT_KINDS = ("points", "airfoil", "polyline", "fit_points")
@@ -67,6 +67,9 @@ class WriteCheck:
         Per record, the factor ``s`` applied to the moves of point data (1.0: as faired).
     notes : tuple of str
         What was changed to meet the tolerance, one sentence each.
+    read_back : tuple of curves
+        The curves read back from the written file, one per input record (not in
+        :meth:`to_dict`).
     """
 
     max_deviation: float
@@ -76,6 +79,7 @@ class WriteCheck:
     precision: str
     move_scale: tuple[float, ...]
     notes: tuple[str, ...] = field(default_factory=tuple)
+    read_back: tuple[Any, ...] = field(default_factory=tuple, compare=False, repr=False)
 
     def to_dict(self) -> dict[str, Any]:
         return {"max_deviation": self.max_deviation, "deviations": list(self.deviations),
@@ -89,46 +93,149 @@ def _label(rec: CurveRecord, i: int) -> str:
     return f"curve {i}" + (f" ({rec.name})" if rec.name else "")
 
 
+def _entity(r: CurveRecord) -> tuple[Any, ...] | None:
+    """The source entity of a record (3dm object id, DXF handle, SVG element and subpath)."""
+    src = r.source
+    for k in ("id", "handle"):
+        if src.get(k) is not None:
+            return (k, src[k])
+    if src.get("element") is not None:
+        return ("element", src["element"], src.get("subpath"))
+    return None
+
+
+def _ordered(reference: Sequence[CurveRecord], back: Sequence[CurveRecord]
+             ) -> list[CurveRecord]:
+    """The records read back that correspond to ``reference``, in its order.
+
+    Records that name their source entity are paired by it: a writer may move a replaced
+    entity to the end (a 3dm object whose degree changed), and a template's other entities,
+    written back untouched, are read back too (a subset of a file's curves written). Records
+    without one (bare curves written as new entities, appended by the writers) take the last
+    unclaimed records read back, in order. When that cannot be done, ``back`` as read.
+    """
+    ref_keys = [_entity(r) for r in reference]
+    back_keys = [_entity(b) for b in back]
+    if all(k is None for k in ref_keys):
+        return list(back)
+    by: dict[Any, list[CurveRecord]] = {}
+    for k, b in zip(back_keys, back, strict=True):
+        if k is not None:
+            by.setdefault(k, []).append(b)
+    wanted = {k for k in ref_keys if k is not None}
+    if not wanted <= set(by):
+        return list(back)
+    unclaimed = [b for k, b in zip(back_keys, back, strict=True) if k not in wanted]
+    n_bare = sum(k is None for k in ref_keys)
+    if n_bare > len(unclaimed):
+        return list(back)
+    bare = unclaimed[len(unclaimed) - n_bare:]
+    out: list[CurveRecord] = []
+    seen: set[Any] = set()
+    for k in ref_keys:
+        if k is None:
+            out.append(bare.pop(0))
+        elif k not in seen:
+            seen.add(k)
+            out.extend(by[k])
+    return out
+
+
+def _groups(records: Sequence[CurveRecord]) -> list[list[CurveRecord]]:
+    """Records grouped by source entity: the pieces ``0 .. n_pieces-1`` of a point list split
+    at corners form one group, any other record a group of its own."""
+    out: list[list[CurveRecord]] = []
+    for r in records:
+        piece = r.source.get("piece")
+        if isinstance(piece, int) and piece > 0 and out and \
+                out[-1][-1].source.get("piece") == piece - 1:
+            out[-1].append(r)
+        else:
+            out.append([r])
+    return out
+
+
+def _shapes_agree(ref: Sequence[CurveRecord], back: Sequence[CurveRecord]) -> bool:
+    """Same number of records and, for point data, the same number of points each."""
+    return len(ref) == len(back) and all(
+        r.kind not in POINT_KINDS or b.kind not in POINT_KINDS or r.points is None
+        or b.points is None or np.shape(r.points) == np.shape(b.points)
+        for r, b in zip(ref, back, strict=True))
+
+
 def _matched(reference: Sequence[CurveRecord], back: Sequence[CurveRecord]
              ) -> list[Any] | None:
     """The curves read back, one per reference record, or None when they cannot be paired.
 
-    Same number of records: in order. Otherwise (a point list split at other corners when
-    read back) each reference piece is rebuilt from the points read back at its indices.
+    Per source entity (see :func:`_groups`): the same pieces in order; otherwise (a point
+    list split at other corners when read back, e.g. after moves that made or removed a
+    corner) each reference piece is rebuilt from the points read back at its indices.
     """
-    if len(back) == len(reference):
+    if _shapes_agree(reference, back):
         return [b.curve for b in back]
-    if not all("indices" in r.source for r in list(reference) + list(back)):
-        return None
-    n = {int(r.source["n_points"]) for r in list(reference) + list(back)}
-    if len(n) != 1:
-        return None
-    full = np.full((n.pop(), back[0].points.shape[1]), np.nan)  # type: ignore[union-attr]
-    for b in back:
-        full[np.asarray(b.source["indices"], dtype=int)] = np.asarray(b.points)
-    if np.isnan(full).any():
+    rg, bg = _groups(reference), _groups(back)
+    if len(rg) != len(bg):
         return None
     out = []
-    for r in reference:
-        idx = np.asarray(r.source["indices"], dtype=int)
-        out.append(points_curve(full[idx], bool(r.curve.closed)))
+    for rr, bb in zip(rg, bg, strict=True):
+        if _shapes_agree(rr, bb):
+            out.extend(b.curve for b in bb)
+            continue
+        p0 = rr[0].points if rr[0].points is not None else getattr(rr[0].curve, "points", None)
+        if len(rr) == 1 and "indices" not in rr[0].source and isinstance(p0, np.ndarray) and \
+                all("indices" in b.source and "n_points" in b.source for b in bb):
+            # a bare curve written as points, read back split at corners: the whole list
+            n0 = int(p0.shape[0])
+            if {int(b.source["n_points"]) for b in bb} != {n0}:
+                return None
+            full = np.full((n0, p0.shape[1]), np.nan)
+            for b in bb:
+                full[np.asarray(b.source["indices"], dtype=int)] = np.asarray(b.points)
+            if np.isnan(full).any():
+                return None
+            out.append(points_curve(full, bool(rr[0].curve.closed)))
+            continue
+        if not all("indices" in r.source and "n_points" in r.source for r in rr + bb):
+            return None
+        n = {int(r.source["n_points"]) for r in rr + bb}
+        if len(n) != 1:
+            return None
+        full = np.full((n.pop(), bb[0].points.shape[1]), np.nan)  # type: ignore[union-attr]
+        for b in bb:
+            full[np.asarray(b.source["indices"], dtype=int)] = np.asarray(b.points)
+        if np.isnan(full).any():
+            return None
+        for r in rr:
+            idx = np.asarray(r.source["indices"], dtype=int)
+            out.append(points_curve(full[idx], bool(r.curve.closed)))
     return out
 
 
 def _lost_points(reference: Sequence[CurveRecord], back: Sequence[CurveRecord]) -> str | None:
     """Why the point data read back is not the point data written (points merged or dropped
     on reading, e.g. rounded onto each other), or None."""
-    n_ref = {int(r.source["n_points"]) for r in reference if "n_points" in r.source}
-    n_back = {int(r.source["n_points"]) for r in back if "n_points" in r.source}
-    if len(reference) == len(back):
-        for i, (r, b) in enumerate(zip(reference, back, strict=True)):
-            if r.points is not None and b.points is not None and \
-                    r.points.shape != b.points.shape:
-                return (f"{_label(r, i)} reads back with {b.points.shape[0]} points, "
-                        f"{r.points.shape[0]} were written")
-    elif n_ref and n_back and n_ref != n_back:
-        return (f"the point list reads back with {sorted(n_back)[0]} points, "
-                f"{sorted(n_ref)[0]} were written")
+    if _shapes_agree(reference, back):
+        return None
+    rg, bg = _groups(reference), _groups(back)
+    if len(rg) != len(bg):
+        return None  # reported by _matched
+    for rr, bb in zip(rg, bg, strict=True):
+        if _shapes_agree(rr, bb):
+            continue
+        i = next(k for k, r in enumerate(reference) if r is rr[0])
+        nr = {int(r.source["n_points"]) for r in rr if "n_points" in r.source}
+        nb = {int(b.source["n_points"]) for b in bb if "n_points" in b.source}
+        if nr and nb:
+            if nr != nb:
+                return (f"{_label(rr[0], i)} reads back with {sorted(nb)[0]} points, "
+                        f"{sorted(nr)[0]} were written")
+            continue
+        if len(rr) == len(bb):
+            for r, b in zip(rr, bb, strict=True):
+                if r.points is not None and b.points is not None and \
+                        np.shape(r.points) != np.shape(b.points):
+                    return (f"{_label(r, i)} reads back with {b.points.shape[0]} points, "
+                            f"{r.points.shape[0]} were written")
     return None
 
 
@@ -185,7 +292,7 @@ def write_checked(path: str | os.PathLike[str], records: Sequence[CurveRecord],
                   reference: Sequence[CurveRecord], *, tol: float | None,
                   reader: Callable[[str], list[CurveRecord]], template: object = None,
                   format: str | None = None, overwrite: bool = False,
-                  decimals: int | None = None) -> WriteCheck:
+                  decimals: int | None = None, precision: str = "file") -> WriteCheck:
     """Write ``records`` to ``path`` only if the file read back is within ``tol`` of
     ``reference``; see the module docstring.
 
@@ -201,9 +308,10 @@ def write_checked(path: str | os.PathLike[str], records: Sequence[CurveRecord],
     reader : callable
         ``reader(path) -> records``: how the file is read (the same corner handling as the
         input).
-    template, format, overwrite, decimals
-        As for :func:`curvefair.write_curves`; ``decimals`` given: the rounding asked for is
-        kept, and a file it puts out of tolerance is not written.
+    template, format, overwrite, decimals, precision
+        As for :func:`curvefair.write_curves` (which calls this function; ``overwrite`` is
+        checked there); ``decimals`` given: the rounding asked for is kept, and a file it puts
+        out of tolerance is not written; ``precision="exact"``: exact numbers from the start.
 
     Raises
     ------
@@ -211,22 +319,26 @@ def write_checked(path: str | os.PathLike[str], records: Sequence[CurveRecord],
         The file would not read back, or a curve read back would be farther than ``tol``
         from its input; nothing is written.
     """
-    from . import detect_format, write_curves
+    from . import _template_path, _write_plain, detect_format
 
+    del overwrite  # the destination is checked by write_curves / the CLI; tmp is never an input
     if len(records) != len(reference):
         raise InputError(f"write_checked: {len(records)} records for {len(reference)} "
                          "reference records")
     fmt = detect_format(path, format)
-    precision = "file" if decimals is None else "decimals"
+    if decimals is not None:
+        precision = "decimals"
+    elif precision not in ("file", "exact"):
+        raise InputError(f"precision must be 'file' or 'exact', got {precision!r}")
+    tpath = _template_path(template)
     recs = list(records)
     scale = [1.0] * len(recs)
     notes: list[str] = []
     where = os.fspath(path)
     with atomic_path(path) as tmp:
         for _attempt in range(_MAX_SHRINK + 3):
-            write_curves(tmp, recs, template=template, format=fmt,  # type: ignore[arg-type]
-                         overwrite=overwrite, decimals=decimals,
-                         precision="exact" if precision == "exact" else "file")
+            _write_plain(tmp, recs, fmt, tpath, decimals,
+                         "exact" if precision == "exact" else "file")
             try:
                 back = reader(os.fspath(tmp))
             except CurvefairError as exc:
@@ -240,6 +352,7 @@ def write_checked(path: str | os.PathLike[str], records: Sequence[CurveRecord],
                     else ""
                 raise WriteCheckError(f"{where}: not written: the file would not read back: "
                                       f"{msg}{hint}") from None
+            back = _ordered(reference, back)
             lost = _lost_points(reference, back)
             if lost is not None:
                 hint = f" (--decimals {decimals} rounds too much?)" if decimals is not None \
@@ -260,7 +373,7 @@ def write_checked(path: str | os.PathLike[str], records: Sequence[CurveRecord],
             over = [i for i, d in enumerate(devs) if tol is not None and not d <= tol]
             if not over:
                 return WriteCheck(max(devs, default=0.0), tuple(devs), tuple(kinds), mpd,
-                                  precision, tuple(scale), tuple(notes))
+                                  precision, tuple(scale), tuple(notes), tuple(curves))
             if precision == "file" and fmt == "svg":
                 precision = "exact"
                 worst = max(over, key=lambda i: devs[i])
@@ -292,3 +405,50 @@ def write_checked(path: str | os.PathLike[str], records: Sequence[CurveRecord],
         raise WriteCheckError(f"{where}: not written: the curves read back stay farther than "
                               f"tol {tol:g} from the input")
     raise AssertionError("unreachable")  # pragma: no cover
+
+
+def rescaled_report(report: dict[str, Any], original: Any, written: Any,
+                    scale: float) -> dict[str, Any]:
+    """A :func:`curvefair.fair` report whose after-figures describe ``written``, the curve read
+    back from the file, instead of the faired curve whose moves were scaled by ``scale`` to
+    hold the tolerance on disk (point data re-interpolated on reading; see the module
+    docstring, step 2).
+
+    Recomputed: every ``<figure>_after`` of :func:`curvefair.analyze` (energies, jumps,
+    Sapidis sum, inflections, extrema), the data point moves (``moved``, ``n_moved``,
+    ``max_point_displacement``, ``max_point_index``) and the deviation from ``original``
+    (``max_deviation*``, with ``kind="auto"``: geometric, since re-interpolation gives new
+    chord parameters). A method's own after-figure (``measure_max_after``) cannot be
+    recomputed and becomes None. ``move_scale`` and ``after_figures`` say what was done.
+    """
+    from ..analysis import deviation
+    from ..fairing._tolerance import point_report
+    from ..fairing.fair import _analysis_block
+
+    out = dict(report)
+    after = _analysis_block(written)
+    redone = []
+    for k, v in after.items():
+        out[f"{k}_after"] = v
+        redone.append(f"{k}_after")
+    for k in list(out):
+        if k.endswith("_after") and k not in redone:
+            out[k] = None
+    moved_idx, disp, max_disp, max_idx = point_report(original, written)
+    out["moved"] = {"indices": [int(i) for i in moved_idx],
+                    "displacement": [float(x) for x in disp]}
+    out["n_moved"] = int(moved_idx.size)
+    out["max_point_displacement"] = float(max_disp)
+    out["max_point_index"] = None if max_idx is None else int(max_idx)
+    d = deviation(original, written)
+    ub = getattr(d, "upper_bound", None)
+    out["max_deviation"] = float(d.max_distance)
+    out["max_deviation_upper_bound"] = None if ub is None or not np.isfinite(ub) else float(ub)
+    out["max_deviation_param"] = None if d.param is None else float(d.param)
+    out["max_deviation_point"] = None if d.point_a is None else \
+        [float(x) for x in np.asarray(d.point_a).reshape(-1)]
+    out["max_deviation_kind"] = d.kind
+    out["move_scale"] = float(scale)
+    out["after_figures"] = (f"recomputed for the curve read back from the written file: the "
+                            f"faired moves were scaled by {scale:.6g} to hold tol on disk")
+    return out

@@ -112,6 +112,9 @@ def _spline_record(e: Any, base: dict[str, Any], path: object, corner_angle: flo
         check_points(fits, path, None, what=what)
         pts, z = planar(fits)
         distinct, row_map, closed = _ring(pts, closed_flag)
+        if closed and distinct.shape[0] < 3:
+            raise Unsupported(f"closed SPLINE with {distinct.shape[0]} distinct fit points (a "
+                              "segment drawn there and back, not a closed curve)")
         row_map = row_map[where]
         src = dict(base, z=z, row_map=tuple(int(i) for i in row_map),
                    has_end_tangents=bool(e.dxf.hasattr("start_tangent")))
@@ -192,6 +195,9 @@ def _polyline_record(e: Any, base: dict[str, Any], path: object,
     check_points(pts, path, None, what=what)
     closed_flag = bool(e.closed) if kind == "LWPOLYLINE" else bool(e.is_closed)
     distinct, row_map, closed = _ring(pts, closed_flag)
+    if closed and distinct.shape[0] < 3:
+        raise Unsupported(f"closed {kind} with {distinct.shape[0]} distinct vertices (a segment "
+                          "drawn there and back, not a closed curve)")
     row_map = row_map[where]
     src = dict(base, z=z, row_map=tuple(int(i) for i in row_map))
     return point_records(distinct, closed=closed, corner_angle=corner_angle, kind="polyline",
@@ -203,10 +209,55 @@ def _load(path: object, what: str) -> Any:
     try:
         return ezdxf.readfile(os.fspath(path))  # type: ignore[call-overload]
     except OSError as exc:
+        if _truncated(path) == "the file is empty":
+            raise FileFormatError("not a readable DXF file: the file is empty", path) from None
         raise FileFormatError(f"not a readable DXF file ({exc})", path) from None
     except Exception as exc:  # ezdxf raises its own DXFStructureError, ValueError, ...
-        raise FileFormatError(f"not a readable DXF file ({type(exc).__name__}: {exc})",
-                              path) from None
+        detail = f"{type(exc).__name__}: {exc}" if str(exc) else type(exc).__name__
+        cut = _truncated(path)
+        if cut:
+            raise FileFormatError(f"not a readable DXF file: {cut} ({detail})", path) from None
+        raise FileFormatError(f"not a readable DXF file ({detail})", path) from None
+
+
+_BINARY_SENTINEL = b"AutoCAD Binary DXF\r\n\x1a\x00"
+
+
+def _truncated(path: object) -> str | None:
+    """Why the DXF file at ``path`` looks cut short, or None.
+
+    Every DXF file ends with the group ``0 / EOF`` (ASCII: the lines ``0`` and ``EOF``;
+    binary DXF: group code 0 then ``EOF`` and a NUL byte), AutoCAD DXF Reference, "DXF File
+    Structure". ezdxf's parser meets the missing end as StopIteration, IndexError, a struct
+    error or a missing ENDSEC, none of which tells the user that the file is incomplete.
+    """
+    try:
+        with open(os.fspath(path), "rb") as fh:  # type: ignore[arg-type]
+            head = fh.read(len(_BINARY_SENTINEL))
+            fh.seek(0, os.SEEK_END)
+            size = fh.tell()
+            fh.seek(max(0, size - 4096))
+            tail = fh.read()
+    except OSError:
+        return None
+    if size == 0:
+        return "the file is empty"
+    if head == _BINARY_SENTINEL:
+        if tail.endswith(b"EOF\x00"):
+            return None
+        return (f"binary DXF file ends at byte {size} without the closing EOF group: it "
+                "looks truncated")
+    lines = [ln.strip() for ln in tail.splitlines() if ln.strip()]
+    if len(lines) >= 2 and lines[-1].upper() == b"EOF" and lines[-2] == b"0":
+        return None
+    if any(ln.upper() == b"EOF" for ln in lines):
+        return None  # data after EOF (ezdxf ignores it): not a truncation
+    with open(os.fspath(path), "rb") as fh:  # type: ignore[arg-type]
+        nlines = sum(chunk.count(b"\n") for chunk in iter(lambda: fh.read(1 << 20), b""))
+    if not tail.endswith(b"\n"):
+        nlines += 1
+    return (f"the file ends at line {nlines} without the closing '0 / EOF' group: it looks "
+            "truncated")
 
 
 def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
@@ -378,6 +429,13 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
             before[handle] = old
     if before:
         _follow_hatches(doc, before, template)
+    if others and template is not None and doc.dxfversion < "AC1015":
+        # new curves are SPLINE / LWPOLYLINE entities, which R12 cannot hold (ezdxf refuses
+        # to add them): written as R2000, like a template that holds such entities
+        doc.dxfversion = "AC1015"
+        warnings.warn(f"{os.fspath(template)}: read as DXF R12 ({doc.loaded_dxfversion}), which "
+                      "cannot hold the new curves (SPLINE / LWPOLYLINE entities); the output is "
+                      "written as DXF R2000 (AC1015)", UserWarning, stacklevel=3)
     # records from another DXF file that were split into pieces: join them again
     for _key, recs in _group_foreign(others).items():
         if len(recs) > 1 or "indices" in recs[0].source:

@@ -910,7 +910,8 @@ def _patch_iges(text: str, patches: list[_Patch]) -> str:
         if len(hits) != 1:
             raise _Refuse(f"edge {pa.k}: {'no' if not hits else len(hits)} free 126 "
                           "entities hold its curve as OCC read it; OCC may have built the "
-                          "edge from another entity, e.g. a curve on a surface (142)")
+                          "edge from another entity, e.g. a curve on a surface (142)"
+                          + _surface_curve_note(ents, params))
         (d, f, raw, knots, m, c0), scale = hits[0]
         if d in done:
             raise _Refuse(f"edge {pa.k}: entity {d} is shared with another faired edge")
@@ -956,6 +957,32 @@ def _patch_iges(text: str, patches: list[_Patch]) -> str:
     if int(t[25:32]) != len(out_p):
         t = t[:24] + "P" + _pad(len(out_p), t[25:32]) + t[32:]
     return nl.join(sec["S"] + sec["G"] + new_de + out_p + [t]) + nl
+
+
+def _surface_curve_note(ents: dict[int, Any], params: Any) -> str:
+    """Why a curve on a surface cannot take a faired curve, naming the entities: a 142 whose
+    preferred representation is its 2-D curve on the surface (PREF 1, or 0 with a 2-D curve)
+    is read by OCC as the image of that curve on the surface; the faired 3-D curve has moved
+    off the surface (by up to tol), so it can be neither that image nor a model-space curve
+    (CPTR) of the same 142 without making the entity contradict itself, and pointing CPTR at
+    it with PREF 2 changes how OCC splits every other edge of the 142."""
+    notes = []
+    for d, (t, _, _) in sorted(ents.items()):
+        if t != 142:
+            continue
+        try:
+            f = params(d)
+            sptr, bptr, cptr, pref = int(f[2]), int(f[3]), int(f[4]), int(f[5])
+        except (ValueError, IndexError):
+            continue
+        if bptr and pref in (0, 1):
+            notes.append(f"DE {d}: the 2-D curve DE {bptr} on surface DE {sptr}, preference "
+                         f"{pref}" + (f", model-space curve DE {cptr} not used" if cptr else ""))
+    if not notes:
+        return ""
+    return ("; OCC built edges from curves on a surface (" + "; ".join(notes) + "): a faired "
+            "3-D curve is off that surface, so it cannot be written there without making the "
+            "142 inconsistent")
 
 
 def _pad(v: int, like: str) -> str:

@@ -1,0 +1,289 @@
+"""write_curves reads back what it wrote (issue 11): the measured on-disk deviation, nothing
+written when tol is broken, verify=False to skip; one case per format, checked against an
+independent measurement (dense sampling of the input and of the file read back with scipy's
+cKDTree, or at equal parameters)."""
+
+from __future__ import annotations
+
+import os
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.spatial import cKDTree
+
+from curvefair import BSplineCurve, read_curves, write_curves
+from curvefair.io import WriteCheck, WriteCheckError
+
+DATA = Path(__file__).parent / "data"
+
+
+def _to_polyline(q, poly):
+    """Distance of each point of q to the polyline ``poly`` (its two segments next to the
+    nearest vertex)."""
+    j = cKDTree(poly).query(q)[1]
+    best = np.full(q.shape[0], np.inf)
+    for a, b in ((j - 1, j), (j, j + 1)):
+        a = np.clip(a, 0, len(poly) - 1)
+        b = np.clip(b, 0, len(poly) - 1)
+        pa, pb = poly[a], poly[b]
+        d = pb - pa
+        L2 = np.maximum(np.einsum("ij,ij->i", d, d), 1e-300)
+        s = np.clip(np.einsum("ij,ij->i", q - pa, d) / L2, 0.0, 1.0)
+        best = np.minimum(best, np.linalg.norm(q - (pa + s[:, None] * d), axis=1))
+    return best
+
+
+def _dense_distance(a, b, n=100000) -> float:
+    """Independent distance of curve b from curve a: at equal parameters when the domains
+    agree (B-spline entities keep their knots), else the two-way sampled Hausdorff distance
+    (samples of one curve to the dense polyline of the other)."""
+    ta, tb = np.linspace(*a.domain, n), np.linspace(*b.domain, n)
+    if np.allclose(a.domain, b.domain, rtol=0, atol=1e-12):
+        return float(np.linalg.norm(a(ta) - b(tb), axis=1).max())
+    # the breakpoints too: a polyline that cuts a corner is off by half a sample step there
+    ta = np.union1d(ta, a.piecewise.breaks)
+    tb = np.union1d(tb, b.piecewise.breaks)
+    pa, pb = a(ta), b(tb)
+    return float(max(_to_polyline(pa, pb).max(), _to_polyline(pb, pa).max()))
+
+
+def _moved_bspline(rec, delta, seed=0):
+    """rec's B-spline with every control point moved by a vector of length exactly ``delta``
+    (convex hull: the curve moves at most ``delta``)."""
+    c = rec.curve
+    rng = np.random.default_rng(seed)
+    v = rng.normal(size=c.control_points.shape)
+    v *= delta / np.linalg.norm(v, axis=1, keepdims=True)
+    return rec.with_curve(c.replace(control_points=np.asarray(c.control_points) + v))
+
+
+def _moved_points(rec, delta, seed=0):
+    from curvefair.io._common import points_curve
+
+    pts = np.array(rec.curve.points)
+    rng = np.random.default_rng(seed)
+    v = rng.normal(size=pts.shape)
+    v *= delta / np.linalg.norm(v, axis=1, keepdims=True)
+    v[[0, -1]] = 0.0
+    return rec.with_curve(points_curve(pts + v, bool(rec.curve.closed)))
+
+
+def _check_result(check, recs, out, tol):
+    assert isinstance(check, WriteCheck)
+    assert check.max_deviation <= tol
+    back = read_curves(out, corner_angle=60.0, on_unsupported="skip")
+    assert len(back) == len(recs)
+    indep = [_dense_distance(r.curve, b.curve) for r, b in zip(recs, back, strict=True)]
+    # the independent sampled distance never exceeds tol, and the reported figure is the
+    # real one (the sampled distance is a lower bound of it, close to it)
+    assert max(indep) <= tol * (1 + 1e-9)
+    for d_ref, d, kind in zip(indep, check.deviations, check.kinds, strict=True):
+        assert d_ref <= d * (1 + 1e-4) + 1e-15
+        if kind != "geometric upper bound":  # else a bound, used because it meets tol
+            assert d <= max(d_ref * 1.05, d_ref + 1e-3 * tol)
+
+
+CASES = {
+    "dxf": (DATA / "real/dxf-parser/splines.dxf", _moved_bspline, 1.0),
+    "3dm": (DATA / "real/rhino-developer-samples/nurbscurve.3dm", _moved_bspline, 0.01),
+    "dat": (DATA / "clarky.dat", _moved_points, 1e-4),
+    "svg": (DATA / "real/fontawesome/3.svg", None, 1.0),
+}
+
+
+@pytest.mark.parametrize("fmt", sorted(CASES))
+def test_write_within_tol_reports_the_measured_deviation(fmt, tmp_path):
+    src, move, tol = CASES[fmt]
+    if fmt == "3dm":
+        pytest.importorskip("rhino3dm")
+    if fmt in ("dxf",):
+        pytest.importorskip("ezdxf")
+    if fmt == "svg":
+        pytest.importorskip("svgpathtools")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        recs = read_curves(src, on_unsupported="skip")
+    if move is None:  # SVG: move the B-spline records
+        moved = [_moved_bspline(r, 0.5 * tol, i) if isinstance(r.curve, BSplineCurve) else r
+                 for i, r in enumerate(recs)]
+    else:
+        moved = [move(r, 0.5 * tol, i) for i, r in enumerate(recs)]
+    out = tmp_path / ("out" + src.suffix.lower())
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        check = write_curves(out, moved, template=src, tol=tol)
+    _check_result(check, recs, out, tol)
+
+
+@pytest.mark.parametrize("ext", ["csv", "json", "dxf", "3dm", "svg", "igs", "step"])
+def test_bare_curve_each_format(ext, tmp_path):
+    lib = {"dxf": "ezdxf", "3dm": "rhino3dm", "svg": "svgpathtools", "igs": "OCP",
+           "step": "OCP"}.get(ext)
+    if lib:
+        pytest.importorskip(lib)
+    rng = np.random.default_rng(3)
+    n, p = 9, 3
+    t = np.r_[[0.0] * (p + 1), np.linspace(0, 1, n - p + 1)[1:-1], [1.0] * (p + 1)]
+    pts = np.c_[np.linspace(0.0, 8.0, n), rng.normal(size=n)]
+    if ext == "csv":
+        from curvefair import interpolate_cubic
+
+        c = interpolate_cubic(pts, "chord", "natural")
+    else:
+        c = BSplineCurve(pts, t, p)
+    out = tmp_path / f"c.{ext}"
+    # IGES stores reals with fewer digits than float64 (about 5e-10 relative, measured)
+    tol = 1e-7 if ext == "igs" else 1e-9
+    check = write_curves(out, [c], tol=tol)
+    assert check.max_deviation <= tol
+    back = read_curves(out, corner_angle=None)
+    assert _dense_distance(c, back[0].curve, 4000) <= tol
+    # verify=False: written, nothing measured
+    out2 = tmp_path / f"d.{ext}"
+    assert write_curves(out2, [c], verify=False) is None
+    assert out2.exists()
+
+
+def test_tol_broken_nothing_written(tmp_path):
+    pytest.importorskip("ezdxf")
+    src = DATA / "real/dxf-parser/splines.dxf"
+    recs = read_curves(src)
+    moved = [_moved_bspline(r, 3.0, i) for i, r in enumerate(recs)]
+    out = tmp_path / "out.dxf"
+    out.write_bytes(b"keep me")
+    before = sorted(os.listdir(tmp_path))
+    with pytest.raises(WriteCheckError, match=r"not written: curve \d.*more than tol 1"):
+        write_curves(out, moved, template=src, tol=1.0)
+    assert out.read_bytes() == b"keep me"           # untouched
+    assert sorted(os.listdir(tmp_path)) == before     # no temporary file left
+    # the independent measure agrees that tol is broken
+    assert max(_dense_distance(r.curve, m.curve) for r, m in zip(recs, moved, strict=True)) > 1.0
+    # without tol the same write goes through and reports the move (reference: the curves
+    # given, so the figure is what the file does to them: nothing)
+    check = write_curves(out, moved, template=src)
+    assert check.max_deviation <= 1e-12
+    # reference= measures from the input explicitly
+    check = write_curves(out, moved, template=src, reference=recs, overwrite=False)
+    indep = max(_dense_distance(r.curve, m.curve) for r, m in zip(recs, moved, strict=True))
+    assert indep <= check.max_deviation * (1 + 1e-6)
+
+
+def test_decimals_rounding_refused(tmp_path):
+    recs = read_curves(DATA / "clarky.dat")
+    out = tmp_path / "c.dat"
+    with pytest.raises(WriteCheckError, match="not written: .*(more than tol|points)"):
+        write_curves(out, recs, decimals=2, tol=1e-4)
+    assert not out.exists()
+    # the same rounding without tol: written, the figure reported is the rounding's effect,
+    # checked against the independent distance
+    check = write_curves(out, recs, decimals=3)
+    indep = _dense_distance(recs[0].curve, read_curves(out)[0].curve)
+    assert indep > 1e-4 and indep <= check.max_deviation * (1 + 1e-6)
+
+
+def test_point_moves_scaled_with_a_warning(tmp_path):
+    recs = read_curves(DATA / "clarky.dat")
+    tol = 1e-4
+    moved = [_moved_points(recs[0], 0.98 * tol, 7)]
+    out = tmp_path / "c.dat"
+    with pytest.warns(UserWarning, match="scaled down"):
+        check = write_curves(out, moved, tol=tol)
+    assert check.move_scale[0] < 1.0
+    _check_result(check, recs, out, tol)
+
+
+def test_bad_arguments():
+    from curvefair import InputError
+
+    c = BSplineCurve([[0, 0], [1, 1], [2, 0]], [0, 0, 0, 1, 1, 1], 2)
+    with pytest.raises(InputError, match="tol"):
+        write_curves("x.json", [c], tol=-1.0)
+    with pytest.raises(InputError, match="verify"):
+        write_curves("x.json", [c], verify="no")
+    with pytest.raises(InputError, match="reference has 2 curves"):
+        write_curves("x.json", [c], reference=[c, c])
+    assert not Path("x.json").exists()
+
+
+def test_report_after_figures_describe_the_written_file(tmp_path):
+    """When the moves were scaled for the on-disk tolerance, rescaled_report's after-figures
+    are those of the curve read back from the file: checked against analyze() of the file
+    re-read independently, numpy point moves, and scipy's natural cubic spline through the
+    written points (chord parameters) for the inflection count."""
+    from scipy.interpolate import CubicSpline
+
+    from curvefair import analyze, fair
+    from curvefair.io._verify import rescaled_report
+
+    recs = read_curves(DATA / "clarky.dat")
+    tol = 1e-4
+    res = fair(recs[0].curve, tol=tol, max_steps=5)
+    moved = [_moved_points(recs[0], 0.98 * tol, 7)]
+    out = tmp_path / "c.dat"
+    with pytest.warns(UserWarning, match="scaled down"):
+        check = write_curves(out, moved, tol=tol)
+    s = check.move_scale[0]
+    assert s < 1.0
+    rep = rescaled_report(res.report, recs[0].curve, check.read_back[0], s)
+    back = read_curves(out)[0]
+    a = analyze(back.curve)
+    assert rep["energy_after"] == a.energy2 and rep["extrema_after"] == a.extrema
+    assert rep["energy_before"] == res.report["energy_before"]
+    p0, p1 = np.asarray(recs[0].points), np.asarray(back.points)
+    assert rep["max_point_displacement"] == pytest.approx(
+        np.linalg.norm(p1 - p0, axis=1).max(), rel=1e-12)
+    assert rep["max_point_displacement"] <= 0.98 * tol * s * (1 + 1e-9)
+    assert rep["n_moved"] == int(np.count_nonzero(np.any(p1 != p0, axis=1)))
+    assert rep["max_deviation"] <= tol and rep["move_scale"] == s
+    assert rep["measure_max_after"] is None
+    # inflections of the written curve, independently
+    t = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(p1, axis=0), axis=1))]
+    cs = CubicSpline(t, p1, bc_type="natural")
+    u = np.linspace(t[0], t[-1], 200001)
+    d1, d2 = cs(u, 1), cs(u, 2)
+    k = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]
+    sg = np.sign(k[np.abs(k) > 1e-9 * np.abs(k).max()])
+    assert rep["inflections_after"] == int(np.count_nonzero(sg[1:] != sg[:-1]))
+
+
+def test_subset_and_new_curve_into_a_template(tmp_path):
+    """Writing one of a file's curves plus a new curve into the file as template: the
+    template's other curves read back too; the check pairs the written ones by handle and the
+    new one as the appended entity."""
+    pytest.importorskip("ezdxf")
+    src = DATA / "libdxfrw_closed_splines.dxf"  # AC1021
+    recs = read_curves(src)
+    assert len(recs) == 2
+    new = BSplineCurve([[0, 0], [1, 2], [3, 2], [4, 0]], [0, 0, 0, 0, 1, 1, 1, 1], 3)
+    moved = _moved_bspline(recs[1], 0.25)
+    out = tmp_path / "o.dxf"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        check = write_curves(out, [moved, new], template=src, tol=1.0)
+    assert len(check.deviations) == 2 and check.max_deviation <= 1.0
+    back = read_curves(out)
+    assert len(back) == 3
+    got = {b.source["handle"]: b for b in back}
+    d_moved = _dense_distance(recs[1].curve, got[recs[1].source["handle"]].curve)
+    assert d_moved <= check.deviations[0] * (1 + 1e-4) + 1e-15
+    d_new = _dense_distance(new, back[-1].curve)
+    assert d_new <= 1e-9 and check.deviations[1] <= 1e-9
+
+
+def test_new_curve_into_an_r12_template(tmp_path):
+    """A new SPLINE written into a drawing ezdxf loads as R12 (no $ACADVER): ezdxf refused it
+    (DXFVersionError); the drawing is written as R2000 with a warning, every entity kept."""
+    ezdxf = pytest.importorskip("ezdxf")
+    src = DATA / "real/dxf-parser/splines.dxf"
+    recs = read_curves(src)
+    new = BSplineCurve([[0, 0], [1, 2], [3, 2], [4, 0]], [0, 0, 0, 0, 1, 1, 1, 1], 3)
+    out = tmp_path / "o.dxf"
+    with pytest.warns(UserWarning, match="R2000"):
+        check = write_curves(out, recs + [new], template=src, tol=1e-9)
+    assert check.max_deviation <= 1e-9
+    doc = ezdxf.readfile(str(out))
+    assert doc.dxfversion >= "AC1015"
+    assert sum(e.dxftype() == "SPLINE" for e in doc.modelspace()) == 3
+    assert _dense_distance(new, read_curves(out)[-1].curve, 4000) <= 1e-9
