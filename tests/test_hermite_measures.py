@@ -172,14 +172,15 @@ def test_methods_command_says_the_default_and_why():
     from curvefair.cli import main
 
     out = CliRunner().invoke(main, ["methods"]).output
-    line = next(s for s in out.splitlines() if s.startswith("default for BSplineCurve"))
+    line = next(s for s in out.splitlines() if s.startswith("default for BSplineCurve: global"))
     assert "global" in line and "16/84" in line
     js = CliRunner().invoke(main, ["methods", "--json"]).output
     import json
 
     rows = {r["name"]: r for r in json.loads(js)}
     assert rows["global"]["default"] and "l=3" in rows["global"]["default_options"]
-    assert not rows["eck-hadenfeld"]["default"]
+    # eck-hadenfeld is the default only above global_fair.DEFAULT_MAX_CTRL control points
+    assert rows["eck-hadenfeld"]["default"] and "200,000" in rows["eck-hadenfeld"]["default_reason"]
 
 
 def test_structure_free_removes_knots_within_tol():

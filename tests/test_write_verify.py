@@ -219,7 +219,7 @@ def test_report_after_figures_describe_the_written_file(tmp_path):
 
     recs = read_curves(DATA / "clarky.dat")
     tol = 1e-4
-    res = fair(recs[0].curve, tol=tol, max_steps=5)
+    res = fair(recs[0].curve, "poliakoff", tol=tol, max_steps=5)  # reports measure_max_after
     moved = [_moved_points(recs[0], 0.98 * tol, 7)]
     out = tmp_path / "c.dat"
     with pytest.warns(UserWarning, match="scaled down"):
