@@ -68,8 +68,8 @@ def _snapshot(root: Path) -> dict[str, bytes]:
 def test_folder_to_output_folder_reports_and_same_bytes_as_single_file(tmp_path: Path):
     src = _tree(tmp_path)
     before = _snapshot(src)
-    # the airfoil by poliakoff: the default (points-l1) adds inflections on this Lednicer file
-    # at this tol, so the never-worse guard keeps it unchanged, and the test wants a move
+    # the airfoil by poliakoff explicitly (points-l1 adds inflections on this Lednicer file at
+    # this tol, so the never-worse guard would keep it unchanged, and the test wants a move)
     r = _run(["fair", "in", "-o", "out", "--tol", str(TOL), "--no-corners", "-j", "1",
               "--method", "airfoil=poliakoff"], tmp_path)
     assert r.exit_code == 0, r.output

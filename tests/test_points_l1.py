@@ -160,16 +160,19 @@ def test_default_only_for_natural_chord_point_data_up_to_the_size_limit():
     # points-l1 returns the chord-length natural cubic through the moved points: it is the
     # default only where the input is that kind of curve (point data), and up to
     # DEFAULT_MAX_POINTS; elsewhere the Poliakoff loop, which keeps the input's tangents
+    # (registered as a default only with points_l1.DEFAULT_ENABLED; the rule is _prefer)
     from curvefair.fairing import points_l1 as pl
     from curvefair.fairing.fair import _default_method
 
     t = np.linspace(0.0, 3.0, 40)
     P = np.c_[t, np.sin(t)]
-    assert _default_method(interpolate_cubic(P)).name == "points-l1"
+    assert pl._prefer(interpolate_cubic(P))
+    assert _default_method(interpolate_cubic(P)).name == ("points-l1" if pl.DEFAULT_ENABLED
+                                                          else "poliakoff")
     clamped = interpolate_cubic(P, bc="clamped", end_tangents=([1.0, 0.0], [1.0, 0.0]))
-    assert _default_method(clamped).name == "poliakoff"
-    assert _default_method(interpolate_cubic(P, param="uniform")).name == "poliakoff"
+    assert not pl._prefer(clamped)
+    assert not pl._prefer(interpolate_cubic(P, param="uniform"))
     big = np.linspace(0.0, 3.0, pl.DEFAULT_MAX_POINTS + 1)
-    assert _default_method(interpolate_cubic(np.c_[big, np.sin(big)])).name == "poliakoff"
+    assert not pl._prefer(interpolate_cubic(np.c_[big, np.sin(big)]))
     # an explicit request is honoured whatever the size or kind
     assert "points-l1" in available_methods(clamped)

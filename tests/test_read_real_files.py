@@ -265,8 +265,8 @@ def test_g2_hold_on_short_airfoils_and_when_it_covers_everything(tmp_path):
     # e387 (61 points): the hold zone of a C2 spline would hold most points, so the end
     # segment itself is kept (g2_hold "segment") and the interior is faired
     p = REAL / "uiuc" / "e387.dat"
-    # the hold rule of the local methods (points-l1, the default for point files, rebuilds a
-    # natural cubic: zero end curvature before and after, nothing to hold)
+    # the hold rule of the local methods (points-l1 rebuilds a natural cubic: zero end
+    # curvature before and after, nothing to hold)
     res = _run("fair", p, "-o", tmp_path / "o.dat", "--tol", "1e-4", "--clamp", "g2",
                "-m", "poliakoff", "--report", tmp_path / "r.json")
     assert res.exit_code == 0
