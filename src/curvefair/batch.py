@@ -54,6 +54,7 @@ from typing import Any
 
 import numpy as np
 
+from ._fileid import file_key
 from ._version import __version__
 from .errors import CurvefairError, InputError
 
@@ -181,13 +182,7 @@ def _known_exts() -> tuple[str, ...]:
     return tuple(e for exts in FORMATS.values() for e in exts)
 
 
-def _file_key(path: str) -> tuple[Any, ...]:
-    real = os.path.realpath(path)
-    try:
-        st = os.stat(real)
-    except OSError:
-        return ("path", os.path.normcase(real))
-    return ("inode", st.st_dev, st.st_ino)
+_file_key = file_key
 
 
 def _glob_base(pattern: str) -> str:

@@ -29,6 +29,7 @@ except ImportError:  # pragma: no cover - exercised only without the extra
     raise SystemExit(1) from None
 
 from . import __version__
+from ._fileid import file_key
 from .errors import CurvefairError
 
 __all__ = ["main"]
@@ -72,15 +73,7 @@ def _user_errors() -> Iterator[None]:
         raise InputFailure(f"{where}{exc.strerror or exc}") from None
 
 
-def _file_key(path: str) -> tuple[Any, ...]:
-    """What identifies the file ``path`` names: device and inode of an existing file (any
-    spelling, symbolic or hard link), else the resolved absolute path."""
-    real = os.path.realpath(path)
-    try:
-        st = os.stat(real)
-    except OSError:
-        return ("path", os.path.normcase(real))
-    return ("inode", st.st_dev, st.st_ino)
+_file_key = file_key
 
 
 def _check_outputs(inputs: Sequence[tuple[str, str]], outputs: Sequence[tuple[str | None, str]],
