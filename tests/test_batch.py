@@ -397,3 +397,15 @@ def test_a_killed_pool_worker_loses_nothing(tmp_path: Path):
         f.name: f.read_bytes() for f in (tmp_path / "ref").glob("w*.json")}
     assert len(list(out.glob("w*.json"))) == 4
     assert [q for q in out.rglob(".*") if q.is_file()] == []
+
+
+def test_scheduler_without_distributed_names_the_extra(tmp_path, monkeypatch):
+    # `--scheduler` with dask distributed missing: a usage error naming the package and the
+    # extra (it used to be a TypeError from building MissingDependencyError with one argument)
+    src = _tree(tmp_path)
+    monkeypatch.setitem(sys.modules, "distributed", None)  # `import distributed` fails
+    r = _run(["fair", str(src), "-o", str(tmp_path / "out"), "--tol", "0.05",
+              "--scheduler", "tcp://127.0.0.1:1", "-q"], tmp_path)
+    assert r.exit_code == 1, r.output
+    assert "'distributed'" in r.output and "pip install 'curvefair[dask]'" in r.output
+    assert not (tmp_path / "out").exists() or not any((tmp_path / "out").rglob("*.*"))

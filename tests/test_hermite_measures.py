@@ -4,6 +4,8 @@ defaults of the method registry."""
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 from scipy.integrate import quad
@@ -18,6 +20,7 @@ from curvefair import (
     steps,
 )
 from curvefair.curves.hermite import CubicHermite, QuinticHermite
+from curvefair.fairing.fair import FairingReport
 
 
 def _cubic(rng, n=9, dim=2, uniform=False):
@@ -194,5 +197,11 @@ def test_structure_free_removes_knots_within_tol():
     u = np.linspace(*b.domain, 20001)
     assert np.linalg.norm(r.curve(u) - b(u), axis=1).max() <= 4e-3
     assert r.report["extrema_before"] == fair(b, tol=4e-3).report["extrema_before"]
+    # the report is a FairingReport like every other fair() report (it was a plain dict,
+    # without to_dict()): JSON-ready, its per-point entries as lists
+    assert isinstance(r.report, FairingReport)
+    d = json.loads(json.dumps(r.report.to_dict()))
+    assert d["structure"]["knots_removed"] == st["knots_removed"]
+    assert d["moved"]["indices"] == np.asarray(r.report["moved"]["indices"]).tolist()
     with pytest.raises(InputError, match="structure"):
         fair(b, tol=4e-3, structure="new")

@@ -240,8 +240,7 @@ def _dask_client(address: str) -> Iterator[Any]:
     try:
         from distributed import Client
     except ImportError:
-        raise _Failure(str(MissingDependencyError(
-            "--scheduler needs dask distributed: pip install 'curvefair[dask]'"))) from None
+        raise _Failure(str(MissingDependencyError("distributed", "dask", "--scheduler"))) from None
     try:
         client = Client(address, timeout="10s")
     except (OSError, TimeoutError, ValueError) as exc:
@@ -259,7 +258,7 @@ def _print_summary(jobs: Sequence[_batch.Job], reports: Sequence[Mapping[str, An
         return
     echo = (lambda s: click.echo(s, err=True)) if to_err else click.echo
     for j, r in zip(jobs, reports, strict=True):
-        st = r.get("status")
+        st: Any = r.get("status")
         if r.get("skipped"):
             echo(f"skipped {j.display}: output {j.output} is up to date")
             continue

@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Iterable, Sequence
+from typing import Literal, cast, overload
 
 import numpy as np
 
@@ -294,14 +295,14 @@ def check_fits(n_bytes: float, what: str) -> None:
 
 
 def _as_scalar(value: object, name: str, what: str) -> float:
-    if isinstance(value, (bool, np.bool_, str, bytes)) or np.iscomplexobj(value):
+    if isinstance(value, (bool, np.bool_, str, bytes)) or np.iscomplexobj(cast(ArrayLike, value)):
         raise InputError(f"{name} must be {what}, got {value!r}")
     try:
         return float(value)  # type: ignore[arg-type]
     except OverflowError:
         raise InputError(f"{name} must be {what} within the float64 range (and curvefair's "
                          f"working range [{MIN_STEP:g}, {MAX_MAGNITUDE:g}]), got an integer "
-                         f"with {len(str(abs(int(value))))} digits") from None  # type: ignore
+                         f"with {len(str(abs(int(cast(int, value)))))} digits") from None
     except (TypeError, ValueError):
         raise InputError(f"{name} must be {what}, got {value!r}") from None
 
@@ -313,6 +314,12 @@ def _check_window(v: float, value: object, name: str) -> None:
                          f"formulas take, e.g. {name}**2); {_RESCALE}")
 
 
+@overload
+def as_positive(value: object, name: str, *, allow_none: Literal[False] = False,
+                window: bool = False) -> float: ...
+@overload
+def as_positive(value: object, name: str, *, allow_none: bool = False,
+                window: bool = False) -> float | None: ...
 def as_positive(value: object, name: str, *, allow_none: bool = False,
                 window: bool = False) -> float | None:
     """A finite float > 0 (or None when allowed); ``window``: a length (tolerance, scale)

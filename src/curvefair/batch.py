@@ -50,13 +50,16 @@ import warnings
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
 from ._fileid import file_key
 from ._version import __version__
 from .errors import CurvefairError, InputError
+
+if TYPE_CHECKING:
+    from .io import FormatName
 
 __all__ = ["fair_files", "fair_file", "plan_inputs", "Job", "file_sha256", "options_digest",
            "parse_methods", "REPORT_DIR"]
@@ -430,7 +433,8 @@ def _read(path: str, opts: Mapping[str, Any], notes: list[str] | None = None,
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        recs = read_curves(path, corner_angle=opts["corner_angle"], format=fmt,
+        recs = read_curves(path, corner_angle=opts["corner_angle"],
+                           format=cast("FormatName | None", fmt),
                            on_unsupported="raise" if opts["strict"] else "skip")
     if notes is not None:
         notes.extend(dict.fromkeys(str(w.message) for w in caught))

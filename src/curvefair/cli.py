@@ -20,7 +20,7 @@ import sys
 import time
 from collections.abc import Iterator, Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 try:
     import click
@@ -396,7 +396,7 @@ def _read(path: str, corner_angle: float | None, strict: bool = False,
         with _warnings_to_stderr(quiet, into=seen):
             return read_curves(path, corner_angle=corner_angle,
                                on_unsupported="raise" if strict else "skip",
-                               **({} if glyphs is None else {"glyphs": glyphs}))
+                               **cast(dict[str, Any], {} if glyphs is None else {"glyphs": glyphs}))
     except CurvefairError as exc:
         skipped = sum(": skipped " in w for w in seen)
         if skipped:
@@ -605,7 +605,7 @@ def _bad_point_list(curve: Any, a: Any) -> list[dict[str, Any]]:
     from . import BSplineCurve, bad_points
 
     if isinstance(curve, BSplineCurve) and curve.degree == 3:
-        out = []
+        out: list[dict[str, Any]] = []
         pieces = _c0_pieces(curve)
         for piece, (offset, sub) in enumerate(pieces):
             try:
@@ -1040,7 +1040,7 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
     in_fmt = _format_of(infile, "IN")
     with _user_errors():
         try:
-            out_fmt = detect_format(out)
+            out_fmt: str = detect_format(out)
         except CurvefairError:
             out_fmt = in_fmt
         records = _read(infile, _corner(corner_angle, no_corners), strict, quiet, glyphs)

@@ -340,7 +340,7 @@ def curvature_comb(curve: PiecewiseCurve, scale: float | None = None,
     if scale is None:
         scale = _auto_scale(float(np.nanmax(np.abs(smp.kappa))), _extent(smp.flat("r")))
     else:
-        scale = float(as_positive(scale, "scale", window=True))  # type: ignore[arg-type]
+        scale = float(as_positive(scale, "scale", window=True))
     base = smp.flat("r")
     tip = base - scale * smp.flat("kvec")
     return Comb(base=base, tip=tip, kappa=smp.flat("kappa"), u=smp.flat("u"), scale=scale)
@@ -506,7 +506,7 @@ def _joint_scale(prepared: list[_Prepared], comb_scale: object) -> float:
 def _joint_scale_clip(prepared: list[_Prepared], comb_scale: object) -> tuple[float, float | None]:
     """``(scale, clip)``: the given scale (no clip), or :func:`robust_comb_scale`."""
     if comb_scale is not None:
-        return float(as_positive(comb_scale, "comb_scale", window=True)), None  # type: ignore
+        return float(as_positive(comb_scale, "comb_scale", window=True)), None
     extent = _extent(np.vstack([p.fine.flat("r") for p in prepared]))
     return robust_comb_scale([p.comb.flat("kappa") for p in prepared],
                              [p.comb.flat("s") for p in prepared], extent)
@@ -1099,10 +1099,10 @@ def figure(curve: PiecewiseCurve | Sequence[PiecewiseCurve],
     scale, clip = _joint_scale_clip(everything, comb_scale)
 
     # layout: curve panel height from the data's aspect ratio
-    xy = [proj(p.fine.flat("r")) for p in everything]
+    xys = [proj(p.fine.flat("r")) for p in everything]
     if comb:
-        xy += [proj(p.comb.flat("r")) - scale * proj.vec(p.comb.flat("kvec")) for p in everything]
-    xy = np.vstack(xy)
+        xys += [proj(p.comb.flat("r")) - scale * proj.vec(p.comb.flat("kvec")) for p in everything]
+    xy = np.vstack(xys)
     xy = xy[np.all(np.isfinite(xy), axis=1)]
     span = np.ptp(xy, axis=0) if xy.size else np.ones(2)
     aspect = float(span[1] / span[0]) if span[0] > 0 else 1.0

@@ -63,8 +63,8 @@ def locate(curve: PiecewiseCurve, u: ArrayLike, side: str
     shape = ua.shape
     uf = ua.reshape(-1)
     if not np.all(np.isfinite(uf)):
-        bad = int(np.flatnonzero(~np.isfinite(uf))[0])
-        raise InputError(f"u contains a non-finite parameter {uf[bad]!r} at index {bad}")
+        ib = int(np.flatnonzero(~np.isfinite(uf))[0])
+        raise InputError(f"u contains a non-finite parameter {uf[ib]!r} at index {ib}")
     pp = curve.piecewise
     b = pp.breaks
     t0, t1 = float(b[0]), float(b[-1])

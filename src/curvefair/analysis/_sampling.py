@@ -21,6 +21,7 @@ import math
 from dataclasses import dataclass
 from functools import lru_cache
 from math import comb
+from typing import cast
 
 import numpy as np
 
@@ -116,7 +117,8 @@ def _plan(degree: int, planar: bool) -> _Plan:
             S[q] = (fit_v @ to_vals).T
         subs.append(S)
     return _Plan(P=P, K=K, x=x, xk=xk, w7=0.5 * _GK_W7, w4=0.5 * _GK_W4, tab=tab,
-                 fit=(fits[0], fits[1]), sub=(subs[0], subs[1]), degs=(d_n, d_e))
+                 fit=(fits[0], cast(FloatArray, fits[1])), sub=(subs[0], cast(FloatArray, subs[1])),
+                 degs=(d_n, d_e))
 
 
 def _variations(b: FloatArray) -> np.ndarray:
@@ -677,8 +679,8 @@ def _frenet_at(cw: FloatArray, h: FloatArray, segs: np.ndarray, us: FloatArray,
     rr = derivs_at(cg, uf * hg, 3)
     s1, s2 = _speed_scales(cg, hg)
     dim = cw.shape[2]
-    fr = frenet(*[[r_[:, d] for d in range(dim)] for r_ in rr], s1, s2,
-                numerators=numerators)
+    r1, r2, r3 = ([r_[:, d] for d in range(dim)] for r_ in rr)  # rr: [r', r'', r''']
+    fr = frenet(r1, r2, r3, s1, s2, numerators=numerators)
     return {k: v.reshape(shape) for k, v in fr.items()}
 
 

@@ -258,7 +258,7 @@ def _banded(h: FloatArray, npt: int, nseg_band: int, lo: int, up: int
     return dsc, ab
 
 
-def _set_row(ab: FloatArray, F: FloatArray, lo: int, up: int, r: int, cols: FloatArray,
+def _set_row(ab: FloatArray, F: FloatArray, lo: int, up: int, r: int, cols: np.ndarray,
              vals: FloatArray, rhs: FloatArray) -> None:
     """Replace row ``r`` of the banded matrix and right-hand side (row scaled to max 1)."""
     c = np.arange(max(r - lo, 0), min(r + up + 1, ab.shape[1]))
@@ -268,7 +268,7 @@ def _set_row(ab: FloatArray, F: FloatArray, lo: int, up: int, r: int, cols: Floa
     F[r] = rhs / scale
 
 
-def _nak_row(k: int, h: FloatArray, dsc: FloatArray) -> tuple[FloatArray, FloatArray]:
+def _nak_row(k: int, h: FloatArray, dsc: FloatArray) -> tuple[np.ndarray, FloatArray]:
     """Columns and scaled coefficients of ``jump(r^(5))`` at interior point ``k`` in the
     unknowns; ``r^(5) = (720 dp - 360 (m0 + m1) h + 60 (s1 - s0) h^2) / h^5`` per segment."""
     a, b = h[k - 1], h[k]
@@ -317,7 +317,7 @@ def _quintic_hermite_data(pts: FloatArray, t: FloatArray, left: Any, right: Any,
     else:
         r3l, r4l, r3r, r4r, r5 = _one_sided(h, delta, m0, s0)
         rp = np.arange(1, npt)
-    res = np.zeros((npt, 2, dim))  # f - K x0 per point: (-jump(r''''), jump(r'''))
+    res: FloatArray = np.zeros((npt, 2, dim))  # f - K x0 per point: (-jump(r''''), jump(r'''))
     res[: h.size, 0] -= r4l
     res[rp, 0] += r4r
     res[: h.size, 1] += r3l

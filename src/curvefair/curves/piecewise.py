@@ -30,7 +30,7 @@ def _frozen(arr: np.ndarray) -> bool:
     """True if ``arr`` is read-only and its memory is an immutable ``bytes`` object."""
     if arr.flags.writeable:
         return False
-    base = arr
+    base: object = arr
     while isinstance(base, np.ndarray):
         base = base.base
     return isinstance(base, bytes)

@@ -14,7 +14,7 @@ import math
 import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
@@ -22,6 +22,9 @@ from .._typing import FloatArray
 from ..curves.piecewise import PiecewiseCurve, readonly
 from ..errors import InputError
 from ..interop import as_curve as _as_curve
+
+if TYPE_CHECKING:
+    from ..curves.bspline import BSplineCurve
 
 __all__ = [
     "MethodSpec",
@@ -583,7 +586,8 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
         from .structure import fair_new_structure
 
         return fair_new_structure(
-            curve, method, _pos(tol, "tol", allow_none=True, window=True), fair, eps=eps,
+            cast("BSplineCurve", curve), method,
+            _pos(tol, "tol", allow_none=True, window=True), fair, eps=eps,
             max_steps=max_steps, clamp=clamp, protect=protect, mode=mode, joins=joins,
             g1_angle=g1_angle, guard=guard, **options)
     if method is None:

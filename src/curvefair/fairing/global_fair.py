@@ -31,6 +31,7 @@ from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import ThreadPoolExecutor
 from contextlib import contextmanager
 from dataclasses import dataclass
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -80,6 +81,7 @@ def energy_matrix(curve: BSplineCurve, l: Any = 2) -> sp.csr_matrix:  # noqa: E7
     for k, v in w.items():
         Gk = curve.gram_matrix(k) * v
         G = Gk if G is None else G + Gk
+    assert G is not None  # _weights raises when no weight is positive
     return G.tocsr()
 
 
@@ -190,7 +192,7 @@ def _ranges_start(fn: Callable[[int, int], Any], lo: int, hi: int
     bounds = [lo + (m * q) // k for q in range(k + 1)]
     out: list[Any] = [None] * k
     lock = threading.Lock()
-    state = {"next": 0, "pending": 0, "error": None}
+    state: dict[str, Any] = {"next": 0, "pending": 0, "error": None}
     idle = threading.Event()
     idle.set()
 
@@ -652,10 +654,10 @@ def _global_fair(curve: BSplineCurve, tol: float | None, l: Any,  # noqa: E741
     closed = curve.closed
     band = _band_storage(curve.n_ctrl, curve.dim, p, closed)
     W = None
-    for k, v in w.items():
+    for k, wgt in w.items():
         Wk = np.asarray(curve.gram_band(k))  # cached, read-only: scaled copies only if needed
-        if v != 1.0:
-            Wk = Wk * v
+        if wgt != 1.0:
+            Wk = Wk * wgt
         W = Wk if W is None else W + Wk
     W = np.ascontiguousarray(W)
     d0 = np.ascontiguousarray(curve.control_points, dtype=float)  # read only: no copy
@@ -1068,9 +1070,9 @@ def _ssn_loop(system: _System, g0: FloatArray, free: np.ndarray, tol: float, v: 
     rejects = 0
     it = 0
     while True:
-        parts = _ranges(lambda a, b, dlt=delta + mu: _k.ssn_eval_range(  # (mu = 0: delta)
-            g0, K, ks, p, closed, v, lam, free, t2, kappa, dlt, S, rd, B, nrm, c,
-            system.Q, system.fix, system.fix0, a, b), 0, n)
+        parts = _ranges(partial(_k.ssn_eval_range,  # (mu = 0: delta)
+            g0, K, ks, p, closed, v, lam, free, t2, kappa, delta + mu, S, rd, B, nrm, c,
+            system.Q, system.fix, system.fix0), 0, n)
         rdm, feas, fS, nS = parts[0]
         for a_, b_, c_, d_ in parts[1:]:  # as one pass: maxima (NaN propagates), a count
             rdm = a_ if not a_ <= rdm else rdm
@@ -1095,7 +1097,7 @@ def _ssn_loop(system: _System, g0: FloatArray, free: np.ndarray, tol: float, v: 
         if not chord:
             # the right-hand side prepared on the worker thread during the factorisation
             ok = system.factor(B, nrot=nS,
-                               then=lambda nS=nS: system.prep_start(B, nS, rd, c, dv, -1.0))
+                               then=partial(system.prep_start, B, nS, rd, c, dv, -1.0))
             fin, system.then = system.then, None
             if fin is not None:
                 fin()

@@ -42,7 +42,7 @@ plain behaviour).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -89,7 +89,7 @@ def join_angles(curve: PiecewiseCurve) -> FloatArray:
     w = np.asarray(pp.widths)
     p = c.shape[1] - 1
     right = c[:, 1, :]
-    left = sum(j * c[:, j, :] * w[:, None] ** (j - 1) for j in range(1, p + 1))
+    left = cast(FloatArray, sum(j * c[:, j, :] * w[:, None] ** (j - 1) for j in range(1, p + 1)))
     pairs = [(left[k - 1], right[k]) for k in range(1, c.shape[0])]
     if curve.closed:
         pairs.append((left[-1], right[0]))
@@ -196,8 +196,8 @@ def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozense
     n = P.shape[0]
     eps = _ROUND * _size(P)
     hold: set[int] = set()
-    rep = {"g1_joins": 0, "g1_joins_reparametrised": 0, "g2_joins_held": 0, "corners_held": 0,
-           "straight_spans_held": 0}
+    rep: dict[str, Any] = {"g1_joins": 0, "g1_joins_reparametrised": 0, "g2_joins_held": 0,
+                           "corners_held": 0, "straight_spans_held": 0}
 
     # straight spans: every control point of a span lying on one line
     straight, rep["straight_spans_held"] = _straight_spans(curve, P, eps)

@@ -108,7 +108,7 @@ from __future__ import annotations
 import time
 import warnings
 from functools import partial
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from scipy.interpolate import CubicSpline
@@ -167,7 +167,7 @@ def spline_derivatives(curve: HermiteSpline, P: FloatArray, clamp: tuple[str, st
             spl = CubicSpline(t, pts, bc_type="periodic", axis=0)
             ders = [spl(t, 1)]
         else:
-            T0 = np.asarray(curve.tangents, dtype=float)
+            T0 = np.asarray(cast(CubicHermite, curve).tangents, dtype=np.float64)
             lo = 1 if g2_segment[0] else 0
             hi = t.shape[0] - 2 if g2_segment[1] else t.shape[0] - 1
             d1 = np.array(T0)
@@ -180,7 +180,7 @@ def spline_derivatives(curve: HermiteSpline, P: FloatArray, clamp: tuple[str, st
     else:
         # the banded Hermite solve of interpolate_quintic (make_interp_spline(k=5) is far less
         # accurate: relative errors up to 1e-6 in r', r'' on nearly straight data)
-        ends = (None, None) if curve.closed else (_end_bc(curve, clamp[0], 0),
+        ends: tuple[Any, Any] = (None, None) if curve.closed else (_end_bc(curve, clamp[0], 0),
                                                   _end_bc(curve, clamp[1], -1))
         ders = list(_quintic_hermite_data(pts, t, *ends, curve.closed))
     D = np.stack(ders, axis=1)
@@ -380,7 +380,7 @@ def prepare(curve: HermiteSpline, *, method: str, tol: float | None, eps: float 
     n_elig = int(eligible.sum())
     max_eff = 20 * n_elig + 1000 if max_steps is None else int(max_steps)
     scale = float(np.abs(P).max()) + float(np.ptp(P, axis=0).max())
-    floor = 8.0 * np.finfo(float).eps * scale
+    floor: float = 8.0 * np.finfo(float).eps * scale
     if tol is not None:
         floor = max(floor, 1e-9 * tol)
     K0, pe = _GRAM[degree]
@@ -434,7 +434,7 @@ def _curve_deviation(curve: HermiteSpline, P: FloatArray, D: FloatArray) -> floa
     """Certified upper bound of ``max_t |curve(t) - new(t)|`` (Bernstein hull bound)."""
     from ..analysis import deviation
 
-    return float(deviation(curve, rebuild(curve, P, D)).upper_bound)
+    return float(cast(float, deviation(curve, rebuild(curve, P, D)).upper_bound))
 
 
 def _enforce_curve_tol(curve: HermiteSpline, st: dict[str, Any], tol: float,
@@ -500,8 +500,8 @@ def hermite_driver(curve: HermiteSpline, *, method: str, tol: float | None, eps:
 
     choice(tol_on, ("curve", "points"), "tol_on")
     t0 = time.perf_counter()
-    kw = dict(method=method, eps=eps, max_steps=max_steps, clamp=clamp, protect=protect, mode=mode,
-              measure=measure)
+    kw: dict[str, Any] = dict(method=method, eps=eps, max_steps=max_steps, clamp=clamp,
+                              protect=protect, mode=mode, measure=measure)
     point_tol = tol
     snap = None
     for attempt in range(_CURVE_TOL_RERUNS + 1):
@@ -510,7 +510,7 @@ def hermite_driver(curve: HermiteSpline, *, method: str, tol: float | None, eps:
             if tol is not None and tol_on == "curve":
                 snap = _copy_state(st)  # a re-run starts from this state
         else:
-            st = _retarget(snap, point_tol)
+            st = _retarget(snap, cast(float, point_tol))
         (steps, stop, h_idx, h_meas, h_disp, blocked, n_trunc, n_skip,
          max_window) = _k.drive(*st["args"])
         if tol is None or tol_on == "points":
@@ -520,11 +520,11 @@ def hermite_driver(curve: HermiteSpline, *, method: str, tol: float | None, eps:
             break
         # the curve between the data points strays farther than the points: fair again with
         # the points held proportionally closer (the curve change is linear in the moves)
-        point_tol = point_tol * _SHRINK * tol / dev
+        point_tol = cast(float, point_tol) * _SHRINK * tol / dev
     if tol is not None and tol_on == "curve":
         scale, dev = _enforce_curve_tol(curve, st, tol, dev)
         st["extra"]["curve_tolerance"] = {
-            "point_tol_used": float(point_tol), "reruns": attempt, "scale": scale,
+            "point_tol_used": float(cast(float, point_tol)), "reruns": attempt, "scale": scale,
             "deviation_upper_bound": float(dev)}
     P, D, measure, eligible = st["P"], st["D"], st["measure"], st["eligible"]
     eps_eff, n_elig, spline, degree = st["eps"], st["n_elig"], st["spline"], st["degree"]
@@ -561,7 +561,7 @@ def hermite_driver(curve: HermiteSpline, *, method: str, tol: float | None, eps:
                    st["measure_name"] != "energy" else
                    ("energy_drop_position" if spline else "energy_drop"),
         "measure_max_before": m0,
-        "measure_max_after": float(measure[eligible].max()) if n_elig else 0.0,
+        "measure_max_after": float(cast(FloatArray, measure)[eligible].max()) if n_elig else 0.0,
         "held": sorted(held),
         "skipped": int(n_skip),
         "blocked_by_tol": int(np.sum(blocked == 1)),

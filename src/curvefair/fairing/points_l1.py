@@ -52,6 +52,7 @@ round's points (the first round at those of the input), so the last solve uses p
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -310,7 +311,7 @@ def _block_diag(W: FloatArray) -> sp.csr_matrix:
     return sp.csr_matrix((W.reshape(-1), (r, c)), shape=(k * dim, k * dim))
 
 
-def points_l1(points: ArrayLike, tol: float, *, hold: ArrayLike = (), rounds: int = 5,
+def points_l1(points: ArrayLike, tol: float, *, hold: Iterable[int] = (), rounds: int = 5,
               delta: float = 1e-5, beta: float = 1e-6, tau: float = 1e-2,
               reparam: int = 2, max_steps: int = 80, curve_tol: bool = True
               ) -> PointsL1Result:

@@ -19,7 +19,7 @@ derivative of a cubic may jump), and the fairing energy (E3 for the default ``gl
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -76,7 +76,7 @@ def reduce_knots(curve: BSplineCurve, tol: float) -> tuple[BSplineCurve, float, 
         cand = _lsq(curve, np.sort(np.concatenate([keep, fixed_rep])))
         if cand is None:
             return None
-        d = float(deviation(curve, cand, kind="parametric").upper_bound)
+        d = float(cast(float, deviation(curve, cand, kind="parametric").upper_bound))
         return (cand, d) if d <= tol else None
 
     lo, hi = 0, free.size  # hi: the smallest count known to pass (the input itself)
@@ -97,13 +97,13 @@ def fair_new_structure(curve: BSplineCurve, method: str | None, tol: float | Non
                        fair_fn: Any, **kw: Any) -> Any:
     """``fair(curve, method, tol=tol, structure="free", **kw)`` (module docstring)."""
     from ..analysis import deviation
-    from .fair import FairingResult
+    from .fair import FairingReport, FairingResult
 
     if tol is None:
         return fair_fn(curve, method, tol=tol, **kw)
     reduced, d_a, removed = reduce_knots(curve, 0.5 * tol)
     res = fair_fn(reduced, method, tol=tol - d_a, **kw)
-    dev = float(deviation(curve, res.curve, kind="parametric").upper_bound)
+    dev = float(cast(float, deviation(curve, res.curve, kind="parametric").upper_bound))
     if not dev <= tol:  # pragma: no cover - the triangle inequality makes this impossible
         res = fair_fn(curve, method, tol=tol, **kw)
         removed, dev = 0, float(res.report["max_deviation"])
@@ -121,4 +121,4 @@ def fair_new_structure(curve: BSplineCurve, method: str | None, tol: float | Non
     rep["inflections_before"] = int(a.inflections)
     rep["max_deviation_upper_bound"] = dev
     rep["tol"] = tol
-    return FairingResult(res.curve, rep, res.history)
+    return FairingResult(res.curve, FairingReport(rep), res.history)

@@ -78,7 +78,8 @@ import os
 import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any, Literal
+from types import ModuleType
+from typing import Any, Literal, cast
 
 import numpy as np
 
@@ -116,14 +117,14 @@ FOLDER_FORMATS = ("ufo",)
 FONT_FORMATS = ("ufo", "opentype", "glyphs", "designspace")
 
 
-def detect_format(path: str | os.PathLike[str], format: str | None = None) -> str:
+def detect_format(path: str | os.PathLike[str], format: str | None = None) -> FormatName:
     """The format name for ``path`` (by extension) or the validated ``format``."""
     if format is not None:
-        return choice(format, FORMATS, "format")
+        return cast(FormatName, choice(format, FORMATS, "format"))
     ext = Path(path).suffix.lower()
     for name, exts in FORMATS.items():
         if ext in exts:
-            return name
+            return cast(FormatName, name)
     known = ", ".join(e for exts in FORMATS.values() for e in exts)
     raise InputError(f"cannot tell the format of {os.fspath(path)!r} from its extension "
                      f"{ext!r}; known: {known}; or pass format=")
@@ -131,6 +132,7 @@ def detect_format(path: str | os.PathLike[str], format: str | None = None) -> st
 
 def _module(fmt: str) -> Any:
     # the modules themselves import their optional libraries lazily
+    m: ModuleType
     if fmt == "points":
         from . import points as m
     elif fmt == "airfoil":

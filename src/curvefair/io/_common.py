@@ -368,7 +368,8 @@ def check_points(pts: FloatArray, path: object, lines: Sequence[int | None] | No
         ln = None if lines is None else lines[i]
         raise FileFormatError(f"{what} {i} has a non-finite coordinate {pts[i].tolist()}",
                               path, ln)
-    big = np.flatnonzero(np.abs(pts).max(axis=1) > MAX_MAGNITUDE) if pts.size else []
+    big: np.ndarray | list[int] = (np.flatnonzero(np.abs(pts).max(axis=1) > MAX_MAGNITUDE)
+                                   if pts.size else [])
     if len(big):
         i = int(big[0])
         ln = None if lines is None else lines[i]

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 import os
 import re
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
@@ -189,7 +189,7 @@ class TextLayout:
         return [i + 1 for i in self.data_lines]
 
     def render(self, values: FloatArray, decimals: int | None = None,
-               keep_rows: Sequence[int] = ()) -> str:
+               keep_rows: Iterable[int] = ()) -> str:
         """The file text with the data rows replaced by ``values`` (shape ``(rows, ncols)``).
 
         Rows listed in ``keep_rows`` are written exactly as they were (e.g. a Lednicer count

@@ -26,12 +26,15 @@ from __future__ import annotations
 import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
 from ..errors import CurvefairError, InputError
 from ._common import CurveRecord, atomic_path, points_curve
+
+if TYPE_CHECKING:
+    from ..curves.hermite import CubicHermite
 
 __all__ = ["WriteCheck", "WriteCheckError", "write_checked", "rescaled_report"]
 
@@ -176,7 +179,7 @@ def _matched(reference: Sequence[CurveRecord], back: Sequence[CurveRecord]
     rg, bg = _groups(reference), _groups(back)
     if len(rg) != len(bg):
         return None
-    out = []
+    out: list[Any] = []
     for rr, bb in zip(rg, bg, strict=True):
         if _shapes_agree(rr, bb):
             out.extend(b.curve for b in bb)
@@ -273,8 +276,8 @@ def _measure(reference: Sequence[CurveRecord], curves: Sequence[Any], tol: float
 
 def _scaled(rec: CurveRecord, ref: CurveRecord, s: float) -> CurveRecord:
     """``rec`` with its data points moved ``s`` times as far from ``ref``'s as faired."""
-    p0 = np.asarray(ref.curve.points, dtype=float)  # type: ignore[attr-defined]
-    p1 = np.asarray(rec.curve.points, dtype=float)  # type: ignore[attr-defined]
+    p0 = np.asarray(cast("CubicHermite", ref.curve).points, dtype=np.float64)
+    p1 = np.asarray(cast("CubicHermite", rec.curve).points, dtype=np.float64)
     pts = p0 + s * (p1 - p0)
     # keep exactly the points that did not move (corners, clamped ends, protected points)
     pts[np.all(p1 == p0, axis=1)] = p0[np.all(p1 == p0, axis=1)]

@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -69,7 +69,7 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
     lay = parse_text(path, header=True, ncols=(2,), what="airfoil file", notes=True)
     vals = lay.values
     lines = lay.line_numbers()
-    name = lay.header_text.strip() if lay.header is not None else None
+    name = cast(str, lay.header_text).strip() if lay.header is not None else None
     if _is_count_row(vals[0]):
         nu, nl = (int(v) for v in vals[0])
         pts = vals[1:]

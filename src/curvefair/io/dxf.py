@@ -204,10 +204,10 @@ def _polyline_record(e: Any, base: dict[str, Any], path: object,
                          name=base["name"], source=src, first_index=index)
 
 
-def _load(path: object, what: str) -> Any:
+def _load(path: str | os.PathLike[str], what: str) -> Any:
     ezdxf = _ezdxf(what)
     try:
-        return ezdxf.readfile(os.fspath(path))  # type: ignore[call-overload]
+        return ezdxf.readfile(os.fspath(path))
     except OSError as exc:
         if _truncated(path) == "the file is empty":
             raise FileFormatError("not a readable DXF file: the file is empty", path) from None
@@ -223,7 +223,7 @@ def _load(path: object, what: str) -> Any:
 _BINARY_SENTINEL = b"AutoCAD Binary DXF\r\n\x1a\x00"
 
 
-def _truncated(path: object) -> str | None:
+def _truncated(path: str | os.PathLike[str]) -> str | None:
     """Why the DXF file at ``path`` looks cut short, or None.
 
     Every DXF file ends with the group ``0 / EOF`` (ASCII: the lines ``0`` and ``EOF``;
@@ -232,7 +232,7 @@ def _truncated(path: object) -> str | None:
     error or a missing ENDSEC, none of which tells the user that the file is incomplete.
     """
     try:
-        with open(os.fspath(path), "rb") as fh:  # type: ignore[arg-type]
+        with open(os.fspath(path), "rb") as fh:
             head = fh.read(len(_BINARY_SENTINEL))
             fh.seek(0, os.SEEK_END)
             size = fh.tell()
@@ -252,7 +252,7 @@ def _truncated(path: object) -> str | None:
         return None
     if any(ln.upper() == b"EOF" for ln in lines):
         return None  # data after EOF (ezdxf ignores it): not a truncation
-    with open(os.fspath(path), "rb") as fh:  # type: ignore[arg-type]
+    with open(os.fspath(path), "rb") as fh:
         nlines = sum(chunk.count(b"\n") for chunk in iter(lambda: fh.read(1 << 20), b""))
     if not tail.endswith(b"\n"):
         nlines += 1
@@ -551,6 +551,7 @@ def _move_path(doc: Any, path: Any, src: list[str],
             cps = np.asarray([tuple(v)[:2] for v in ed.control_points], dtype=float)
             for (old_cps, old_knots), e in splines:
                 if cps.shape == old_cps.shape and np.array_equal(cps, old_cps) and \
+                        old_knots is not None and \
                         np.array_equal(np.asarray(ed.knot_values, dtype=float), old_knots):
                     ed.control_points = [tuple(v)[:2] for v in e.control_points]
                     ed.knot_values = [float(k) for k in e.knots]

@@ -32,7 +32,7 @@ import json
 import math
 import os
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -79,7 +79,7 @@ def _array(obj: dict[str, Any], key: str, where: str, path: object, ndim: int) -
     return arr
 
 
-def curve_from_json(obj: Any, where: str = "curve", path: object = None,
+def curve_from_json(obj: Any, where: str = "curve", path: str | os.PathLike[str] | None = None,
                     index: int = 0) -> CurveRecord:
     """One curve object of the schema -> :class:`CurveRecord` (FileFormatError if invalid)."""
     if not isinstance(obj, dict):
@@ -117,7 +117,7 @@ def curve_from_json(obj: Any, where: str = "curve", path: object = None,
         if typ == "bspline":
             ctrl = _array(obj, "control_points", where, path, 2)
             knots = _array(obj, "knots", where, path, 1)
-            curve: Any = BSplineCurve(ctrl, knots, degree, closed=closed)
+            curve: Any = BSplineCurve(ctrl, knots, cast(int, degree), closed=closed)
         elif typ == "points":
             pts = _array(obj, "points", where, path, 2)
             check_points(pts, path, None, what=f"{where} point")

@@ -75,8 +75,8 @@ def _occ(what: str) -> Any:
     return lazy_import("OCP", "cadquery-ocp", "occ", what)
 
 
-def _fmt_of(path: object) -> str:
-    ext = os.path.splitext(os.fspath(path))[1].lower()  # type: ignore[call-overload]
+def _fmt_of(path: str | os.PathLike[str]) -> str:
+    ext = os.path.splitext(os.fspath(path))[1].lower()
     return "iges" if ext in (".igs", ".iges") else "step"
 
 
@@ -238,9 +238,11 @@ def _geom(curve: BSplineCurve, z: float | None) -> Any:
 
         pnt_a, real_a, int_a = _c.Array1_gp_Pnt, _c.Array1_double, _c.Array1_int
     except (ImportError, AttributeError):  # 7.x
-        from OCP.TColgp import TColgp_Array1OfPnt as pnt_a
-        from OCP.TColStd import TColStd_Array1OfInteger as int_a
-        from OCP.TColStd import TColStd_Array1OfReal as real_a
+        import OCP.TColgp as _tg
+        import OCP.TColStd as _ts
+
+        pnt_a = _tg.TColgp_Array1OfPnt
+        int_a, real_a = _ts.TColStd_Array1OfInteger, _ts.TColStd_Array1OfReal
 
     def arr(cls: Any, vals: Sequence[Any]) -> Any:
         a = cls(1, len(vals))
@@ -450,8 +452,8 @@ def _num(v: float, exp: str = "E") -> str:
     return mant + (exp + ex if ex else "")
 
 
-def _orig_curve(edge: Any) -> tuple[Any, Any, Any]:
-    """(local Geom_BSplineCurve, edge location gp_Trsf, local curve) of a free edge."""
+def _orig_curve(edge: Any) -> tuple[Any, Any]:
+    """(local Geom_BSplineCurve, edge location gp_Trsf) of a free edge."""
     from OCP.BRep import BRep_Tool
     from OCP.GeomAbs import GeomAbs_CurveType
     from OCP.GeomAdaptor import GeomAdaptor_Curve
@@ -549,7 +551,8 @@ class _Refuse(Exception):
 
 
 def _mults(flat: FloatArray) -> tuple[list[float], list[int]]:
-    knots, mults = [], []
+    knots: list[float] = []
+    mults: list[int] = []
     for v in flat:
         if knots and v == knots[-1]:
             mults[-1] += 1
@@ -875,8 +878,8 @@ def _patch_iges(text: str, patches: list[_Patch]) -> str:
         if t == 504:                    # edge list of BRep faces: N, then (CURV, SVP, SV, EVP, EV)
             try:
                 f = params(d)
-                for q in range(int(f[1])):
-                    mark(int(f[2 + 5 * q]))
+                for e in range(int(f[1])):
+                    mark(int(f[2 + 5 * e]))
             except (ValueError, IndexError):
                 raise _Refuse(f"cannot follow the edge list at DE {d}") from None
     cands = []
@@ -886,11 +889,11 @@ def _patch_iges(text: str, patches: list[_Patch]) -> str:
         try:
             f = params(d)
             k, m = int(f[1]), int(f[2])
-            nk = k + m + 2
+            n_knots = k + m + 2
             base = 7
-            knots = np.array([_iges_real(v) for v in f[base:base + nk]])
-            w = np.array([_iges_real(v) for v in f[base + nk:base + nk + k + 1]])
-            c0 = base + nk + k + 1
+            knots = np.array([_iges_real(v) for v in f[base:base + n_knots]])
+            w = np.array([_iges_real(v) for v in f[base + n_knots:base + n_knots + k + 1]])
+            c0 = base + n_knots + k + 1
             raw = np.array([_iges_real(v) for v in f[c0:c0 + 3 * (k + 1)]]).reshape(-1, 3)
         except (ValueError, IndexError):
             continue
@@ -927,11 +930,11 @@ def _patch_iges(text: str, patches: list[_Patch]) -> str:
             nf += f[7 + len(knots):c0]
         else:
             nf += [_num(v) for v in nk] + ["1."] * (kk + 1)
-        for j, q in enumerate(new):
+        for j, pt in enumerate(new):
             for c in range(3):
                 idx = c0 + 3 * j + c
-                same = same_layout and (bool(pa.kept[j]) or q[c] == raw[j, c])
-                nf.append(f[idx] if same else _num(q[c]))
+                same = same_layout and (bool(pa.kept[j]) or pt[c] == raw[j, c])
+                nf.append(f[idx] if same else _num(pt[c]))
         tail = f[c0 + 3 * raw.shape[0]:]
         if not same_layout or nk[pa.new_p] != knots[m] or nk[-pa.new_p - 1] != knots[-m - 1]:
             tail = [_num(nk[pa.new_p]), _num(nk[-pa.new_p - 1])] + tail[2:]
@@ -953,10 +956,10 @@ def _patch_iges(text: str, patches: list[_Patch]) -> str:
         if d in start and int(b[24:32]) != len(new_blocks[d]):
             b = b[:24] + _pad(len(new_blocks[d]), b[24:32]) + b[32:]
         new_de += [a, b]
-    t = sec["T"][0]
-    if int(t[25:32]) != len(out_p):
-        t = t[:24] + "P" + _pad(len(out_p), t[25:32]) + t[32:]
-    return nl.join(sec["S"] + sec["G"] + new_de + out_p + [t]) + nl
+    tr = sec["T"][0]
+    if int(tr[25:32]) != len(out_p):
+        tr = tr[:24] + "P" + _pad(len(out_p), tr[25:32]) + tr[32:]
+    return nl.join(sec["S"] + sec["G"] + new_de + out_p + [tr]) + nl
 
 
 def _surface_curve_note(ents: dict[int, Any], params: Any) -> str:

@@ -80,9 +80,9 @@ def _rhino(what: str) -> Any:
     return lazy_import("rhino3dm", "rhino3dm", "rhino", what)
 
 
-def _load(path: object, what: str) -> Any:
+def _load(path: str | os.PathLike[str], what: str) -> Any:
     rh = _rhino(what)
-    p = os.fspath(path)  # type: ignore[call-overload]
+    p = os.fspath(path)
     try:
         size = os.path.getsize(p)
     except OSError as exc:
@@ -365,10 +365,10 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
         if obj is None:
             # files of archive version 1 store no object ids: openNURBS makes new random ones
             # at every read, so the object is found by its index in the object table
-            k = recs[0].source.get("object")
-            if isinstance(k, int) and 0 <= k < len(model.Objects) and \
-                    type(model.Objects[k].Geometry).__name__ == recs[0].source.get("geometry"):
-                obj = model.Objects[k]
+            ko = recs[0].source.get("object")
+            if isinstance(ko, int) and 0 <= ko < len(model.Objects) and \
+                    type(model.Objects[ko].Geometry).__name__ == recs[0].source.get("geometry"):
+                obj = model.Objects[ko]
         if obj is None:
             raise InputError(f"write_curves: the template has no object with id {ident}")
         before = _geometry_key(obj.Geometry)

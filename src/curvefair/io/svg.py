@@ -161,15 +161,15 @@ def bezier_chain_to_bspline(P: FloatArray, closed: bool) -> BSplineCurve:
     exact = _c0_bspline(P, t)
     if np.all(mult[:n_joins] == 3):
         return exact
-    periodic = closed and np.all(mult == 1)
+    periodic = closed and bool(np.all(mult == 1))
     try:
         cand = _fit(P, t, mult, periodic)
     except (ValueError, np.linalg.LinAlgError):
         return exact
     s = np.linspace(0.0, 1.0, 9)
-    ref = _bezier_eval(P, s).reshape(-1, dim)
+    ref_pts = _bezier_eval(P, s).reshape(-1, dim)
     u = (t[:-1, None] + h[:, None] * s[None, :]).reshape(-1)
-    if float(np.abs(cand(u) - ref).max()) <= 1e-9 * scale:
+    if float(np.abs(cand(u) - ref_pts).max()) <= 1e-9 * scale:
         return cand
     return exact
 
@@ -212,7 +212,7 @@ def _xy(z: complex) -> tuple[float, float]:
 
 
 def _segments_to_cubics(seg: Any, spt: Any) -> FloatArray:
-    out = []
+    out: list[list[Any]] = []
     for g in seg:
         if isinstance(g, spt.CubicBezier):
             out.append([_xy(g.start), _xy(g.control1), _xy(g.control2), _xy(g.end)])
@@ -286,9 +286,9 @@ def _path_elements(text: str, path: object) -> list[ET.Element]:
     return [el for el in root.iter() if _local(el.tag) == "path"]
 
 
-def _read_text(path: object) -> str:
+def _read_text(path: str | os.PathLike[str]) -> str:
     try:
-        with open(os.fspath(path), "rb") as f:  # type: ignore[call-overload]
+        with open(os.fspath(path), "rb") as f:
             raw = f.read()
     except OSError as exc:
         raise FileFormatError(f"cannot read the file: {exc.strerror or exc}", path) from None
