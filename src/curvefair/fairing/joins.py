@@ -483,9 +483,15 @@ def _g2_through(jplan: JoinPlan, R0: BSplineCurve, knot: dict[int, float], left:
                 if len(r) == 1 and next(iter(r.values())) == 1.0}
         changed = [i for i in range(n0) if i not in unit]
 
-        def owner(i: int, acc: tuple[int, ...] = tuple(acc)) -> int:
+        ids = sorted(acc, key=lambda jq: left[jq])
+        pos = np.array([left[jq] + 0.5 for jq in ids])
+
+        def owner(i: int, ids: list[int] = ids, pos: np.ndarray = pos) -> int:
             """The join whose removal changed row ``i`` of ``R0`` (the nearest one)."""
-            return min(acc, key=lambda jq: abs(left[jq] + 0.5 - i))
+            k = int(np.searchsorted(pos, i))
+            if k == len(ids) or (k > 0 and i - pos[k - 1] <= pos[k] - i):
+                k -= 1
+            return ids[k]
 
         bad = {owner(i) for i in changed if i in fixed}
         if not bad:
