@@ -30,7 +30,9 @@ Hull networks
 splines) that lies within ``shared_distance`` of a point of another curve of the same file
 (default ``1e-9`` times the drawing's bounding-box diagonal): station / longitudinal
 intersections of an offsets table stay where they are in both curves, so the network stays
-connected.
+connected. Where two B-spline records cross inside a knot span (at no control point of
+either), :func:`shared_crossings` finds the crossing and holds the ``degree + 1`` control
+points of the span in each curve, which keeps the crossing point exactly in both.
 """
 
 from __future__ import annotations
@@ -392,6 +394,115 @@ def shared_points(records: Sequence[Any], distance: float | None = None) -> list
     return out
 
 
+def _span_support(curve: Any, u: float) -> set[int]:
+    """Control-point indices of the ``degree + 1`` basis functions of the knot span holding
+    ``u`` (both spans when ``u`` is within rounding of a knot): holding them keeps ``C(u)``."""
+    p = curve.degree
+    t = np.asarray(curve.knots)
+    lo, hi = curve.domain
+    u = min(max(u, lo), hi)
+    out: set[int] = set()
+    eps = 1e-12 * max(hi - lo, 1e-300)
+    for v in {u - eps, u, u + eps}:
+        v = min(max(v, lo), hi)
+        k = int(np.searchsorted(t, v, side="right")) - 1
+        k = min(max(k, p), t.shape[0] - p - 2)
+        while k > p and t[k] == t[k + 1]:  # an empty span at the domain's end
+            k -= 1
+        out.update(int(i) for i in curve.control_index(np.arange(k - p, k + 1)))
+    return out
+
+
+def _samples(curve: Any, per_span: int = 16) -> tuple[np.ndarray, np.ndarray]:
+    """``(u, C(u))`` at ``per_span`` equal steps in every knot span (ends included)."""
+    br = np.asarray(curve.piecewise.breaks)
+    f = np.linspace(0.0, 1.0, per_span, endpoint=False)
+    u = np.append((br[:-1, None] + f[None, :] * np.diff(br)[:, None]).ravel(), br[-1])
+    return u, np.asarray(curve(u))
+
+
+def _held_shared(records: Sequence[Any], distance: float | None) -> list[list[int]]:
+    """:func:`shared_points` and :func:`shared_crossings` together, per record."""
+    pts = shared_points(records, distance)
+    cross = shared_crossings(records, distance)
+    return [sorted(set(a) | set(b)) for a, b in zip(pts, cross, strict=True)]
+
+
+def shared_crossings(records: Sequence[Any], distance: float | None = None
+                     ) -> list[list[int]]:
+    """For every B-spline record, the control points to hold so that each place where it
+    meets another B-spline record of the file -- a crossing inside a knot span, not at a
+    control point -- stays where it is in both curves.
+
+    Two curves meet at ``(u, v)`` when ``|A(u) - B(v)| <= distance`` (default ``1e-9`` times
+    the bounding-box diagonal of all control points). Candidates are the local minima along
+    ``A``'s samples (16 per span) of the distance to ``B``'s nearest sample, refined by
+    Gauss-Newton on ``A(u) - B(v)`` (scipy ``least_squares``, bounded to the domains). Holding
+    the ``degree + 1`` control points whose basis functions are non-zero at ``u`` keeps
+    ``A(u)`` exactly (``A(u) = sum_i N_i(u) P_i``), and the same at ``v`` in ``B``: the
+    crossing point is unchanged in both, so the network stays connected. Point-data records
+    (interpolating Hermite curves, re-interpolated after every step) are not handled here;
+    their shared vertices are held by :func:`shared_points`.
+    """
+    from scipy.optimize import least_squares
+    from scipy.spatial import cKDTree
+
+    from .curves.bspline import BSplineCurve
+
+    out: list[set[int]] = [set() for _ in records]
+    idx = [k for k, r in enumerate(records) if isinstance(r.curve, BSplineCurve)]
+    if len(idx) < 2:
+        return [[] for _ in records]
+    dim = max(records[k].curve.dim for k in idx)
+
+    def pad(x: np.ndarray) -> np.ndarray:
+        x = np.atleast_2d(x)
+        return np.c_[x, np.zeros((x.shape[0], dim - x.shape[1]))] if x.shape[1] < dim else x
+
+    if distance is None:
+        allp = np.vstack([pad(np.asarray(records[k].curve.control_points)) for k in idx])
+        distance = 1e-9 * float(np.linalg.norm(allp.max(axis=0) - allp.min(axis=0)))
+    samp = {k: _samples(records[k].curve) for k in idx}
+    trees = {k: cKDTree(pad(samp[k][1])) for k in idx}
+    for ia, a in enumerate(idx):
+        ca = records[a].curve
+        ua, xa = samp[a][0], pad(samp[a][1])
+        for b in idx[ia + 1:]:
+            cb = records[b].curve
+            ub = samp[b][0]
+            d, j = trees[b].query(xa)
+            # a crossing lies within a sample step of both polylines
+            step = max(float(np.linalg.norm(np.diff(xa, axis=0), axis=1).max()),
+                       float(np.linalg.norm(np.diff(pad(samp[b][1]), axis=0), axis=1).max()))
+            near = d <= step + distance
+            if not near.any():
+                continue
+            dd = np.where(near, d, np.inf)
+            loc = np.flatnonzero(near & (dd <= np.r_[np.inf, dd[:-1]])
+                                 & (dd <= np.r_[dd[1:], np.inf]))
+            (la, ha), (lb, hb) = ca.domain, cb.domain
+
+            def res(x: np.ndarray, ca: Any = ca, cb: Any = cb) -> np.ndarray:
+                return (pad(np.asarray(ca(np.array([x[0]])))) -
+                        pad(np.asarray(cb(np.array([x[1]])))))[0]
+
+            seen: list[tuple[float, float]] = []
+            for i in loc[:1000]:
+                x0 = np.array([ua[i], ub[j[i]]])
+                sol = least_squares(res, x0, bounds=([la, lb], [ha, hb]), xtol=1e-15,
+                                    ftol=1e-15, gtol=1e-15, max_nfev=100)
+                u, v = float(sol.x[0]), float(sol.x[1])
+                if float(np.linalg.norm(res(sol.x))) > distance:
+                    continue
+                if any(abs(u - s0) <= 1e-9 * (ha - la) and abs(v - s1) <= 1e-9 * (hb - lb)
+                       for s0, s1 in seen):
+                    continue
+                seen.append((u, v))
+                out[a].update(_span_support(ca, u))
+                out[b].update(_span_support(cb, v))
+    return [sorted(o) for o in out]
+
+
 # ------------------------------------------------------------------------------------------
 # one file
 # ------------------------------------------------------------------------------------------
@@ -508,7 +619,7 @@ def _fair_file(infile: str, outfile: str | None, options: Mapping[str, Any] | No
         return _finish(rep, report, dry_run)
     if progress is not None:
         progress("curves", len(records))
-    shared = (shared_points(records, opts["shared_distance"]) if opts["hold_shared"]
+    shared = (_held_shared(records, opts["shared_distance"]) if opts["hold_shared"]
               else [[] for _ in records])
     rows: list[dict[str, Any]] = []
     faired = []

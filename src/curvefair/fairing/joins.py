@@ -20,9 +20,16 @@ geometry the curve's author drew on purpose. :func:`plan` looks at the curve fir
   point within ``tol`` of its original position (a knot-insertion row is a convex
   combination).
 * **G2 joins** (the curvature also continuous, to ``1e-6`` of its size, at a C0 or C1 knot of a
-  curve that is not C2 there): the control points on which the value, tangent and second
-  derivative on either side depend are held, which keeps position, tangent and curvature of
-  both sides exactly.
+  curve that is not C2 there) of open curves of degree >= 3 are faired through when that is
+  cheap: after the G1 step above (C0 knots) the join is C1 with ``r''_+ - r''_- = beta2 r'``
+  (Farin's beta-constraints, ``beta1 = 1``); one more knot copy is removed by least squares
+  (only the two control points beside the join move, by the residual, which is zero when
+  ``beta2 = 0``), so the method fairs a curve that is C2 there and the result, written back
+  on the original knots by knot insertion, is G2 to rounding whatever the method does
+  (:func:`_g2_through`). When the residual plus the G1 step's ``err`` exceeds ``tol / 4``,
+  or one of those points is held, the join is held instead: the control points on which the
+  value, tangent and second derivative on either side depend, which keeps position, tangent
+  and curvature of both sides exactly.
 * **corners** (a C0 knot whose tangents differ by more than ``g1_angle``): the join point
   ``P_j`` is held; the corner stays where it is and stays a corner.
 * **straight pieces**: the control points of a knot span whose control points are collinear
@@ -124,6 +131,10 @@ class JoinPlan:
     _orig: BSplineCurve | None = None
     _keep: np.ndarray | None = None  # original index of each reduced control point
     _ins: list[tuple[int, int, int, float]] = field(default_factory=list)  # (j, jl, jr, a)
+    # G2 joins faired through (second knot copy removed): the knot-insertion matrix from
+    # ``curve``'s control points to those of the once-reduced curve, and each column's row
+    _g2: Any = None
+    _g2_row: np.ndarray | None = None
 
     @property
     def reduced(self) -> bool:
@@ -144,6 +155,8 @@ class JoinPlan:
             return faired
         assert isinstance(faired, BSplineCurve) and self._keep is not None
         Q = np.asarray(faired.control_points)
+        if self._g2 is not None:
+            Q = np.asarray(self._g2 @ Q)
         P = np.empty((self._orig.n_ctrl, Q.shape[1]))
         P[self._keep] = Q
         for j, jl, jr, a in self._ins:
@@ -154,7 +167,10 @@ class JoinPlan:
         """Map indices of ``curve``'s control points to the input's."""
         if self._keep is None:
             return np.asarray(idx)
-        return self._keep[np.asarray(idx, dtype=np.int64)]
+        idx = np.asarray(idx, dtype=np.int64)
+        if self._g2_row is not None:
+            idx = self._g2_row[idx]
+        return self._keep[idx]
 
 
 def _size(pts: FloatArray) -> float:
@@ -189,7 +205,8 @@ def _side_support(curve: BSplineCurve, span: int, u: float, nder: int) -> list[i
 
 
 def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozenset[int],
-                  g1: float, tol: float | None, allow_reduce: bool = True) -> JoinPlan:
+                  g1: float, tol: float | None, allow_reduce: bool = True,
+                  no_g2: frozenset[int] = frozenset()) -> JoinPlan:
     p = curve.degree
     t = np.asarray(curve.knots, dtype=float)
     P = np.asarray(curve.control_points, dtype=float)
@@ -197,7 +214,7 @@ def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozense
     eps = _ROUND * _size(P)
     hold: set[int] = set()
     rep: dict[str, Any] = {"g1_joins": 0, "g1_joins_reparametrised": 0, "g2_joins_held": 0,
-                           "corners_held": 0, "straight_spans_held": 0}
+                           "g2_joins_faired": 0, "corners_held": 0, "straight_spans_held": 0}
 
     # straight spans: every control point of a span lying on one line
     straight, rep["straight_spans_held"] = _straight_spans(curve, P, eps)
@@ -209,6 +226,8 @@ def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozense
     pp = curve.piecewise
     br = np.asarray(pp.breaks)
     reduce: list[tuple[int, int, float, float]] = []  # (j, knot position a, dl, dr)
+    g2_cand: dict[int, set[int]] = {}  # G2 C0 join point -> the control points it depends on
+    g2_c1: dict[int, set[int]] = {}  # G2 C1 knot (first index in t) -> the same
     # candidates: interior knots of multiplicity p - 1 or p (C1 / C0); C2 or smoother knots
     # are left to the method, which cannot break them
     cand = (vals > lo) & (vals < hi) & (counts <= p) & (counts >= p - 1)
@@ -246,10 +265,18 @@ def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozense
             if abs(kl - kr) <= _G2_REL * max(abs(kl), abs(kr)) and max(abs(kl), abs(kr)) > 0:
                 sl = int(np.searchsorted(t, v, side="left")) - 1  # span ending at v
                 sr = int(np.searchsorted(t, v, side="right")) - 1  # span starting at v
-                hold.update(_side_support(curve, sl, v, 2))
-                hold.update(_side_support(curve, sr, v, 2))
-                rep["g2_joins_held"] += 1
-                continue
+                sup = set(_side_support(curve, sl, v, 2)) | set(_side_support(curve, sr, v, 2))
+                through = p >= 3 and not curve.closed and allow_reduce
+                if c0 and through and (a - 1) not in protect and (a - 1) not in no_g2:
+                    g2_cand[a - 1] = sup  # faired through if both knot copies can go (below)
+                elif (m == p - 1 and through and not protect & {a - 2, a - 1}
+                      and -a - 1 not in no_g2):
+                    g2_c1[a] = sup  # a C1 knot: faired through if one copy can go (below)
+                    continue
+                else:
+                    hold.update(sup)
+                    rep["g2_joins_held"] += 1
+                    continue
         if not c0:
             continue  # C1 or smoother: the method keeps the tangent continuous itself
         j = int(a - 1)
@@ -310,7 +337,7 @@ def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozense
         else:
             errs[j] = e
     reduce = [r for r in reduce if r[0] in errs]
-    if reduce:
+    if reduce or g2_c1:
         # block scales: blocks are separated by the C0 knots; s_{b+1}/s_b from each reduced join
         c0_knots = [float(v) for v, m in zip(vals, counts, strict=True)
                     if lo < v < hi and m == p]
@@ -327,9 +354,12 @@ def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozense
         edges = np.array([lo] + c0_knots + [hi])
         # phi: piecewise linear, slope scales[b] on block b, phi(lo) = lo
         phi_e = lo + np.r_[0.0, np.cumsum(np.diff(edges) * np.array(scales))]
-        tau = np.interp(t, edges, phi_e)
-        tau[t <= lo] = lo
-        tau[t >= hi] = phi_e[-1]
+        if ratio:
+            tau = np.interp(t, edges, phi_e)
+            tau[t <= lo] = lo
+            tau[t >= hi] = phi_e[-1]
+        else:  # only G2 C1 knots to remove: the curve's own parameter
+            tau = t.copy()
         drop_j = {j for j, *_ in reduce if float(t[j + 1]) in ratio}
         drop_knot = sorted(j + 1 for j in drop_j)
         keep = np.array([i for i in range(n) if i not in drop_j], dtype=np.int64)
@@ -344,6 +374,10 @@ def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozense
             w = dl2 / (dl2 + dr2)
             ins.append((j, j - 1, j + 1, w))
             err = max(err, float(np.linalg.norm((1.0 - w) * P[j - 1] + w * P[j + 1] - P[j])))
+        for jj, sup in g2_cand.items():
+            if jj not in drop_j:  # its G1 reduction was refused: hold what keeps it G2
+                hold.update(sup)
+                rep["g2_joins_held"] += 1
         inv = {int(o): r for r, o in enumerate(keep)}
         jplan.curve = R0
         jplan._orig = curve
@@ -357,12 +391,156 @@ def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozense
             if i not in inv:  # a dropped join point asked to hold: hold its neighbours
                 hold_r.update((inv[i - 1], inv[i + 1]))
         prot_r = {inv[i] for i in protect if i in inv}
-        jplan.protect = frozenset(hold_r | prot_r)
+        g2_js = sorted(jj for jj in g2_cand if jj in drop_j)
+        # C1 knots (key -a - 1 apart from the join points): rows a-2, a-1 of the input change
+        for a, sup in g2_c1.items():
+            if a - 2 in inv and a - 1 in inv:
+                g2_cand[-a - 1] = sup
+                g2_js.append(-a - 1)
+            else:
+                hold.update(sup)
+                rep["g2_joins_held"] += 1
+        fixed = hold_r | prot_r
+        if g2_js:
+            knot_of = {jj: float(tau[jj + 1] if jj >= 0 else tau[-jj - 1]) for jj in g2_js}
+            left = {jj: inv[jj - 1] if jj >= 0 else inv[-jj - 3] for jj in g2_js}
+            sup_r = {jj: {inv[i] for i in g2_cand[jj] if i in inv}
+                     | ({inv[jj - 1], inv[jj + 1]} if jj >= 0 else set()) for jj in g2_js}
+            fixed = _g2_through(jplan, R0, knot_of, left, sup_r, fixed, tol, err, rep)
+            refused = rep.pop("_g2_refused")
+            if refused:  # plan again holding those joins exactly as before (no reduction)
+                return _bspline_plan(curve, clamp, protect, g1, tol, allow_reduce,
+                                     no_g2 | frozenset(refused))
+        jplan.protect = frozenset(fixed)
         rep["held"] = sorted(hold)
         return jplan
     jplan.protect = frozenset(hold | set(protect))
     rep["held"] = sorted(hold)
     return jplan
+
+
+def _insert_rows(U: FloatArray, rows: list[dict[int, float]], p: int, u: float
+                 ) -> tuple[FloatArray, list[dict[int, float]]]:
+    """Boehm's knot insertion of ``u`` into ``U`` (Piegl & Tiller A5.1) applied to control
+    points given as rows of weights over some basis: ``Q_i = a_i P_i + (1 - a_i) P_{i-1}``
+    for ``k - p < i <= k - s``, ``a_i = (u - U_i) / (U_{i+p} - U_i)``, the others copied."""
+    k = int(np.searchsorted(U, u, side="right")) - 1
+    m = int(np.count_nonzero(U == u))
+    new = rows[:k - p + 1]
+    for i in range(k - p + 1, k - m + 1):
+        a = float((u - U[i]) / (U[i + p] - U[i]))
+        row: dict[int, float] = {}
+        for q, w in rows[i].items():
+            if a * w != 0.0:
+                row[q] = row.get(q, 0.0) + a * w
+        for q, w in rows[i - 1].items():
+            if (1.0 - a) * w != 0.0:
+                row[q] = row.get(q, 0.0) + (1.0 - a) * w
+        new.append(row)
+    new.extend(rows[k - m:])
+    return np.insert(U, k + 1, u), new
+
+
+def _g2_through(jplan: JoinPlan, R0: BSplineCurve, knot: dict[int, float], left: dict[int, int],
+                sup_r: dict[int, set[int]], fixed: set[int], tol: float | None, err1: float,
+                rep: dict[str, Any]) -> set[int]:
+    """Fair through the G2 joins ``knot`` (join point index -> its knot in ``R0``, the
+    once-reduced curve, where the join is C1 with a knot of multiplicity ``degree - 1``).
+
+    A G2 join made C1 by the block scaling satisfies ``r''_+ - r''_- = beta2 r'`` (Farin's
+    beta-constraints with ``beta1 = 1``). Removing one more knot copy makes it C2 in the scaled
+    parameter -- curvature continuous, and G2 whatever the method then does -- at the cost of
+    the least-squares residual of the removal: with ``A`` the knot-insertion matrix back to
+    ``R0`` (rows are convex combinations), the free control points (those that are not the
+    copy of one ``R0`` point) solve ``min |A Q - R0|`` with the others fixed to their ``R0``
+    values, so only the two points of ``R0`` beside each join move, by ``|A Q - R0|``. A
+    join is refused (its support held instead, as before) when that residual plus the first
+    reduction's ``err1`` exceeds ``tol / 4``, or when one of those two points is held.
+    Sets ``jplan``'s curve, insertion matrix and margin (the largest distance of the restored
+    control points from the input's, measured); returns what to protect on the new curve.
+    """
+    from scipy.sparse import csr_matrix
+    from scipy.sparse.linalg import spsolve
+
+    p = R0.degree
+    tau = np.asarray(R0.knots)
+    Q0 = np.asarray(R0.control_points)
+    n0 = Q0.shape[0]
+    acc = sorted(knot)
+    refused: list[int] = []
+    fixed = set(fixed)
+    lim = None if tol is None else 0.25 * tol - err1
+    while acc:
+        U2 = tau.copy()
+        for jj in acc:
+            U2 = np.delete(U2, int(np.flatnonzero(U2 == knot[jj])[-1]))
+        n2 = n0 - len(acc)
+        rows: list[dict[int, float]] = [{i: 1.0} for i in range(n2)]
+        U = U2
+        for jj in acc:
+            U, rows = _insert_rows(U, rows, p, knot[jj])
+        unit = {i: next(iter(r)) for i, r in enumerate(rows)
+                if len(r) == 1 and next(iter(r.values())) == 1.0}
+        changed = [i for i in range(n0) if i not in unit]
+
+        ids = sorted(acc, key=lambda jq: left[jq])
+        pos = np.array([left[jq] + 0.5 for jq in ids])
+
+        def owner(i: int, ids: list[int] = ids, pos: np.ndarray = pos) -> int:
+            """The join whose removal changed row ``i`` of ``R0`` (the nearest one)."""
+            k = int(np.searchsorted(pos, i))
+            if k == len(ids) or (k > 0 and i - pos[k - 1] <= pos[k] - i):
+                k -= 1
+            return ids[k]
+
+        bad = {owner(i) for i in changed if i in fixed}
+        if not bad:
+            r_i = np.repeat(np.arange(n0), [len(r) for r in rows])
+            c_i = np.fromiter((q for r in rows for q in r), dtype=np.int64)
+            w_i = np.fromiter((w for r in rows for w in r.values()), dtype=float)
+            A = csr_matrix((w_i, (r_i, c_i)), shape=(n0, n2))
+            fixed_cols = np.array(sorted(unit.values()), dtype=np.int64)
+            free = np.setdiff1d(np.arange(n2), fixed_cols)
+            Q2 = np.empty((n2, Q0.shape[1]))
+            back = {c: i for i, c in unit.items()}
+            Q2[fixed_cols] = Q0[[back[int(c)] for c in fixed_cols]]
+            Ac = A[changed]
+            rhs = Q0[changed] - Ac[:, fixed_cols] @ Q2[fixed_cols]
+            Af = Ac[:, free]
+            sol = spsolve((Af.T @ Af).tocsc(), Af.T @ rhs)
+            Q2[free] = np.asarray(sol).reshape(len(free), -1)
+            res = np.linalg.norm(A @ Q2 - Q0, axis=1)
+            worst: dict[int, float] = {}
+            for i in changed:
+                o = owner(i)
+                worst[o] = max(worst.get(o, 0.0), float(res[i]))
+            if lim is not None:
+                bad = {jj for jj, e in worst.items() if not e <= lim}
+            bad |= {jj for jj, e in worst.items() if not np.isfinite(e)}
+        if bad:
+            for jj in bad:
+                acc.remove(jj)
+                refused.append(jj)
+                fixed |= sup_r[jj]
+            continue
+        R2 = BSplineCurve(Q2, U2, p, closed=False)
+        row_of = np.array([back.get(c, int(np.argmax(A[:, c].toarray()))) for c in range(n2)],
+                          dtype=np.int64)
+        jplan.curve = R2
+        jplan._g2 = A
+        jplan._g2_row = row_of
+        restored = np.asarray(jplan.restore(R2).control_points)
+        assert jplan._orig is not None
+        jplan.margin = float(np.linalg.norm(
+            restored - np.asarray(jplan._orig.control_points), axis=1).max())
+        rep["g2_joins_faired"] = len(acc)
+        rep["g2_joins_held"] += len(refused)
+        rep["g2_reduction_error"] = float(max(worst.values()))
+        rep["_g2_refused"] = refused
+        return {unit[i] for i in fixed}
+    rep["g2_joins_held"] += len(refused)
+    rep["_g2_refused"] = refused
+    return fixed
 
 
 def plan(curve: PiecewiseCurve, clamp: tuple[str, str], protect: frozenset[int],
