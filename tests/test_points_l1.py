@@ -94,20 +94,53 @@ def test_tube_qp_matches_scipy_minimize_and_kkt() -> None:
     assert np.all(mu[off] <= 1e-6 * max(mu.max(), 1e-300))
 
 
-def test_points_l1_tolerance_and_rebuilt_curve() -> None:
+def test_points_l1_tolerance_on_the_input_parameters() -> None:
+    """The result is the natural cubic through q at the INPUT's parameters (scipy's
+    CubicSpline), within tol of the input's at equal parameter (dense sampling), and
+    fairer both as returned and as rebuilt from its points (chord lengths of q)."""
     p = _noisy_arc(60, 1e-3, seed=7)
     tol = 4e-3
     res = points_l1(p, tol, hold=[0, 59], curve_tol=False)
     q = np.asarray(res.points)
     assert all(np.linalg.norm(q[i] - p[i]) <= tol for i in range(len(p)))
     assert np.array_equal(q[[0, -1]], p[[0, -1]])
-    # the curve is the chord-length natural cubic through q (what a reader rebuilds)
-    cs = CubicSpline(_chord(q), q, bc_type="natural")
-    uu = np.linspace(0.0, _chord(q)[-1], 5001)
-    assert np.allclose(res.curve(uu), cs(uu), atol=1e-12)
+    u = _chord(p)
+    uu = np.unique(np.r_[np.linspace(0.0, u[-1], 40001), u])
+    cq = CubicSpline(u, q, bc_type="natural")
+    assert np.allclose(res.curve(uu), cq(uu), rtol=0.0, atol=1e-12)
+    dist = np.linalg.norm(cq(uu) - CubicSpline(u, p, bc_type="natural")(uu), axis=1)
+    assert dist.max() <= tol
+    assert res.report["param_deviation"] <= tol
     before = analyze(interpolate_cubic(p)).extrema
-    after = analyze(res.curve).extrema
-    assert after < before / 3
+    assert analyze(res.curve).extrema < before / 2
+    assert analyze(interpolate_cubic(q)).extrema < before
+
+
+def test_fair_result_lives_on_the_input_domain() -> None:
+    """fair(..., "points-l1"): same parameters as the input, so evaluating at the input's
+    parameters works, and the equal-parameter deviation (dense sampling against scipy) is
+    within tol and what the report says (to the sampling)."""
+    p = _noisy_arc(40, 1e-3, seed=4)
+    c = interpolate_cubic(p)
+    tol = 4e-3
+    res = fair(c, "points-l1", tol=tol)
+    out = res.curve
+    assert out.domain == c.domain
+    u = np.asarray(c.params)
+    np.testing.assert_array_equal(np.asarray(out.params), u)
+    np.testing.assert_allclose(out(u), np.asarray(out.points), rtol=0, atol=1e-12)
+    uu = np.unique(np.r_[np.linspace(u[0], u[-1], 40001), u])
+    a = CubicSpline(u, p, bc_type="natural")(uu)
+    b = CubicSpline(u, np.asarray(out.points), bc_type="natural")(uu)
+    np.testing.assert_allclose(out(uu), b, rtol=0, atol=1e-12)
+    d = np.linalg.norm(a - b, axis=1).max()
+    assert d <= tol
+    assert d <= res.report["max_deviation_upper_bound"] <= tol
+    assert abs(res.report["max_deviation"] - d) <= 1e-3 * tol
+    assert res.report["extrema_after"] < res.report["extrema_before"]
+    # a not-a-knot interpolant is not what points-l1 returns for unmoved points: refused
+    with pytest.raises(InputError, match="natural"):
+        fair(interpolate_cubic(p, "chord", "not-a-knot"), "points-l1", tol=tol)
 
 
 def test_fair_method_registered_and_refusals() -> None:
