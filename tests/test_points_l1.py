@@ -209,3 +209,29 @@ def test_default_only_for_natural_chord_point_data_up_to_the_size_limit():
     assert not pl._prefer(interpolate_cubic(np.c_[big, np.sin(big)]))
     # an explicit request is honoured whatever the size or kind
     assert "points-l1" in available_methods(clamped)
+
+
+def test_rebuilt_distance_matches_dense_hausdorff() -> None:
+    """The on-disk check's distance (per-span bound, sampled where it is not sharp) against an
+    independent Hausdorff distance: both curves from scipy's CubicSpline sampled 200,000
+    times, nearest points both ways with scipy's cKDTree."""
+    from scipy.spatial import cKDTree
+
+    from curvefair.fairing.points_l1 import _matched_bound, _rebuilt_distance
+
+    p = _noisy_arc(50, 1e-3, seed=11)
+    tol = 4e-3
+    res = points_l1(p, tol, hold=[0, 49], curve_tol=False)
+    q = np.asarray(res.points)
+    a = CubicSpline(_chord(p), p, bc_type="natural")(np.linspace(0, _chord(p)[-1], 200001))
+    b = CubicSpline(_chord(q), q, bc_type="natural")(np.linspace(0, _chord(q)[-1], 200001))
+    h = max(cKDTree(b).query(a)[0].max(), cKDTree(a).query(b)[0].max())
+    spacing = np.linalg.norm(np.diff(a, axis=0), axis=1).max()
+    ca, cb = interpolate_cubic(p), interpolate_cubic(q)
+    # the per-span bound is an upper bound; the refined figure is the distance to sampling
+    assert _matched_bound(ca, cb).max() >= h - spacing
+    # a tol above the bound: the bound itself (no refinement)
+    big = 2.0 * _matched_bound(ca, cb).max()
+    assert _rebuilt_distance(ca, cb, big) == _matched_bound(ca, cb).max()
+    d = _rebuilt_distance(ca, cb, 0.5 * h)  # every span refined: the sampled distance
+    assert abs(d - h) <= 1e-3 * h + spacing

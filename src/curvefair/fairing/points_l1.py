@@ -99,8 +99,9 @@ class PointsL1Result:
         ``rounds`` (reweighting rounds), ``newton_steps``, ``stop_reason``, ``n_active``,
         ``jumps_l1_before`` / ``jumps_l1_after`` (``sum_k |J_k|`` on the input's parameters),
         ``attempts`` (solves with shrunk radii), ``param_deviation`` (certified bound of the
-        equal-parameter deviation), ``curve_deviation`` (Hausdorff distance of the curve
-        rebuilt from the points, chord lengths of ``q``, from the input's chord interpolant),
+        equal-parameter deviation), ``curve_deviation`` (upper bound of the Hausdorff
+        distance of the curve rebuilt from the points, chord lengths of ``q``, from the
+        input's chord interpolant, :func:`_rebuilt_distance`; None without ``curve_tol``),
         ``scale`` (factor of a final scaling of the moves, 1.0: none).
     """
 
@@ -293,7 +294,8 @@ def _block_diag(W: FloatArray) -> sp.csr_matrix:
 def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
               hold: ArrayLike = (), rounds: int = 5, delta: float = 1e-5, beta: float = 1e-6,
               tau: float = 1.0, max_steps: int = 80, curve_tol: bool = True,
-              samples: int = 3, max_attempts: int = 4) -> PointsL1Result:
+              samples: int = 3, max_attempts: int = 4, warm: float = 0.9,
+              round_gap: float = 1e-6, warm_lam: bool = True) -> PointsL1Result:
     """The natural cubic through moved points with the sparsest third-derivative jumps.
 
     Parameters
@@ -321,9 +323,10 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
     curve_tol : bool
         Also keep the curve rebuilt from the written points (the chord-length natural cubic
         through ``q``) within ``tol`` of the input's chord-length natural cubic as a curve
-        (Hausdorff distance, :func:`curvefair.deviation`), as the read-back check of a
-        written point file measures it: when it strays farther, the radii are scaled by
-        ``0.98 tol / distance`` and the problem solved again (at most 4 times).
+        (Hausdorff distance, :func:`_rebuilt_distance`), as the read-back check
+        of a written point file measures it: when it strays farther, the radii are scaled by
+        ``0.98 tol / bound`` and the problem solved again (``max_attempts`` times at most;
+        the equal-parameter bound shrinks them the same way).
     samples : int
         Curve samples per span (equally spaced inside it) constrained like the data points:
         ``|S_q(s) - S_p(s)| <= tol``; the certified bound then rarely needs the final scaling.
@@ -400,18 +403,27 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
     curve_dev = None
     ref = interpolate_cubic(p_in, "chord", "natural") if curve_tol else None
     reason = "converged"
+    w = np.ones(N - 2)
+    x = xp
+    lam = None
+    floor = None
+    shrink = 1.0
     while True:
         attempts += 1
         rad = np.r_[rad_p, rad_s]
-        w = np.ones(N - 2)
-        x = xp
-        lam = None
-        floor = None
-        for r in range(max(1, int(rounds))):
+        # a new attempt (radii shrunk by ``shrink``) goes on from the weights and the solution
+        # of the last one, with two more rounds
+        nr = max(1, int(rounds)) if attempts == 1 else min(2, max(1, int(rounds)))
+        for r in range(nr):
             K = _energy_matrix(ops, w, b, Pn, tau)
             # strictly feasible start: the last solution pulled toward the input's curve
-            x0 = xp + 0.9 * (x - xp) if r > 0 else xp
-            x, lam, st, reason = _tube_qp(K, C, x0, Y, rad, max_steps=max_steps)
+            x0 = xp + (warm * shrink) * (x - xp) if (r > 0 or attempts > 1) else xp
+            shrink = 1.0
+            last = r == nr - 1
+            x, lam, st, reason = _tube_qp(K, C, x0, Y, rad, max_steps=max_steps,
+                                          gap=1e-9 if last else round_gap,
+                                          lam0=None if (lam is None or not warm_lam)
+                                          else np.maximum(lam, 1e-3))
             newton += st
             rounds_done += 1
             jn = _jump_norms(ops, x, Pn)
@@ -437,13 +449,10 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
             # the curve rebuilt from the written points (chord-length parameters of q): the
             # read-back check of a point file measures its (Hausdorff) distance from the
             # input's chord-length interpolant
-            from ..analysis import deviation
-            from ..analysis._deviation import geometric_upper_bound
-
+            # (:func:`_rebuilt_distance`: an O(n) bound, sampled where it is not sharp; the
+            # geometric distance of :func:`curvefair.deviation` takes seconds at 10,000 points)
             rebuilt = interpolate_cubic(np.array(q_out), "chord", "natural")
-            curve_dev = float(geometric_upper_bound(ref, rebuilt))
-            if curve_dev > tol_out:
-                curve_dev = float(deviation(ref, rebuilt).max_distance)
+            curve_dev = _rebuilt_distance(ref, rebuilt, tol_out)
             if curve_dev > tol_out:
                 shrink = min(shrink, 0.98 * tol_out / curve_dev)
         if shrink >= 1.0 or attempts > max_attempts:
@@ -464,6 +473,86 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
               "scale": float(cert.scale)}
     q_out.setflags(write=False)
     return PointsL1Result(q_out, curve, report)
+
+
+#: values at 0, 1/3, 2/3, 1 -> Bernstein control points of a cubic
+_TO_BERNSTEIN = np.linalg.inv(np.array([[(1 - x) ** 3, 3 * x * (1 - x) ** 2, 3 * x * x * (1 - x),
+                                         x ** 3] for x in (0.0, 1 / 3, 2 / 3, 1.0)]))
+
+
+def _matched_bound(a: CubicHermite, b: CubicHermite, pieces: int = 4) -> FloatArray:
+    """Per span, an upper bound of the Hausdorff distance of two cubic Hermite curves through
+    the same number of points: ``max_t |b(t) - a(psi(t))|`` with ``psi`` the piecewise-linear map of
+    ``b``'s parameters onto ``a``'s (point ``i`` to point ``i``). Every point of either curve
+    then has a point of the other within that distance. On each span ``a o psi - b`` is one
+    cubic (Hermite data: the point differences and the tangents, ``a``'s scaled by the span
+    ratio); its ``pieces`` sub-pieces are bounded by their Bernstein control points (convex
+    hull), up to rounding of the coordinates."""
+    ua, ub = np.asarray(a.params), np.asarray(b.params)
+    ha, hb = np.diff(ua), np.diff(ub)
+    pa, pb = np.asarray(a.points), np.asarray(b.points)
+    ta, tb = np.asarray(a.tangents), np.asarray(b.tangents)
+    r = (ha / hb)[:, None]
+    d0, d1 = pa[:-1] - pb[:-1], pa[1:] - pb[1:]
+    # derivatives with respect to the span's unit parameter s = (t - t_i) / hb
+    m0 = ta[:-1] * r * hb[:, None] - tb[:-1] * hb[:, None]
+    m1 = ta[1:] * r * hb[:, None] - tb[1:] * hb[:, None]
+    best = np.zeros(len(ha))
+    k = np.arange(4) / 3.0
+    for j in range(pieces):
+        s = (j + k) / pieces
+        h00 = 2 * s ** 3 - 3 * s ** 2 + 1
+        h10 = s ** 3 - 2 * s ** 2 + s
+        h01 = -2 * s ** 3 + 3 * s ** 2
+        h11 = s ** 3 - s ** 2
+        vals = (d0[:, None, :] * h00[None, :, None] + m0[:, None, :] * h10[None, :, None]
+                + d1[:, None, :] * h01[None, :, None] + m1[:, None, :] * h11[None, :, None])
+        ctrl = np.einsum("kv,svd->skd", _TO_BERNSTEIN, vals)
+        best = np.maximum(best, np.sqrt(np.max(np.sum(ctrl * ctrl, axis=2), axis=1)))
+    return best * (1.0 + 1e-12)
+
+
+def _polyline_distance(x: FloatArray, poly: FloatArray) -> FloatArray:
+    """Distance of every row of ``x`` to the polyline ``poly`` (k-d tree: the segments next to
+    the two nearest vertices)."""
+    from scipy.spatial import cKDTree
+
+    _, idx = cKDTree(poly).query(x, k=2)
+    best = np.full(x.shape[0], np.inf)
+    for col in range(idx.shape[1]):
+        for off in (-1, 0):
+            i0 = np.clip(idx[:, col] + off, 0, poly.shape[0] - 2)
+            a, b = poly[i0], poly[i0 + 1]
+            d = b - a
+            dd = np.maximum(np.sum(d * d, axis=1), 1e-300)
+            s = np.clip(np.sum((x - a) * d, axis=1) / dd, 0.0, 1.0)
+            best = np.minimum(best, np.linalg.norm(x - a - s[:, None] * d, axis=1))
+    return best
+
+
+def _rebuilt_distance(a: CubicHermite, b: CubicHermite, tol: float, dense: int = 32) -> float:
+    """The Hausdorff distance of ``a`` and ``b`` (same number of points), as far as it matters
+    against ``tol``: the per-span upper bound :func:`_matched_bound` where it is within
+    ``tol``; on the spans where it is not, both curves sampled ``dense`` times per span and
+    measured against the other, sampled ``dense`` times per span on every span, as a
+    polyline (exact to ``O(h^2 / dense^2)`` curvature terms)."""
+    per = _matched_bound(a, b)
+    bad = np.flatnonzero(per > tol)
+    if bad.size == 0:
+        return float(per.max()) if per.size else 0.0
+    fr = np.arange(dense + 1) / dense
+
+    def samples(c: CubicHermite, spans: FloatArray) -> FloatArray:
+        u = np.asarray(c.params)
+        t = (u[spans, None] + np.diff(u)[spans, None] * fr[None, :]).reshape(-1)
+        return np.asarray(c(np.clip(t, u[0], u[-1])))
+
+    all_spans = np.arange(len(per))
+    pa, pb = samples(a, all_spans), samples(b, all_spans)
+    worst = float(np.max(per[per <= tol])) if np.any(per <= tol) else 0.0
+    worst = max(worst, float(_polyline_distance(samples(b, bad), pa).max()),
+                float(_polyline_distance(samples(a, bad), pb).max()))
+    return worst
 
 
 def _solve_tri(A: sp.csr_matrix, rhs: FloatArray) -> FloatArray:
