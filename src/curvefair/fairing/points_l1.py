@@ -628,7 +628,8 @@ def _prefer(curve: Any) -> bool:
 
 def _driver(curve: CubicHermite, *, tol: float | None, eps: float | None,
             max_steps: int | None, clamp: Any, protect: Any, rounds: int = 5,
-            delta: float = 1e-5, curve_tol: bool = True, samples: int = 3) -> Any:
+            delta: float = 1e-5, curve_tol: bool = True, samples: int = 3,
+            backoff: int = 4) -> Any:
     from .fair import DriverOutput, FairingHistory
 
     if curve.closed:
@@ -661,14 +662,41 @@ def _driver(curve: CubicHermite, *, tol: float | None, eps: float | None,
     if steps == 0:
         return DriverOutput(curve=curve, steps=0, stop_reason="max_steps",
                             history=FairingHistory.empty(), curve_within_tol=False)
-    res = points_l1(p0, tol, params=np.asarray(curve.params), hold=sorted(hold),
-                    rounds=rounds, delta=delta, max_steps=steps, curve_tol=curve_tol,
-                    samples=samples)
+    def solve(t: float) -> PointsL1Result:
+        return points_l1(p0, t, params=np.asarray(curve.params), hold=sorted(hold),
+                         rounds=rounds, delta=delta, max_steps=steps, curve_tol=curve_tol,
+                         samples=samples)
+
+    res = solve(tol)
+    total = int(res.report["newton_steps"])
+    # tolerance back-off: in a wide tube (a few tenths of a percent of the size and more)
+    # the sparsest jumps can take a shape whose curvature crosses zero where the input's does
+    # not (naca2412.dat at tol 0.01 chord: 3 -> 6 inflections, on the flat aft surfaces);
+    # then the problem is solved again in half the tube, up to ``backoff`` times, and the
+    # first result that adds neither inflections nor curvature extrema (curvefair's counts,
+    # as fair()'s never-worse guard counts them) is kept -- a fair curve in a narrower tube,
+    # where the guard could only scale the moves back (and with them the noise)
+    used = tol
+    tries = 0
+    if backoff > 0:
+        from .fair import _analysis_block
+
+        a0 = _analysis_block(curve)
+        a1 = _analysis_block(res.curve)
+        while ((a1["inflections"] > a0["inflections"] or a1["extrema"] > a0["extrema"])
+               and tries < int(backoff)):
+            tries += 1
+            used = tol * 0.5 ** tries
+            res = solve(used)
+            total += int(res.report["newton_steps"])
+            a1 = _analysis_block(res.curve)
+    res.report["tol_used"] = used
+    res.report["backoff"] = tries
     p1 = np.asarray(res.points)
     moved = np.flatnonzero(np.any(p0 != p1, axis=1))
     disp = np.sqrt(np.sum((p1[moved] - p0[moved]) ** 2, axis=1))
     hist = FairingHistory.from_arrays(moved, np.zeros(moved.size), disp)
-    return DriverOutput(curve=res.curve, steps=int(res.report["newton_steps"]),
+    return DriverOutput(curve=res.curve, steps=total,
                         stop_reason=str(res.report["stop_reason"]), history=hist,
                         max_steps=steps, extra={"points_l1": res.report,
                                                 "history_is": "one entry per moved point "
