@@ -580,11 +580,10 @@ def _accepts(curve: Any) -> bool:
 #: machine, see docs/benchmarks.md); longer point lists default to ``poliakoff``
 DEFAULT_MAX_POINTS = 20_000
 
-#: whether ``points-l1`` is registered as a default at all. Not yet: it costs far more than one
-#: csaps fit (benchmarks/bench_points_l1.py) and the never-worse guard keeps the input on some
-#: airfoils (more inflections); with True it is the default for the curves :func:`_prefer`
-#: accepts
-DEFAULT_ENABLED = False
+#: whether ``points-l1`` is registered as a default at all: True, for the curves :func:`_prefer`
+#: accepts (open chord-length natural cubics, i.e. point files, up to ``DEFAULT_MAX_POINTS``);
+#: False leaves ``poliakoff`` the default for point data
+DEFAULT_ENABLED = True
 
 
 def _is_natural_chord_interpolant(curve: CubicHermite) -> bool:
@@ -711,22 +710,23 @@ def _register() -> None:
         name="points-l1",
         curve_types=(CubicHermite,),
         driver=_driver,
-        summary="Point data: moves the points (each within tol) so that their chord-length "
-                "natural cubic -- the curve rebuilt from the written file -- has the sparsest "
-                "third-derivative jumps (reweighted L1, banded interior point, O(n)). "
-                "Default for open point data: fairest on the rebuilt curves of bench-quality "
-                "(airfoils median extrema ratio 0.554 vs make_splprep 0.613, poliakoff 0.995)",
+        summary="Point data: moves the points (each within tol, the curve within tol at equal "
+                "parameter) so that their natural cubic on the input's parameters -- and the "
+                "one rebuilt from the written file -- has the sparsest third-derivative jumps "
+                "(reweighted L1, banded interior point, O(n)). "
+                "Default for open point data up to 20,000 points.",
         source="convex problem over the data points of the natural cubic interpolant; "
                "reweighted L1 (Candes, Wakin & Boyd 2008); interior point (Boyd & "
                "Vandenberghe sec. 11.7)",
-        # opt-in for now (DEFAULT_ENABLED): see there
+        # DEFAULT_ENABLED: see there
         default=DEFAULT_ENABLED,
         accepts=_accepts,
         prefer=_prefer,
         default_reason="default for point files (open chord-length natural cubics, up to "
-                       "20,000 points): fairest on the curve rebuilt from the written points - "
-                       "airfoil extrema ratio median 0.554 (make_splprep 0.613), glyph runs "
-                       "0.35 (0.678) [benchmarks/quality/run.py --tools cf:points-l1 ...]",
+                       "20,000 points): on the 6 airfoil files of tests/data at tol 1e-4 of the "
+                       "size, 51 curvature extrema in all on the curve rebuilt from the written "
+                       "points (input 127, poliakoff 91); bench-quality not rerun since the "
+                       "result moved onto the input's parameters",
     ))
 
 
