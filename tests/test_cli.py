@@ -87,7 +87,7 @@ def test_fair_csv_end_to_end(tmp_path: Path, ex1: Path):
     assert ex1.read_bytes() == before  # input untouched, byte for byte
     for col in ("energy", "inflections", "extrema", "max deviation", "steps", "time"):
         assert col in res.stdout
-    assert "poliakoff" in res.stdout  # the default method for point lists (cubic Hermite)
+    assert "points-l1" in res.stdout  # the default method for open point lists
     p0 = np.loadtxt(ex1, delimiter=",", skiprows=2)
     (rec,) = read_curves(tmp_path / "out.csv")
     p1 = np.asarray(rec.points)

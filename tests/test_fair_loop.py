@@ -336,8 +336,8 @@ def test_same_input_same_output():
 def test_default_methods_and_registry():
     c = interpolate_cubic(_noisy(8, 2))
     q = interpolate_quintic(_noisy(8, 2))
-    # cubic Hermite point data: poliakoff (points-l1 is opt-in: see its module)
-    assert fair(c, tol=0.1).report["method"] == "poliakoff"
+    # open chord-length natural cubics (point data): points-l1; closed: poliakoff
+    assert fair(c, tol=0.1).report["method"] == "points-l1"
     loop = interpolate_cubic(np.vstack([_noisy(8, 2), _noisy(8, 2)[:1]]), "chord", "periodic")
     assert fair(loop).report["method"] == "poliakoff"
     assert fair(q).report["method"] == "wang-quintic"

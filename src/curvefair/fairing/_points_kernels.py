@@ -1,26 +1,32 @@
-"""Compiled kernels of :mod:`curvefair.fairing.points_l1`: the block-banded Newton matrix.
+"""Compiled kernels of :mod:`curvefair.fairing.points_l1`: the interior point of one tube QP.
 
 Unknowns interleaved: B-spline coefficient ``j`` (of the natural cubic, after the two end
-conditions are eliminated), coordinate ``a`` is unknown ``j dim + a``. The Newton matrix is
+conditions are eliminated), coordinate ``a`` is unknown ``j dim + a``. Constraint row ``i``
+(a data point, or a curve sample between two data points) evaluates the curve at one parameter:
+``C_i x = sum_s W[i, s] x_{start_i + s}`` (``s = 0 .. 3``; a cubic B-spline has at most four
+non-zero basis functions there). The Newton matrix is
 
-    M = K + sum_i A_i^T B_i A_i,
+    M = K + sum_i C_i^T B_i C_i,
 
-``K`` the interleaved energy matrix, banded with ``dim x dim`` blocks of block half-bandwidth
-4 (given by its lower band ``L0``), the
-collocation ``A`` tridiagonal (``A[i, i - 1 + s] = Aw[i, s]``) and one symmetric
-``dim x dim`` block ``B_i`` per data point. Lower band storage ``L[r, k] = M[r + k, r]`` with
+``K`` the (scaled) interleaved energy matrix, banded with ``dim x dim`` blocks of block
+half-bandwidth 4 (given by its lower band ``Kb``), and one symmetric ``dim x dim`` block
+``B_i`` per constraint row. Lower band storage ``L[r, k] = M[r + k, r]`` with
 ``kd = 5 dim - 1``, as :func:`curvefair.fairing._global_kernels.band_cholesky` takes it.
 """
 
 from __future__ import annotations
 
+import numpy as np
+
 from .._jit import njit
+from ._global_kernels import band_cholesky, band_solve
 
 
 @njit(cache=True)
 def assemble_newton(L0, Aw, B, dim, L):  # type: ignore[no-untyped-def]
-    """``L = L0 + band(sum_i A_i^T B_i A_i)``: ``L0`` the lower band of the (interleaved)
-    energy matrix, ``L`` of the same shape ``(N dim, 5 dim)``."""
+    """``L = L0 + band(sum_i A_i^T B_i A_i)`` for a tridiagonal ``A`` (``A[i, i - 1 + s] =
+    Aw[i, s]``): ``L0`` the lower band of the (interleaved) energy matrix, ``L`` of the same
+    shape ``(N dim, 5 dim)``."""
     N = Aw.shape[0]
     kd = L.shape[1] - 1
     L[:, :] = L0
@@ -47,3 +53,236 @@ def assemble_newton(L0, Aw, B, dim, L):  # type: ignore[no-untyped-def]
                         if k >= 0 and k <= kd:
                             L[r, k] += w * B[i, a, b]
     return 0
+
+
+@njit(cache=True)
+def _rows(start, W, x, out):  # type: ignore[no-untyped-def]
+    """``out = C x`` (``x`` shape (N, dim), ``out`` shape (m, dim))."""
+    m = start.shape[0]
+    dim = x.shape[1]
+    for i in range(m):
+        j0 = start[i]
+        for a in range(dim):
+            s = 0.0
+            for s_ in range(4):
+                s += W[i, s_] * x[j0 + s_, a]
+            out[i, a] = s
+
+
+@njit(cache=True)
+def _rows_t(start, W, v, out):  # type: ignore[no-untyped-def]
+    """``out += C^T v`` (``v`` shape (m, dim), ``out`` shape (N, dim))."""
+    m = start.shape[0]
+    dim = v.shape[1]
+    for i in range(m):
+        j0 = start[i]
+        for s_ in range(4):
+            w = W[i, s_]
+            if w != 0.0:
+                for a in range(dim):
+                    out[j0 + s_, a] += w * v[i, a]
+
+
+@njit(cache=True)
+def _band_mv(Kb, x, out):  # type: ignore[no-untyped-def]
+    """``out = K x`` for the symmetric band ``Kb[r, k] = K[r + k, r]`` (``x``, ``out`` 1-D)."""
+    n = x.shape[0]
+    kd = Kb.shape[1] - 1
+    for r in range(n):
+        out[r] = Kb[r, 0] * x[r]
+    for r in range(n):
+        kmax = min(kd, n - 1 - r)
+        xr = x[r]
+        for k in range(1, kmax + 1):
+            v = Kb[r, k]
+            out[r + k] += v * xr
+            out[r] += v * x[r + k]
+
+
+@njit(cache=True)
+def _residuals(Kb, start, W, Y, t2, x, lam, tinv, v, fi, rd, rc):  # type: ignore[no-untyped-def]
+    """``v = C x - Y``, ``f_i = (|v_i|^2 / t2_i - 1) / 2``, ``rd = K x + C^T (lam v / t2)``,
+    ``rc = -lam f - tinv``; returns the residual norm squared without ``rd``'s scaling."""
+    m, dim = Y.shape
+    N = x.shape[0]
+    _rows(start, W, x, v)
+    for i in range(m):
+        s = 0.0
+        for a in range(dim):
+            v[i, a] -= Y[i, a]
+            s += v[i, a] * v[i, a]
+        fi[i] = 0.5 * (s / t2[i] - 1.0)
+        rc[i] = -lam[i] * fi[i] - tinv
+    rdf = rd.reshape(N * dim)
+    _band_mv(Kb, x.reshape(N * dim), rdf)
+    tmp = np.empty((m, dim))
+    for i in range(m):
+        c = lam[i] / t2[i]
+        for a in range(dim):
+            tmp[i, a] = c * v[i, a]
+    _rows_t(start, W, tmp, rd)
+
+
+@njit(cache=True)
+def tube_ipm(Kb, start, W, Y, rad, x, lam, max_steps, gap):  # type: ignore[no-untyped-def]
+    """Primal-dual interior point for ``min x^T K x / 2`` (``K`` the scaled energy, lower band
+    ``Kb``) s.t. ``|C_i x - Y_i| <= rad_i``, from a strictly feasible ``x`` and positive ``lam``
+    (both updated in place). Boyd & Vandenberghe sec. 11.7: surrogate gap ``eta = -f.lam``,
+    centring ``t = 10 m / eta``, Newton step on the modified KKT residual, step length kept
+    strictly feasible (``lam > 0``, every ``|C_i x - Y_i| < rad_i``) with a backtracking line
+    search on the residual norm.
+
+    Returns ``(steps, code)``: code 0 converged (``eta < gap`` and ``max|rd| < 1e-8`` of its
+    initial value), 1 max_steps, 2 numerical (factorisation, non-finite step or no progress:
+    converged if ``eta < 1e-6``, reported by the caller).
+    """
+    N, dim = x.shape
+    m = Y.shape[0]
+    n = N * dim
+    kd = Kb.shape[1] - 1
+    t2 = rad * rad
+    v = np.empty((m, dim))
+    fi = np.empty(m)
+    rd = np.empty((N, dim))
+    rc = np.empty(m)
+    v1 = np.empty((m, dim))
+    fi1 = np.empty(m)
+    rd1 = np.empty((N, dim))
+    rc1 = np.empty(m)
+    a = np.empty((m, dim))
+    L = np.empty((n, kd + 1))
+    rhs = np.empty((N, dim))
+    tmp = np.empty((m, dim))
+    Cdx = np.empty((m, dim))
+    dlam = np.empty(m)
+    x1 = np.empty((N, dim))
+    lam1 = np.empty(m)
+    _residuals(Kb, start, W, Y, t2, x, lam, 0.0, v, fi, rd, rc)
+    gscale = 0.0
+    for j in range(N):
+        for b in range(dim):
+            gscale = max(gscale, abs(rd[j, b]))
+    if gscale == 0.0:
+        gscale = 1.0
+    steps = 0
+    code = 1
+    while steps < max_steps:
+        eta = 0.0
+        for i in range(m):
+            eta -= fi[i] * lam[i]
+        tinv = eta / (10.0 * m)
+        _residuals(Kb, start, W, Y, t2, x, lam, tinv, v, fi, rd, rc)
+        rdn = 0.0
+        for j in range(N):
+            for b in range(dim):
+                rdn = max(rdn, abs(rd[j, b]))
+        if eta < gap and rdn < 1e-8 * gscale:
+            code = 0
+            break
+        # Newton matrix K + sum_i C_i^T B_i C_i, B_i = lam_i / t2_i I + ww_i a_i a_i^T
+        L[:, :] = Kb
+        for i in range(m):
+            ww = lam[i] / (-fi[i])
+            d0 = lam[i] / t2[i]
+            for b in range(dim):
+                a[i, b] = v[i, b] / t2[i]
+            j0 = start[i]
+            for s2 in range(4):
+                w2 = W[i, s2]
+                if w2 == 0.0:
+                    continue
+                for s1 in range(s2, 4):
+                    w = W[i, s1] * w2
+                    if w == 0.0:
+                        continue
+                    for b in range(dim):
+                        r = (j0 + s2) * dim + b
+                        for aa in range(dim):
+                            k = (j0 + s1) * dim + aa - r
+                            if k >= 0 and k <= kd:
+                                bab = ww * a[i, aa] * a[i, b]
+                                if aa == b:
+                                    bab += d0
+                                L[r, k] += w * bab
+        # rhs = -rd - C^T (a rc / f)
+        for j in range(N):
+            for b in range(dim):
+                rhs[j, b] = -rd[j, b]
+        for i in range(m):
+            c = -rc[i] / fi[i]
+            for b in range(dim):
+                tmp[i, b] = c * a[i, b]
+        _rows_t(start, W, tmp, rhs)
+        if band_cholesky(L, n) != 0:
+            code = 2
+            break
+        dxf = rhs.reshape(n)
+        band_solve(L, n, dxf)
+        dx = rhs
+        finite = True
+        for j in range(n):
+            if not np.isfinite(dxf[j]):
+                finite = False
+                break
+        if not finite:
+            code = 2
+            break
+        _rows(start, W, dx, Cdx)
+        smax = 1.0
+        tmax = np.inf
+        for i in range(m):
+            adx = 0.0
+            a2 = 0.0
+            a1 = 0.0
+            c0 = 0.0
+            for b in range(dim):
+                adx += a[i, b] * Cdx[i, b]
+                a2 += Cdx[i, b] * Cdx[i, b]
+                a1 += v[i, b] * Cdx[i, b]
+                c0 += v[i, b] * v[i, b]
+            c0 -= t2[i]
+            dl = (rc[i] - lam[i] * adx) / fi[i]
+            dlam[i] = dl
+            if dl < 0.0:
+                smax = min(smax, -lam[i] / dl)
+            if a2 > 0.0:
+                disc = max(a1 * a1 - a2 * c0, 0.0)
+                tmax = min(tmax, (-a1 + np.sqrt(disc)) / a2)
+        st = min(0.99 * smax, 0.99 * tmax)
+        rn = 0.0
+        for j in range(N):
+            for b in range(dim):
+                rn += (rd[j, b] / gscale) ** 2
+        for i in range(m):
+            rn += rc[i] * rc[i]
+        rnorm = np.sqrt(rn)
+        while st > 1e-14:
+            for j in range(N):
+                for b in range(dim):
+                    x1[j, b] = x[j, b] + st * dx[j, b]
+            for i in range(m):
+                lam1[i] = lam[i] + st * dlam[i]
+            _residuals(Kb, start, W, Y, t2, x1, lam1, tinv, v1, fi1, rd1, rc1)
+            ok = True
+            for i in range(m):
+                if not fi1[i] < 0.0:
+                    ok = False
+                    break
+            if ok:
+                r1 = 0.0
+                for j in range(N):
+                    for b in range(dim):
+                        r1 += (rd1[j, b] / gscale) ** 2
+                for i in range(m):
+                    r1 += rc1[i] * rc1[i]
+                if np.sqrt(r1) <= (1.0 - 0.01 * st) * rnorm:
+                    break
+            st *= 0.5
+        if st <= 1e-14:
+            code = 2
+            break
+        x[:, :] = x1
+        lam[:] = lam1
+        fi[:] = fi1
+        steps += 1
+    return steps, code

@@ -529,7 +529,7 @@ def _g2_through(jplan: JoinPlan, R0: BSplineCurve, knot: dict[int, float], left:
         jplan.curve = R2
         jplan._g2 = A
         jplan._g2_row = row_of
-        restored = np.asarray(jplan.restore(R2).control_points)
+        restored = np.asarray(cast(BSplineCurve, jplan.restore(R2)).control_points)
         assert jplan._orig is not None
         jplan.margin = float(np.linalg.norm(
             restored - np.asarray(jplan._orig.control_points), axis=1).max())
