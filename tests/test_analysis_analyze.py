@@ -365,3 +365,26 @@ def test_bad_quad_rtol(rtol):
     c = cf.interpolate_cubic([[0, 0], [1, 1], [2, 0]])
     with pytest.raises(InputError, match="quad_rtol"):
         cf.analyze(c, quad_rtol=rtol)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_counts_do_not_depend_on_the_drawing_scale(dim):
+    """kappa ~ 1/size and dkappa/ds ~ 1/size**2 leave float32's range at 1e24 / 1e-18 unless
+    the stored samples are made dimensionless (before: every extremum lost at 1e24)."""
+    from curvefair.curves.interpolate import interpolate_quintic
+    rng = np.random.default_rng(1)
+    t = np.linspace(0, 2 * np.pi, 8)[:-1]
+    P = np.c_[np.cos(t) * (1 + 0.1 * rng.standard_normal(7)),
+              np.sin(t) * (1 + 0.1 * rng.standard_normal(7))]
+    if dim == 3:  # a twisted closed curve
+        P = np.c_[P, 0.3 * np.sin(2 * t)]
+    P = np.vstack([P, P[:1]])
+    c = interpolate_quintic(P, "chord", "periodic")
+    ref = cf.analyze(c)
+    assert ref.extrema > 0
+    for s in (1e-18, 1e-12, 1e6, 1e12, 1e20, 1e24):
+        cs = c.replace(points=np.asarray(c.points) * s, d1=np.asarray(c.d1) * s,
+                       d2=np.asarray(c.d2) * s)
+        a = cf.analyze(cs)
+        assert (a.extrema, a.inflections) == (ref.extrema, ref.inflections), s
+        np.testing.assert_allclose(a.extremum_params, ref.extremum_params, rtol=0, atol=1e-6)

@@ -327,13 +327,18 @@ def analyze(curve: object, *, quad_rtol: float = QUAD_RTOL) -> Analysis:
     invL = 1.0 / L if L > 0 else 0.0
     ktol = ZERO_RTOL * max(max_k, invL)
     kstol = ZERO_RTOL * max(max_ks, invL * invL)
+    # the samples hold kappa * unit and dkappa/ds * unit**2 (a power of two, exact): scale
+    # the thresholds, the refined values and the rounding band's lengths alike
+    g = smp.unit
+    ell_g, pos_g = smp.ell / g, smp.pos / g
+    ex_k, ex_ks = smp.extra
     if planar:
-        n_infl, infl_at = scan_sign_changes(kap, smp.x, breaks, smp.extra[0], ktol, closed,
-                                            smp.ell, smp.pos, 1)
+        n_infl, infl_at = scan_sign_changes(kap, smp.x, breaks, (ex_k[0], ex_k[1], ex_k[2] * g),
+                                            ktol * g, closed, ell_g, pos_g, 1)
     else:
         n_infl, infl_at = 0, np.zeros(0)
-    n_ext, ext_at = scan_sign_changes(dks, smp.x, breaks, smp.extra[1], kstol, closed,
-                                      smp.ell, smp.pos, 2)
+    n_ext, ext_at = scan_sign_changes(dks, smp.x, breaks, (ex_ks[0], ex_ks[1], ex_ks[2] * g * g),
+                                      kstol * g * g, closed, ell_g, pos_g, 2)
 
     # -- Sapidis-Farin measure from the one-sided samples at the knots ----------------------
     z = smp.knots[ks, 2].copy()

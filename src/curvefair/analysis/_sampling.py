@@ -156,8 +156,8 @@ class Samples:
     """Output of :func:`sample_curve` (internal)."""
 
     x: FloatArray  # (K,) fractions
-    kappa: np.ndarray  # (m, K) float32 (clamped to +-1e38)
-    dkds: np.ndarray  # (m, K) float32
+    kappa: np.ndarray  # (m, K) float32: kappa * unit (clamped to +-1e38)
+    dkds: np.ndarray  # (m, K) float32: dkappa/ds * unit**2
     arc_length: float
     dkds_energy: float
     arc_length_error: float
@@ -171,6 +171,7 @@ class Samples:
     pos: FloatArray  # (m,) norm of each segment's start point
     energies: FloatArray  # (m, 2): exact int |r''|^2 and int |r'''|^2 per segment
     extra: tuple[tuple[np.ndarray, FloatArray, FloatArray], ...]  # per quantity: seg, u, value
+    unit: float = 1.0  # the power of two near the curve's size that scales kappa and dkds
 
 
 # -- compiled kernels ----------------------------------------------------------------------------
@@ -264,7 +265,7 @@ def _frenet_node(r1, r2, r3, sc1, sc2, speed_rtol, cross_rtol):  # type: ignore[
 @njit(cache=True, fastmath=_FM, error_model="numpy")
 def _pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cross_rtol,
                  closed, kap, dks, knots, energies, quad, box, ell, pos,
-                 gaps):  # type: ignore[no-untyped-def]
+                 gaps, unit):  # type: ignore[no-untyped-def]
     """One fused pass over the segments (see :func:`sample_curve`).
 
     ``x`` the node fractions, ``tab[nu-1, q, j] = j!/(j-nu)! x_q^(j-nu)`` (derivative ``nu``
@@ -272,7 +273,8 @@ def _pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, c
     ``w7``/``w4`` the Kronrod/Lobatto weights of one piece on [0, 1], ``fall[j, nu] =
     j!/(j-nu)!``; ``fits[k]`` (K, dmax+1) maps sampled numerator values to Bernstein
     coefficients (``nfit[k]`` of them; 0: not wanted), ``subs[k]`` (K-1, K, dmax+1) the same
-    per gap. Writes ``kap``/``dks`` (m, K); ``knots[i]`` = jumps at breakpoint ``i`` of the
+    per gap. Writes ``kap``/``dks`` (m, K), scaled by ``unit`` and ``unit**2`` (see
+    :func:`sample_curve`); ``knots[i]`` = jumps at breakpoint ``i`` of the
     third derivative, of the ``degree``-th derivative and of ``dkappa/ds`` (row 0: the seam of
     a closed curve, else 0); ``energies[i]`` (exact ``int |r''|^2``, ``int |r'''|^2``);
     ``quad[i]`` (7-point arc length, its error estimate, the same for ``int kappa_s^2 ds``);
@@ -284,6 +286,7 @@ def _pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, c
     m, p1, dim = cw.shape
     K = tab.shape[1]
     p = p1 - 1
+    unit2 = unit * unit
     e = np.empty((p1, dim))
     r1 = np.empty(dim)
     r2 = np.empty(dim)
@@ -397,8 +400,8 @@ def _pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, c
                 k_ = k_ if good else 0.0
                 ks = ks if good else 0.0
                 nsing += not good
-                kap[i, qn] = min(max(k_, -_F32_MAX), _F32_MAX)
-                dks[i, qn] = min(max(ks, -_F32_MAX), _F32_MAX)
+                kap[i, qn] = min(max(k_ * unit, -_F32_MAX), _F32_MAX)
+                dks[i, qn] = min(max(ks * unit2, -_F32_MAX), _F32_MAX)
                 maxk = max(maxk, abs(k_))
                 maxks = max(maxks, abs(ks))
                 ksa[qn] = ks
@@ -430,8 +433,8 @@ def _pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, c
                 vals[1, qn] = enum
                 nsing += sing
                 # stored in float32 (sign and rough size are all the counts need), clamped
-                kap[i, qn] = min(max(k_, -_F32_MAX), _F32_MAX)
-                dks[i, qn] = min(max(ks, -_F32_MAX), _F32_MAX)
+                kap[i, qn] = min(max(k_ * unit, -_F32_MAX), _F32_MAX)
+                dks[i, qn] = min(max(ks * unit2, -_F32_MAX), _F32_MAX)
                 if qn == 0:
                     ks_start = ks
                 ks_end = ks
@@ -731,6 +734,14 @@ def sample_curve(cw: FloatArray, h: FloatArray, planar: bool, closed: bool,
     re-integration of the segments whose error estimate exceeds ``rtol`` (relative, with an
     equal share of ``rtol`` times the total per unit parameter length), worst first, within a
     budget of ``max(200000, m / 8)`` pieces of 7 nodes.
+
+    The samples are stored in float32 (their signs and rough sizes are all the counts need)
+    as the dimensionless ``kappa * unit`` and ``dkappa/ds * unit**2``, ``unit`` the power of
+    two nearest the diagonal of the segments' start points: curvature scales as 1/size and
+    its derivative as 1/size**2, so a curve drawn at 1e24 (or 1e-24) would otherwise leave
+    float32's range (dkappa/ds ~ 1e-48 flushes to zero and every extremum is lost). A power
+    of two scales exactly: for curves of ordinary size the stored values are those of
+    ``unit = 1`` times ``unit``, bit for bit.
     """
     m, p1, dim = cw.shape
     p = p1 - 1
@@ -752,6 +763,7 @@ def sample_curve(cw: FloatArray, h: FloatArray, planar: bool, closed: bool,
             fall[j, nu] = falling(j, nu)[0]
     kap = np.empty((m, K), dtype=np.float32)
     dks = np.empty((m, K), dtype=np.float32)
+    unit = _unit(cw)
     knots = np.empty((m, 3))
     energies = np.empty((m, 2))
     quad = np.empty((m, 4))
@@ -764,7 +776,8 @@ def sample_curve(cw: FloatArray, h: FloatArray, planar: bool, closed: bool,
     while True:
         nsing, maxk, maxks, ngap = _pass_kernel(
             cwc, hc, plan.x, plan.tab, plan.w7, plan.w4, plan.P, fall, fits, nfit, subs, SPEED_RTOL,
-            CROSS_RTOL, bool(closed), kap, dks, knots, energies, quad, box, ell, pos, gaps)
+            CROSS_RTOL, bool(closed), kap, dks, knots, energies, quad, box, ell, pos, gaps,
+            unit)
         if ngap <= gaps.shape[0]:
             break
         gaps = np.empty((ngap, 3), dtype=np.int64)  # rare: the buffer was too small; redo
@@ -802,7 +815,18 @@ def sample_curve(cw: FloatArray, h: FloatArray, planar: bool, closed: bool,
                    n_singular=int(nsing), max_kappa=float(maxk),
                    max_dkds=float(maxks), knots=knots, energies=energies,
                    diagonal=float(np.sqrt(np.sum((box[1] - box[0]) ** 2))), ell=ell,
-                   pos=pos, extra=(extra[0], extra[1]))
+                   pos=pos, extra=(extra[0], extra[1]), unit=unit)
+
+
+def _unit(cw: FloatArray) -> float:
+    """The power of two nearest the diagonal of the segments' start points (1.0 if none)."""
+    if cw.shape[0] == 0:
+        return 1.0
+    start = cw[:, 0, :]
+    diag = float(np.sqrt(np.sum((start.max(axis=0) - start.min(axis=0)) ** 2)))
+    if not (np.isfinite(diag) and diag > 0.0):
+        return 1.0
+    return float(2.0 ** int(np.clip(np.round(np.log2(diag)), -1000, 1000)))
 
 
 @njit(cache=True, error_model="numpy")
