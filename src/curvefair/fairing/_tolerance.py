@@ -53,6 +53,7 @@ __all__ = ["Certificate", "enforce_tolerance", "curve_fields", "difference_devia
            "point_report", "prime_power_forms"]
 
 _MAX_SCALINGS = 8
+_ZERO = np.frombuffer(bytes(8), dtype=np.float64).reshape(1, 1, 1)  # immutable +0.0
 
 
 @dataclass(frozen=True)
@@ -182,7 +183,10 @@ def difference_deviation(a: PiecewiseCurve, b: PiecewiseCurve,
             assert fa is not None and fb is not None
             delta = {k: fb[k] - fa[k] for k in fa}
             pp = _difference_form(a, delta)
-        zero = PiecewisePolynomial(np.array(pp.breaks), np.zeros_like(pp.coeffs))
+        # the zero curve on the same breaks: one frozen 0.0 broadcast to the coefficients'
+        # shape (PiecewisePolynomial keeps a frozen array as it is: no 8-byte-per-entry
+        # zeros and copy of them)
+        zero = PiecewisePolynomial(pp.breaks, np.broadcast_to(_ZERO, pp.coeffs.shape))
         d = deviation(_PowerForm(pp, a.closed), _PowerForm(zero, a.closed))
     else:
         d = deviation(a, b)
