@@ -26,6 +26,7 @@ FULL = [
     ["bench_call_cost.py"],
     ["bench_io.py"],
     ["bench_plot.py"],
+    ["bench_dxf_entities.py", "1000", "10000"],  # entity counts: not given --sizes
 ]
 # how each script takes sizes: "pos" positional, "--sizes" an option, "--n" one size (largest)
 SIZE_ARG = {"bench_analyze.py": "pos", "bench_fair_step.py": "--sizes",
@@ -70,6 +71,7 @@ QUICK = [
     ["bench_call_cost.py", "1e3", "1e4", "--repeat", "1"],
     ["bench_io.py", "--sizes", "1000", "10000"],
     ["bench_plot.py", "1e3", "--repeat", "1"],
+    ["bench_dxf_entities.py", "100"],
 ]
 
 

@@ -65,3 +65,36 @@ def test_report_to_dict_lists_arrays_and_drops_non_finite():
     d2 = rep2.to_dict()
     assert d2["extra_values"] == [1.0, None, None, 2.0] and d2["extra_int"] == 3
     json.dumps(d2, allow_nan=False)
+
+
+@pytest.mark.parametrize("degree,closed,dim", [(3, False, 2), (3, True, 2), (2, False, 3),
+                                               (5, True, 3), (4, False, 2)])
+def test_primed_power_forms_equal_separate_ones(degree, closed, dim):
+    # fair() builds the result's power form and the difference curve's in one pass over the
+    # spans; each must be bitwise what the curve's own power form and the certificate's
+    # separate pass (_difference_form on new - original) give
+    from curvefair.fairing import _tolerance as T
+
+    rng = np.random.default_rng(degree * 10 + closed)
+    P = _noisy(40, 7)
+    if dim == 3:
+        P = np.c_[P, 0.1 * rng.normal(size=40)]
+    c = cf.interpolate_bspline(P, degree=degree, closed=closed)
+    moved = np.array(c.control_points) + 1e-3 * rng.normal(size=c.control_points.shape)
+    new = c.replace(control_points=moved)
+    primed = T.prime_power_forms(c, new)
+    assert primed is not None and primed[0] is new
+    fresh = c.replace(control_points=moved)  # no cached form
+    assert np.array_equal(new.piecewise.coeffs, fresh.piecewise.coeffs)
+    assert np.array_equal(new.piecewise.breaks, fresh.piecewise.breaks)
+    delta = {"control_points": np.asarray(fresh.control_points) - np.asarray(c.control_points)}
+    sep = T._difference_form(c, delta)
+    assert np.array_equal(primed[1].coeffs, sep.coeffs)
+    assert np.array_equal(primed[1].breaks, sep.breaks)
+    # and the certificate from it is the one computed from scratch
+    assert T.difference_deviation(c, new, primed[1]) == T.difference_deviation(c, fresh)
+    # other knots or a Hermite curve: nothing primed
+    other = cf.interpolate_bspline(P * 1.01, degree=degree, closed=closed)
+    assert T.prime_power_forms(c, other) is None
+    h = cf.interpolate_cubic(P)
+    assert T.prime_power_forms(h, h) is None

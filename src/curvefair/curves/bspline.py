@@ -173,6 +173,50 @@ def _power_form_kernel(knots, p, spans, ctrl, closed, out):  # type: ignore[no-u
 
 
 @njit(cache=True)
+def _power_form_pair_kernel(knots, p, spans, ctrl, base, closed, out, out_diff):  # type: ignore[no-untyped-def]
+    """:func:`_power_form_kernel` of ``ctrl`` into ``out`` and of ``ctrl - base`` into
+    ``out_diff`` in one pass: the basis derivatives of each span (most of the work) are
+    computed once for both. The same operations in the same order as two calls of
+    :func:`_power_form_kernel` (the second on the array ``ctrl - base``): bitwise the same."""
+    n = ctrl.shape[0]
+    dim = ctrl.shape[1]
+    ndu = np.empty((p + 1, p + 1))
+    left = np.empty(p + 1)
+    right = np.empty(p + 1)
+    a = np.empty((2, p + 1))
+    d = np.empty((1, p + 1, p + 1))
+    fact = np.empty(p + 1)
+    fact[0] = 1.0
+    for k in range(1, p + 1):
+        fact[k] = fact[k - 1] * k
+    prev = np.empty(2 * p)
+    have = False
+    for m in range(spans.shape[0]):
+        s = spans[m]
+        ts = knots[s]
+        same = have
+        for k in range(2 * p):
+            v = knots[s - p + 1 + k] - ts
+            same = same and v == prev[k]
+            prev[k] = v
+        if not same:
+            _ders_one(knots, p, s, 0.0, ts, p, ndu, left, right, a, d, 0)
+            have = True
+        for k in range(p + 1):
+            for e in range(dim):
+                acc = 0.0
+                acc2 = 0.0
+                for b in range(p + 1):
+                    i = s - p + b
+                    if closed:
+                        i = i % n
+                    acc += d[0, k, b] * ctrl[i, e]
+                    acc2 += d[0, k, b] * (ctrl[i, e] - base[i, e])
+                out[m, k, e] = acc / fact[k]
+                out_diff[m, k, e] = acc2 / fact[k]
+
+
+@njit(cache=True)
 def _gram_kernel(knots, p, spans, l, xq, wq, n, closed, W):  # type: ignore[no-untyped-def]  # noqa: E741
     """Banded Gram matrix ``W`` (n, 2p+1) of ``int N_i^(l) N_j^(l)`` (see ``gram_band``),
     accumulated into ``W`` (zeros on entry, allocated by numpy: huge pages, see

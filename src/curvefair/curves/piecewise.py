@@ -136,8 +136,17 @@ class PiecewisePolynomial:
         if self.evaluator is not None:
             seg = np.broadcast_to(seg, uf.shape)
             return self.at(seg, uf - self.breaks[seg], nu).reshape(shape + (self.dim,))
-        c = derivative_coefficients(self.coeffs, nu)
         s = (uf - self.breaks[seg])[:, None]
+        if seg.shape[0] < self.n_segments:
+            # fewer parameters than segments (a few knots of a long curve): the derivative
+            # coefficients of the segments asked for only (the same products, O(k) not O(m))
+            c = derivative_coefficients(self.coeffs[seg], nu)
+            out = c[:, -1, :].copy()
+            for j in range(c.shape[1] - 2, -1, -1):
+                out *= s
+                out += c[:, j, :]
+            return out.reshape(shape + (self.dim,))
+        c = derivative_coefficients(self.coeffs, nu)
         out = c[seg, -1, :].copy()
         for j in range(c.shape[1] - 2, -1, -1):
             out *= s
@@ -154,7 +163,8 @@ class PiecewisePolynomial:
             if nu > self.degree:
                 return np.zeros((s.shape[0], self.dim))
             return self.evaluator(seg, s, int(nu))
-        c = derivative_coefficients(self.coeffs, nu)[seg]
+        c = (derivative_coefficients(self.coeffs[seg], nu) if seg.shape[0] < self.n_segments
+             else derivative_coefficients(self.coeffs, nu)[seg])
         out = c[:, -1, :].copy()
         for j in range(c.shape[1] - 2, -1, -1):
             out *= s[:, None]

@@ -35,7 +35,12 @@ import numpy as np
 
 from .._distance import exceeds, point_distances
 from .._typing import FloatArray
-from ..curves.bspline import BSplineCurve, _power_form_kernel
+from ..curves.bspline import (
+    POWER_FORM_MAX_DEGREE,
+    BSplineCurve,
+    _power_form_kernel,
+    _power_form_pair_kernel,
+)
 from ..curves.hermite import (
     CubicHermite,
     QuinticHermite,
@@ -45,9 +50,10 @@ from ..curves.hermite import (
 from ..curves.piecewise import PiecewiseCurve, PiecewisePolynomial
 
 __all__ = ["Certificate", "enforce_tolerance", "curve_fields", "difference_deviation",
-           "point_report"]
+           "point_report", "prime_power_forms"]
 
 _MAX_SCALINGS = 8
+_ZERO = np.frombuffer(bytes(8), dtype=np.float64).reshape(1, 1, 1)  # immutable +0.0
 
 
 @dataclass(frozen=True)
@@ -131,21 +137,56 @@ def _difference_form(a: PiecewiseCurve, delta: dict[str, FloatArray]) -> Piecewi
     return PiecewisePolynomial(np.array(params), c)
 
 
-def difference_deviation(a: PiecewiseCurve, b: PiecewiseCurve) -> tuple[float, float, float]:
+def prime_power_forms(original: PiecewiseCurve, new: PiecewiseCurve
+                      ) -> tuple[PiecewiseCurve, PiecewisePolynomial] | None:
+    """For two comparable B-splines (same knots, degree, closedness, shapes): ``new``'s power
+    form (cached on it, as its :attr:`~curvefair.PiecewiseCurve.piecewise` would be) and
+    the power form of the difference curve ``new - original`` in one pass
+    (:func:`~curvefair.curves.bspline._power_form_pair_kernel`: the basis derivatives once
+    for both, bitwise the two separate results). Returns ``(new, difference form)`` for
+    :func:`enforce_tolerance`'s ``primed``, or None (other curves, high degree, ``new``'s form
+    already built, a non-finite form: the usual paths then)."""
+    if (not isinstance(new, BSplineCurve) or "piecewise" in new.__dict__
+            or new.degree > POWER_FORM_MAX_DEGREE or not _comparable(original, new)):
+        return None
+    p = new.degree
+    t = np.ascontiguousarray(new.knots)
+    s = np.ascontiguousarray(new.spans, dtype=np.int64)
+    ctrl = np.ascontiguousarray(new.control_points, dtype=np.float64)
+    base = np.ascontiguousarray(original.control_points, dtype=np.float64)  # type: ignore[attr-defined]
+    coeffs = np.empty((s.size, p + 1, ctrl.shape[1]))
+    diff = np.empty_like(coeffs)
+    _power_form_pair_kernel(t, p, s, ctrl, base, bool(new.closed), coeffs, diff)
+    if not (np.isfinite(coeffs).all() and np.isfinite(diff).all()):
+        return None  # new.piecewise raises its own message when asked
+    breaks = np.append(t[s], t[s[-1] + 1])
+    new.__dict__["piecewise"] = PiecewisePolynomial(breaks, coeffs)  # the cached_property
+    return new, PiecewisePolynomial(breaks, diff)
+
+
+def difference_deviation(a: PiecewiseCurve, b: PiecewiseCurve,
+                         form: PiecewisePolynomial | None = None) -> tuple[float, float, float]:
     """``(max_distance, upper_bound, param)`` of ``max_t |a(t) - b(t)|``.
 
     On the difference curve when ``a`` and ``b`` share type, knots / parameters and data
     shapes (exactly linear, no rounding of the coordinates' offset), else
-    :func:`curvefair.deviation` of the two curves.
+    :func:`curvefair.deviation` of the two curves. ``form``: the difference curve's power
+    form when the caller has it (:func:`prime_power_forms`).
     """
     from ..analysis import deviation
 
-    if _comparable(a, b):
-        fa, fb = curve_fields(a), curve_fields(b)
-        assert fa is not None and fb is not None
-        delta = {k: fb[k] - fa[k] for k in fa}
-        pp = _difference_form(a, delta)
-        zero = PiecewisePolynomial(np.array(pp.breaks), np.zeros_like(pp.coeffs))
+    if form is not None or _comparable(a, b):
+        if form is not None:
+            pp = form
+        else:
+            fa, fb = curve_fields(a), curve_fields(b)
+            assert fa is not None and fb is not None
+            delta = {k: fb[k] - fa[k] for k in fa}
+            pp = _difference_form(a, delta)
+        # the zero curve on the same breaks: one frozen 0.0 broadcast to the coefficients'
+        # shape (PiecewisePolynomial keeps a frozen array as it is: no 8-byte-per-entry
+        # zeros and copy of them)
+        zero = PiecewisePolynomial(pp.breaks, np.broadcast_to(_ZERO, pp.coeffs.shape))
         d = deviation(_PowerForm(pp, a.closed), _PowerForm(zero, a.closed))
     else:
         d = deviation(a, b)
@@ -183,7 +224,9 @@ def _pull_back(orig: FloatArray, moved: FloatArray, tol: float) -> tuple[FloatAr
 
 
 def enforce_tolerance(original: PiecewiseCurve, new: PiecewiseCurve, tol: float | None,
-                      curve_bound: bool = True) -> tuple[PiecewiseCurve, Certificate]:
+                      curve_bound: bool = True,
+                      primed: tuple[PiecewiseCurve, PiecewisePolynomial] | None = None
+                      ) -> tuple[PiecewiseCurve, Certificate]:
     """``new`` made to satisfy the tolerance exactly in float64 (see the module docstring).
 
     Parameters
@@ -194,16 +237,22 @@ def enforce_tolerance(original: PiecewiseCurve, new: PiecewiseCurve, tol: float 
         ``None``: nothing is enforced, only the deviation is measured.
     curve_bound : bool
         The method promises the curve within ``tol`` too (certify and scale if needed).
+    primed : (curve, PiecewisePolynomial) or None
+        :func:`prime_power_forms` of ``(original, new)``: the difference form is used while
+        the curve checked is that very ``curve`` object (not after a pull-back or scaling).
 
     Returns
     -------
     (curve, Certificate)
     """
+    def form_of(cur: PiecewiseCurve) -> PiecewisePolynomial | None:
+        return primed[1] if primed is not None and primed[0] is cur else None
+
     fo = curve_fields(original)
     fn = curve_fields(new)
     if (tol is None or fo is None or fn is None or type(original) is not type(new)
             or fo[next(iter(fo))].shape != fn[next(iter(fn))].shape):
-        dmax, ub, t = difference_deviation(original, new)
+        dmax, ub, t = difference_deviation(original, new, form_of(new))
         return new, Certificate(dmax, ub, t, 0, 1.0)
     pos = next(iter(fo))
     if not _comparable(original, new):
@@ -230,7 +279,7 @@ def enforce_tolerance(original: PiecewiseCurve, new: PiecewiseCurve, tol: float 
             cf = dict(curve_fields(cur))  # type: ignore[arg-type]
             cf[pos] = fixed
             cur = _rebuild(new, cf)
-        dmax, ub, t = difference_deviation(original, cur)
+        dmax, ub, t = difference_deviation(original, cur, form_of(cur))
         if not curve_bound or ub <= tol:
             return cur, Certificate(dmax, ub, t, pulled_total, scale)
         if attempt == _MAX_SCALINGS:

@@ -645,6 +645,11 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
         h = out.history
         out.history = FairingHistory.from_arrays(jp.original_index(h.index), h.measure,
                                                  h.displacement)
+    from ._tolerance import enforce_tolerance, point_report, prime_power_forms
+
+    # a B-spline result on the input's knots: its power form (for the analysis) and the
+    # difference curve's (for the certificate below) share one pass over the spans
+    primed = prime_power_forms(curve, new)
     after = _analysis_block(new)
     guard_info: dict[str, Any] = {"kept": "output"}
     if guard and (after["inflections"] > before["inflections"]
@@ -656,9 +661,8 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
     # the one final guarantee every result passes through (after the joins are restored and
     # the never-worse guard chose): data points within tol in float64 (pulled back if rounding
     # put one outside), curve deviation certified on the difference curve
-    from ._tolerance import enforce_tolerance, point_report
-
-    checked, cert = enforce_tolerance(curve, new, tol_v, curve_bound=out.curve_within_tol)
+    checked, cert = enforce_tolerance(curve, new, tol_v, curve_bound=out.curve_within_tol,
+                                      primed=primed)
     if checked is not new:
         new, after = checked, _analysis_block(checked)
 
