@@ -142,3 +142,32 @@ def test_faired_ufo_compiles_with_ufo2ft(masters, tmp_path):
             else:  # glyf: cubics converted to quadratics, within cu2qu's 1 unit
                 P, xy = np.array(pts, float), np.array(got, float)
                 assert xy.min(0)[0] >= P.min(0)[0] - 1.5 and xy.max(0)[0] <= P.max(0)[0] + 1.5
+
+
+def test_faired_masters_build_variable_fonts_and_cff2_is_refused(masters, tmp_path):
+    """The faired designspace builds as variable fonts (ufo2ft merges the masters with varLib:
+    it fails on incompatible masters); a CFF2 binary is refused with a message naming the
+    table."""
+    ufo2ft = pytest.importorskip("ufo2ft")
+    from curvefair import read_curves
+    from curvefair.errors import FileFormatError
+
+    _, ds = masters
+    out = tmp_path / "out"
+    res = CliRunner().invoke(main, ["fair", str(ds), "--tol", "2", "-o", str(out), "-q",
+                                    "--glyphs", ",".join(GLYPHS)])
+    assert res.exit_code == 0, res.output
+    doc = DesignSpaceDocument.fromfile(out / ds.name)
+    doc.loadSourceFonts(ufoLib2.Font.open)
+    vf = ufo2ft.compileVariableTTF(doc)
+    assert "gvar" in vf and "fvar" in vf
+    doc = DesignSpaceDocument.fromfile(out / ds.name)
+    doc.loadSourceFonts(ufoLib2.Font.open)
+    cff2 = ufo2ft.compileVariableCFF2(doc, optimizeCFF=0)
+    assert "CFF2" in cff2 and "CFF " not in cff2
+    cff2.save(tmp_path / "V.otf")
+    with pytest.raises(FileFormatError, match="CFF2"):
+        read_curves(tmp_path / "V.otf")
+    res = CliRunner().invoke(main, ["fair", str(tmp_path / "V.otf"), "--tol", "2", "-o",
+                                    str(tmp_path / "W.otf")])
+    assert res.exit_code == 1 and "CFF2" in res.output and "Traceback" not in res.output

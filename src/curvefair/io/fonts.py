@@ -191,8 +191,12 @@ def _open_binary(path: Any) -> Any:
     except Exception as exc:  # fontTools raises many kinds for a garbled file
         raise FileFormatError(f"not a font fontTools can read ({exc})", path) from None
     if "glyf" not in font and "CFF " not in font:
-        raise FileFormatError("no glyf or CFF outlines (CFF2 variable outlines are not "
-                              "supported)", path)
+        if "CFF2" in font:
+            raise FileFormatError("its outlines are in a CFF2 table (variable OpenType/CFF2), "
+                                  "which curvefair does not read or write: fair the font's "
+                                  "sources (a .designspace with 'curvefair fair', or its UFO "
+                                  "masters) and build it again", path)
+        raise FileFormatError("no glyf or CFF outlines", path)
     if "CFF " in font:
         font["CFF "].cff.desubroutinize()
     return font
