@@ -179,3 +179,29 @@ def test_no_written_contour_has_more_curvature_extrema(tmp_path, which):
                                                                  c.quadratic)
     if which == "dejavu":
         assert worse > 0
+
+
+def test_cli_says_which_contours_were_written_unchanged(tmp_path):
+    """The CLI's report marks a contour the guard kept (``written: "input"``); on disk it is
+    the input exactly."""
+    import json
+    import shutil
+
+    from click.testing import CliRunner
+
+    from curvefair.cli import main
+
+    shutil.copy(LOBSTER, tmp_path / "L.otf")
+    res = CliRunner().invoke(main, ["fair", str(tmp_path / "L.otf"), "-o",
+                                    str(tmp_path / "F.otf"), "--tol", "2", "--glyphs",
+                                    "B,zero", "--report", str(tmp_path / "r.json")])
+    assert res.exit_code == 0, res.output
+    rep = json.loads((tmp_path / "r.json").read_text())
+    f, g = TTFont(LOBSTER), TTFont(tmp_path / "F.otf")
+    kept = [r["name"] for r in rep["curves"] if r.get("report", {}).get("written") == "input"]
+    for r in rep["curves"]:
+        name, ci = r["name"].split("#")
+        p0 = file_contours(f, name)[int(ci)][0]
+        p1 = file_contours(g, name)[int(ci)][0]
+        assert np.array_equal(p0, p1) == (r["name"] in kept), r["name"]
+    assert kept and len(kept) < len(rep["curves"])

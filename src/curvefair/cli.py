@@ -1105,6 +1105,7 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
                                   format=out_fmt, overwrite=in_place, decimals=decimals)
             from .io._verify import rescaled_report
 
+            kept_notes: list[str] = []
             for i, (row, d, kind) in enumerate(zip(rows, check.deviations, check.kinds,
                                                    strict=True)):
                 if row["status"] == "ok":
@@ -1115,8 +1116,20 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
                                                         check.move_scale[i])
                     row["report"]["on_disk_deviation"] = d
                     row["report"]["on_disk_deviation_kind"] = kind
+                    if d == 0.0 and "outline" in records[i].source and \
+                            faired[i].curve is not records[i].curve:
+                        # a font contour the write-side never-worse guard kept as it was
+                        # (curvefair.io.fonts.record_points): the figures above are the fair's,
+                        # the file holds the input
+                        row["report"]["written"] = "input"
+                        kept_notes.append(
+                            f"curve {i} ({row['label']}): written unchanged: the outline as "
+                            "written (smooth nodes, integer grid) was not fairer than the input")
             for note in check.notes:
                 click.echo(f"Warning: {out}: {note}", err=True)
+            if not quiet:
+                for note in kept_notes:
+                    click.echo(f"Note: {out}: {note}", err=True)
         if plot_path is not None:
             from .plot import figure
 
