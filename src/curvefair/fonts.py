@@ -18,7 +18,8 @@
 - :func:`check_outlines` lists kinks at smooth nodes, G2 breaks and inflections by glyph name
   and contour point index.
 - :func:`fair_designspace` fairs every master of a designspace document with the same
-  options and checks that they still interpolate (fontTools' ``varLib.interpolatable``).
+  options and checks that they still interpolate (fontTools' ``varLib.interpolatable``); the
+  CLI's ``curvefair fair X.designspace --tol T -o OUTDIR`` calls it.
 
 Fairing uses :func:`curvefair.fair` on the contour's B-spline (``method=None``: the B-spline
 default), with ``protect`` = the corner nodes and the points of straight segments.

@@ -8,7 +8,8 @@ One record per contour of every glyph (``glyphs=`` chooses glyphs by name), in g
 the default layer of a UFO (``.ufo`` folder), the ``glyf`` (quadratic) or ``CFF `` (cubic)
 outlines of a ``.ttf``/``.otf``, every master layer of a ``.glyphs`` source (brace, bracket
 and backup layers are left as they are), every source UFO of a ``.designspace`` document
-(read only: :func:`curvefair.fonts.fair_designspace` writes one, masters included; records
+(read only: :func:`curvefair.fonts.fair_designspace`, or ``curvefair fair X.designspace --tol T
+-o OUTDIR``, writes one, masters included; records
 named ``"<glyph>@<source name>#<contour>"``). Units are font units, ``y`` up. Contours made
 of straight lines only, components and empty glyphs carry no curve and are not records (they
 are written back untouched). The curve is the contour's B-spline of
@@ -30,7 +31,9 @@ points become the contour's points with the outline's rules enforced
 (:func:`curvefair.io._outline.constrained_points`: same points in the same order, smooth
 nodes exactly smooth, extrema keep their horizontal/vertical tangent, corners and straight
 segments unmoved, integers in binary fonts), each contour no farther from its input than the
-record's faired control points are (so within the fairing's ``tol``).
+record's faired control points are (so within the fairing's ``tol``), and never less fair than
+its input as written (:func:`record_points`: no more curvature extrema, no more bending
+energy; else the input contour is written).
 
 - UFO: the template folder is copied and only the ``.glif`` files of changed glyphs are
   rewritten (through fontTools' glifLib, in the glyph's own GLIF format version); kerning,
