@@ -17,8 +17,11 @@ Peer at equal deviation: scipy's ``splprep`` smoothing spline (cubic, through 40
 segment of each smooth run, ends fixed by weight), its smoothing factor bisected until its
 largest distance from the input run equals curvefair's on that contour. The peer does not
 keep the outline's structure (its number of control points is printed); it shows what a
-general smoother reaches at the same deviation. The "floats" column is the same fairing
-written without rounding to integers (as into a UFO).
+general smoother reaches at the same deviation (on a run curvefair leaves unchanged, the peer's
+figures are the input's). The "floats" column is the same fairing written without rounding to
+integers (as into a UFO). What is written passes ``record_points``' never-worse guard (no
+contour with more curvature extrema or more energy than its input; the run counts include
+the runs it kept as they were).
 
 Usage::
 
@@ -196,8 +199,8 @@ def bench(path, glyphs, tol, method=None):
             dev = float(np.max(np.linalg.norm(xb - xa, axis=1)))
             p = peer(xa, dev, M * len(ra))
             xf, Ef, ef = run_metrics(rf_runs.pop(0))
-            if p is None:
-                continue
+            if p is None:  # curvefair left the run as it was (deviation 0): so does the peer
+                p = (Ea, ea, sum(len(s) - 1 for s in ra) + 1)
             tot["E_in"] += Ea
             tot["E_cf"] += Eb
             tot["E_peer"] += p[0]

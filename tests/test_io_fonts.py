@@ -230,11 +230,27 @@ def test_truetype_implied_only_and_repeated_points(tmp_path):
 
     assert any(all_off(n) for n in names)
     out = tmp_path / "faired.ttf"
-    write_curves(out, _fair_records(recs, 3.0), template=src)
+    faired = _fair_records(recs, 3.0)
+    write_curves(out, faired, template=src)
     g = TTFont(out)
-    worst = check_outlines(f.getGlyphSet(), g.getGlyphSet(), names, 3.0)
-    assert worst > 0
+    check_outlines(f.getGlyphSet(), g.getGlyphSet(), names, 3.0)
     assert {n: list(g["glyf"][n].flags) for n in names} == flags
+    # these circles are already as fair as the integer grid allows: the never-worse guard
+    # keeps them (test_fonts_never_worse.py); the write path of the moved points, without
+    # the guard, keeps the structure exactly too
+    from curvefair.io.fonts import record_points, write_binary
+
+    changes = {}
+    for r in faired:
+        pts = record_points(r, guard=False)
+        if not np.array_equal(pts, r.source["outline"].points):
+            changes.setdefault(r.source["glyph"], {})[r.source["contour"]] = pts
+    out2 = tmp_path / "unguarded.ttf"
+    write_binary(out2, changes, str(src))
+    g2 = TTFont(out2)
+    worst = check_outlines(f.getGlyphSet(), g2.getGlyphSet(), names, 3.0)
+    assert worst > 0
+    assert {n: list(g2["glyf"][n].flags) for n in names} == flags
 
 
 def test_cff_lobster_round_trip(tmp_path):
@@ -422,6 +438,7 @@ def test_point_pen_passes_everything_on():
 
     font = TTFont(LOBSTER)
     gs = font.getGlyphSet()
+    moved = []
     for g in ("zero", "B"):
         rec = RecordingPointPen()
         from fontTools.pens.pointPen import SegmentToPointPen
@@ -435,7 +452,8 @@ def test_point_pen_passes_everything_on():
         p0 = np.array([a[0] for op, a, kw in ref.value if op == "addPoint"], float)
         p1 = np.array([a[0] for op, a, kw in rec.value if op == "addPoint"], float)
         assert np.linalg.norm(p1 - p0, axis=1).max() <= 2.0
-        assert np.any(p1 != p0)
+        moved.append(bool(np.any(p1 != p0)))
+    assert any(moved)  # (B's fair adds extrema on the grid: the never-worse guard keeps it)
 
 
 def test_designspace_masters_stay_compatible(ufo_pair, tmp_path):

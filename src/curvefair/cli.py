@@ -1000,6 +1000,12 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
     """
     from ._batch_cli import fair_many, wants_batch
 
+    if len(paths) == 1 and paths[0].lower().endswith(".designspace"):
+        _fair_designspace_cmd(paths[0], out, in_place=in_place, method=method, tol=tol,
+                              eps=eps, max_steps=max_steps, clamp=clamp, protect=protect,
+                              mode=mode, method_option=method_option, report=report,
+                              plot_path=plot_path, glyphs=glyphs, quiet=quiet)
+        return
     if wants_batch(paths, out, method, batch):
         if glyphs:
             raise click.BadParameter("--glyphs works on one font file (IN, -o OUT)",
@@ -1099,6 +1105,7 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
                                   format=out_fmt, overwrite=in_place, decimals=decimals)
             from .io._verify import rescaled_report
 
+            kept_notes: list[str] = []
             for i, (row, d, kind) in enumerate(zip(rows, check.deviations, check.kinds,
                                                    strict=True)):
                 if row["status"] == "ok":
@@ -1109,8 +1116,20 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
                                                         check.move_scale[i])
                     row["report"]["on_disk_deviation"] = d
                     row["report"]["on_disk_deviation_kind"] = kind
+                    if d == 0.0 and "outline" in records[i].source and \
+                            faired[i].curve is not records[i].curve:
+                        # a font contour the write-side never-worse guard kept as it was
+                        # (curvefair.io.fonts.record_points): the figures above are the fair's,
+                        # the file holds the input
+                        row["report"]["written"] = "input"
+                        kept_notes.append(
+                            f"curve {i} ({row['label']}): written unchanged: the outline as "
+                            "written (smooth nodes, integer grid) was not fairer than the input")
             for note in check.notes:
                 click.echo(f"Warning: {out}: {note}", err=True)
+            if not quiet:
+                for note in kept_notes:
+                    click.echo(f"Note: {out}: {note}", err=True)
         if plot_path is not None:
             from .plot import figure
 
@@ -1155,6 +1174,73 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
         for r in failures:
             click.echo(f"Error: {infile}: curve {r['index']} ({r['label']}): {r['error']}",
                        err=True)
+        raise SystemExit(EXIT_INPUT)
+
+
+def _fair_designspace_cmd(infile: str, out: str | None, *, in_place: bool, method: str | None,
+                          tol: float | None, eps: float | None, max_steps: int | None,
+                          clamp: str, protect: str | None, mode: str,
+                          method_option: tuple[str, ...], report: str | None,
+                          plot_path: str | None, glyphs: str | None, quiet: bool) -> None:
+    """``curvefair fair X.designspace --tol T -o OUTDIR``: every master faired with the same
+    options by :func:`curvefair.fonts.fair_designspace`, written into OUTDIR (a copy of the
+    document and of each source UFO, same relative names); exit 1 when the result has an
+    interpolation problem the input did not have."""
+    if not os.path.isfile(infile):
+        raise click.BadParameter(f"file {infile!r} does not exist", param_hint="IN")
+    if out is None or in_place:
+        raise click.UsageError("a designspace is faired into a new folder: pass -o OUTDIR "
+                               "(not --in-place); OUTDIR gets the document and its masters")
+    if out == "-":
+        raise click.BadParameter("a designspace is written as a folder, not to stdout",
+                                 param_hint="-o/--output")
+    if tol is None:
+        raise click.UsageError("--tol is required for a designspace (font units): every master "
+                               "is faired within the same tolerance")
+    for opt, val in (("--protect", protect), ("--plot", plot_path)):
+        if val is not None:
+            raise click.BadParameter("not available for a designspace (the masters are "
+                                     "written as UFOs; use them on one master)", param_hint=opt)
+    parent = Path(out).resolve().parent
+    if not parent.is_dir():
+        raise click.BadParameter(f"the folder of {out!r} does not exist", param_hint="-o/--output")
+    if os.path.exists(out) and not os.path.isdir(out):
+        raise click.BadParameter(f"{out!r} is a file; a designspace is written into a folder",
+                                 param_hint="-o/--output")
+    if Path(out).resolve() == Path(infile).resolve().parent:
+        raise click.UsageError(f"-o/--output {out!r} is the folder of the designspace: the "
+                               "masters would be replaced; give another folder")
+    options = _parse_method_options(method_option)
+    _check_option_values(method, options)
+    from .fairing import METHODS
+
+    if method is not None and method not in METHODS:
+        raise click.BadParameter(f"unknown method {method!r}; valid: " + ", ".join(METHODS),
+                                 param_hint="--method")
+    from .fonts import fair_designspace
+
+    t0 = time.perf_counter()
+    with _user_errors(), _warnings_to_stderr(quiet):
+        res = fair_designspace(infile, out, tol, glyphs=glyphs, method=method, eps=eps,
+                               max_steps=max_steps, clamp=clamp, mode=mode, **options)
+    kinds = {p["type"] for p in res["problems"]}
+    new_kinds = sorted(kinds - {p["type"] for p in res["problems_before"]})
+    if report is not None:
+        _write_json(report, {"curvefair": __version__, "input": os.path.abspath(infile),
+                             "output": os.path.abspath(out), "format": "designspace",
+                             "options": {"method": method, "tol": tol, "eps": eps,
+                                         "max_steps": max_steps, "clamp": clamp, "mode": mode,
+                                         "method_options": {k: _option_default(v)
+                                                            for k, v in options.items()}},
+                             "time_s": time.perf_counter() - t0, **res})
+    if not quiet:
+        for s in res["sources"]:
+            click.echo(f"{s['ufo']}: {s['contours']} contours faired within {tol:g}")
+        click.echo(f"wrote {out} (interpolation problems: {len(res['problems_before'])} in the "
+                   f"input, {len(res['problems'])} in the output)")
+    if new_kinds:
+        click.echo(f"Error: {out}: the faired masters have interpolation problems the input "
+                   f"did not have: {', '.join(new_kinds)}", err=True)
         raise SystemExit(EXIT_INPUT)
 
 

@@ -18,7 +18,8 @@
 - :func:`check_outlines` lists kinks at smooth nodes, G2 breaks and inflections by glyph name
   and contour point index.
 - :func:`fair_designspace` fairs every master of a designspace document with the same
-  options and checks that they still interpolate (fontTools' ``varLib.interpolatable``).
+  options and checks that they still interpolate (fontTools' ``varLib.interpolatable``); the
+  CLI's ``curvefair fair X.designspace --tol T -o OUTDIR`` calls it.
 
 Fairing uses :func:`curvefair.fair` on the contour's B-spline (``method=None``: the B-spline
 default), with ``protect`` = the corner nodes and the points of straight segments.
@@ -35,7 +36,7 @@ from typing import Any
 import numpy as np
 
 from ._typing import FloatArray
-from .errors import CurvefairError, InputError, MissingDependencyError
+from .errors import CurvefairError, FileFormatError, InputError, MissingDependencyError
 from .io._common import CurveRecord
 from .io._outline import Contour
 from .io.fonts import glyph_contours, record_points, ufo_contour
@@ -293,17 +294,33 @@ def fair_designspace(path: str | os.PathLike[str], out_dir: str | os.PathLike[st
     out = os.path.abspath(os.fspath(out_dir))
     if os.path.dirname(src) == out:
         raise InputError("out_dir must not be the folder of the designspace document")
-    os.makedirs(out, exist_ok=True)
-    doc = DesignSpaceDocument.fromfile(src)
+    try:
+        doc = DesignSpaceDocument.fromfile(src)
+    except Exception as exc:  # fontTools raises many kinds for a garbled document
+        raise FileFormatError(f"not a designspace document fontTools can read ({exc})",
+                              src) from None
     base = os.path.dirname(src)
-    done: dict[str, Any] = {"sources": []}
-    for s in doc.sources:
-        ufo = s.path or os.path.join(base, s.filename)
-        rel = os.path.relpath(ufo, base)
+    ufos = []
+    for k, s in enumerate(doc.sources):  # every master checked before anything is written
+        ufo = s.path or (os.path.join(base, s.filename) if s.filename else None)
+        if ufo is None or not os.path.isdir(ufo):
+            raise FileFormatError(f"source {k} ({s.filename!r}): no such UFO "
+                                  f"({ufo!r})", src)
         if s.layerName:
-            raise InputError(f"designspace source {rel!r}: sparse layer masters are not "
-                             "supported")
+            raise InputError(f"designspace source {k} ({s.filename!r}): sparse layer masters "
+                             "are not supported")
+        ufos.append(ufo)
+    os.makedirs(out, exist_ok=True)
+    done: dict[str, Any] = {"sources": []}
+    for ufo in ufos:
+        rel = os.path.relpath(ufo, base)
+        if rel.startswith(os.pardir):
+            raise InputError(f"designspace source {rel!r} is outside the document's folder: "
+                             "out_dir cannot hold it at the same relative path")
         recs = read_curves(ufo, glyphs=glyphs, on_unsupported="skip")
+        # integer masters stay integer (as FairFilter's grid="auto"): a build's rounding then
+        # neither moves points nor breaks smooth nodes
+        recs = [_grid_if_integer(r) for r in recs]
         faired: list[CurveRecord] = []
         for r in recs:
             try:
@@ -322,6 +339,13 @@ def fair_designspace(path: str | os.PathLike[str], out_dir: str | os.PathLike[st
     done["problems_before"] = interpolation_problems(src)
     done["problems"] = interpolation_problems(os.path.join(out, os.path.basename(src)))
     return done
+
+
+def _grid_if_integer(r: CurveRecord) -> CurveRecord:
+    c: Contour = r.source["outline"]
+    if c.grid or not np.array_equal(c.points, np.round(c.points)):
+        return r
+    return dataclasses.replace(r, source=dict(r.source, outline=dataclasses.replace(c, grid=True)))
 
 
 def interpolation_problems(designspace: str | os.PathLike[str]) -> list[dict[str, Any]]:

@@ -387,3 +387,88 @@ def harmonize(c: Contour, q: FloatArray, tol: float | None, sweeps: int = 8) -> 
                     q[ia], q[ib] = na, nb
                     break
     return q
+
+
+#: samples per Bezier segment of :func:`fairness` (``t = 0, 1/(M-1), ..., 1``)
+FAIRNESS_SAMPLES = 40
+
+
+def _segments(c: Contour, pts: FloatArray) -> list[list[FloatArray]]:
+    """The smooth runs of the contour drawn with points ``pts``: lists of Bezier control
+    polygons (degree 2 or 3), split at the corner nodes (on-curve points not kept smooth,
+    :func:`_node_kinds`) and at straight segments. A TrueType run of ``k`` off-curve points
+    between two on-curve points is ``k`` quadratic pieces joined at the implied on-curve
+    midpoints; a contour of off-curve points only is one run of such pieces."""
+    P = np.asarray(pts, dtype=np.float64)
+    n = len(c.on)
+    if not any(c.on):
+        return [[np.array([(P[i - 1] + P[i]) / 2, P[i], (P[i] + P[(i + 1) % n]) / 2])
+                 for i in range(n)]]
+    _, corners, _ = _node_kinds(c)
+    start = _rotation(c, corners)
+    order = [(start + i) % n for i in range(n)] + ([start] if c.closed else [])
+    out: list[list[FloatArray]] = []
+    cur: list[FloatArray] = []
+    cset = set(corners)
+    i = 0
+    while i < len(order) - 1:
+        j = i + 1
+        while j < len(order) - 1 and not c.on[order[j]]:
+            j += 1
+        a, b = P[order[i]], P[order[j]]
+        offs = [P[k] for k in order[i + 1:j]]
+        if not offs:  # a line ends a run
+            if cur:
+                out.append(cur)
+            cur = []
+        elif c.quadratic and len(offs) > 1:
+            ends = [a] + [(offs[m] + offs[m + 1]) / 2 for m in range(len(offs) - 1)] + [b]
+            cur.extend(np.array([ends[m], o, ends[m + 1]]) for m, o in enumerate(offs))
+        else:
+            cur.append(np.array([a, *offs, b]))
+        if order[j] in cset and cur:
+            out.append(cur)
+            cur = []
+        i = j
+    if cur:
+        out.append(cur)
+    return out
+
+
+def fairness(c: Contour, pts: FloatArray) -> tuple[int, float]:
+    """``(curvature extrema, bending energy)`` of the contour drawn with points ``pts``,
+    measured on its Bezier segments as written (not on a B-spline fitted to them).
+
+    Each smooth run (:func:`_segments`) is sampled at :data:`FAIRNESS_SAMPLES` parameters per
+    segment; the signed curvature of a segment ``x(t)`` is
+    ``kappa = (x' x y'' - x'' y') / |x'|^3`` (Bernstein derivatives, e.g. Farin, *Curves and
+    Surfaces for CAGD*), the energy is ``sum over runs of int kappa^2 |x'| dt`` (trapezoid-free
+    Riemann sum, step ``1/(M-1)``), and an extremum is a sign change of the successive
+    differences of ``kappa`` along the run, differences below ``1e-3 / M`` of the run's largest
+    ``|kappa|`` ignored (sampling noise, flat stretches). The same definition is used by
+    ``benchmarks/bench_fonts.py``.
+    """
+    m = FAIRNESS_SAMPLES
+    t = np.linspace(0.0, 1.0, m)[:, None]
+    ext, energy = 0, 0.0
+    for run in _segments(c, pts):
+        ks = []
+        for S in run:
+            deg = len(S) - 1
+            D = deg * np.diff(S, axis=0)
+            if deg == 2:
+                d1 = (1 - t) * D[0] + t * D[1]
+                d2 = np.broadcast_to(D[1] - D[0], d1.shape)
+            else:  # cubic
+                d1 = (1 - t) ** 2 * D[0] + 2 * t * (1 - t) * D[1] + t ** 2 * D[2]
+                d2 = 2 * ((1 - t) * (D[1] - D[0]) + t * (D[2] - D[1]))
+            sp = np.hypot(d1[:, 0], d1[:, 1])
+            k = (d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]) / np.maximum(sp, 1e-300) ** 3
+            energy += float(np.sum(k * k * sp)) / (m - 1)
+            ks.append(k)
+        kap = np.concatenate(ks)
+        scale = max(float(np.max(np.abs(kap))), 1e-300)
+        d = np.diff(kap)
+        d = d[np.abs(d) > 1e-3 * scale / m]
+        ext += int(np.sum(np.sign(d[1:]) != np.sign(d[:-1])))
+    return ext, energy

@@ -8,7 +8,8 @@ One record per contour of every glyph (``glyphs=`` chooses glyphs by name), in g
 the default layer of a UFO (``.ufo`` folder), the ``glyf`` (quadratic) or ``CFF `` (cubic)
 outlines of a ``.ttf``/``.otf``, every master layer of a ``.glyphs`` source (brace, bracket
 and backup layers are left as they are), every source UFO of a ``.designspace`` document
-(read only: :func:`curvefair.fonts.fair_designspace` writes one, masters included; records
+(read only: :func:`curvefair.fonts.fair_designspace`, or ``curvefair fair X.designspace --tol T
+-o OUTDIR``, writes one, masters included; records
 named ``"<glyph>@<source name>#<contour>"``). Units are font units, ``y`` up. Contours made
 of straight lines only, components and empty glyphs carry no curve and are not records (they
 are written back untouched). The curve is the contour's B-spline of
@@ -30,7 +31,9 @@ points become the contour's points with the outline's rules enforced
 (:func:`curvefair.io._outline.constrained_points`: same points in the same order, smooth
 nodes exactly smooth, extrema keep their horizontal/vertical tangent, corners and straight
 segments unmoved, integers in binary fonts), each contour no farther from its input than the
-record's faired control points are (so within the fairing's ``tol``).
+record's faired control points are (so within the fairing's ``tol``), and never less fair than
+its input as written (:func:`record_points`: no more curvature extrema, no more bending
+energy; else the input contour is written).
 
 - UFO: the template folder is copied and only the ``.glif`` files of changed glyphs are
   rewritten (through fontTools' glifLib, in the glyph's own GLIF format version); kerning,
@@ -63,7 +66,7 @@ import numpy as np
 from .._typing import FloatArray
 from ..errors import CurvefairError, FileFormatError, InputError
 from ._common import CurveRecord, Unsupported, lazy_import
-from ._outline import Contour, constrained_points, contour_curve
+from ._outline import Contour, constrained_points, contour_curve, fairness
 from ._outline import harmonize as _harmonize
 
 __all__ = ["read", "write", "glyph_contours", "font_contours"]
@@ -191,8 +194,12 @@ def _open_binary(path: Any) -> Any:
     except Exception as exc:  # fontTools raises many kinds for a garbled file
         raise FileFormatError(f"not a font fontTools can read ({exc})", path) from None
     if "glyf" not in font and "CFF " not in font:
-        raise FileFormatError("no glyf or CFF outlines (CFF2 variable outlines are not "
-                              "supported)", path)
+        if "CFF2" in font:
+            raise FileFormatError("its outlines are in a CFF2 table (variable OpenType/CFF2), "
+                                  "which curvefair does not read or write: fair the font's "
+                                  "sources (a .designspace with 'curvefair fair', or its UFO "
+                                  "masters) and build it again", path)
+        raise FileFormatError("no glyf or CFF outlines", path)
     if "CFF " in font:
         font["CFF "].cff.desubroutinize()
     return font
@@ -382,11 +389,25 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
 # ------------------------------------------------------------------------------------------
 # write
 # ------------------------------------------------------------------------------------------
-def record_points(rec: CurveRecord, tol: float | None = None, *, harmonize: bool = False
-                  ) -> FloatArray:
+#: the moves tried by the never-worse guard of :func:`record_points`, as fractions of the fair's
+GUARD_SCALES = (1.0, 0.5, 0.25, 0.125)
+
+
+def record_points(rec: CurveRecord, tol: float | None = None, *, harmonize: bool = False,
+                  guard: bool = True) -> FloatArray:
     """The contour points to write for a (faired) record: its control points at the contour's
     indices with the outline's rules enforced, no farther from the input than ``tol`` (default:
-    the farthest faired control point, i.e. the fairing's own tolerance)."""
+    the farthest faired control point, i.e. the fairing's own tolerance).
+
+    Never worse (``guard=True``): what is written -- after the smooth-node and extremum rules,
+    the rounding to integers of binary fonts and ``harmonize`` -- is measured with
+    :func:`curvefair.io._outline.fairness` on the contour's own Bezier segments, for the fair's
+    moves scaled by each of :data:`GUARD_SCALES`. Of the candidates with no more curvature
+    extrema and no more bending energy than the input, the one with the fewest extrema (then
+    the least energy) is written; when there is none the input contour is written unchanged.
+    The fair itself works on the B-spline and cannot see these rules: rounding a TrueType
+    point to the grid, or putting a node back on its neighbours' line, can add an extremum
+    the fair's own check did not count."""
     c: Contour = rec.source["outline"]
     idx = np.asarray(rec.source["point_index"], dtype=np.intp)
     cp = np.asarray(rec.curve.control_points, dtype=np.float64)  # type: ignore[attr-defined]
@@ -401,10 +422,24 @@ def record_points(rec: CurveRecord, tol: float | None = None, *, harmonize: bool
             raise InputError(f"{rec.name}: {cp.shape[0]} control points, the contour has "
                              f"{P0.shape[0]}: its structure must be kept")
         tol = float(np.max(np.linalg.norm(cp - P0, axis=1)))
-    pts, _ = constrained_points(c, new, tol)
-    if harmonize:
-        pts = _harmonize(c, pts, tol)
-    return pts
+    P0 = np.asarray(c.points, dtype=np.float64)
+
+    def candidate(s: float) -> FloatArray:
+        pts, _ = constrained_points(c, P0 + s * (new - P0) if s != 1.0 else new, tol)
+        return _harmonize(c, pts, tol) if harmonize else pts
+
+    if not guard:
+        return candidate(1.0)
+    ext0, e0 = fairness(c, P0)
+    best: tuple[int, float, FloatArray] | None = None
+    for s in GUARD_SCALES:
+        pts = candidate(s)
+        if np.array_equal(pts, P0):
+            continue
+        ext, e = fairness(c, pts)
+        if ext <= ext0 and e <= e0 and (best is None or (ext, e) < best[:2]):
+            best = (ext, e, pts)
+    return P0.copy() if best is None else best[2]
 
 
 def _by_glyph(records: Sequence[CurveRecord], tpath: str) -> dict[str, dict[int, FloatArray]]:
