@@ -482,7 +482,8 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
         (with a B-spline method registered).
     method : str, optional
         A name from :func:`available_methods`; default: the curve type's default
-        (``"poliakoff"`` for cubic, ``"wang-quintic"`` for quintic Hermite splines,
+        (``"points-l1"`` for open chord-length natural cubics - point data - up to 20,000
+        points, ``"poliakoff"`` for other cubic, ``"wang-quintic"`` for quintic Hermite splines,
         ``"global"`` with ``l=3`` for B-splines: the fairest method of the quality benchmark
         that keeps the B-spline's degree, knots and number of control points), with that
         method's ``default_options`` under the caller's own options.
