@@ -29,6 +29,7 @@ from ..analysis.discrete import (
 )
 from ..errors import InputError
 from .ranking import tt_build, tt_top, tt_update
+from .stop import StopReason
 
 __all__ = ["cheng_yu", "cheng_yu_driver", "CYResult"]
 
@@ -637,7 +638,7 @@ def _movable(curve: Any, clamp: Any, protect: Iterable[int]) -> np.ndarray:
     return mask
 
 
-_STOP = {_NONE_LEFT: "no_improvement", _EPS: "eps", _CONVERGED: "converged",
+_STOP: dict[int, StopReason] = {_NONE_LEFT: "no_improvement", _EPS: "eps", _CONVERGED: "converged",
          _MAX_STEPS: "max_steps"}
 
 
@@ -668,7 +669,7 @@ class CYResult:
 
     curve: Any
     steps: int
-    stop_reason: str
+    stop_reason: StopReason
     indicator_before: float
     indicator_after: float
     threshold: float

@@ -28,6 +28,7 @@ from .._validate import as_nonnegative, as_step_count, check_finite, choice
 from ..curves.bspline import BSplineCurve, band_energy, band_residual, residual_row
 from ..errors import InputError
 from ._prefetch import prefetch
+from .stop import StopReason
 
 __all__ = [
     "eck_hadenfeld",
@@ -38,7 +39,7 @@ __all__ = [
     "movable_mask",
 ]
 
-STOP_REASONS = {0: "converged", 1: "max_steps", 2: "no_movable_point"}
+STOP_REASONS: dict[int, StopReason] = {0: "converged", 1: "max_steps", 2: "no_movable_point"}
 
 
 # ------------------------------------------------------------------------------------------
@@ -914,7 +915,7 @@ class EHResult:
 
     curve: BSplineCurve
     steps: int
-    stop_reason: str
+    stop_reason: StopReason
     energy_before: float
     energy_after: float
     eps_absolute: float

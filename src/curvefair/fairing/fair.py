@@ -22,6 +22,7 @@ from .._typing import FloatArray
 from ..curves.piecewise import PiecewiseCurve, readonly
 from ..errors import InputError
 from ..interop import as_curve as _as_curve
+from .stop import StopReason
 
 __all__ = [
     "MethodSpec",
@@ -122,7 +123,7 @@ class DriverOutput:
 
     curve: PiecewiseCurve
     steps: int
-    stop_reason: str
+    stop_reason: StopReason
     history: FairingHistory | None = None
     eps: float | None = None
     max_steps: int | None = None
