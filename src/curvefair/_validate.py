@@ -350,6 +350,8 @@ def parse_clamp(clamp: object, name: str = "clamp") -> tuple[str, str]:
     if clamp is None or isinstance(clamp, str):
         pair: tuple[object, object] = (clamp, clamp)
     else:
+        left: object
+        right: object
         try:
             left, right = clamp  # type: ignore[misc]
         except (TypeError, ValueError):
