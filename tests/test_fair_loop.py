@@ -261,7 +261,7 @@ def test_protect_and_report_moved():
 def test_protect_everything_nothing_to_move():
     c = interpolate_cubic(_noisy(6, 2, seed=33))
     res = fair(c, "poliakoff", protect=range(6))
-    assert res.report["steps"] == 0 and res.report["stop_reason"] == "nothing_to_move"
+    assert res.report["steps"] == 0 and res.report["stop_reason"] == "no_movable_point"
     np.testing.assert_array_equal(res.curve.points, c.points)
 
 

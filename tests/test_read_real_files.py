@@ -19,7 +19,8 @@ from _helpers import record_points
 from click.testing import CliRunner
 
 from curvefair import read_curves, write_curves
-from curvefair.cli import _c0_pieces, main
+from curvefair.analysis import c0_pieces
+from curvefair.cli import main
 from curvefair.errors import FileFormatError
 
 spt = pytest.importorskip("svgpathtools")
@@ -226,7 +227,7 @@ def test_analyze_splits_at_corner_knots():
     t = np.asarray(c.knots)
     _, counts = np.unique(t[4:-4], return_counts=True)
     assert (counts >= 3).sum() >= 5                   # a glyph outline: corner knots
-    pieces = _c0_pieces(c)
+    pieces = c0_pieces(c)
     assert len(pieces) == (counts >= 3).sum() + 1
     for off, sub in pieces:                           # each piece is the curve there
         u = np.linspace(*sub.domain, 101)

@@ -336,6 +336,45 @@ def as_positive(value: object, name: str, *, allow_none: bool = False,
     return v
 
 
+#: End conditions of ``clamp`` (case-insensitive; ``None`` is ``"none"``): ``"none"`` leaves the
+#: end free, ``"g0"`` keeps the end point, ``"g1"`` also the end tangent, ``"g2"`` also the end
+#: curvature.
+CLAMP_VALUES = ("none", "g0", "g1", "g2")
+
+
+def parse_clamp(clamp: object, name: str = "clamp") -> tuple[str, str]:
+    """The one grammar of ``clamp``, for :func:`curvefair.fair` and every method function.
+
+    ``clamp`` is one end condition for both ends or a ``(left, right)`` pair; each is ``None``
+    or one of :data:`CLAMP_VALUES`, in any case (``"G1"`` is ``"g1"``). Returns the pair in
+    lower case, ``None`` as ``"none"``.
+
+    Raises
+    ------
+    InputError
+        Naming ``name`` (and the end) for anything else.
+    """
+    if clamp is None or isinstance(clamp, str):
+        pair: tuple[object, object] = (clamp, clamp)
+    else:
+        left: object
+        right: object
+        try:
+            left, right = clamp  # type: ignore[misc]
+        except (TypeError, ValueError):
+            raise InputError(f"{name} must be one of {CLAMP_VALUES} (any case) or None, or a "
+                             f"(left, right) pair of them, got {clamp!r}") from None
+        pair = (left, right)
+    out = []
+    for side, v in zip(("left", "right"), pair, strict=True):
+        key = "none" if v is None else (v.lower() if isinstance(v, str) else v)
+        if key not in CLAMP_VALUES:
+            raise InputError(f"unknown {name} {v!r} ({side} end); valid values are: None, "
+                             + ", ".join(repr(c) for c in CLAMP_VALUES) + " (any case)")
+        out.append(str(key))
+    return out[0], out[1]
+
+
 def choice(value: object, valid: Iterable[str], name: str) -> str:
     """Check a string option; the error lists the valid names."""
     valid = list(valid)

@@ -552,91 +552,6 @@ def methods_cmd(as_json: bool) -> None:
 # ------------------------------------------------------------------------------------------
 # analyze
 # ------------------------------------------------------------------------------------------
-_CHENG_YU_KINDS = {1: "inflection (Cheng-Yu kind 1)", 2: "curvature extremum (Cheng-Yu kind 2)",
-                   3: "convexity (Cheng-Yu kind 3)"}
-
-
-def _c0_pieces(curve: Any) -> list[tuple[int, Any]]:
-    """An open clamped B-spline cut at its C0 knots (interior knots of multiplicity >= degree:
-    the curve passes through a control point there, a corner or a kink), as ``(index of the
-    piece's first control point in the curve, piece)``; ``[(0, curve)]`` when there are none.
-
-    With ``u = t_{k+1} = ... = t_{k+p}`` the curve is ``P_k`` at ``u``, and the two pieces are
-    the B-splines on ``P_0..P_k`` with knots ``t_0..t_{k+p}, u`` and on ``P_k..P_{n-1}`` with
-    knots ``u, t_{k+1}..t_{n+p}`` (the B-spline basis is local: no control point changes).
-    Closed curves are returned whole (their discrete curvature needs no split unless a C0
-    knot is present, which then makes :func:`curvefair.bad_points` refuse them).
-    """
-    import numpy as np
-
-    from . import BSplineCurve
-
-    p = curve.degree
-    if curve.closed:
-        return [(0, curve)]
-    t = np.asarray(curve.knots, dtype=float)
-    P = np.asarray(curve.control_points, dtype=float)
-    inner, counts = np.unique(t[p + 1:-p - 1], return_counts=True)
-    cuts = []
-    for u, m in zip(inner, counts, strict=True):
-        if m >= p:
-            k = int(np.searchsorted(t, u, side="left")) - 1   # t_{k+1} = u
-            cuts.append((int(k + m - p), u))
-    if not cuts:
-        return [(0, curve)]
-    out = []
-    start = 0
-    for k in [c for c, _ in cuts] + [P.shape[0] - 1]:
-        # P_start..P_k on the knots t_{start+1}..t_{k+p}, each end knot once more
-        knots = np.r_[t[start + 1], t[start + 1:k + p + 1], t[k + p]]
-        out.append((start, BSplineCurve(P[start:k + 1], knots, p)))
-        start = k
-    return out
-
-
-def _bad_point_list(curve: Any, a: Any) -> list[dict[str, Any]]:
-    """The ranked bad points of a curve, from the library's measures.
-
-    Hermite curves (and B-splines of degree other than 3): breakpoints ranked by the jump of the
-    third derivative (Wang & Cao 2006), or of the highest derivative when a C4 quintic has
-    none; for a Hermite curve the breakpoint index is the data-point index. Cubic B-splines:
-    the bad control points of Cheng & Yu (:func:`curvefair.bad_points`), ranked by ``z_i``.
-    """
-    from . import BSplineCurve, bad_points
-
-    if isinstance(curve, BSplineCurve) and curve.degree == 3:
-        out: list[dict[str, Any]] = []
-        pieces = _c0_pieces(curve)
-        for piece, (offset, sub) in enumerate(pieces):
-            try:
-                found = bad_points(sub)
-            except CurvefairError:
-                continue   # a single Bezier segment, or a closed curve with a C0 knot
-            out += [{"index": int(b.index) + offset, "index_of": "control point",
-                     "param": None, "measure": float(b.value),
-                     "measure_name": "z = D^2 (Cheng-Yu)",
-                     "kind": _CHENG_YU_KINDS.get(int(b.kind), str(b.kind)),
-                     "kinds": [int(k) for k in b.kinds]}
-                    | ({"piece": piece} if len(pieces) > 1 else {}) for b in found]
-        out.sort(key=lambda b: -b["measure"])
-        return out
-    import numpy as np
-
-    jumps, name, kind = np.asarray(a.jumps), "|Δr'''|", "third-derivative jump"
-    if a.degree > 3 and not a.max_jump > 1e-9 * a.max_top_jump:
-        jumps, name = np.asarray(a.top_jumps), f"|Δr^({a.degree})|"
-        kind = f"derivative-{a.degree} jump"
-    if jumps.size == 0 or float(jumps.max()) <= 0.0:
-        return []
-    top = float(jumps.max())
-    order = np.argsort(-jumps, kind="stable")
-    of = "data point" if hasattr(curve, "points") else "breakpoint"
-    return [{"index": int(a.jump_indices[i]), "index_of": of, "param": float(a.jump_params[i]),
-             "measure": float(jumps[i]), "measure_name": name,
-             "kind": kind, "sapidis": float(a.sapidis[i])}
-            for i in order if jumps[i] > 1e-9 * top]
-
-
 @main.command("analyze")
 @click.argument("infile", metavar="IN", type=click.Path(exists=True, dir_okay=True))
 @click.option("--json", "as_json", is_flag=True, help="Machine-readable output (JSON on stdout).")
@@ -649,6 +564,7 @@ def analyze_cmd(infile: str, as_json: bool, top: int, corner_angle: float, no_co
     """Analyse every curve of IN: energies, inflections, curvature extrema, the worst jumps,
     and the ranked list of bad points (index, measure, kind)."""
     from . import analyze
+    from .analysis import rank_bad_points
 
     with _user_errors():
         records = _read(infile, _corner(corner_angle, no_corners), strict, quiet)
@@ -657,7 +573,8 @@ def analyze_cmd(infile: str, as_json: bool, top: int, corner_angle: float, no_co
             a = analyze(rec.curve)
             out.append({"index": i, "name": rec.name, "kind": rec.kind,
                         "curve_type": type(rec.curve).__name__, "corners": list(rec.corners),
-                        "analysis": a.to_dict(), "bad_points": _bad_point_list(rec.curve, a)})
+                        "analysis": a.to_dict(),
+                        "bad_points": [b.to_dict() for b in rank_bad_points(rec.curve, a)]})
     if as_json:
         click.echo(json.dumps({"file": infile, "curves": out}, indent=2, allow_nan=False))
         return

@@ -20,8 +20,9 @@ Conventions
   plane (``"xy"``, ``"xz"``, ``"yz"``); the axes labels say which. The comb uses the 3-D
   principal normal and is projected with the curve.
 * **Markers**: inflections (sign changes of the curvature, planar curves only), curvature extrema,
-  and the worst bad points, ranked by the jump of the third derivative at the breakpoints
-  (Wang & Cao 2006, section "Bad points identification"), labelled 1, 2, 3, ...
+  and the worst bad points of :func:`curvefair.analysis.rank_bad_points` (the jump of the third
+  derivative at the breakpoints, Wang & Cao 2006, section "Bad points identification"; the bad
+  control points of Cheng & Yu on a cubic B-spline), labelled 1, 2, 3, ...
 
 Indices are 0-based (the papers number points from 1).
 """
@@ -352,30 +353,29 @@ class _Features:
     inflections: FloatArray = field(default_factory=lambda: np.empty(0))  # parameters
     extrema: FloatArray = field(default_factory=lambda: np.empty(0))  # parameters
     bad: list[tuple[int, float, float]] = field(default_factory=list)  # (index, u, measure)
-    bad_order: int = 3  # derivative whose jump ranks the bad points
+    bad_label: str = "max |Δr'''|"  # what ranks the bad points (legend)
 
 
 def _features(curve: PiecewiseCurve, n_bad: int) -> _Features:
     """Inflections, curvature extrema and the ``n_bad`` worst bad points, from :func:`analyze`.
 
-    Bad points are the breakpoints ranked by the jump of the third derivative (Wang & Cao 2006);
-    a curve without third-derivative jumps (a C4 quintic spline) is ranked by the jump of its
-    highest derivative, ``Analysis.top_jumps``.
+    Bad points are those of :func:`curvefair.analysis.rank_bad_points` (the ranking
+    ``curvefair analyze`` lists): breakpoints ranked by the jump of the third derivative (Wang
+    & Cao 2006) or, without one, of the highest derivative; on a cubic B-spline the bad control
+    points of Cheng & Yu, marked at the joint their criterion looks at.
     """
-    from .analysis import analyze
+    from .analysis import analyze, rank_bad_points
 
     a = analyze(curve)
     feats = _Features(inflections=np.asarray(a.inflection_params, dtype=float),
                       extrema=np.asarray(a.extremum_params, dtype=float))
-    if n_bad > 0 and a.jumps.size:
-        jumps, order_ = np.asarray(a.jumps), 3
-        if a.degree > 3 and not a.max_jump > 1e-9 * a.max_top_jump:
-            jumps, order_ = np.asarray(a.top_jumps), a.degree
-        top = float(jumps.max())
-        rank = np.argsort(-jumps, kind="stable")[:n_bad]
-        feats.bad = [(int(a.jump_indices[i]), float(a.jump_params[i]), float(jumps[i]))
-                     for i in rank if top > 0.0 and jumps[i] > 1e-9 * top]
-        feats.bad_order = order_
+    if n_bad > 0:
+        ranked = rank_bad_points(curve, a)[:n_bad]
+        feats.bad = [(b.index, b.param, b.measure) for b in ranked]
+        if ranked:
+            d = ranked[0].derivative
+            feats.bad_label = (f"max |Δr{_prime(d)}|" if d is not None
+                               else "max Cheng-Yu z = D²")
     return feats
 
 
@@ -591,15 +591,14 @@ def _legend_handles(has: dict[str, Any]) -> list[Any]:
                           label="curvature extremum"))
     if has.get("bad"):
         out.append(Line2D([], [], ls="none", marker="o", ms=9, mfc="none", mec=_BAD, mew=1.4,
-                          label=("worst bad points (largest derivative jumps)"
-                                 if has["bad_order"] is None else
-                                 f"worst bad points (max |Δr{_prime(has['bad_order'])}|)")))
+                          label=("worst bad points" if has["bad_label"] is None else
+                                 f"worst bad points ({has['bad_label']})")))
     return out
 
 
-def _common_order(prepared: list[_Prepared]) -> int | None:
-    orders = {p.feats.bad_order for p in prepared if p.feats.bad}
-    return orders.pop() if len(orders) == 1 else (3 if not orders else None)
+def _common_label(prepared: list[_Prepared]) -> str | None:
+    labels = {p.feats.bad_label for p in prepared if p.feats.bad}
+    return labels.pop() if len(labels) == 1 else (_Features.bad_label if not labels else None)
 
 
 def _prime(order: int) -> str:
@@ -625,7 +624,7 @@ def _finish_curve_axes(ax: Any, prepared: list[_Prepared], proj: _Projector, sca
             "inflection": any(p.feats.inflections.size for p in prepared),
             "extremum": any(p.feats.extrema.size for p in prepared),
             "bad": any(p.feats.bad for p in prepared),
-            "bad_order": _common_order(prepared),
+            "bad_label": _common_label(prepared),
         })
     if handles and legend:
         ax.legend(handles=handles, loc="best", fontsize=8, framealpha=0.85)
@@ -843,8 +842,8 @@ def plot_curve(curve: PiecewiseCurve, ax: Any = None, comb: bool = True,
         Hair intervals per curve segment (``density + 1`` hairs per segment, both ends included).
         Default: about 600 hairs in all.
     markers : bool
-        Mark inflections (◆), curvature extrema (▲) and the ``n_bad`` worst bad points (○, ranked
-        by the jump of the third derivative at the breakpoints, Wang & Cao 2006).
+        Mark inflections (◆), curvature extrema (▲) and the ``n_bad`` worst bad points (○, those of
+        :func:`curvefair.analysis.rank_bad_points`).
     points : bool
         Draw the data points (Hermite curves) or the control polygon (B-splines).
     label : str, optional

@@ -1,7 +1,9 @@
 """Fairness analysis: exact energies, curvature and torsion, bad-point measures, deviation.
 
 Public: :func:`energy`, :func:`curvature`, :func:`curvature_derivative`, :func:`torsion`,
-:func:`analyze` (-> :class:`Analysis`), :func:`deviation` (-> :class:`Deviation`); the discrete
+:func:`analyze` (-> :class:`Analysis`), :func:`deviation` (-> :class:`Deviation`),
+:func:`rank_bad_points` (-> list of :class:`RankedBadPoint`: the one bad-point ranking that
+``curvefair analyze`` and the plots show); the discrete
 curvature of Cheng & Yu lives in :mod:`curvefair.analysis.discrete`.
 """
 
@@ -9,6 +11,7 @@ from ._analyze import Analysis, analyze, derivative_jumps
 from ._curvature import curvature, curvature_derivative, torsion
 from ._deviation import Deviation, deviation
 from ._energy import energy, segment_energies
+from ._ranking import RankedBadPoint, c0_pieces, rank_bad_points
 from .discrete import (
                        BadPoint,
                        SecondDiscreteCurvature,
@@ -33,4 +36,7 @@ __all__ = [
     "bad_points",
     "BadPoint",
     "SecondDiscreteCurvature",
+    "rank_bad_points",
+    "RankedBadPoint",
+    "c0_pieces",
 ]

@@ -19,6 +19,7 @@ from .fair import (
     method_options,
     register_method,
 )
+from .stop import STOP_REASONS, StopReason
 
 __all__ = [
     "fair",
@@ -30,6 +31,8 @@ __all__ = [
     "register_method",
     "available_methods",
     "method_options",
+    "StopReason",
+    "STOP_REASONS",
 ]
 
 METHOD_MODULES = [

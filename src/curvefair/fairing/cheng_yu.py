@@ -21,7 +21,7 @@ import numpy as np
 
 from .._jit import njit
 from .._typing import FloatArray
-from .._validate import as_nonnegative, as_step_count
+from .._validate import as_nonnegative, as_step_count, parse_clamp
 from ..analysis.discrete import (
     _cubic_bspline,
     corner_cut_ratios,
@@ -29,6 +29,7 @@ from ..analysis.discrete import (
 )
 from ..errors import InputError
 from .ranking import tt_build, tt_top, tt_update
+from .stop import StopReason
 
 __all__ = ["cheng_yu", "cheng_yu_driver", "CYResult"]
 
@@ -607,24 +608,13 @@ def _run(Q, Q0, W, lw, mw, closed, planar, movable, e, eps, max_steps,  # type: 
     return steps, reason
 
 
-_CLAMP_POINTS = {None: 0, "free": 0, "g0": 1, "g1": 2, "g2": 3}
+_CLAMP_POINTS = {"none": 0, "g0": 1, "g1": 2, "g2": 3}
 
 
 def _movable(curve: Any, clamp: Any, protect: Iterable[int]) -> np.ndarray:
     """Control points the driver may move: not clamped (open curves), not protected."""
     n = curve.n_ctrl
-    if clamp is None or isinstance(clamp, str):
-        clamp = (clamp, clamp)
-    try:
-        left, right = clamp
-    except (TypeError, ValueError):
-        raise InputError(f"clamp must be a (left, right) pair, got {clamp!r}") from None
-    counts = []
-    for side, c in (("left", left), ("right", right)):
-        if c not in _CLAMP_POINTS:
-            raise InputError(f"unknown clamp {c!r} ({side} end); valid values are: None, 'g0', "
-                             "'g1', 'g2'")
-        counts.append(_CLAMP_POINTS[c])
+    counts = [_CLAMP_POINTS[c] for c in parse_clamp(clamp)]
     mask = np.ones(n, dtype=np.bool_)
     if not curve.closed:  # closed curves have no ends: the clamp is ignored
         mask[: counts[0]] = False
@@ -637,7 +627,7 @@ def _movable(curve: Any, clamp: Any, protect: Iterable[int]) -> np.ndarray:
     return mask
 
 
-_STOP = {_NONE_LEFT: "no_improvement", _EPS: "eps", _CONVERGED: "converged",
+_STOP: dict[int, StopReason] = {_NONE_LEFT: "no_improvement", _EPS: "eps", _CONVERGED: "converged",
          _MAX_STEPS: "max_steps"}
 
 
@@ -668,7 +658,7 @@ class CYResult:
 
     curve: Any
     steps: int
-    stop_reason: str
+    stop_reason: StopReason
     indicator_before: float
     indicator_after: float
     threshold: float

@@ -24,10 +24,11 @@ import numpy as np
 
 from .._jit import njit
 from .._typing import FloatArray
-from .._validate import as_nonnegative, as_step_count, check_finite, choice
+from .._validate import as_nonnegative, as_step_count, check_finite, choice, parse_clamp
 from ..curves.bspline import BSplineCurve, band_energy, band_residual, residual_row
 from ..errors import InputError
 from ._prefetch import prefetch
+from .stop import StopReason
 
 __all__ = [
     "eck_hadenfeld",
@@ -38,7 +39,7 @@ __all__ = [
     "movable_mask",
 ]
 
-STOP_REASONS = {0: "converged", 1: "max_steps", 2: "no_movable_point"}
+STOP_REASONS: dict[int, StopReason] = {0: "converged", 1: "max_steps", 2: "no_movable_point"}
 
 
 # ------------------------------------------------------------------------------------------
@@ -76,33 +77,22 @@ def check_schedule(schedule: object) -> str:
     return choice(schedule, SCHEDULES, "schedule")
 
 
-CLAMP_POINTS = {None: 0, "none": 0, "free": 0, "g0": 1, "g1": 2, "g2": 3}
+CLAMP_POINTS = {"none": 0, "g0": 1, "g1": 2, "g2": 3}
 
 
 def movable_mask(curve: BSplineCurve, clamp: Any = (None, None),
                  protect: Iterable[int] = ()) -> np.ndarray:
     """Boolean mask of the control points a method may move.
 
-    ``clamp = (left, right)``, each ``None``/``"free"`` or ``"g0"``, ``"g1"``, ``"g2"``: fix
-    1, 2, 3 end control points, which keeps position, tangent, curvature at that end of a clamped
-    B-spline (ERRATA, Eck & Hadenfeld: fixing ``m + 1`` points keeps ``C^m`` contact). A single
-    string applies to both ends. Closed curves have no ends: the clamp is ignored.
+    ``clamp = (left, right)`` in the grammar of :func:`curvefair._validate.parse_clamp`, each
+    ``None``/``"none"`` or ``"g0"``, ``"g1"``, ``"g2"`` (any case): fix 0, 1, 2, 3 end control
+    points, which keeps position, tangent, curvature at that end of a clamped B-spline (ERRATA,
+    Eck & Hadenfeld: fixing ``m + 1`` points keeps ``C^m`` contact). A single string applies to
+    both ends. Closed curves have no ends: the clamp is ignored.
     ``protect``: control-point indices that never move.
     """
     n = curve.n_ctrl
-    if clamp is None or isinstance(clamp, str):
-        clamp = (clamp, clamp)
-    try:
-        left, right = clamp
-    except (TypeError, ValueError):
-        raise InputError(f"clamp must be a (left, right) pair, got {clamp!r}") from None
-    counts = []
-    for side, c in (("left", left), ("right", right)):
-        key = c.lower() if isinstance(c, str) else c
-        if key not in CLAMP_POINTS:
-            raise InputError(f"unknown clamp {c!r} ({side} end); valid values are: None, 'g0', "
-                             "'g1', 'g2'")
-        counts.append(CLAMP_POINTS[key])
+    counts = [CLAMP_POINTS[c] for c in parse_clamp(clamp)]
     mask = np.ones(n, dtype=bool)
     if not curve.closed:
         mask[: counts[0]] = False
@@ -914,7 +904,7 @@ class EHResult:
 
     curve: BSplineCurve
     steps: int
-    stop_reason: str
+    stop_reason: StopReason
     energy_before: float
     energy_after: float
     eps_absolute: float

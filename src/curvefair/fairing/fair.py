@@ -22,6 +22,7 @@ from .._typing import FloatArray
 from ..curves.piecewise import PiecewiseCurve, readonly
 from ..errors import InputError
 from ..interop import as_curve as _as_curve
+from .stop import StopReason
 
 if TYPE_CHECKING:
     from ..curves.bspline import BSplineCurve
@@ -41,7 +42,7 @@ __all__ = [
     "MODES",
 ]
 
-CLAMPS = ("g0", "g1", "g2")
+CLAMPS = ("none", "g0", "g1", "g2")
 MODES = ("spline", "hermite")
 
 
@@ -125,7 +126,7 @@ class DriverOutput:
 
     curve: PiecewiseCurve
     steps: int
-    stop_reason: str
+    stop_reason: StopReason
     history: FairingHistory | None = None
     eps: float | None = None
     max_steps: int | None = None
@@ -380,23 +381,11 @@ def data_points(curve: PiecewiseCurve) -> FloatArray:
 
 
 def normalize_clamp(clamp: object) -> tuple[str, str]:
-    """``"g1"`` -> ``("g1", "g1")``; a pair is checked element-wise."""
-    if isinstance(clamp, str):
-        pair: tuple[object, object] = (clamp, clamp)
-    else:
-        left: object
-        right: object
-        try:
-            left, right = clamp  # type: ignore[misc]
-        except (TypeError, ValueError):
-            raise InputError(f"clamp must be one of {CLAMPS} or a (left, right) pair of them, "
-                             f"got {clamp!r}") from None
-        pair = (left, right)
-    for side, v in zip(("left", "right"), pair, strict=True):
-        if not isinstance(v, str) or v not in CLAMPS:
-            raise InputError(f"unknown clamp {v!r} ({side} end); valid values are: "
-                             + ", ".join(repr(c) for c in CLAMPS))
-    return pair  # type: ignore[return-value]
+    """``"G1"`` -> ``("g1", "g1")``: :func:`curvefair._validate.parse_clamp`, the grammar every
+    method function shares."""
+    from .._validate import parse_clamp
+
+    return parse_clamp(clamp)
 
 
 def normalize_protect(protect: object, curve: PiecewiseCurve) -> frozenset[int]:
@@ -505,9 +494,11 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
         initial largest measure; see the method's notes).
     max_steps : int >= 0, optional
         Step cap (default method-specific).
-    clamp : {"g0", "g1", "g2"} or (left, right)
+    clamp : {"none", "g0", "g1", "g2"} (any case) or (left, right)
         End conditions kept exactly: ``"g0"`` end points fixed, ``"g1"`` also the end tangent,
-        ``"g2"`` also the end second derivative (curvature). Ignored for closed curves.
+        ``"g2"`` also the end second derivative (curvature); ``"none"`` (or None): the B-spline
+        methods may move the end control points (the Hermite methods refuse it: they always
+        keep the end points). Ignored for closed curves.
     protect : iterable of int
         Data-point indices that never move (0-based; B-splines: control points).
     mode : {"spline", "hermite"}
@@ -609,6 +600,12 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
     if max_steps is not None:
         max_steps = as_step_count(max_steps, default=0)
     clamp_pair = normalize_clamp(clamp)
+    from ..curves.bspline import BSplineCurve
+
+    if ("none" in clamp_pair and not isinstance(curve, BSplineCurve)
+            and not getattr(curve, "closed", False)):
+        raise InputError(f"clamp 'none' is not available for method {spec.name!r}: the methods "
+                         "for point data always keep the end points; use 'g0', 'g1' or 'g2'")
     prot = normalize_protect(protect, curve)
     if not isinstance(mode, str) or mode not in MODES:
         raise InputError(f"unknown mode {mode!r}; valid values are: "

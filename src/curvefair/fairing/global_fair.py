@@ -43,6 +43,7 @@ from ..curves.bspline import BSplineCurve, band_energy
 from ..errors import InputError
 from . import _global_kernels as _k
 from .eck_hadenfeld import check_bspline, movable_mask
+from .stop import StopReason
 
 __all__ = ["global_fair", "GlobalResult", "energy_matrix"]
 
@@ -529,7 +530,7 @@ class GlobalResult:
     energy_after: float
     multipliers: np.ndarray
     iterations: int
-    stop_reason: str
+    stop_reason: StopReason
     active: np.ndarray
 
 
@@ -721,7 +722,8 @@ def _global_fair(curve: BSplineCurve, tol: float | None, l: Any,  # noqa: E741
 
 
 def _solve_balls(system: _System, g0: FloatArray, free: np.ndarray, tol: float, gap: float,
-                 max_steps: int, switch: float = 1e-2) -> tuple[FloatArray, FloatArray, int, str]:
+                 max_steps: int, switch: float = 1e-2
+                 ) -> tuple[FloatArray, FloatArray, int, StopReason]:
     """``min F(v) = F(o) + g0.v + v.K v / 2`` (``K = system.K``) over the displacements ``v``
     from the original points, s.t. ``|v_i| <= tol`` at the free points (``v = 0`` at the
     others): interior point, then active-set Newton (see :func:`global_fair`). Working with
@@ -778,7 +780,7 @@ def _solve_balls(system: _System, g0: FloatArray, free: np.ndarray, tol: float, 
     ds = np.empty(n)
     dl = np.empty(n)
     B = np.empty((n, dim, dim))
-    reason = "max_steps"
+    reason: StopReason = "max_steps"
     while steps < max_steps:
         rdm, smin, ls = _k.ip_eval(g0, K, ks, p, closed, v, lam, free, t2, rd, s)
         rdn = rdm / gscale

@@ -65,7 +65,7 @@ DEFAULT_G1_ANGLE = 0.5
 _G2_REL = 1e-6
 _STRAIGHT_REL = 1e-9  # straight: off the line by at most this times the piece's length
 _ROUND = 8 * np.finfo(float).eps  # plus this times the curve's size (rounding)
-_CLAMP_RANK = {"g0": 0, "g1": 1, "g2": 2}
+_CLAMP_RANK = {"none": -1, "g0": 0, "g1": 1, "g2": 2}
 
 
 def _angle(a: FloatArray, b: FloatArray) -> float:

@@ -25,6 +25,7 @@ from ..curves.bspline import BSplineCurve, basis_derivatives
 from ..errors import InputError
 from .eck_hadenfeld import check_bspline, movable_mask
 from .ranking import tt_build, tt_update, tt_update_range
+from .stop import StopReason
 
 __all__ = ["knot_removal", "knot_jumps", "interior_knots", "knot_removal_fair", "KRResult"]
 
@@ -340,7 +341,7 @@ class KRResult:
 
     curve: BSplineCurve
     steps: int
-    stop_reason: str
+    stop_reason: StopReason
     sum_before: float
     sum_after: float
     history: np.ndarray
@@ -446,7 +447,7 @@ def knot_removal_fair(curve: BSplineCurve, *, variant: Variant = "one-point",
     return KRResult(out, steps, reason, sum0, float(kd.jumps(d).sum()), hist, blocked, total)
 
 
-_REASONS = ("max_steps", "tolerance", "eps", "no_decrease")
+_REASONS: tuple[StopReason, ...] = ("max_steps", "tolerance", "eps", "no_decrease")
 
 #: Relative rounding floor of the Sapidis-Farin loop: a jump at or below ``ROUNDING_FLOOR``
 #: times the largest initial jump counts as zero (the loop stops there as at ``eps``), and a step
@@ -459,7 +460,7 @@ ROUNDING_FLOOR = 2.0 ** -40
 def _run_loop(curve: BSplineCurve, kd: _KnotData, d: FloatArray, orig: FloatArray,
               mask: np.ndarray, variant: str, tolv: float, eps_abs: float, max_steps: int,
               on_tol: str, z: FloatArray, floor: float = 0.0
-              ) -> tuple[BSplineCurve, int, str, float, FloatArray, list[int]]:
+              ) -> tuple[BSplineCurve, int, StopReason, float, FloatArray, list[int]]:
     """Run the compiled loop on the set-up of :func:`_loop_args`; ``d`` is updated in place."""
     steps, code, total, hist, blocked, nb = _kr_loop(
         *_loop_args(curve, kd, d, orig, mask, variant, tolv, eps_abs, max_steps, on_tol, z,

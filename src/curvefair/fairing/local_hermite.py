@@ -120,6 +120,7 @@ from ..errors import InputError
 from . import _hermite_kernels as _k
 from ._hermite_data import distinct_data, rebuild, uniform_spacing
 from .fair import DriverOutput, FairingHistory, MethodSpec, register_method
+from .stop import StopReason
 
 __all__ = ["hermite_driver", "prepare", "hold_zone_cubic", "spline_derivatives"]
 
@@ -529,6 +530,7 @@ def hermite_driver(curve: HermiteSpline, *, method: str, tol: float | None, eps:
     P, D, measure, eligible = st["P"], st["D"], st["measure"], st["eligible"]
     eps_eff, n_elig, spline, degree = st["eps"], st["n_elig"], st["spline"], st["degree"]
     extra, held, m0, Hinv, nd = st["extra"], st["held"], st["m0"], st["Hinv"], st["nd"]
+    reason: StopReason
     if stop == _k.STOP_MAX_STEPS:
         reason = "max_steps"
     elif stop == _k.STOP_EPS:
@@ -536,7 +538,7 @@ def hermite_driver(curve: HermiteSpline, *, method: str, tol: float | None, eps:
         if np.any((blocked != 0) & eligible & (measure >= eps_eff)):
             reason = "tolerance"
     elif n_elig == 0:
-        reason = "nothing_to_move"
+        reason = "no_movable_point"
     else:
         reason = "tolerance" if np.any(blocked == 1) else "converged"
     interior = set(range(1, nd - 1))

@@ -81,6 +81,7 @@ from ..curves.hermite import CubicHermite
 from ..curves.interpolate import interpolate_cubic
 from ..curves.parameterize import parameterize
 from ..errors import InputError
+from .stop import StopReason
 
 __all__ = ["points_l1", "PointsL1Result", "natural_operators"]
 
@@ -699,7 +700,7 @@ def _driver(curve: CubicHermite, *, tol: float | None, eps: float | None,
     disp = np.sqrt(np.sum((p1[moved] - p0[moved]) ** 2, axis=1))
     hist = FairingHistory.from_arrays(moved, np.zeros(moved.size), disp)
     return DriverOutput(curve=res.curve, steps=total,
-                        stop_reason=str(res.report["stop_reason"]), history=hist,
+                        stop_reason=cast(StopReason, res.report["stop_reason"]), history=hist,
                         max_steps=steps, extra={"points_l1": res.report,
                                                 "history_is": "one entry per moved point "
                                                               "(simultaneous solve)"},
