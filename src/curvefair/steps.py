@@ -28,12 +28,12 @@ from .curves.hermite import CubicHermite, HermiteSpline, QuinticHermite
 from .errors import InputError
 from .fairing import _hermite_kernels as _k
 from .fairing._hermite_data import distinct_data, rebuild, uniform_spacing
-from .fairing.cheng_yu import cheng_yu  # noqa: F401  (Cheng & Yu, cubic B-splines)
-from .fairing.eck_hadenfeld import eck_hadenfeld  # noqa: F401  (Eck & Hadenfeld, B-splines)
-from .fairing.knot_removal import knot_removal  # noqa: F401  (Farin, B-splines)
+from .fairing.cheng_yu import cheng_yu  # (Cheng & Yu, cubic B-splines)
+from .fairing.eck_hadenfeld import eck_hadenfeld  # (Eck & Hadenfeld, B-splines)
+from .fairing.knot_removal import knot_removal  # (Farin, B-splines)
 
 __all__ = ["kjellander", "poliakoff", "wang_cao", "wang_quintic", "uniform_spacing",
-           "bad_point_measure"]
+           "bad_point_measure", "eck_hadenfeld", "knot_removal", "cheng_yu"]
 
 
 # ----------------------------------------------------------------------------------------------
