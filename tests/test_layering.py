@@ -92,10 +92,8 @@ def test_the_checker_sees_a_private_import_across_packages(tmp_path):
 # the test, and so does an entry that no longer occurs (remove it from the list).
 KNOWN = {
     "batch -> io._verify.write_checked",
-    "cli -> fairing.fair._jsonable",
     "cli -> io._verify.write_checked",
     "cli -> io._verify.rescaled_report",
-    "curves.bspline -> _validate._as_float",
     "fairing._tolerance -> curves.bspline._power_form_kernel",
     "fairing._tolerance -> curves.bspline._power_form_pair_kernel",
     "fairing.cheng_yu -> analysis.discrete._cubic_bspline",

@@ -40,7 +40,7 @@ from .errors import InputError
 
 __all__ = ["as_points", "as_vectors", "as_params", "as_positive", "choice", "check_finite",
            "as_nonnegative", "as_step_count", "as_count", "as_eval_params", "check_magnitude",
-           "magnitude", "MAX_MAGNITUDE", "MIN_EXTENT", "MIN_STEP", "MAX_STEPS"]
+           "magnitude", "MAX_MAGNITUDE", "MIN_EXTENT", "MIN_STEP", "MAX_STEPS", "as_float"]
 
 #: Largest accepted magnitude of a coordinate, parameter, knot or tolerance.
 MAX_MAGNITUDE = 1e30
@@ -111,7 +111,7 @@ def _refuse_kind(a: np.ndarray, name: str) -> None:
                                  f"({type(v).__name__})")
 
 
-def _as_float(x: ArrayLike, name: str) -> FloatArray:
+def as_float(x: ArrayLike, name: str) -> FloatArray:
     """A float64 copy of ``x``; complex, boolean, string and date values are refused (a complex
     value would lose its imaginary part, a string would be parsed)."""
     try:
@@ -150,7 +150,7 @@ def as_points(
     closed_ok : bool
         Ignored for consecutive checks: first == last is never "consecutive".
     """
-    arr = _as_float(points, name)
+    arr = as_float(points, name)
     if arr.ndim != 2:
         raise InputError(f"{name} must be a 2-D array of shape (n, dim), got shape {arr.shape}")
     n, dim = arr.shape
@@ -228,7 +228,7 @@ def as_vectors(vectors: ArrayLike, shape: tuple[int, ...], name: str) -> FloatAr
     Derivative data are bounded by ``MAX_DERIVATIVE = 1e60`` (about a coordinate of ``1e30``
     over the smallest parameter step): the power coefficients and energies built from them
     stay finite (see the module docstring)."""
-    arr = _as_float(vectors, name)
+    arr = as_float(vectors, name)
     if arr.shape != tuple(shape):
         raise InputError(f"{name} must have shape {tuple(shape)}, got {arr.shape}")
     check_finite(arr, name)
@@ -238,7 +238,7 @@ def as_vectors(vectors: ArrayLike, shape: tuple[int, ...], name: str) -> FloatAr
 
 def as_params(params: ArrayLike, n: int, name: str = "params") -> FloatArray:
     """Validate a strictly increasing parameter vector of length ``n``; float64 copy."""
-    arr = _as_float(params, name)
+    arr = as_float(params, name)
     if arr.ndim != 1:
         raise InputError(f"{name} must be 1-D, got shape {arr.shape}")
     if arr.shape[0] != n:

@@ -153,10 +153,10 @@ def _write_json(path: str, obj: Any) -> None:
 def _json_array(obj: Any) -> Any:
     import numpy as np
 
-    from .fairing.fair import _jsonable
+    from .fairing.fair import jsonable
 
     if isinstance(obj, np.ndarray):
-        return _jsonable(obj)
+        return jsonable(obj)
     raise TypeError(f"Object of type {type(obj).__name__} is not JSON serializable")
 
 

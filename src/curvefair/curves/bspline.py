@@ -28,7 +28,7 @@ from scipy.sparse import csr_matrix
 
 from .._jit import njit
 from .._typing import ArrayLike, FloatArray
-from .._validate import _as_float, as_count, as_params, as_points, check_steps, magnitude
+from .._validate import as_count, as_float, as_params, as_points, check_steps, magnitude
 from ..errors import InputError
 from .parameterize import parameterize
 from .piecewise import PiecewiseCurve, PiecewisePolynomial, readonly
@@ -405,7 +405,7 @@ class BSplineCurve(PiecewiseCurve):
         pts = as_points(control_points, "control_points", min_points=p + 1,
                         allow_coincident=True)
         n = pts.shape[0]
-        t = _as_float(knots, "knots")
+        t = as_float(knots, "knots")
         if t.ndim != 1:
             raise InputError(f"knots must be 1-D, got shape {t.shape}")
         check_steps(t, "knots", strict=False)
@@ -699,9 +699,9 @@ class BSplineCurve(PiecewiseCurve):
         if not isinstance(spl, BSpline):
             raise InputError(f"spl must be a scipy.interpolate.BSpline, got "
                              f"{type(spl).__name__}")
-        t = _as_float(spl.t, "spl.t")
+        t = as_float(spl.t, "spl.t")
         k = _as_degree(spl.k)
-        c = _as_float(spl.c, "spl.c")
+        c = as_float(spl.c, "spl.c")
         if c.ndim != 2:
             raise InputError(f"spl.c must have shape (n, dim) with dim 2 or 3, got {c.shape}")
         c = c[: t.shape[0] - k - 1]

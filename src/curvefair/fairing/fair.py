@@ -201,7 +201,7 @@ class FairingReport(dict):  # type: ignore[type-arg]
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON-ready copy: arrays become lists, non-finite floats ``None``."""
-        return _jsonable(self)  # type: ignore[no-any-return]
+        return jsonable(self)  # type: ignore[no-any-return]
 
 
 @dataclass(frozen=True, eq=False)
@@ -339,12 +339,12 @@ def _finite_or_none(v: Any) -> Any:
     return v
 
 
-def _jsonable(obj: Any) -> Any:
+def jsonable(obj: Any) -> Any:
     """Convert numpy scalars/arrays to plain Python; non-finite floats to None."""
     if isinstance(obj, dict):
-        return {str(k): _jsonable(v) for k, v in obj.items()}
+        return {str(k): jsonable(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
-        return [_jsonable(v) for v in obj]
+        return [jsonable(v) for v in obj]
     if isinstance(obj, np.ndarray):
         if obj.dtype.kind in "iub":
             return obj.tolist()  # plain ints / bools: no per-element conversion needed
@@ -353,7 +353,7 @@ def _jsonable(obj: Any) -> Any:
             if bool(np.isfinite(obj).all()):
                 return vals
             return [_finite_or_none(v) for v in vals]
-        return _jsonable(obj.tolist())
+        return jsonable(obj.tolist())
     if isinstance(obj, (np.bool_, bool)):
         return bool(obj)
     if isinstance(obj, (np.integer,)):
@@ -363,7 +363,7 @@ def _jsonable(obj: Any) -> Any:
     if obj is None or isinstance(obj, (int, str)):
         return obj
     if isinstance(obj, (set, frozenset)):
-        return sorted(_jsonable(v) for v in obj)
+        return sorted(jsonable(v) for v in obj)
     return str(obj)
 
 
@@ -719,7 +719,7 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
     # everything plain Python except the per-point arrays (FairingReport): converting a
     # million of them is what to_dict() does when a JSON file is asked for
     report["moved"] = None
-    rep = FairingReport(_jsonable(report))
+    rep = FairingReport(jsonable(report))
     rep["moved"] = {"indices": readonly(np.asarray(moved_idx, dtype=np.int64)),
                     "displacement": readonly(np.asarray(disp, dtype=np.float64))}
     return FairingResult(new, rep, history)
