@@ -270,3 +270,33 @@ def test_wide_tube_adds_no_inflections_on_naca2412(tol: float) -> None:
     # without the back-off the same problem adds inflections (what the back-off is for)
     raw = fair(c, "points-l1", tol=tol, guard=False, backoff=0)
     assert _sign_changes(u, np.asarray(raw.curve.points)) > _sign_changes(u, np.asarray(c.points))
+
+
+@pytest.mark.parametrize("clamp", ["g1", "g2", ("g0", "g2"), ("g1", "g0")])
+def test_clamps_that_hold_the_end_tangent_are_refused(clamp):
+    # g1/g2 hold the end tangent (fair()'s contract); the natural cubic rebuilt through moved
+    # points cannot keep it, so the method refuses rather than break the clamp
+    t = np.linspace(0.0, 3.0, 12)
+    c = interpolate_cubic(np.c_[t, np.sin(t)], "chord", "natural")
+    with pytest.raises(InputError, match="end tangent cannot be held"):
+        fair(c, "points-l1", tol=0.01, clamp=clamp)
+
+
+def test_default_for_a_g1_or_g2_clamp_is_a_method_that_keeps_it():
+    # points-l1 cannot hold an end tangent: with clamp g1/g2 the default falls back to
+    # poliakoff, which keeps the tangent (measured here by the end derivative)
+    t = np.linspace(0.0, 3.0, 14)
+    rng = np.random.default_rng(3)
+    c = interpolate_cubic(np.c_[t, np.sin(t) + 0.01 * rng.standard_normal(t.size)], "chord",
+                          "natural")
+    assert fair(c, tol=0.01).report["method"] == "points-l1"
+    for clamp in ("g1", "g2", ("g0", "g1")):
+        res = fair(c, tol=0.01, clamp=clamp)
+        assert res.report["method"] == "poliakoff"
+        d0, d1 = c(np.array(c.domain), 1), res.curve(np.array(c.domain), 1)
+        u0 = d0 / np.linalg.norm(d0, axis=1)[:, None]
+        u1 = d1 / np.linalg.norm(d1, axis=1)[:, None]
+        ends = (clamp, clamp) if isinstance(clamp, str) else clamp
+        for k, e in enumerate(ends):
+            if e != "g0":
+                np.testing.assert_allclose(u1[k], u0[k], atol=1e-12)

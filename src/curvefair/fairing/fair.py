@@ -166,6 +166,9 @@ class MethodSpec:
         ``prefer(curve) -> bool``, for a ``default`` method: the curves it is the default for
         (e.g. open point data up to a size); where it does not hold, the default of the curve
         type without such a condition is used. None: ``accepts`` decides.
+    clamps : tuple of str or None
+        The end conditions the method can keep (``"g0"`` ...); None: all. A default method
+        is not chosen for a call whose ``clamp`` it cannot keep (the next default is).
     default_options : dict or callable
         Options :func:`fair` passes when it chooses this method as the default (``method``
         not given), or ``default_options(curve) -> dict``; options the caller gives win.
@@ -183,6 +186,7 @@ class MethodSpec:
     modes: tuple[str, ...] = ("spline",)
     accepts: Callable[[Any], bool] | None = None
     prefer: Callable[[Any], bool] | None = None
+    clamps: tuple[str, ...] | None = None
     default_options: dict[str, Any] | Callable[[Any], dict[str, Any]] = field(
         default_factory=dict)
     default_reason: str = ""
@@ -415,13 +419,20 @@ def normalize_protect(protect: object, curve: PiecewiseCurve) -> frozenset[int]:
     return frozenset(out)
 
 
-def _default_method(curve: PiecewiseCurve) -> MethodSpec:
+def _default_method(curve: PiecewiseCurve, clamp: object = "g0") -> MethodSpec:
     # a default with an ``accepts`` condition that holds is more specific than one without
-    # (e.g. 'points-l1' for open cubic Hermite point data, 'poliakoff' for the closed ones)
+    # (e.g. 'points-l1' for open cubic Hermite point data, 'poliakoff' for the closed ones),
+    # if it can keep the ends the call asks for
+    try:
+        ends = normalize_clamp(clamp)
+    except InputError:
+        ends = ("g0", "g0")   # fair() reports the bad clamp itself
     for spec in METHODS.values():
         cond = spec.prefer if spec.prefer is not None else spec.accepts
         if (spec.default and isinstance(curve, spec.curve_types) and cond is not None
-                and cond(curve)):
+                and cond(curve)
+                and (spec.clamps is None or bool(curve.closed)
+                     or all(e in spec.clamps for e in ends))):
             return spec
     for spec in METHODS.values():
         if (spec.default and isinstance(curve, spec.curve_types) and spec.accepts is None
@@ -583,7 +594,7 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
             max_steps=max_steps, clamp=clamp, protect=protect, mode=mode, joins=joins,
             g1_angle=g1_angle, guard=guard, **options)
     if method is None:
-        spec = _default_method(curve)
+        spec = _default_method(curve, clamp)
         dflt = spec.default_options
         options = {**(dflt(curve) if callable(dflt) else dflt), **options}
     else:

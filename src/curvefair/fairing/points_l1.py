@@ -650,10 +650,13 @@ def _driver(curve: CubicHermite, *, tol: float | None, eps: float | None,
     n = curve.n_points
     if n < 4:
         raise InputError(f"method 'points-l1' needs at least 4 points, got {n}")
-    if clamp[0] == "g1" or clamp[1] == "g1":
-        raise InputError("method 'points-l1' rebuilds the natural cubic through the moved "
-                         "points: its end tangent cannot be held; use clamp 'g0' or 'g2' "
-                         "(curvature is zero at a natural end, before and after)")
+    if any(c in ("g1", "g2") for c in clamp):
+        # g1 and g2 hold the end tangent (g2 the curvature too): the natural cubic's end
+        # tangent depends on every moved point, so it cannot be held exactly
+        raise InputError(f"method 'points-l1' rebuilds the natural cubic through the moved "
+                         f"points: its end tangent cannot be held (clamp {clamp!r}); use "
+                         f"clamp 'g0' (the ends stay natural: zero curvature, before and "
+                         f"after), or 'poliakoff' for a G1/G2 clamp")
     if not _has_natural_ends(curve):
         raise InputError("method 'points-l1' returns the natural cubic through the moved "
                          "points on the input's parameters: this curve's ends are not natural "
@@ -726,6 +729,7 @@ def _register() -> None:
         default=DEFAULT_ENABLED,
         accepts=_accepts,
         prefer=_prefer,
+        clamps=("g0", "none"),
         default_reason="default for point files (open chord-length natural cubics, up to "
                        "20,000 points): on the 6 airfoil files of tests/data at tol 1e-4 of the "
                        "size, 51 curvature extrema in all on the curve rebuilt from the written "
