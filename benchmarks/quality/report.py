@@ -60,7 +60,9 @@ def _pct(k: int, n: int) -> str:
     return f"{100.0 * k / n:.0f}% ({k}/{n})" if n else "-"
 
 
-def _tool_label(t: str) -> str:
+def _tool_label(t: str | None) -> str:
+    if t is None:  # a partial run (--tools) without any peer
+        return "(no peer run)"
     return t.removeprefix("cf:").removeprefix("peer:") if t != BASELINE else "interpolant (input)"
 
 

@@ -399,7 +399,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--quick", action="store_true", help="a tiny subset (about a minute)")
     ap.add_argument("--jobs", type=int, default=min(2, os.cpu_count() or 1))
     ap.add_argument("--out", type=Path, default=ROOT / "docs" / "benchmarks.md")
-    ap.add_argument("--img", type=Path, default=ROOT / "docs" / "img" / "bench")
+    ap.add_argument("--img", type=Path, default=None,
+                    help="folder of the comb images (default: docs/img/bench for the default "
+                         "--out, else an img/ folder beside --out, so that a partial run never "
+                         "overwrites the committed page's images)")
     ap.add_argument("--csv", type=Path, default=HERE / "results.csv")
     ap.add_argument("--airfoils", type=int, default=None, help="number of UIUC airfoils")
     ap.add_argument("--glyphs", type=int, default=None, help="number of glyph runs")
@@ -435,6 +438,10 @@ def main(argv: list[str] | None = None) -> int:
           f"{len(all_tools())} tools; {args.jobs} processes", flush=True)
     rows = run_all(cases, args.jobs, args.tools)
     elapsed = time.perf_counter() - t_start
+    if args.img is None:
+        page = ROOT / "docs" / "benchmarks.md"
+        args.img = (ROOT / "docs" / "img" / "bench" if args.out.resolve() == page.resolve()
+                    else args.out.parent / "img")
     args.csv.parent.mkdir(parents=True, exist_ok=True)
     write_csv(rows, args.csv)
 
