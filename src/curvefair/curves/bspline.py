@@ -133,6 +133,31 @@ def _ders_kernel(knots, p, span, x, nder, local, out):  # type: ignore[no-untype
 
 
 @njit(cache=True)
+def _factorials(p):  # type: ignore[no-untyped-def]
+    fact = np.empty(p + 1)
+    fact[0] = 1.0
+    for k in range(1, p + 1):
+        fact[k] = fact[k - 1] * k
+    return fact
+
+
+@njit(cache=True)
+def _span_basis(knots, p, s, prev, have, ndu, left, right, a, d):  # type: ignore[no-untyped-def]
+    """Basis derivatives of span ``s`` into ``d[0]`` (local offsets), unless its local knot
+    pattern equals the previous span's (kept in ``prev``): then ``d`` already holds bitwise the
+    same values. Returns whether ``d`` is valid (``have`` for the next span)."""
+    ts = knots[s]
+    same = have  # the basis derivatives depend on the local knot pattern only
+    for k in range(2 * p):
+        v = knots[s - p + 1 + k] - ts
+        same = same and v == prev[k]
+        prev[k] = v
+    if not same:
+        _ders_one(knots, p, s, 0.0, ts, p, ndu, left, right, a, d, 0)
+    return True
+
+
+@njit(cache=True)
 def _power_form_kernel(knots, p, spans, ctrl, closed, out):  # type: ignore[no-untyped-def]
     """``out[m, k, :] = sum_a N_{s-p+a}^(k)(t_s) d_{s-p+a} / k!`` for ``s = spans[m]`` (control
     indices mod ``n`` for a closed curve): the piecewise power form of the B-spline. A span
@@ -144,23 +169,12 @@ def _power_form_kernel(knots, p, spans, ctrl, closed, out):  # type: ignore[no-u
     right = np.empty(p + 1)
     a = np.empty((2, p + 1))
     d = np.empty((1, p + 1, p + 1))
-    fact = np.empty(p + 1)
-    fact[0] = 1.0
-    for k in range(1, p + 1):
-        fact[k] = fact[k - 1] * k
+    fact = _factorials(p)
     prev = np.empty(2 * p)
     have = False
     for m in range(spans.shape[0]):
         s = spans[m]
-        ts = knots[s]
-        same = have  # the basis derivatives depend on the local knot pattern only
-        for k in range(2 * p):
-            v = knots[s - p + 1 + k] - ts
-            same = same and v == prev[k]
-            prev[k] = v
-        if not same:  # (local offsets: a repeated pattern gives bitwise the same values)
-            _ders_one(knots, p, s, 0.0, ts, p, ndu, left, right, a, d, 0)
-            have = True
+        have = _span_basis(knots, p, s, prev, have, ndu, left, right, a, d)
         for k in range(p + 1):
             for e in range(dim):
                 acc = 0.0
@@ -185,23 +199,12 @@ def _power_form_pair_kernel(knots, p, spans, ctrl, base, closed, out, out_diff):
     right = np.empty(p + 1)
     a = np.empty((2, p + 1))
     d = np.empty((1, p + 1, p + 1))
-    fact = np.empty(p + 1)
-    fact[0] = 1.0
-    for k in range(1, p + 1):
-        fact[k] = fact[k - 1] * k
+    fact = _factorials(p)
     prev = np.empty(2 * p)
     have = False
     for m in range(spans.shape[0]):
         s = spans[m]
-        ts = knots[s]
-        same = have
-        for k in range(2 * p):
-            v = knots[s - p + 1 + k] - ts
-            same = same and v == prev[k]
-            prev[k] = v
-        if not same:
-            _ders_one(knots, p, s, 0.0, ts, p, ndu, left, right, a, d, 0)
-            have = True
+        have = _span_basis(knots, p, s, prev, have, ndu, left, right, a, d)
         for k in range(p + 1):
             for e in range(dim):
                 acc = 0.0
