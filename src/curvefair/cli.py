@@ -515,9 +515,23 @@ def _default_methods_text() -> str:
         rows = _method_rows()
     except Exception:  # pragma: no cover - help must always render
         return "the registry's default for the curve type"
-    pairs = [f"{t}: {r['name']}" + (f" ({r['default_options']})" if r["default_options"] else "")
-             for r in rows if r["default"] for t in r["curve_types"]]
-    return "; ".join(pairs) if pairs else "the first method accepting the curve type"
+    # one entry per curve type; a type with several defaults (chosen by size or kind, e.g.
+    # points-l1 for open point data, poliakoff otherwise) lists them once, joined by "or"
+    per_type: dict[str, list[str]] = {}
+    for r in rows:
+        if not r["default"]:
+            continue
+        label = r["name"] + (f" ({r['default_options']})" if r["default_options"] else "")
+        for t in r["curve_types"]:
+            if label not in per_type.setdefault(t, []):
+                per_type[t].append(label)
+    pairs = [f"{t}: {' or '.join(labels)}" for t, labels in per_type.items()]
+    if not pairs:
+        return "the first method accepting the curve type"
+    text = "; ".join(pairs)
+    if any(len(labels) > 1 for labels in per_type.values()):
+        text += " (which one, by size and kind: 'curvefair methods')"
+    return text
 
 
 @main.command("methods")
