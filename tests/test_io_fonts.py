@@ -548,17 +548,22 @@ def _master_layers(font):
 def test_glyphs_source_round_trip_and_compatible(tmp_path):
     glyphsLib = pytest.importorskip("glyphsLib")
     recs = read_curves(GLYPHS_SRC)
-    assert {r.source["master"] for r in recs} == {"Light", "Regular", "Bold"}
+    # the masters and the brace layer {155} of "a" (interpolated with them)
+    assert {r.source["master"] for r in recs} == {"Light", "Regular", "Bold",
+                                                  "{155, 100} Regular"}
     assert all(r.name == f"{r.source['glyph']}@{r.source['master']}#{r.source['contour']}"
                for r in recs)
     out = tmp_path / "faired.glyphs"
-    write_curves(out, _fair_records(recs, 2.0), template=GLYPHS_SRC)
+    # tol 5: the masters share one never-worse decision per contour (instances included);
+    # at 2 it keeps every contour of this source
+    tol = 5.0
+    write_curves(out, _fair_records(recs, tol), template=GLYPHS_SRC)
     a, b = glyphsLib.GSFont(str(GLYPHS_SRC)), glyphsLib.GSFont(str(out))
     la, lb = _master_layers(a), _master_layers(b)
     worst = 0.0
     for m in la:
         names = sorted({r.source["glyph"] for r in recs if r.source["master"] == m})
-        worst = max(worst, check_outlines(la[m], lb[m], names, 2.0, smooth_from="flags"))
+        worst = max(worst, check_outlines(la[m], lb[m], names, tol, smooth_from="flags"))
     assert worst > 0
     # the rest of the file is what glyphsLib read: unchanged glyphs, features, kerning
     assert a.features[0].code == b.features[0].code
