@@ -710,3 +710,49 @@ def test_check_outlines_kinks_g2_inflections(tmp_path):
     h.save(tmp_path / "H.ufo")
     after = len([r for r in check_outlines(tmp_path / "H.ufo") if r["kind"] == "g2"])
     assert after < before
+
+
+def test_fontmake_builds_with_the_filter(tmp_path):
+    """The issue's command, run as a user runs it: ``fontmake -u Font.ufo --filter
+    "curvefair.fonts::FairFilter(tol=2)"`` (fontmake from PyPI, the test extra) on a UFO made
+    from the Lobster subset. Its OTF and TTF, re-read with fontTools, hold faired outlines:
+    against ufo2ft's build of the same UFO without the filter (for the TTF: the same cu2qu
+    conversion, which fontmake runs before the filter), the same structure, every point and
+    the sampled outline within tol, smooth nodes exact, and some glyph moved."""
+    import subprocess
+    import sys
+
+    pytest.importorskip("fontmake")
+    ufo2ft = pytest.importorskip("ufo2ft")
+    from curvefair.fonts import font_to_ufo
+
+    names = ["zero", "three", "B", "J"]
+    font_to_ufo(LOBSTER, tmp_path / "Font.ufo", glyphs=[".notdef", *names])
+    exe = Path(sys.executable).with_name("fontmake")
+    cmd = [str(exe) if exe.exists() else "fontmake", "-u", "Font.ufo", "--filter",
+           "curvefair.fonts::FairFilter(tol=2)"]
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(
+        [str(Path(__file__).parents[1] / "src"), os.environ.get("PYTHONPATH", "")]))
+    res = subprocess.run(cmd, cwd=tmp_path, env=env, capture_output=True, text=True,
+                         timeout=300)
+    assert res.returncode == 0, res.stderr[-2000:]
+    assert "Running FairFilter" in res.stderr
+    moved = 0.0
+    for ext, build in (("otf", ufo2ft.compileOTF), ("ttf", ufo2ft.compileTTF)):
+        built = TTFont(tmp_path / f"master_{ext}" / f"Font.{ext}")
+        plain = build(ufoLib2.Font.open(tmp_path / "Font.ufo"))
+        if ext == "otf":
+            check_outlines(plain.getGlyphSet(), built.getGlyphSet(), names, 2.0)
+            moved = max(float(np.abs(bezier_samples(built.getGlyphSet(), g)
+                                     - bezier_samples(plain.getGlyphSet(), g)).max())
+                        for g in names)
+            assert moved > 0
+            continue
+        moved = 0.0
+        for g in names:
+            a = bezier_samples(built.getGlyphSet(), g)
+            b = bezier_samples(plain.getGlyphSet(), g, m=400)
+            near = np.sqrt(((a[:, None, :] - b[None, :, :]) ** 2).sum(-1)).min(axis=1)
+            assert near.max() <= 2.0 + 1.5, (g, near.max())
+            moved = max(moved, float(near.max()))
+        assert moved > 0.5
