@@ -756,3 +756,34 @@ def test_fontmake_builds_with_the_filter(tmp_path):
             assert near.max() <= 2.0 + 1.5, (g, near.max())
             moved = max(moved, float(near.max()))
         assert moved > 0.5
+
+
+def test_glyph_plots_right_way_up_with_a_comb_per_contour():
+    """Plots of a glyph (Lobster "zero", CFF, font units, y up): one panel per contour, titled
+    with its record name, the drawn outline is the contour's own points' curve with y as in
+    the font (not flipped: a font is y up, only SVG is y down), each panel with its comb."""
+    pytest.importorskip("matplotlib")
+    from fontTools.pens.boundsPen import BoundsPen
+
+    from curvefair import plot as cfplot
+
+    recs = read_curves(LOBSTER, glyphs=["zero"])
+    assert len(recs) >= 2
+    fig = cfplot.figure([r.curve for r in recs], names=[r.name for r in recs], markers=False)
+    by_title = {ax.get_title(loc="left"): ax for ax in fig.axes}
+    gs = TTFont(LOBSTER).getGlyphSet()
+    bp = BoundsPen(gs)
+    gs["zero"].draw(bp)
+    xmin, ymin, xmax, ymax = bp.bounds
+    for r in recs:
+        ax = by_title[r.name]
+        assert not ax.yaxis_inverted()
+        (line,) = [ln for ln in ax.lines if ln.get_gid() == "curvefair-curve"]
+        xy = np.asarray(line.get_xydata())
+        # the drawn outline lies on the font's outline (fontTools' own segments, sampled)
+        ref = bezier_samples(gs, "zero", m=400)
+        near = np.sqrt(((xy[:, None, :] - ref[None, :, :]) ** 2).sum(-1)).min(axis=1)
+        assert near.max() < 1.0  # font units
+        assert xy[:, 1].min() >= ymin - 1e-6 and xy[:, 1].max() <= ymax + 1e-6
+        hairs = [c for c in ax.collections if c.get_gid() == "curvefair-comb-hairs"]
+        assert len(hairs) == 1 and len(hairs[0].get_segments()) > 10
