@@ -142,16 +142,17 @@ def main() -> None:
             qs = np.quantile(arr, q)
             low = name.startswith("inflection")
             counts = {c: int(np.sum(arr < c) if low else np.sum(arr > c)) for c in cands}
-            print(f"  {name}: n={arr.size} quantiles {dict(zip(q, np.round(qs, 6)))}")
+            print(f"  {name}: n={arr.size} quantiles {dict(zip(q, np.round(qs, 6), strict=True))}")
             print(f"     {'below' if low else 'above'}: {counts}")
-            s[name] = {"n": int(arr.size), "quantiles": dict(zip(map(str, q), qs.tolist())),
+            s[name] = {"n": int(arr.size),
+                       "quantiles": dict(zip(map(str, q), qs.tolist(), strict=True)),
                        "counts": {str(k): v for k, v in counts.items()}}
         if True:
             nz = ang[(ang > 0)]
             if nz.size:
                 hist, edges = np.histogram(np.log10(nz), bins=np.arange(-12, 3.01, 1))
                 s["angle_log10_hist"] = dict(zip([f"1e{int(e)}" for e in edges[:-1]],
-                                                 hist.tolist()))
+                                                 hist.tolist(), strict=True))
                 print("  nonzero join angles per decade (deg):", s["angle_log10_hist"])
                 print("  exactly 0:", int(np.sum(ang == 0)))
         summary[kind] = s

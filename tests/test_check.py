@@ -295,7 +295,8 @@ def test_a_deliberately_kinked_glyph_is_found_by_name_and_point(tmp_path: Path):
     node, h = np.array([pts[k].x, pts[k].y]), np.array([pts[(k + 1) % n].x, pts[(k + 1) % n].y])
     th = math.radians(1.0)
     v = h - node
-    new = node + [v[0] * math.cos(th) - v[1] * math.sin(th), v[0] * math.sin(th) + v[1] * math.cos(th)]
+    new = node + [v[0] * math.cos(th) - v[1] * math.sin(th),
+                  v[0] * math.sin(th) + v[1] * math.cos(th)]
     pts[(k + 1) % n].x, pts[(k + 1) % n].y = float(new[0]), float(new[1])
     pts[k].smooth = False  # what an editor does when the handle is pulled off the line
     f.save(tmp_path / "K.ufo")

@@ -4,8 +4,8 @@ The designspace and its three master UFOs are made by glyphsLib (``build_masters
 real Glyphs source tests/data/real/glyphsLib/GlyphsUnitTestSans3.glyphs. Checked here with
 fontTools/ufoLib2 only: same point structure per master, every point within tol, masters
 still interpolation-compatible (fontTools' interpolatable), clear errors (no -o, a missing
-master, a layer source whose layer is missing), and the faired UFO compiles with ufo2ft into an OTF and
-a TTF that fontTools reads back with the faired outlines.
+master, a layer source whose layer is missing), and the faired UFO compiles with ufo2ft into an
+OTF and a TTF that fontTools reads back with the faired outlines.
 """
 
 from __future__ import annotations

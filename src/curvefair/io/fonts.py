@@ -580,15 +580,15 @@ def shared_points(recs: Sequence[CurveRecord], tol: float | None = None, *,
     a master whose own candidate has more curvature extrema or more bending energy than its
     input (it keeps its input); then the instances ``(1 - w) A + w B`` of every pair of
     neighbouring masters (:func:`neighbour_pairs` of ``source["location"]``; every pair when
-    a record has no location), ``w`` in :data:`INSTANCE_WEIGHTS`, are measured the same way against the same
-    instances of the input (their contours take their corners from the interpolated input,
-    smooth where both masters are). The scale is admissible when none of these instances is
-    worse; of the admissible scales the one with the fewest extrema in total over masters and
-    instances (then the least energy) is written, else every master's input. A guard per
-    master alone could fair a contour in one master and leave its instances unguarded (the
-    masters stay compatible, the instances between them need not stay fair). Masters with
-    different structures (point counts, on-curve pattern) cannot interpolate and are guarded
-    one by one."""
+    a record has no location), ``w`` in :data:`INSTANCE_WEIGHTS`, are measured the same way
+    against the same instances of the input (their contours take their corners from the
+    interpolated input, smooth where both masters are). The scale is admissible when none of
+    these instances is worse; of the admissible scales the one with the fewest extrema in total
+    over masters and instances (then the least energy) is written, else every master's input.
+    A guard per master alone could fair a contour in one master and leave its instances
+    unguarded (the masters stay compatible, the instances between them need not stay fair).
+    Masters with different structures (point counts, on-curve pattern) cannot interpolate and
+    are guarded one by one."""
     setups = [_guard_setup(r, tol) for r in recs]
     if not guard:
         return [_candidate(c, P0, new, t, 1.0, harmonize) for c, P0, new, t in setups]
@@ -681,7 +681,8 @@ def write_ufo(path: str | os.PathLike[str], changes: dict[str, dict[int, FloatAr
         else:
             os.unlink(dest)
     shutil.copytree(template, dest, symlinks=True)
-    todo: dict[str | None, dict[str, dict[int, FloatArray]]] = {None: changes, **(layers or {})}
+    todo: dict[str | None, dict[str, dict[int, FloatArray]]] = {None: changes}
+    todo.update(layers or {})
     for layer_name, layer_changes in todo.items():
         if layer_changes:
             _write_layer(dest, template, layer_name, layer_changes)
