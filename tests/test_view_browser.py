@@ -254,16 +254,13 @@ def test_screenshot_layout(page_setup):
         page.click("#mode-both")
 
 
-def test_clipped_curvature_axis(tmp_path):
+def test_clipped_curvature_axis(page_setup, tmp_path):
     """The curvature plot's clipped mode, on a curve whose curvature spans four decades (a
     flat ellipse: 125 at the ends of its long axis, 0.008 at the middle). The curvature is
     computed here from a dense evaluation of the curve (finite differences of the samples,
     not the page's data); the page must print a clip level of 1.5 x the 95 % quantile of |k|,
     draw every sample at its curvature clamped to that level (mapped through the plot's axes),
     and the linear mode must draw the peak the clipped one cuts."""
-    _need_browser()
-    from playwright.sync_api import sync_playwright
-
     from curvefair.view import write_html
 
     t = np.linspace(-1.2, 1.2, 41)
@@ -277,21 +274,20 @@ def test_clipped_curvature_axis(tmp_path):
     kap = (d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]) / np.linalg.norm(d1, axis=1) ** 3
     s_ref = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))]
     messages = []
-    with sync_playwright() as pw:
-        browser = pw.chromium.launch(executable_path=CHROMIUM, args=ARGS)
-        try:
-            page = browser.new_page(viewport={"width": 1100, "height": 900})
-            page.on("console", lambda m: messages.append((m.type, m.text)))
-            page.on("pageerror", lambda e: messages.append(("pageerror", str(e))))
-            page.goto(path.as_uri())
-            page.wait_for_selector("body[data-ready='1']", timeout=10000)
-            drawn = {}
-            for mode in ("linear", "clip"):
-                page.select_option("#kscale", mode)
-                drawn[mode] = (page.get_attribute("#kplot path.kcurve.before", "d"),
-                               page.text_content("#kplot"))
-        finally:
-            browser.close()
+    # a second page in the module's browser (one Playwright session per module)
+    page = page_setup[0].context.browser.new_page(viewport={"width": 1100, "height": 900})
+    try:
+        page.on("console", lambda m: messages.append((m.type, m.text)))
+        page.on("pageerror", lambda e: messages.append(("pageerror", str(e))))
+        page.goto(path.as_uri())
+        page.wait_for_selector("body[data-ready='1']", timeout=10000)
+        drawn = {}
+        for mode in ("linear", "clip"):
+            page.select_option("#kscale", mode)
+            drawn[mode] = (page.get_attribute("#kplot path.kcurve.before", "d"),
+                           page.text_content("#kplot"))
+    finally:
+        page.close()
     assert [m for m in messages if m[0] in ("error", "warning", "pageerror")] == []
     W, H, L, B = 800.0, 220.0, 70.0, 22.0  # the plot's frame (viewBox 0 0 800 220)
 
