@@ -262,3 +262,66 @@ def test_g2_breaks_of_a_real_svg_match_svgpathtools(tmp_path: Path):
     got = sorted(f.value for f in found if f.rule == "g2-break")
     assert len(want) > 50
     np.testing.assert_allclose(got, sorted(want), rtol=1e-6)
+
+
+@pytest.mark.parametrize("clean", ["trimesh/spline.DXF", "occt/trj7_c2-ac-214.stp",
+                                   "opennurbs/v3_my_curves.3dm"])
+def test_calibrated_thresholds_leave_clean_real_files_alone(tmp_path: Path, clean: str):
+    """Real CAD files with fair curves (tests/data/real) give no finding at the default
+    thresholds (calibrated on that corpus: docs/benchmarks.md)."""
+    r = _run(["check", str(ROOT / "tests" / "data" / "real" / clean), "--format", "json"],
+             tmp_path)
+    rep = json.loads(r.output)
+    assert r.exit_code == 0 and rep["n_curves"] > 0 and rep["findings"] == [], rep
+
+
+def test_a_deliberately_kinked_glyph_is_found_by_name_and_point(tmp_path: Path):
+    """A smooth node of a real glyph (Lobster "zero", made a UFO with font_to_ufo) is kinked by
+    turning its outgoing handle 1 degree about the node: ``curvefair check`` then reports a
+    kink of that angle (computed here from the edited points) at that glyph, contour and
+    point index, which it did not report before. The node is the seam of the contour's chain
+    (the reader starts a closed contour at its first corner): the seam is a join too."""
+    ufoLib2 = pytest.importorskip("ufoLib2")
+    from curvefair.fonts import font_to_ufo
+
+    lob = ROOT / "tests" / "data" / "real" / "fonttools" / "Lobster.subset.otf"
+    font_to_ufo(lob, tmp_path / "Z.ufo", glyphs=[".notdef", "zero"])
+    before = json.loads(_run(["check", "Z.ufo", "--format", "json"], tmp_path).stdout)
+    f = ufoLib2.Font.open(tmp_path / "Z.ufo")
+    pts = f["zero"].contours[0].points
+    n = len(pts)
+    k = next(i for i, p in enumerate(pts) if p.smooth and pts[i - 1].type is None
+             and pts[(i + 1) % n].type is None)
+    node, h = np.array([pts[k].x, pts[k].y]), np.array([pts[(k + 1) % n].x, pts[(k + 1) % n].y])
+    th = math.radians(1.0)
+    v = h - node
+    new = node + [v[0] * math.cos(th) - v[1] * math.sin(th),
+                  v[0] * math.sin(th) + v[1] * math.cos(th)]
+    pts[(k + 1) % n].x, pts[(k + 1) % n].y = float(new[0]), float(new[1])
+    pts[k].smooth = False  # what an editor does when the handle is pulled off the line
+    f.save(tmp_path / "K.ufo")
+    expect = _leg_angle(np.array([pts[k - 1].x, pts[k - 1].y]), node, new)
+    after = json.loads(_run(["check", "K.ufo", "--format", "json"], tmp_path).stdout)
+
+    def kinks(rep):
+        return [x for x in rep["findings"] if x["rule"] == "kink" and x["label"] == "zero#0"]
+
+    assert not [x for x in kinks(before) if x.get("point_index") == k]
+    hit = [x for x in kinks(after) if x.get("point_index") == k]
+    assert len(hit) == 1, kinks(after)
+    assert hit[0]["glyph"] == "zero" and hit[0]["label"] == "zero#0"
+    assert f"point {k}" in hit[0]["message"]
+    assert abs(hit[0]["value"] - expect) < 1e-6 * expect
+
+
+def test_a_ufo_folder_given_by_name_is_one_input(tmp_path: Path):
+    """``curvefair check Font.ufo``: the UFO folder named on the command line is one font,
+    not a folder to walk (its .glif files are no inputs)."""
+    pytest.importorskip("ufoLib2")
+    from curvefair.fonts import font_to_ufo
+
+    lob = ROOT / "tests" / "data" / "real" / "fonttools" / "Lobster.subset.otf"
+    font_to_ufo(lob, tmp_path / "Z.ufo", glyphs=[".notdef", "zero"])
+    for arg in ("Z.ufo", "Z.ufo/", str(tmp_path / "Z.ufo")):
+        rep = json.loads(_run(["check", arg, "--format", "json"], tmp_path).stdout)
+        assert rep["n_files"] == 1 and rep["n_curves"] == 2, (arg, rep)

@@ -4,8 +4,8 @@ The designspace and its three master UFOs are made by glyphsLib (``build_masters
 real Glyphs source tests/data/real/glyphsLib/GlyphsUnitTestSans3.glyphs. Checked here with
 fontTools/ufoLib2 only: same point structure per master, every point within tol, masters
 still interpolation-compatible (fontTools' interpolatable), clear errors (no -o, a missing
-master, a sparse brace-layer source), and the faired UFO compiles with ufo2ft into an OTF and
-a TTF that fontTools reads back with the faired outlines.
+master, a layer source whose layer is missing), and the faired UFO compiles with ufo2ft into an
+OTF and a TTF that fontTools reads back with the faired outlines.
 """
 
 from __future__ import annotations
@@ -99,9 +99,14 @@ def test_cli_designspace_errors(masters, tmp_path):
     assert res.exit_code == 2 and "folder of the designspace" in res.output
     res = run(main, ["fair", str(ds), "--tol", "2", "-o", str(tmp_path / "no" / "o")])
     assert res.exit_code == 2 and "does not exist" in res.output
-    res = run(main, ["fair", str(full), "--tol", "2", "-o", str(tmp_path / "o"), "-q"])
-    assert res.exit_code == 1 and "sparse layer" in res.output
-    assert "Traceback" not in res.output
+    # a layer source (the brace layer) whose layer is not in its UFO: named, nothing written
+    doc = DesignSpaceDocument.fromfile(full)
+    next(s for s in doc.sources if s.layerName).layerName = "{999}"
+    doc.write(full.parent / "Bad.designspace")
+    res = run(main, ["fair", str(full.parent / "Bad.designspace"), "--tol", "2", "-o",
+                     str(tmp_path / "o"), "-q"])
+    assert res.exit_code == 1 and "no layer '{999}'" in res.output, res.output
+    assert "Traceback" not in res.output and not (tmp_path / "o").exists()
     # a master that is not there: named, nothing written
     doc = DesignSpaceDocument.fromfile(ds)
     shutil.rmtree(doc.sources[1].path)

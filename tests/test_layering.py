@@ -105,7 +105,6 @@ KNOWN = {
     "fonts -> io.fonts._exact_smooth_flags",
     "fonts -> io._common.atomic_write",
     "fonts -> io._outline.smooth_angle",
-    "fonts -> io.fonts._by_glyph",
     "io._verify -> analysis._deviation._point_displacement",
     "io._verify -> analysis._deviation.geometric_upper_bound",
     "io._verify -> fairing._tolerance.point_report",

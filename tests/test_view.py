@@ -170,3 +170,31 @@ def test_cli_view_real_svg_is_y_down(tmp_path):
     assert res.exit_code == 0, res.output
     d = _page_json(page.read_text())
     assert d["y_down"] is True and len(d["curves"]) == n
+
+
+def test_result_repr_shows_the_input_before_the_faired_curve():
+    """A FairingResult displays the curve that was faired (grey) under the faired one (blue):
+    the grey polyline is the input's own drawing (the same mapping: both curves' samples
+    agree to the tolerance in pixels) and differs from the faired one; a result built without
+    its input shows the faired curve alone."""
+    from curvefair import FairingResult
+
+    c = interpolate_cubic(_noisy())
+    r = fair(c, tol=0.01)
+    assert r.original is c
+    h = r._repr_html_()
+    assert "before (grey)" in h
+
+    def poly(html, colour):
+        m = re.findall(rf'polyline points="([^"]*)" stroke="{colour}" stroke-width="1.6"', html)
+        return [np.array([[float(v) for v in p.split(",")] for p in s.split()]) for s in m]
+
+    before, after = poly(h, "#8c8c8c"), poly(h, "#1f4e79")
+    assert len(before) == 1 and len(after) == 1 and before[0].shape == after[0].shape
+    # pixel scale from the drawing's width (the SVG's viewBox) over the data's x extent
+    width = float(re.search(r'viewBox="0 0 ([0-9.]+) ', h).group(1))
+    diff = np.linalg.norm(before[0] - after[0], axis=1).max()
+    span = np.ptp(np.asarray(c.points)[:, 0])
+    assert 0 < diff <= (0.01 * width / span) * 1.2 + 0.15  # within tol, in pixels
+    alone = FairingResult(r.curve, r.report, r.history)._repr_html_()
+    assert not poly(alone, "#8c8c8c") and len(poly(alone, "#1f4e79")) == 1

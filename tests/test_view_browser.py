@@ -252,3 +252,73 @@ def test_screenshot_layout(page_setup):
     finally:
         page.check("#comb")
         page.click("#mode-both")
+
+
+def test_clipped_curvature_axis(page_setup, tmp_path):
+    """The curvature plot's clipped mode, on a curve whose curvature spans four decades (a
+    flat ellipse: 125 at the ends of its long axis, 0.008 at the middle). The curvature is
+    computed here from a dense evaluation of the curve (finite differences of the samples,
+    not the page's data); the page must print a clip level of 1.5 x the 95 % quantile of |k|,
+    draw every sample at its curvature clamped to that level (mapped through the plot's axes),
+    and the linear mode must draw the peak the clipped one cuts."""
+    from curvefair.view import write_html
+
+    t = np.linspace(-1.2, 1.2, 41)
+    c = interpolate_cubic(np.c_[5.0 * np.cos(t), 0.2 * np.sin(t)])
+    path = tmp_path / "clip.html"
+    write_html(path, [c], names=["ellipse"], title="clip test")
+    # curvature along arc length, independently: dense samples, central differences
+    u = np.linspace(*c.domain, 400001)
+    p = c(u)
+    d1, d2 = np.gradient(p, u, axis=0), np.gradient(np.gradient(p, u, axis=0), u, axis=0)
+    kap = (d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]) / np.linalg.norm(d1, axis=1) ** 3
+    s_ref = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))]
+    messages = []
+    # a second page in the module's browser (one Playwright session per module)
+    page = page_setup[0].context.browser.new_page(viewport={"width": 1100, "height": 900})
+    try:
+        page.on("console", lambda m: messages.append((m.type, m.text)))
+        page.on("pageerror", lambda e: messages.append(("pageerror", str(e))))
+        page.goto(path.as_uri())
+        page.wait_for_selector("body[data-ready='1']", timeout=10000)
+        drawn = {}
+        for mode in ("linear", "clip"):
+            page.select_option("#kscale", mode)
+            drawn[mode] = (page.get_attribute("#kplot path.kcurve.before", "d"),
+                           page.text_content("#kplot"))
+    finally:
+        page.close()
+    assert [m for m in messages if m[0] in ("error", "warning", "pageerror")] == []
+    W, H, L, B = 800.0, 220.0, 70.0, 22.0  # the plot's frame (viewBox 0 0 800 220)
+
+    def values(d, ylo, yhi):
+        v = _path_vertices(d)
+        s = (v[:, 0] - L) / (W - 8 - L) * s_ref[-1]
+        k = ylo + (1 - (v[:, 1] - 8) / (H - B - 8)) * (yhi - ylo)
+        return s, k
+
+    def frame(vals):
+        lo, hi = min(0.0, vals.min()), max(0.0, vals.max())
+        return lo - 0.05 * (hi - lo), hi + 0.05 * (hi - lo)
+
+    # the page's samples sit at its own arc lengths: the reference curvature there
+    d_lin, _ = drawn["linear"]
+    v = _path_vertices(d_lin)
+    s_pg = (v[:, 0] - L) / (W - 8 - L) * s_ref[-1]
+    k_ref = np.interp(s_pg, s_ref, kap)
+    ylo, yhi = frame(k_ref)
+    _, k_lin = values(d_lin, ylo, yhi)
+    assert np.allclose(k_lin, k_ref, rtol=0.02, atol=0.01 * kap.max())
+    assert k_lin.max() > 0.9 * kap.max()
+    # clipped: the level printed and every sample clamped to it
+    d_clip, text = drawn["clip"]
+    level = float(re.search(r"clipped at ±(\S+)", text).group(1))
+    srt = np.sort(np.abs(k_ref))
+    expected = 1.5 * srt[min(len(srt) - 1, int(np.floor(0.95 * len(srt))))]
+    assert abs(level - expected) <= 0.03 * expected + 0.001, (level, expected)
+    assert level < 0.5 * kap.max()  # the peak is cut
+    clamped = np.clip(k_ref, -level, level)
+    ylo, yhi = frame(clamped)
+    _, k_clip = values(d_clip, ylo, yhi)
+    assert np.allclose(k_clip, clamped, rtol=0.02, atol=0.005 * level)
+    assert np.sum(np.isclose(k_clip, level, rtol=1e-3)) >= 2  # drawn flat at the level

@@ -371,7 +371,7 @@ def _threshold(value: str | None, name: str) -> float | None:
               help="More inflections than N is a finding [default: off].")
 @click.option("--max-bad", metavar="Z|off",
               help="A breakpoint whose Sapidis-Farin jump of dκ/ds divided by κ² + 1/L² (L "
-                   "the arc length) is above Z is a bad point [default: 500].")
+                   "the arc length) is above Z is a bad point [default: 5000].")
 @click.option("-o", "--output", "out", metavar="FILE",
               help="Write the report to FILE instead of stdout.")
 @click.option("--read-corner-angle", type=click.FloatRange(0, 180, min_open=True),

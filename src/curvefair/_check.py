@@ -23,7 +23,12 @@ are reported, each against a threshold:
     ``z_j / (k_j^2 + 1/L^2)`` (a leading edge's large curvature is not a bad point by itself);
     reported when above ``max_bad``. Reference figures: a clean cubic interpolant of 200
     points on an ellipse gives 0.2, of 60 points on a sine 22; the same with 1e-4 (ellipse) or
-    1e-3 (sine) noise 6400 and 590; NACA 2412 from its .dat 1800.
+    1e-3 (sine) noise 6400 and 590; NACA 2412 from its .dat 1800. The default thresholds are
+    measured on the real files of tests/data/real and on fonts (``benchmarks/calibrate_check.py``;
+    the figures are in docs/benchmarks.md).
+
+Font contours (records with a ``source["outline"]``) also name the glyph and the nearest
+contour point (``point_index``, 0-based, as a font editor numbers the contour's points).
 
 Joins where one side has zero speed (a degenerate control polygon) have no tangent and are
 skipped.
@@ -51,7 +56,7 @@ __all__ = ["THRESHOLDS", "RULES", "check_records", "check_file", "to_sarif", "Fi
 #: Default thresholds (see the module docstring).
 THRESHOLDS: dict[str, float | None] = {"kink_angle": 0.05, "corner_angle": 10.0,
                                        "g2_rel": 0.05, "wiggle": 0.02,
-                                       "max_inflections": None, "max_bad": 500.0}
+                                       "max_inflections": None, "max_bad": 5000.0}
 
 RULES: dict[str, str] = {
     "kink": "a join meant to be smooth has a tangent break (kink)",
@@ -157,7 +162,10 @@ def check_records(records: Sequence[Any], file: str = "",
         L = float(a.arc_length)
         d1r, d2r, d1l, d2l = _side_derivatives(pp)
         joins = [(k, k - 1, k) for k in range(1, m)]
-        if curve.closed:
+        outline = (getattr(rec, "source", None) or {}).get("outline")
+        if curve.closed or (outline is not None and outline.closed and m > 1):
+            # a closed glyph contour is a chain from its seam node round to it: the seam is a
+            # join too (the reader puts the seam at the first corner, so a kink is often there)
             joins.append((0, m - 1, 0))
 
         def at(u: float, pp: Any = pp) -> list[float]:
@@ -220,8 +228,32 @@ def check_records(records: Sequence[Any], file: str = "",
                                        f"bad point: |Δ dκ/ds| / (κ² + 1/L²) = {z[j]:.4g} at "
                                        f"break {int(a.jump_indices[j])}", float(z[j]),
                                        th["max_bad"], u, at(u)))
+        _name_points(rec, out)
         found += _worst(out, top)
     return found
+
+
+def _name_points(rec: Any, findings: list[Finding]) -> None:
+    """Font contours: each finding also names the glyph and the contour point nearest to it
+    (``extra["glyph"]``, ``extra["point_index"]``, 0-based in the contour's point list), the
+    way a type designer finds it in a font editor."""
+    src = getattr(rec, "source", None) or {}
+    outline = src.get("outline")
+    if outline is None or "glyph" not in src:
+        return
+    P = np.asarray(outline.points, dtype=float)
+    on = np.asarray(outline.on, dtype=bool)
+    for f in findings:
+        if f.point is None:
+            continue
+        d = np.linalg.norm(P - np.asarray(f.point[:2], dtype=float), axis=1)
+        # an on-curve point when one is as near as the nearest point (joins are nodes)
+        k = int(np.argmin(np.where(on, d, np.inf))) if on.any() else int(np.argmin(d))
+        if d[k] > float(d.min()) + 1e-9 * max(1.0, float(np.abs(P).max())):
+            k = int(np.argmin(d))
+        f.extra["glyph"] = src["glyph"]
+        f.extra["point_index"] = k
+        f.message += f" (glyph {src['glyph']!r}, contour {src.get('contour')}, point {k})"
 
 
 #: Which way is worse, per rule (a smaller gap between inflections is a worse wiggle).

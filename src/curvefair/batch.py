@@ -241,7 +241,7 @@ def expand_inputs(paths: Sequence[str], skip_dirs: Sequence[str] = ()) -> list[t
     for p in paths:
         if p == "-":
             add(p, "-")
-        elif os.path.isdir(p):
+        elif os.path.isdir(p) and not os.path.normpath(p).lower().endswith(".ufo"):
             for f in _walk(p, skip):
                 add(f, os.path.relpath(f, p))
         elif os.path.exists(p):

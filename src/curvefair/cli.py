@@ -1166,7 +1166,9 @@ def _fair_designspace_cmd(infile: str, out: str | None, *, in_place: bool, metho
                              "time_s": time.perf_counter() - t0, **res})
     if not quiet:
         for s in res["sources"]:
-            click.echo(f"{s['ufo']}: {s['contours']} contours faired within {tol:g}")
+            where = s["ufo"] + (f" (layer {s['layer']})" if s.get("layer") else "")
+            click.echo(f"{where}: {s['contours']} contours, {s['changed']} changed "
+                       f"(faired within {tol:g})")
         click.echo(f"wrote {out} (interpolation problems: {len(res['problems_before'])} in the "
                    f"input, {len(res['problems'])} in the output)")
     if new_kinds:

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import dataclasses
 import os
+import warnings
 from collections.abc import Sequence
 from types import SimpleNamespace
 from typing import Any
@@ -36,7 +37,7 @@ from typing import Any
 import numpy as np
 
 from ._typing import FloatArray
-from .errors import CurvefairError, FileFormatError, InputError, MissingDependencyError
+from .errors import CurvefairError, InputError, MissingDependencyError
 from .io._common import CurveRecord
 from .io._outline import Contour
 from .io.fonts import glyph_contours, record_points, ufo_contour
@@ -273,67 +274,74 @@ def font_to_ufo(src: str | os.PathLike[str], dest: str | os.PathLike[str], *,
 def fair_designspace(path: str | os.PathLike[str], out_dir: str | os.PathLike[str], tol: float,
                      *, glyphs: Sequence[str] | None = None, method: str | None = None,
                      **options: Any) -> dict[str, Any]:
-    """Fair every source (master) UFO of a designspace document into ``out_dir``.
+    """Fair every source (master) of a designspace document into ``out_dir``.
 
     ``out_dir`` gets a copy of the document (same file name) and of every source UFO (same
-    relative file names) whose contours are faired within ``tol`` with the same options. The
-    structure of every contour is kept, so masters that were compatible stay compatible;
-    that is checked with fontTools' ``varLib.interpolatable`` on the result (``problems`` in
-    the returned dict: what it reports for the output, and ``problems_before`` for the
-    input).
+    relative file names) whose contours are faired within ``tol`` with the same options.
+    Sparse sources are faired with the rest: a UFO with only some glyphs, and a layer source
+    (``layerName``: a brace/intermediate master kept in a layer of another master's UFO),
+    whose layer is rewritten in the copy. The structure of every contour is kept, so masters
+    that were compatible stay compatible; that is checked with fontTools'
+    ``varLib.interpolatable`` on the result (``problems`` in the returned dict: what it
+    reports for the output, and ``problems_before`` for the input). Each contour's masters
+    share one never-worse decision (:func:`curvefair.io.fonts.shared_points`: one scale of the
+    fair's moves for all of them, measured on the masters and on instances between them), and
+    every point stays within ``tol`` of its input (so the outline does, by the convex hull
+    property).
     """
-    from fontTools.designspaceLib import DesignSpaceDocument
-
     from .fairing.fair import fair
-    from .io import read_curves
     from .io._common import atomic_write
-    from .io.fonts import write_ufo
+    from .io.fonts import designspace_records, designspace_sources, shared_points, write_ufo
 
     tol = _check_tol(tol)
     src = os.path.abspath(os.fspath(path))
     out = os.path.abspath(os.fspath(out_dir))
     if os.path.dirname(src) == out:
         raise InputError("out_dir must not be the folder of the designspace document")
-    try:
-        doc = DesignSpaceDocument.fromfile(src)
-    except Exception as exc:  # fontTools raises many kinds for a garbled document
-        raise FileFormatError(f"not a designspace document fontTools can read ({exc})",
-                              src) from None
     base = os.path.dirname(src)
-    ufos = []
-    for k, s in enumerate(doc.sources):  # every master checked before anything is written
-        ufo = s.path or (os.path.join(base, s.filename) if s.filename else None)
-        if ufo is None or not os.path.isdir(ufo):
-            raise FileFormatError(f"source {k} ({s.filename!r}): no such UFO "
-                                  f"({ufo!r})", src)
-        if s.layerName:
-            raise InputError(f"designspace source {k} ({s.filename!r}): sparse layer masters "
-                             "are not supported")
-        ufos.append(ufo)
+    sources = designspace_sources(src)  # every source checked before anything is written
+    for s in sources:
+        if os.path.relpath(s["ufo"], base).startswith(os.pardir):
+            raise InputError(f"designspace source {s['index']} "
+                             f"({os.path.relpath(s['ufo'], base)!r}) is outside the "
+                             "document's folder: out_dir cannot hold it at the same relative "
+                             "path")
+
+    def skip(msg: str) -> None:
+        warnings.warn(f"{src}: skipped (left unchanged): {msg}", stacklevel=3)
+
+    # integer masters stay integer (as FairFilter's grid="auto"): a build's rounding then
+    # neither moves points nor breaks smooth nodes
+    recs = [_grid_if_integer(r) for r in designspace_records(src, glyphs, skip)]
+    groups: dict[tuple[str, int], list[CurveRecord]] = {}
+    for r in recs:
+        try:
+            res = fair(r.curve, method, tol=tol, protect=r.corners, **options)
+            r = r.with_curve(res.curve)
+        except CurvefairError:
+            pass
+        groups.setdefault((r.source["glyph"], int(r.source["contour"])), []).append(r)
+    changes: dict[tuple[str, str | None], dict[str, dict[int, FloatArray]]] = {}
+    for group in groups.values():
+        for r, pts in zip(group, shared_points(group, tol), strict=True):
+            if not np.array_equal(pts, r.source["outline"].points):
+                key = (r.source["ufo"], r.source["layer"])
+                changes.setdefault(key, {}).setdefault(r.source["glyph"], {})[
+                    int(r.source["contour"])] = pts
     os.makedirs(out, exist_ok=True)
     done: dict[str, Any] = {"sources": []}
-    for ufo in ufos:
+    for ufo in dict.fromkeys(s["ufo"] for s in sources):
         rel = os.path.relpath(ufo, base)
-        if rel.startswith(os.pardir):
-            raise InputError(f"designspace source {rel!r} is outside the document's folder: "
-                             "out_dir cannot hold it at the same relative path")
-        recs = read_curves(ufo, glyphs=glyphs, on_unsupported="skip")
-        # integer masters stay integer (as FairFilter's grid="auto"): a build's rounding then
-        # neither moves points nor breaks smooth nodes
-        recs = [_grid_if_integer(r) for r in recs]
-        faired: list[CurveRecord] = []
-        for r in recs:
-            try:
-                res = fair(r.curve, method, tol=tol, protect=r.corners, **options)
-                faired.append(r.with_curve(res.curve))
-            except CurvefairError:
-                faired.append(r)
-        from .io.fonts import _by_glyph
-
         dest = os.path.join(out, rel)
         os.makedirs(os.path.dirname(dest), exist_ok=True)
-        write_ufo(dest, _by_glyph(faired, os.path.abspath(ufo)), os.path.abspath(ufo))
-        done["sources"].append({"ufo": rel, "contours": len(recs)})
+        layers = {lay: ch for (u, lay), ch in changes.items() if u == ufo and lay is not None}
+        write_ufo(dest, changes.get((ufo, None), {}), ufo, layers=layers)
+    for s in sources:
+        n = sum(1 for r in recs if r.source["ufo"] == s["ufo"] and r.source["layer"] == s["layer"])
+        ch = changes.get((s["ufo"], s["layer"]), {})
+        done["sources"].append({"ufo": os.path.relpath(s["ufo"], base), "layer": s["layer"],
+                                "contours": n,
+                                "changed": sum(len(v) for v in ch.values())})
     with open(src, "rb") as fh:
         atomic_write(os.path.join(out, os.path.basename(src)), fh.read())
     done["problems_before"] = interpolation_problems(src)
@@ -348,18 +356,33 @@ def _grid_if_integer(r: CurveRecord) -> CurveRecord:
     return dataclasses.replace(r, source=dict(r.source, outline=dataclasses.replace(c, grid=True)))
 
 
+class _Glyphset(dict):  # type: ignore[type-arg]
+    """A glyph set that gives None for a glyph it does not have (interpolatable's sparse
+    masters)."""
+
+    def __missing__(self, key: str) -> None:
+        return None
+
+
 def interpolation_problems(designspace: str | os.PathLike[str]) -> list[dict[str, Any]]:
-    """What ``fontTools.varLib.interpolatable`` reports for a designspace's masters (empty:
-    compatible)."""
+    """What ``fontTools.varLib.interpolatable`` reports for a designspace's sources (empty:
+    compatible). A layer source is its layer; a glyph missing from a sparse source is not a
+    problem (``ignore_missing``)."""
     import ufoLib2
-    from fontTools.designspaceLib import DesignSpaceDocument
     from fontTools.varLib.interpolatable import test as interpolatable_test
 
-    doc = DesignSpaceDocument.fromfile(os.fspath(designspace))
-    fonts = [ufoLib2.Font.open(s.path) for s in doc.sources]
-    names = [os.path.basename(s.path) for s in doc.sources]
-    glyphsets = [{g.name: g for g in f} for f in fonts]
-    problems = interpolatable_test(glyphsets, names=names)
+    from .io.fonts import designspace_sources
+
+    fonts: dict[str, Any] = {}
+    glyphsets, names = [], []
+    for s in designspace_sources(designspace):
+        if s["ufo"] not in fonts:
+            fonts[s["ufo"]] = ufoLib2.Font.open(s["ufo"])
+        font = fonts[s["ufo"]]
+        layer = font.layers[s["layer"]] if s["layer"] else font.layers.defaultLayer
+        glyphsets.append(_Glyphset({g.name: g for g in layer}))
+        names.append(s["label"])
+    problems = interpolatable_test(glyphsets, names=names, ignore_missing=True)
     return [dict(p, glyph=g) for g, ps in problems.items() for p in ps]
 
 

@@ -369,8 +369,8 @@ def curve_repr_html(curve: PiecewiseCurve) -> str:
 
 def result_repr_html(result: Any) -> str:
     """``_repr_html_`` of a :class:`~curvefair.FairingResult`: before (grey) and after (blue),
-    and the main report figures. The input curve comes from the result's history if it has one
-    (``result.history.original`` or the first entry); else only the faired curve is drawn."""
+    and the main report figures. The input curve is ``result.original`` (set by
+    :func:`curvefair.fair`); a result without it shows the faired curve only."""
     r = result.report
     original = getattr(result, "original", None)
     rows = []

@@ -221,11 +221,15 @@ class FairingResult:
         entries are numpy arrays; :meth:`FairingReport.to_dict` makes it JSON-ready.
     history : FairingHistory
         One entry per step.
+    original : PiecewiseCurve or None
+        The curve that was faired (the input, after :func:`curvefair.as_curve`), for the
+        before/after display; None when the result was built without it.
     """
 
     curve: PiecewiseCurve
     report: FairingReport
     history: FairingHistory
+    original: PiecewiseCurve | None = None
 
     def _repr_html_(self) -> str:  # notebook display: curvefair.view.result_repr_html
         from ..view import result_repr_html
@@ -733,4 +737,4 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
     rep = FairingReport(jsonable(report))
     rep["moved"] = {"indices": readonly(np.asarray(moved_idx, dtype=np.int64)),
                     "displacement": readonly(np.asarray(disp, dtype=np.float64))}
-    return FairingResult(new, rep, history)
+    return FairingResult(new, rep, history, curve)

@@ -121,4 +121,4 @@ def fair_new_structure(curve: BSplineCurve, method: str | None, tol: float | Non
     rep["inflections_before"] = int(a.inflections)
     rep["max_deviation_upper_bound"] = dev
     rep["tol"] = tol
-    return FairingResult(res.curve, FairingReport(rep), res.history)
+    return FairingResult(res.curve, FairingReport(rep), res.history, curve)

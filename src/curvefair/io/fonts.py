@@ -6,8 +6,10 @@ Read
 ----
 One record per contour of every glyph (``glyphs=`` chooses glyphs by name), in glyph order:
 the default layer of a UFO (``.ufo`` folder), the ``glyf`` (quadratic) or ``CFF `` (cubic)
-outlines of a ``.ttf``/``.otf``, every master layer of a ``.glyphs`` source (brace, bracket
-and backup layers are left as they are), every source UFO of a ``.designspace`` document
+outlines of a ``.ttf``/``.otf``, every master, brace (intermediate) and bracket (alternate)
+layer of a ``.glyphs`` source (backup layers are left as they are; records of a brace or
+bracket layer are named ``"<glyph>@<layer name> <master name>#<contour>"``), every source of
+a ``.designspace`` document
 (read only: :func:`curvefair.fonts.fair_designspace`, or ``curvefair fair X.designspace --tol T
 -o OUTDIR``, writes one, masters included; records
 named ``"<glyph>@<source name>#<contour>"``). Units are font units, ``y`` up. Contours made
@@ -33,14 +35,16 @@ nodes exactly smooth, extrema keep their horizontal/vertical tangent, corners an
 segments unmoved, integers in binary fonts), each contour no farther from its input than the
 record's faired control points are (so within the fairing's ``tol``), and never less fair than
 its input as written (:func:`record_points`: no more curvature extrema, no more bending
-energy; else the input contour is written).
+energy; else the input contour is written). The layers of a multi-master ``.glyphs`` source
+share that decision per contour, instances between them included (:func:`shared_points`).
+A variable TrueType binary (``gvar``) is refused: its sources are faired instead.
 
 - UFO: the template folder is copied and only the ``.glif`` files of changed glyphs are
   rewritten (through fontTools' glifLib, in the glyph's own GLIF format version); kerning,
   features, groups, lib, other layers, components, anchors, guidelines come back byte for byte.
 - TrueType: the changed glyphs' coordinates are replaced (instructions, flags and point
   counts kept), bounds recomputed, the left side bearing follows ``xMin`` where it was equal.
-- Glyphs: glyphsLib loads the source, the changed master layers' nodes are moved and it saves
+- Glyphs: glyphsLib loads the source, the changed layers' nodes are moved and it saves
   the file again (glyphsLib writes what it read: unchanged sources come back byte for byte).
   Integer coordinates stay integers (Glyphs' default grid); other coordinates are written
   with glyphsLib's 5 decimals.
@@ -221,15 +225,41 @@ def _open_glyphs(path: Any) -> Any:
         raise FileFormatError(f"not a Glyphs source glyphsLib can read ({exc})", path) from None
 
 
-def _glyphs_layers(font: Any, names: Sequence[str]) -> list[tuple[str, str, Any]]:
-    """(glyph, master name, layer) of every master layer of the glyphs, in glyph order."""
-    masters = {m.id: m.name for m in font.masters}
+def _glyphs_layers(font: Any, names: Sequence[str]
+                   ) -> list[tuple[str, str, Any, dict[str, Any]]]:
+    """(glyph, label, layer, location) of every layer that takes part in the design, in glyph
+    order: the master layers (label: the master's name) and the brace (intermediate) and
+    bracket (alternate) layers (label ``"<layer name> <master name>"``); backup and other
+    layers are left out. The location is the design-space position (axis index: value; a
+    bracket layer also has ``"set"``, its layer name: it interpolates with its like only)."""
+    masters = {m.id: m for m in font.masters}
     out = []
     for g in names:
         for layer in font.glyphs[g].layers:
-            if layer.layerId in masters:
-                out.append((g, masters[layer.layerId], layer))
+            m = masters.get(layer.associatedMasterId)
+            if m is None:
+                continue
+            loc: dict[str, Any] = {str(i): float(v) for i, v in enumerate(m.axes or [])}
+            if layer.layerId == m.id:
+                out.append((g, m.name, layer, loc))
+                continue
+            if layer._is_brace_layer():
+                coords = layer._brace_coordinates() or []
+                loc = {str(i): float(v) for i, v in enumerate(coords)}
+            elif layer._is_bracket_layer():
+                loc["set"] = str(layer.name)
+            else:
+                continue
+            out.append((g, f"{layer.name or layer.layerId} {m.name}", layer, loc))
     return out
+
+
+def _glyphs_label(font: Any, g: str, label: str, layer: Any) -> str:
+    """The record label of a .glyphs layer: the glyph name alone for the master layer of a
+    single-master source, else ``"<glyph>@<label>"``."""
+    if len(font.masters) > 1 or layer.layerId != layer.associatedMasterId:
+        return f"{g}@{label}"
+    return g
 
 
 def glyphs_contour(path: Any) -> Contour:
@@ -247,25 +277,85 @@ def glyphs_contour(path: Any) -> Contour:
     return Contour(xy, on, smooth, bool(path.closed), quad, grid=grid)
 
 
-def _designspace_contours(path: Any, glyphs: Sequence[str] | None
-                          ) -> list[tuple[str, list[Contour]]]:
-    """Every source UFO's contours, labelled ``"<glyph>@<source name>"``."""
+def designspace_sources(path: Any) -> list[dict[str, Any]]:
+    """Every source of a designspace document, checked before anything is read or written:
+    ``{"index", "label", "ufo" (absolute path), "layer" (layer name, None for the default
+    layer)}``. A source may be sparse (a UFO with only some glyphs, or a layer of another
+    source's UFO: a brace/intermediate master)."""
     _fonttools("designspace documents")
     from fontTools.designspaceLib import DesignSpaceDocument
 
     try:
-        doc = DesignSpaceDocument.fromfile(os.fspath(path))  # type: ignore[arg-type]
+        doc = DesignSpaceDocument.fromfile(os.fspath(path))
     except Exception as exc:
         raise FileFormatError(f"not a designspace document fontTools can read ({exc})",
                               path) from None
-    out: list[tuple[str, list[Contour]]] = []
+    base = os.path.dirname(os.path.abspath(os.fspath(path)))
+    out: list[dict[str, Any]] = []
+    layers: dict[str, Any] = {}
     for k, s in enumerate(doc.sources):
-        if not s.path or not os.path.isdir(s.path):
-            raise FileFormatError(f"source {k} ({s.filename!r}): no such UFO", path)
+        ufo = s.path or (os.path.join(base, s.filename) if s.filename else None)
+        if ufo is None or not os.path.isdir(ufo):
+            raise FileFormatError(f"source {k} ({s.filename!r}): no such UFO ({ufo!r})", path)
+        ufo = os.path.abspath(ufo)
+        if s.layerName:
+            if ufo not in layers:
+                layers[ufo] = set(_open_ufo(ufo).layers.keys())
+            if s.layerName not in layers[ufo]:
+                raise FileFormatError(f"source {k} ({s.filename!r}): the UFO has no layer "
+                                      f"{s.layerName!r}", path)
         label = s.name or s.styleName or f"source{k}"
-        _, per = font_contours(s.path, glyphs)
-        out += [(f"{g}@{label}", c) for g, c in per]
+        if any(o["label"] == label for o in out):
+            label = f"{label} ({k})"
+        out.append({"index": k, "label": label, "ufo": ufo, "layer": s.layerName or None,
+                    "location": {str(a): float(v) if isinstance(v, (int, float)) else str(v)
+                                 for a, v in (s.location or {}).items()}})
     return out
+
+
+def _ufo_layer_contours(ufo: str, layer_name: str | None, glyphs: Sequence[str] | None
+                        ) -> list[tuple[str, list[Contour]]]:
+    font = _open_ufo(ufo)
+    layer = font.layers[layer_name] if layer_name else font.layers.defaultLayer
+    names = _glyph_order(list(layer.keys()), font.glyphOrder)
+    if glyphs is not None:
+        want = set(glyphs)
+        names = [g for g in names if g in want]
+    out = []
+    for g in names:
+        conts = []
+        for c in layer[g].contours:
+            try:
+                conts.append(ufo_contour(c.points))
+            except Unsupported as exc:
+                conts.append(exc)  # type: ignore[arg-type]
+        out.append((g, conts))
+    return out
+
+
+def designspace_records(path: Any, glyphs: Sequence[str] | str | None, skip: Any
+                        ) -> list[CurveRecord]:
+    """Records of every source of a designspace (:func:`designspace_sources`), named
+    ``"<glyph>@<source label>#<contour>"``, ``source`` with ``ufo`` and ``layer`` besides the
+    usual keys. A sparse source gives the glyphs it has; ``glyphs`` names glyphs that at
+    least one source must have."""
+    where = os.path.abspath(os.fspath(path))
+    if isinstance(glyphs, str):
+        glyphs = [g for g in glyphs.split(",") if g]
+    recs: list[CurveRecord] = []
+    seen: set[str] = set()
+    for src in designspace_sources(path):
+        per = _ufo_layer_contours(src["ufo"], src["layer"], glyphs)
+        base = {"format": "designspace", "path": where, "ufo": src["ufo"],
+                "layer": src["layer"], "location": src["location"]}
+        for g, conts in per:
+            seen.add(g)
+            recs.extend(glyph_contours(f"{g}@{src['label']}", conts, base, skip, len(recs)))
+    missing = [g for g in (glyphs or []) if g not in seen]
+    if missing:
+        raise InputError(f"glyphs: {', '.join(map(repr, missing[:10]))} in no source of "
+                         f"{where!r}")
+    return recs
 
 
 def _glyph_order(names: Sequence[str], order: Sequence[str] | None) -> list[str]:
@@ -289,24 +379,22 @@ def _select(names: list[str], glyphs: Sequence[str] | None, path: Any) -> list[s
 
 
 def font_contours(path: str | os.PathLike[str], glyphs: Sequence[str] | None = None
-                  ) -> tuple[str, list[tuple[str, list[Contour]]]]:
-    """``(format, [(glyph name, contours)])`` of a UFO or binary font, in glyph order."""
+                  ) -> tuple[str, list[tuple[str, list[Contour], dict[str, Any]]]]:
+    """``(format, [(glyph label, contours, extra source keys)])`` of a UFO, Glyphs source or
+    binary font, in glyph order."""
     p = Path(path)
-    if p.suffix.lower() == ".designspace":
-        return "designspace", _designspace_contours(path, glyphs)
     if p.suffix.lower() == ".glyphs":
         font = _open_glyphs(path)
         names = _select([g.name for g in font.glyphs], glyphs, path)
-        multi = len(font.masters) > 1
         out = []
-        for g, master, layer in _glyphs_layers(font, names):
+        for g, label, layer, loc in _glyphs_layers(font, names):
             conts = []
             for c in layer.paths:
                 try:
                     conts.append(glyphs_contour(c))
                 except Unsupported as exc:
                     conts.append(exc)  # type: ignore[arg-type]
-            out.append((f"{g}@{master}" if multi else g, conts))
+            out.append((_glyphs_label(font, g, label, layer), conts, {"location": loc}))
         return "glyphs", out
     if p.suffix.lower() == ".ufo":
         font = _open_ufo(path)
@@ -320,7 +408,7 @@ def font_contours(path: str | os.PathLike[str], glyphs: Sequence[str] | None = N
                     conts.append(ufo_contour(c.points))
                 except Unsupported as exc:
                     conts.append(exc)  # type: ignore[arg-type]
-            out.append((g, conts))
+            out.append((g, conts, {}))
         return "ufo", out
     font = _open_binary(path)
     names = _select(list(font.getGlyphOrder()), glyphs, path)
@@ -328,9 +416,9 @@ def font_contours(path: str | os.PathLike[str], glyphs: Sequence[str] | None = N
     out = []
     for g in names:
         try:
-            out.append((g, get(font, g)))
+            out.append((g, get(font, g), {}))
         except Unsupported as exc:
-            out.append((g, [exc]))  # type: ignore[list-item]
+            out.append((g, [exc], {}))  # type: ignore[list-item]
     return "opentype", out
 
 
@@ -378,11 +466,13 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
                                   "unchanged)", path)
         warnings.warn(f"{where}: skipped (left unchanged): {msg}", stacklevel=4)
 
+    if Path(path).suffix.lower() == ".designspace":
+        return designspace_records(path, glyphs, skip)
     fmt, per_glyph = font_contours(path, glyphs)
     base = {"format": fmt, "path": where}
     recs: list[CurveRecord] = []
-    for g, conts in per_glyph:
-        recs.extend(glyph_contours(g, conts, base, skip, len(recs)))
+    for g, conts, extra in per_glyph:
+        recs.extend(glyph_contours(g, conts, dict(base, **extra), skip, len(recs)))
     return recs
 
 
@@ -391,6 +481,32 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
 # ------------------------------------------------------------------------------------------
 #: the moves tried by the never-worse guard of :func:`record_points`, as fractions of the fair's
 GUARD_SCALES = (1.0, 0.5, 0.25, 0.125)
+
+
+def _guard_setup(rec: CurveRecord, tol: float | None
+                 ) -> tuple[Contour, FloatArray, FloatArray, float]:
+    """(contour, input points, faired points at the contour's indices, tol) of a record."""
+    c: Contour = rec.source["outline"]
+    idx = np.asarray(rec.source["point_index"], dtype=np.intp)
+    cp = np.asarray(rec.curve.control_points, dtype=np.float64)  # type: ignore[attr-defined]
+    if cp.ndim != 2 or cp.shape[1] != 2 or cp.shape[0] <= int(idx.max()):
+        raise InputError(f"{rec.name}: the curve has {cp.shape[0]} control points, the contour "
+                         "needs its own structure back (same knots)")
+    new = cp[idx]
+    if tol is None:
+        ref, _, _ = contour_curve(c)
+        P0 = np.asarray(ref.control_points)
+        if P0.shape != cp.shape:
+            raise InputError(f"{rec.name}: {cp.shape[0]} control points, the contour has "
+                             f"{P0.shape[0]}: its structure must be kept")
+        tol = float(np.max(np.linalg.norm(cp - P0, axis=1)))
+    return c, np.asarray(c.points, dtype=np.float64), new, float(tol)
+
+
+def _candidate(c: Contour, P0: FloatArray, new: FloatArray, tol: float, s: float,
+               harmonize: bool) -> FloatArray:
+    pts, _ = constrained_points(c, P0 + s * (new - P0) if s != 1.0 else new, tol)
+    return _harmonize(c, pts, tol) if harmonize else pts
 
 
 def record_points(rec: CurveRecord, tol: float | None = None, *, harmonize: bool = False,
@@ -407,43 +523,123 @@ def record_points(rec: CurveRecord, tol: float | None = None, *, harmonize: bool
     the least energy) is written; when there is none the input contour is written unchanged.
     The fair itself works on the B-spline and cannot see these rules: rounding a TrueType
     point to the grid, or putting a node back on its neighbours' line, can add an extremum
-    the fair's own check did not count."""
-    c: Contour = rec.source["outline"]
-    idx = np.asarray(rec.source["point_index"], dtype=np.intp)
-    cp = np.asarray(rec.curve.control_points, dtype=np.float64)  # type: ignore[attr-defined]
-    if cp.ndim != 2 or cp.shape[1] != 2 or cp.shape[0] <= int(idx.max()):
-        raise InputError(f"{rec.name}: the curve has {cp.shape[0]} control points, the contour "
-                         "needs its own structure back (same knots)")
-    new = cp[idx]
-    if tol is None:
-        ref, _, _ = contour_curve(c)
-        P0 = np.asarray(ref.control_points)
-        if P0.shape != cp.shape:
-            raise InputError(f"{rec.name}: {cp.shape[0]} control points, the contour has "
-                             f"{P0.shape[0]}: its structure must be kept")
-        tol = float(np.max(np.linalg.norm(cp - P0, axis=1)))
-    P0 = np.asarray(c.points, dtype=np.float64)
+    the fair's own check did not count. The masters of an interpolated design share one
+    decision: :func:`shared_points`."""
+    return shared_points([rec], tol, harmonize=harmonize, guard=guard)[0]
 
-    def candidate(s: float) -> FloatArray:
-        pts, _ = constrained_points(c, P0 + s * (new - P0) if s != 1.0 else new, tol)
-        return _harmonize(c, pts, tol) if harmonize else pts
 
+#: the instances between two masters that :func:`shared_points` measures, as interpolation
+#: weights ``w`` of ``(1 - w) A + w B``
+INSTANCE_WEIGHTS = (0.25, 0.5, 0.75)
+
+
+def neighbour_pairs(locations: Sequence[dict[str, Any]]) -> list[tuple[int, int]]:
+    """The pairs of masters whose straight interpolation is an instance of the design: two
+    locations that differ in one axis only (non-numeric entries, such as a bracket layer's
+    set, equal) with no third location strictly between them on that axis (e.g. Light and
+    Regular, Regular and Bold on a weight axis; not Light and Bold)."""
+    def num(loc: dict[str, Any]) -> dict[str, float]:
+        return {k: v for k, v in loc.items() if isinstance(v, float)}
+
+    def rest(loc: dict[str, Any]) -> dict[str, Any]:
+        return {k: v for k, v in loc.items() if not isinstance(v, float)}
+
+    out = []
+    n = len(locations)
+    for i in range(n):
+        for j in range(i + 1, n):
+            a, b = locations[i], locations[j]
+            if rest(a) != rest(b) or set(num(a)) != set(num(b)):
+                continue
+            diff = [k for k in num(a) if a[k] != b[k]]
+            if len(diff) != 1:
+                continue
+            ax = diff[0]
+            lo, hi = sorted((a[ax], b[ax]))
+            between = any(rest(c) == rest(a) and set(num(c)) == set(num(a))
+                          and all(c[k] == a[k] for k in num(a) if k != ax)
+                          and lo < c[ax] < hi for c in locations)
+            if not between:
+                out.append((i, j))
+    return out
+
+
+def _compatible(cs: Sequence[Contour]) -> bool:
+    c0 = cs[0]
+    return all(len(c.on) == len(c0.on) and c.on == c0.on and c.closed == c0.closed
+               and c.quadratic == c0.quadratic for c in cs[1:])
+
+
+def shared_points(recs: Sequence[CurveRecord], tol: float | None = None, *,
+                  harmonize: bool = False, guard: bool = True) -> list[FloatArray]:
+    """The points to write for one contour faired in several masters of a design (the masters,
+    brace/intermediate and bracket layers of a glyph), with one never-worse decision for all.
+
+    Each master's candidate is built as in :func:`record_points`. For each scale ``s`` of
+    :data:`GUARD_SCALES`, every master takes the fair's moves scaled by that same ``s``, except
+    a master whose own candidate has more curvature extrema or more bending energy than its
+    input (it keeps its input); then the instances ``(1 - w) A + w B`` of every pair of
+    neighbouring masters (:func:`neighbour_pairs` of ``source["location"]``; every pair when
+    a record has no location), ``w`` in :data:`INSTANCE_WEIGHTS`, are measured the same way
+    against the same instances of the input (their contours take their corners from the
+    interpolated input, smooth where both masters are). The scale is admissible when none of
+    these instances is worse; of the admissible scales the one with the fewest extrema in total
+    over masters and instances (then the least energy) is written, else every master's input.
+    A guard per master alone could fair a contour in one master and leave its instances
+    unguarded (the masters stay compatible, the instances between them need not stay fair).
+    Masters with different structures (point counts, on-curve pattern) cannot interpolate and
+    are guarded one by one."""
+    setups = [_guard_setup(r, tol) for r in recs]
     if not guard:
-        return candidate(1.0)
-    ext0, e0 = fairness(c, P0)
-    best: tuple[int, float, FloatArray] | None = None
+        return [_candidate(c, P0, new, t, 1.0, harmonize) for c, P0, new, t in setups]
+    if len(setups) > 1 and not _compatible([st[0] for st in setups]):
+        return [shared_points([r], tol, harmonize=harmonize)[0] for r in recs]
+    # what is measured: each master, then the instances of each pair of neighbours
+    locs = [r.source.get("location") for r in recs]
+    if all(isinstance(loc, dict) for loc in locs):
+        pairs = neighbour_pairs(locs)  # type: ignore[arg-type]
+    else:
+        pairs = [(i, j) for i in range(len(recs)) for j in range(i + 1, len(recs))]
+    mixes: list[tuple[int, int, float, Contour]] = []
+    for i, j in pairs:
+        ci, cj = setups[i][0], setups[j][0]
+        sm = tuple(a and b for a, b in zip(ci.smooth, cj.smooth, strict=True))
+        for w in INSTANCE_WEIGHTS:
+            mixes.append((i, j, w, Contour((1 - w) * setups[i][1] + w * setups[j][1],
+                                           ci.on, sm, ci.closed, ci.quadratic)))
+
+    def measure(pts: list[FloatArray]) -> list[tuple[int, float]]:
+        out = [fairness(st[0], p) for st, p in zip(setups, pts, strict=True)]
+        out += [fairness(cm, (1 - w) * pts[i] + w * pts[j]) for i, j, w, cm in mixes]
+        return out
+
+    inputs = [st[1] for st in setups]
+    base = measure(inputs)
+    nm = len(setups)
+    best: tuple[int, float, list[FloatArray]] | None = None
     for s in GUARD_SCALES:
-        pts = candidate(s)
-        if np.array_equal(pts, P0):
+        pts = [_candidate(c, P0, new, t, s, harmonize) for c, P0, new, t in setups]
+        own = [fairness(st[0], p) for st, p in zip(setups, pts, strict=True)]
+        # a master whose own candidate is worse keeps its input at this scale
+        pts = [p if k <= base[i][0] and en <= base[i][1] else inputs[i]
+               for i, (p, (k, en)) in enumerate(zip(pts, own, strict=True))]
+        if all(np.array_equal(p, q) for p, q in zip(pts, inputs, strict=True)):
             continue
-        ext, e = fairness(c, pts)
-        if ext <= ext0 and e <= e0 and (best is None or (ext, e) < best[:2]):
-            best = (ext, e, pts)
-    return P0.copy() if best is None else best[2]
+        got = measure(pts)
+        if all(k <= k0 and en <= en0
+               for (k, en), (k0, en0) in zip(got[nm:], base[nm:], strict=True)):
+            score = (sum(k for k, _ in got), sum(en for _, en in got))
+            if best is None or score < best[:2]:
+                best = (*score, pts)
+    return [p.copy() for p in inputs] if best is None else best[2]
 
 
-def _by_glyph(records: Sequence[CurveRecord], tpath: str) -> dict[str, dict[int, FloatArray]]:
-    out: dict[str, dict[int, FloatArray]] = {}
+def _by_glyph(records: Sequence[CurveRecord], tpath: str, tol: float | None = None
+              ) -> dict[str, dict[int, FloatArray]]:
+    """The changed contours' points by glyph label (``"<glyph>"`` or ``"<glyph>@<master>"``).
+    The records of one contour in several masters (``source["master"]``) share one guard
+    decision (:func:`shared_points`)."""
+    groups: dict[tuple[Any, ...], list[CurveRecord]] = {}
     for i, r in enumerate(records):
         if "outline" not in r.source or "glyph" not in r.source:
             raise InputError(f"curves[{i}] was not read from a font: a font is written from "
@@ -451,12 +647,16 @@ def _by_glyph(records: Sequence[CurveRecord], tpath: str) -> dict[str, dict[int,
         if r.path is not None and os.path.abspath(r.path) != tpath:
             raise InputError(f"curves[{i}] comes from {r.path!r}, not from the template "
                              f"{tpath!r}")
-        pts = record_points(r)
-        c: Contour = r.source["outline"]
-        if np.array_equal(pts, c.points):
-            continue
-        label = str(r.source["handle"]).rsplit("#", 1)[0]
-        out.setdefault(label, {})[int(r.source["contour"])] = pts
+        key = (r.source["glyph"], int(r.source["contour"])) if "master" in r.source else (i,)
+        groups.setdefault(key, []).append(r)
+    out: dict[str, dict[int, FloatArray]] = {}
+    for group in groups.values():
+        for r, pts in zip(group, shared_points(group, tol), strict=True):
+            c: Contour = r.source["outline"]
+            if np.array_equal(pts, c.points):
+                continue
+            label = str(r.source["handle"]).rsplit("#", 1)[0]
+            out.setdefault(label, {})[int(r.source["contour"])] = pts
     return out
 
 
@@ -469,12 +669,11 @@ def _glif_version(text: bytes) -> tuple[int, int] | None:
 
 
 def write_ufo(path: str | os.PathLike[str], changes: dict[str, dict[int, FloatArray]],
-              template: str) -> None:
-    """Copy the UFO ``template`` to ``path`` and rewrite the changed glyphs' ``.glif`` files."""
-    ufoLib2 = _ufolib2("UFO sources")
-    from fontTools.ufoLib import UFOReader
-    from fontTools.ufoLib.glifLib import GlyphSet
-
+              template: str, layers: dict[str, dict[str, dict[int, FloatArray]]] | None = None
+              ) -> None:
+    """Copy the UFO ``template`` to ``path`` and rewrite the changed glyphs' ``.glif`` files:
+    ``changes`` in the default layer, ``layers`` (layer name: changes) in other layers."""
+    _ufolib2("UFO sources")
     dest = os.fspath(path)
     if os.path.lexists(dest):
         if os.path.isdir(dest) and not os.path.islink(dest):
@@ -482,10 +681,21 @@ def write_ufo(path: str | os.PathLike[str], changes: dict[str, dict[int, FloatAr
         else:
             os.unlink(dest)
     shutil.copytree(template, dest, symlinks=True)
-    if not changes:
-        return
+    todo: dict[str | None, dict[str, dict[int, FloatArray]]] = {None: changes}
+    todo.update(layers or {})
+    for layer_name, layer_changes in todo.items():
+        if layer_changes:
+            _write_layer(dest, template, layer_name, layer_changes)
+
+
+def _write_layer(dest: str, template: str, layer_name: str | None,
+                 changes: dict[str, dict[int, FloatArray]]) -> None:
+    ufoLib2 = _ufolib2("UFO sources")
+    from fontTools.ufoLib import UFOReader
+    from fontTools.ufoLib.glifLib import GlyphSet
+
     with UFOReader(template, validate=False) as reader:
-        layer_dir = reader.getGlyphSet().dirName
+        layer_dir = reader.getGlyphSet(layer_name).dirName
         ufo_version = reader.formatVersionTuple
     gs = GlyphSet(os.path.join(dest, layer_dir), ufoFormatVersion=ufo_version, validateRead=False,
                   validateWrite=True)
@@ -501,13 +711,12 @@ def write_ufo(path: str | os.PathLike[str], changes: dict[str, dict[int, FloatAr
 
 def write_glyphs(path: str | os.PathLike[str], changes: dict[str, dict[int, FloatArray]],
                  template: str) -> None:
-    """Save a copy of the Glyphs source ``template`` with the changed master layers' nodes
-    moved (glyphsLib writes the rest of the file as it read it)."""
+    """Save a copy of the Glyphs source ``template`` with the changed layers' nodes moved
+    (glyphsLib writes the rest of the file as it read it)."""
     font = _open_glyphs(template)
-    multi = len(font.masters) > 1
-    names = sorted({k.split("@")[0] for k in changes} if multi else set(changes))
-    for g, master, layer in _glyphs_layers(font, [n for n in names if n in font.glyphs]):
-        conts = changes.get(f"{g}@{master}" if multi else g)
+    names = sorted({k.split("@")[0] for k in changes})
+    for g, label, layer, _ in _glyphs_layers(font, [n for n in names if n in font.glyphs]):
+        conts = changes.get(_glyphs_label(font, g, label, layer))
         if not conts:
             continue
         paths = list(layer.paths)
@@ -523,8 +732,18 @@ def _number(v: float) -> float | int:
 
 def write_binary(path: str | os.PathLike[str], changes: dict[str, dict[int, FloatArray]],
                  template: str) -> None:
-    """Replace the changed glyphs' outlines in a copy of the binary font ``template``."""
+    """Replace the changed glyphs' outlines in a copy of the binary font ``template``.
+
+    A variable TrueType font (``gvar``) is refused: its instances are the default outline plus
+    the ``gvar`` deltas, so a faired default outline with the deltas kept would move every
+    instance by the default's moves, unchecked against ``tol`` and unfaired."""
     font = _open_binary(template)
+    if "gvar" in font:
+        raise FileFormatError("a variable TrueType font (gvar table): fairing its default "
+                              "outline would move every instance through the unchanged gvar "
+                              "deltas; fair the font's sources (a .designspace with "
+                              "'curvefair fair X.designspace --tol T -o OUTDIR', or its UFO "
+                              "masters) and build it again", template)
     if "glyf" in font:
         glyf, hmtx = font["glyf"], font["hmtx"]
         for gname, conts in changes.items():
