@@ -223,10 +223,42 @@ def read(path: str | os.PathLike[str], *, on_unsupported: str = "raise",
             continue
         except CurvefairError as exc:
             raise FileFormatError(f"edge {k}: {exc}", path) from None
+        if fmt == "iges":
+            why = _iges_surface_bound(path, edge, k)
+            if why:
+                msg = f"edge {k}: unsupported {why}"
+                if on_unsupported == "raise":
+                    raise FileFormatError(msg + " (read_curves(..., on_unsupported='skip') "
+                                          "skips it)", path)
+                warnings.warn(f"{os.fspath(path)}: skipped {msg}; kept untouched", UserWarning,
+                              stacklevel=3)
+                continue
         src = {"format": fmt, "path": os.path.abspath(path), "index": len(records), "edge": k,
                "z": z}
         records.append(CurveRecord(curve, f"edge{k}", "bspline", src))
     return records
+
+
+def _iges_surface_bound(path: object, edge: Any, k: int) -> str:
+    """Why the free edge ``k`` cannot be faired in this IGES file, or "": OCC built it from
+    a curve on a surface (142) whose preferred representation is its 2-D curve on the
+    surface, not from a free 126 entity. A faired 3-D curve is off that surface (by up to
+    tol), so it could be written neither as the 142's image of its 2-D curve nor as its
+    model-space curve without making the 142 contradict itself."""
+    try:
+        with open(os.fspath(path), "rb") as fh:  # type: ignore[call-overload]
+            mod = _iges_model(fh.read().decode("latin-1"))
+        bs, _trsf = _orig_curve(edge)
+    except (_Refuse, OSError, LookupError, ValueError, IndexError):
+        return ""
+    local, knots, p = _local_poles(bs)
+    if any(_match(c[2], c[3], c[4], local, knots, p) is not None for c in mod["cands"]):
+        return ""
+    note = _surface_curve_note(mod["ents"], mod["params"])
+    if not note:
+        return ""
+    return ("curve bound to a surface: no free 126 entity holds it" + note
+            + "; a faired 3-D curve would leave its surface")
 
 
 def _geom(curve: BSplineCurve, z: float | None) -> Any:
@@ -1037,7 +1069,10 @@ def _iges_real(s: str) -> float:
     return float(s.replace("D", "E").replace("d", "e")) if s else 0.0
 
 
-def _patch_iges(text: str, patches: list[_Patch]) -> str:
+def _iges_model(text: str) -> dict[str, Any]:
+    """The sections, directory entries, parameter blocks and the free 126 entities (those
+    under no face: trimmed surface 144, bounded surface 143, BRep edge list 504) of an IGES
+    text, for matching OCC's edges to the file's entities."""
     lines, nl = _iges_sections(text)
     sec = {c: [ln for ln in lines if len(ln) >= 73 and ln[72] == c] for c in "SGDPT"}
     pd, rd = _iges_delims(sec["G"])
@@ -1128,6 +1163,15 @@ def _patch_iges(text: str, patches: list[_Patch]) -> str:
         if not np.all(w == w[0]):
             continue
         cands.append((d, f, raw, knots, m, c0))
+    return {"nl": nl, "sec": sec, "pd": pd, "rd": rd, "de": de, "blocks": blocks,
+            "order": order, "ents": ents, "params": params, "cands": cands}
+
+
+def _patch_iges(text: str, patches: list[_Patch]) -> str:
+    mod = _iges_model(text)
+    nl, sec, pd, rd, de = mod["nl"], mod["sec"], mod["pd"], mod["rd"], mod["de"]
+    blocks, order, ents, params, cands = (mod["blocks"], mod["order"], mod["ents"],
+                                          mod["params"], mod["cands"])
     new_blocks = dict(blocks)
     done: set[int] = set()
     first = sec["P"][0] if sec["P"] else " " * 80
