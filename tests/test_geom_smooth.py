@@ -220,6 +220,41 @@ def test_noise_is_not_taken_for_corners(tmp_path):
     assert split == 0
 
 
+def test_noise_is_not_taken_for_corners_over_seeds():
+    """The same 15 kinds of jittered curves for 20 seeds (300 curves): no point turns by the
+    default corner angle at the scale of the noise (the single-scale rule, chords of 6 sigma,
+    split 23 of them), while noisy squares keep exactly their corners (below)."""
+    from curvefair.io._common import DEFAULT_CORNER_ANGLE, corner_turning, turning_angles
+
+    split, raw = [], 0
+    for seed in range(20):
+        for i, p in enumerate(_noisy_curves(seed)):
+            raw += int(np.any(turning_angles(p, False) >= DEFAULT_CORNER_ANGLE))
+            if np.any(corner_turning(p, False) >= DEFAULT_CORNER_ANGLE):
+                split.append((seed, i))
+    assert raw == 300                  # the plain turning angle would split every one
+    assert split == []
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2, 3, 4])
+@pytest.mark.parametrize("rel", [0.001, 0.004])
+def test_noisy_square_keeps_exactly_its_corners_over_seeds(tmp_path, seed, rel):
+    """A square, 30 samples per side, noise of 0.1 % and 0.4 % of its size, read from CSV:
+    exactly its 4 corners, each found within two samples."""
+    k = np.arange(5)
+    vert = np.c_[np.cos(np.pi * k / 2), np.sin(np.pi * k / 2)]
+    s = np.linspace(0, 1, 30, endpoint=False)[:, None]
+    sq = np.vstack([vert[j] + s * (vert[j + 1] - vert[j]) for j in range(4)])
+    rng = np.random.default_rng(seed)
+    noisy = sq + rng.normal(0, rel * np.ptp(sq, axis=0).max(), sq.shape)
+    f = tmp_path / "square.csv"
+    np.savetxt(f, np.vstack([noisy, noisy[:1]]), delimiter=",", header="x,y", comments="")
+    corners = sorted({int(r.source["indices"][0]) for r in read_curves(f)})
+    assert len(corners) == 4, corners
+    for c, want in zip(corners, (0, 30, 60, 90), strict=True):
+        assert min(abs(c - want), 120 - abs(c - want)) <= 2
+
+
 def test_noisy_square_keeps_its_corners(tmp_path):
     s = np.linspace(0, 1, 30, endpoint=False)
     sq = np.r_[np.c_[s, 0 * s], np.c_[1 + 0 * s, s], np.c_[1 - s, 1 + 0 * s], np.c_[0 * s, 1 - s]]
