@@ -48,12 +48,18 @@ def test_curves_bound_to_a_surface_are_skipped_naming_why(tmp_path):
     skipped = [str(x.message) for x in w if "bound to a surface" in str(x.message)]
     assert len(skipped) == 3 and all("DE 1: the 2-D curve DE 5" in m and "kept untouched" in m
                                      for m in skipped)
-    # the CLI: nothing it can fair in this file; it says so and why, writes nothing
+    # the CLI: nothing it can fair in this file; it says so and why, the run does not fail,
+    # and the file is written back unchanged; --strict refuses it
     out = tmp_path / "o.igs"
     res = CliRunner().invoke(main, ["fair", str(SRC), "-o", str(out), "--tol", "0.01"])
-    assert res.exit_code == 1 and "unsupported entities skipped" in res.stderr
+    assert res.exit_code == 0, res.output
+    assert "nothing to fair" in res.stderr and "unsupported entities skipped" in res.stderr
     assert "curve bound to a surface" in res.stderr and "Traceback" not in res.output
-    assert not out.exists()
+    assert out.read_bytes() == SRC.read_bytes()
+    res = CliRunner().invoke(main, ["fair", str(SRC), "-o", str(tmp_path / "s.igs"),
+                                    "--tol", "0.01", "--strict"])
+    assert res.exit_code == 1 and "curve bound to a surface" in res.stderr
+    assert "Traceback" not in res.output and not (tmp_path / "s.igs").exists()
 
 
 def _read_as_occ(p, monkeypatch):

@@ -776,10 +776,10 @@ def _patch_step(text: str, patches: list[_Patch]) -> str:
         for q in pids[len(new):]:
             if refs.get(q, 0) == 1:
                 edits[q] = ""               # an unshared pole no longer used: removed
-        body = cur.render(pa.new_p, new_ids,
-                          None if np.array_equal(nknots, flat) else nknots)
-        if body is not None:
-            edits[cid] = body
+        new_body = cur.render(pa.new_p, new_ids,
+                              None if np.array_equal(nknots, flat) else nknots)
+        if new_body is not None:
+            edits[cid] = new_body
     out = []
     last = 0
     for i, s, e, b in inst:
@@ -971,7 +971,7 @@ def _trim_edits(tid: int, targs: list[Any], pa: _Patch, scale: float, flat: Floa
             (pa.old_knots[-1] - pa.old_knots[0]) / max(flat[-1] - flat[0], 1e-300))))
         still = (q.X(), q.Y(), q.Z()) == (q0.X(), q0.Y(), q0.Z())   # the curve did not move there
         local = _apply(pa.trsf, np.array([[q.X(), q.Y(), q.Z()]]), inverse=True)[0] / scale
-        new_sel = []
+        new_sel: list[Any] = []
         for v in sel:
             if isinstance(v, tuple) and v[0] == "PARAMETER_VALUE":
                 new_sel.append(v if nu == u else ("PARAMETER_VALUE", [_num(nu)]))

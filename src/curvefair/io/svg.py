@@ -827,7 +827,7 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
         spliced = (_splice_subpaths(raw_d, parsed, new_d, spt)
                    if sp is not None and "&" not in raw_d
                    and _attr_value(raw, sp) == d_text else None)
-        if spliced is not None:
+        if spliced is not None and sp is not None:
             edits.append((sp[0], sp[1], spliced))
             continue
         spliced = _splice_subpaths(d_text, parsed, new_d, spt)
