@@ -188,6 +188,22 @@ def test_pentagon_keeps_corners(tmp_path):
     assert len(recs) == 5
     ends = sorted({tuple(np.round(r.points[i], 12)) for r in recs for i in (0, -1)})
     assert ends == sorted({tuple(np.round(p, 12)) for p in pent})
+    # the corner angle is settable: above 72 degrees the pentagon is one smooth closed list
+    # (API and CLI), at the default the CLI sees the five pieces too
+    assert len(read_curves(f, corner_angle=80.0)) == 1
+    import json
+
+    from click.testing import CliRunner
+
+    from curvefair.cli import main
+
+    def n_curves(*extra):
+        r = CliRunner().invoke(main, ["analyze", str(f), "--json", *extra])
+        assert r.exit_code == 0, r.output
+        return len(json.loads(r.stdout)["curves"])
+
+    assert n_curves() == 5 and n_curves("--corner-angle", "80") == 1
+    assert n_curves("--corner-angle", "70") == 5
 
 
 def _noisy_curves(seed):
