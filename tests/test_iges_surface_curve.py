@@ -67,7 +67,7 @@ def _read_as_occ(p, monkeypatch):
     import curvefair.io.occ as occ
 
     with monkeypatch.context() as m:
-        m.setattr(occ, "_iges_surface_bound", lambda *a: "")
+        m.setattr(occ, "_iges_surface_bound", lambda *a, **k: "")
         return _read(p)
 
 

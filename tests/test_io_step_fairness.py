@@ -29,7 +29,8 @@ from curvefair.io.occ import _free_edges, _quiet, _read_shape  # noqa: E402
 
 DATA = os.path.join(os.path.dirname(__file__), "data", "real", "occt")
 # (the three files holding other Part 42 curve forms are tests/test_io_step_forms.py's)
-FORMS = ("trj7_c2-al-214.stp", "trj7_c2-tc-203.stp", "trj7_c2-sd-214.stp")
+FORMS = ("trj7_c2-al-214.stp", "trj7_c2-tc-203.stp", "trj7_c2-sd-214.stp",
+         "trj8_c2-db-214.stp")
 FILES = sorted(f for f in glob.glob(os.path.join(DATA, "*.stp"))
                if os.path.basename(f) not in FORMS)
 

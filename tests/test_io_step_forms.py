@@ -58,6 +58,15 @@ def _occ_edge(path):
     return u, np.array([[ad.Value(t).X(), ad.Value(t).Y(), ad.Value(t).Z()] for t in u])
 
 
+def _domain_end(body, end):
+    """The first (``end=0``) or last (``-1``) knot of a B-spline's domain from its text."""
+    groups = re.findall(r"\(([-+\d.,E]+)\)", body)
+    mults = [int(v) for v in groups[-2].split(",")]
+    knots = np.repeat([float(v) for v in groups[-1].split(",")], mults)
+    p = int(body.split(",")[1])
+    return float(knots[p] if end == 0 else knots[-p - 1])
+
+
 def _basis_point(inst, cid, u):
     """The point at parameter ``u`` of the B_SPLINE_CURVE_WITH_KNOTS instance ``cid`` of the
     file (test-side: its poles, multiplicities and knots evaluated by scipy)."""
@@ -73,19 +82,20 @@ def _basis_point(inst, cid, u):
     return BSpline(np.repeat(knots, mults), pts, int(body.split(",")[1]))(u)
 
 
-@pytest.mark.parametrize("name, form", [
-    ("trj7_c2-al-214.stp", "RATIONAL_B_SPLINE_CURVE"),
-    ("trj7_c2-tc-203.stp", "QUASI_UNIFORM_CURVE"),
-    ("trj7_c2-sd-214.stp", "TRIMMED_CURVE"),
+@pytest.mark.parametrize("name, form, pole", [
+    ("trj7_c2-al-214.stp", "RATIONAL_B_SPLINE_CURVE", 2),
+    ("trj7_c2-tc-203.stp", "QUASI_UNIFORM_CURVE", 2),
+    ("trj7_c2-sd-214.stp", "TRIMMED_CURVE", 2),     # parameter + point trims, periodic basis
+    ("trj8_c2-db-214.stp", "TRIMMED_CURVE", 0),     # point trims only; its start moves
 ])
-def test_other_forms_written_back_in_place(tmp_path, name, form):
+def test_other_forms_written_back_in_place(tmp_path, name, form, pole):
     src = os.path.join(DATA, name)
     assert form in open(src, encoding="latin-1").read()
     (rec,) = read_curves(src)
     c = rec.curve
     q = np.array(c.control_points)
     size = float(np.ptp(q, axis=0).max())
-    q[2] += 1e-3 * size                       # the one moved control point
+    q[pole] += 1e-3 * size                    # the one moved control point
     moved = c.replace(control_points=q)
     out = tmp_path / name
     write_curves(out, [rec.with_curve(moved)], template=src)
@@ -116,18 +126,26 @@ def test_other_forms_written_back_in_place(tmp_path, name, form):
     if form == "TRIMMED_CURVE":
         (t,) = [v for v in b.values() if v.startswith("TRIMMED_CURVE(")]
         assert t in a.values()                                  # the trim itself unchanged
-        trim_pts = {int(p) for p in re.findall(r"#(\d+)\)", t)}
-        (tp,) = trim_pts
-        u_trim = [float(v) for v in re.findall(r"PARAMETER_VALUE\(([-+\d.E]+)\)", t)]
-        basis = int(re.match(r"TRIMMED_CURVE\('[^']*',#(\d+)", t)[1])
-        # the trim point is the written basis curve's point at both trim parameters
-        xyz = np.array([float(v) for v in b[tp].split(",(")[1].rstrip(")").split(",")])
-        assert tp in changed
-        for u in u_trim:
-            assert np.abs(xyz - _basis_point(b, basis, u)).max() <= 1e-9 * size
-        # (and before, the old point on the old curve to the file's 15 digits)
-        xyz_a = np.array([float(v) for v in a[tp].split(",(")[1].rstrip(")").split(",")])
-        assert np.abs(xyz_a - _basis_point(a, basis, u_trim[0])).max() <= 1e-9 * size
+        m = re.match(r"TRIMMED_CURVE\('[^']*',#(\d+),\((.*?)\),\((.*?)\),\.T\.", t)
+        basis = int(m[1])
+        kn = [float(v) for v in re.findall(r"\(([-+\d.,E]+)\)", a[basis])[-1].split(",")]
+        p = int(a[basis].split(",")[1])
+        for sel, end in ((m[2], 0), (m[3], -1)):
+            us = [float(v) for v in re.findall(r"PARAMETER_VALUE\(([-+\d.E]+)\)", sel)]
+            # a point-only trim is at the end of the basis's domain (OCC reads it whole)
+            u = us[0] if us else _domain_end(a[basis], end)
+            for pid in map(int, re.findall(r"#(\d+)", sel)):
+                trim_pts.add(pid)
+                xyz = np.array([float(v) for v in b[pid].split(",(")[1].rstrip(")").split(",")])
+                old = np.array([float(v) for v in a[pid].split(",(")[1].rstrip(")").split(",")])
+                # before: on the old curve; after: on the written curve, at the trim's
+                # parameter, and moved exactly when the curve moved there
+                assert np.abs(old - _basis_point(a, basis, u)).max() <= 1e-9 * size
+                assert np.abs(xyz - _basis_point(b, basis, u)).max() <= 1e-9 * size
+                moved_there = np.abs(_basis_point(a, basis, u)
+                                     - _basis_point(b, basis, u)).max() > 1e-9 * size
+                assert (pid in changed) == moved_there
+        assert kn and p and trim_pts & changed
     assert changed <= poles | trim_pts
 
 

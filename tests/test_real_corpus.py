@@ -457,7 +457,7 @@ def test_iges_unchanged_bytes_and_refusal(tmp_path, monkeypatch):
     with pytest.warns(UserWarning, match="bound to a surface"):
         with pytest.raises(FileFormatError, match="no curves"):
             read_curves(src, on_unsupported="skip")
-    monkeypatch.setattr(occ, "_iges_surface_bound", lambda *a: "")
+    monkeypatch.setattr(occ, "_iges_surface_bound", lambda *a, **k: "")
     recs = _read(src)
     assert len(recs) == 3
     out = tmp_path / "same.igs"

@@ -209,6 +209,7 @@ def read(path: str | os.PathLike[str], *, on_unsupported: str = "raise",
     fmt = _fmt_of(path)
     shape = _read_shape(path, fmt, f"reading {fmt.upper()} files")
     records: list[CurveRecord] = []
+    model: dict[str, Any] = {}           # the IGES text's entities, parsed once when needed
     for k, edge in enumerate(_free_edges(shape)):
         try:
             curve, z = _bspline_of_edge(edge)
@@ -224,7 +225,7 @@ def read(path: str | os.PathLike[str], *, on_unsupported: str = "raise",
         except CurvefairError as exc:
             raise FileFormatError(f"edge {k}: {exc}", path) from None
         if fmt == "iges":
-            why = _iges_surface_bound(path, edge, k)
+            why = _iges_surface_bound(path, edge, k, model)
             if why:
                 msg = f"edge {k}: unsupported {why}"
                 if on_unsupported == "raise":
@@ -239,18 +240,23 @@ def read(path: str | os.PathLike[str], *, on_unsupported: str = "raise",
     return records
 
 
-def _iges_surface_bound(path: object, edge: Any, k: int) -> str:
+def _iges_surface_bound(path: object, edge: Any, k: int, model: dict[str, Any]) -> str:
     """Why the free edge ``k`` cannot be faired in this IGES file, or "": OCC built it from
     a curve on a surface (142) whose preferred representation is its 2-D curve on the
     surface, not from a free 126 entity. A faired 3-D curve is off that surface (by up to
     tol), so it could be written neither as the 142's image of its 2-D curve nor as its
     model-space curve without making the 142 contradict itself."""
     try:
-        with open(os.fspath(path), "rb") as fh:  # type: ignore[call-overload]
-            mod = _iges_model(fh.read().decode("latin-1"))
+        if not model:
+            with open(os.fspath(path), "rb") as fh:  # type: ignore[call-overload]
+                model.update(_iges_model(fh.read().decode("latin-1")) or {"bad": True})
         bs, _trsf = _orig_curve(edge)
     except (_Refuse, OSError, LookupError, ValueError, IndexError):
+        model.setdefault("bad", True)
         return ""
+    if "cands" not in model:
+        return ""
+    mod = model
     local, knots, p = _local_poles(bs)
     if any(_match(c[2], c[3], c[4], local, knots, p) is not None for c in mod["cands"]):
         return ""
@@ -935,27 +941,42 @@ def _step_parse_complex(body: str) -> list[tuple[str, list[Any]]]:
     return out
 
 
+def _bare_real(v: Any) -> bool:
+    if not isinstance(v, str) or v.startswith(("#", "$", ".", "'")):
+        return False
+    try:
+        float(v)
+    except ValueError:
+        return False
+    return True
+
+
 def _trim_edits(tid: int, targs: list[Any], pa: _Patch, scale: float, flat: FloatArray,
                 nknots: FloatArray, by_id: dict[int, tuple[int, int, str]],
                 refs: dict[int, int], point: Any, edits: dict[int, str]) -> dict[int, str]:
     """Edits that keep a ``TRIMMED_CURVE`` of a faired basis curve consistent: parameter
     trims stay (the basis keeps its parameterisation; a trim at an end of the domain follows
     the end when the knots changed), a cartesian-point trim becomes the faired curve's point
-    at the trim's parameter (the point is edited when only this trim refers to it)."""
+    at the trim's parameter (the point is edited when only this trim refers to it; a trim
+    given by a point alone is at an end of the domain, OCC having read the whole basis)."""
     out: dict[int, str] = {}
     params: list[float | None] = []
     for sel in (targs[2], targs[3]):
         vals = [float(v[1][0]) for v in sel if isinstance(v, tuple)
                 and v[0] == "PARAMETER_VALUE"]
+        vals += [float(v) for v in sel if _bare_real(v)]   # "(0.E0)": written by some
         params.append(vals[0] if vals else None)
     a = list(targs)
     placed: dict[int, FloatArray] = {}
     changed_knots = not np.array_equal(nknots, flat)
     lo, hi = flat[pa.p], flat[-pa.p - 1]
+    forward = str(targs[4]).strip() != ".F."
     for k, sel in ((2, targs[2]), (3, targs[3])):
         u = params[k - 2]
         if u is None:
-            raise _Refuse(f"trimmed curve #{tid}: a trim without a parameter value")
+            # cartesian trims only: OCC read the edge over the basis's whole domain (else the
+            # reader skips it as trimmed), so the trims are its ends, in the sense given
+            u = float(lo if (k == 2) == forward else hi)
         if changed_knots:
             if u not in (lo, hi):
                 raise _Refuse(f"trimmed curve #{tid}: the faired knots move its trim "
@@ -975,6 +996,8 @@ def _trim_edits(tid: int, targs: list[Any], pa: _Patch, scale: float, flat: Floa
         for v in sel:
             if isinstance(v, tuple) and v[0] == "PARAMETER_VALUE":
                 new_sel.append(v if nu == u else ("PARAMETER_VALUE", [_num(nu)]))
+            elif _bare_real(v):
+                new_sel.append(v if nu == u else _num(nu))
             elif isinstance(v, str) and v.startswith("#"):
                 pid = int(v[1:])
                 old = point(pid)
