@@ -188,6 +188,22 @@ def test_pentagon_keeps_corners(tmp_path):
     assert len(recs) == 5
     ends = sorted({tuple(np.round(r.points[i], 12)) for r in recs for i in (0, -1)})
     assert ends == sorted({tuple(np.round(p, 12)) for p in pent})
+    # the corner angle is settable: above 72 degrees the pentagon is one smooth closed list
+    # (API and CLI), at the default the CLI sees the five pieces too
+    assert len(read_curves(f, corner_angle=80.0)) == 1
+    import json
+
+    from click.testing import CliRunner
+
+    from curvefair.cli import main
+
+    def n_curves(*extra):
+        r = CliRunner().invoke(main, ["analyze", str(f), "--json", *extra])
+        assert r.exit_code == 0, r.output
+        return len(json.loads(r.stdout)["curves"])
+
+    assert n_curves() == 5 and n_curves("--corner-angle", "80") == 1
+    assert n_curves("--corner-angle", "70") == 5
 
 
 def _noisy_curves(seed):
@@ -218,6 +234,41 @@ def test_noise_is_not_taken_for_corners(tmp_path):
         split += len(read_curves(f)) > 1
     assert raw == 15
     assert split == 0
+
+
+def test_noise_is_not_taken_for_corners_over_seeds():
+    """The same 15 kinds of jittered curves for 20 seeds (300 curves): no point turns by the
+    default corner angle at the scale of the noise (the single-scale rule, chords of 6 sigma,
+    split 23 of them), while noisy squares keep exactly their corners (below)."""
+    from curvefair.io._common import DEFAULT_CORNER_ANGLE, corner_turning, turning_angles
+
+    split, raw = [], 0
+    for seed in range(20):
+        for i, p in enumerate(_noisy_curves(seed)):
+            raw += int(np.any(turning_angles(p, False) >= DEFAULT_CORNER_ANGLE))
+            if np.any(corner_turning(p, False) >= DEFAULT_CORNER_ANGLE):
+                split.append((seed, i))
+    assert raw == 300                  # the plain turning angle would split every one
+    assert split == []
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2, 3, 4])
+@pytest.mark.parametrize("rel", [0.001, 0.004])
+def test_noisy_square_keeps_exactly_its_corners_over_seeds(tmp_path, seed, rel):
+    """A square, 30 samples per side, noise of 0.1 % and 0.4 % of its size, read from CSV:
+    exactly its 4 corners, each found within two samples."""
+    k = np.arange(5)
+    vert = np.c_[np.cos(np.pi * k / 2), np.sin(np.pi * k / 2)]
+    s = np.linspace(0, 1, 30, endpoint=False)[:, None]
+    sq = np.vstack([vert[j] + s * (vert[j + 1] - vert[j]) for j in range(4)])
+    rng = np.random.default_rng(seed)
+    noisy = sq + rng.normal(0, rel * np.ptp(sq, axis=0).max(), sq.shape)
+    f = tmp_path / "square.csv"
+    np.savetxt(f, np.vstack([noisy, noisy[:1]]), delimiter=",", header="x,y", comments="")
+    corners = sorted({int(r.source["indices"][0]) for r in read_curves(f)})
+    assert len(corners) == 4, corners
+    for c, want in zip(corners, (0, 30, 60, 90), strict=True):
+        assert min(abs(c - want), 120 - abs(c - want)) <= 2
 
 
 def test_noisy_square_keeps_its_corners(tmp_path):

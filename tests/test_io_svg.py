@@ -159,7 +159,11 @@ def test_real_matplotlib_svg_round_trip_and_element_write_back(tmp_path):
     a = src.read_text().splitlines()
     b = (tmp_path / "f.svg").read_text().splitlines()
     changed = [ln for ln in b if ln not in a]
-    assert len(changed) == 1 and 'style="fill:#ffffff;"' in changed[0]
+    # the subpath's text is replaced up to its last command; the line break before the
+    # closing quote and the rest of the element are kept
+    assert len(changed) == 1 and changed[0].lstrip().startswith("<path d=")
+    assert b[b.index(changed[0]) + 1] == '" style="fill:#ffffff;"/>'
+    assert len(b) == len(a) - 9
     assert len(re.findall(r"\bC\b", changed[0])) == 8
     back = read_curves(tmp_path / "f.svg")
     c2 = next(x for x in back if x.source["element"] == circle.source["element"])
@@ -239,3 +243,100 @@ def test_missing_svgpathtools(tmp_path, monkeypatch):
     monkeypatch.setitem(sys.modules, "svgpathtools", None)
     with pytest.raises(MissingDependencyError, match=r"curvefair\[svg\]"):
         read_curves(p)
+
+
+
+def _moveto_pieces(d):
+    """The text of ``d`` cut before every moveto (test-side, by a regular expression)."""
+    cuts = [m.start() for m in re.finditer("[Mm]", d)] + [len(d)]
+    return [d[a:b].strip() for a, b in zip(cuts[:-1], cuts[1:], strict=False)]
+
+
+def _d_span(raw, el_id):
+    """Byte span of the d attribute of the <path> with id ``el_id`` (test-side regex)."""
+    hits = [m for m in re.finditer(rb"<path\b[^>]*>", raw) if b'id="' + el_id + b'"' in m[0]]
+    assert len(hits) == 1
+    m = re.search(rb'\sd="([^"]*)"', hits[0][0])
+    a = hits[0].start() + m.start(1)
+    return raw[a:a + len(m[1])].decode(), a, a + len(m[1])
+
+
+def _span_beziers(c):
+    """Bezier points of every knot span of a cubic B-spline, from 4 scipy evaluations per
+    span (the Bernstein system solved; independent of curvefair)."""
+    bs = BSpline(c.knots, np.asarray(c.control_points), 3)
+    brk = np.unique(c.knots[3:-3])
+    s = np.array([0.0, 1 / 3, 2 / 3, 1.0])
+    M = np.stack([(1 - s) ** 3, 3 * s * (1 - s) ** 2, 3 * s**2 * (1 - s), s**3], axis=1)
+    out = []
+    for u0, u1 in zip(brk[:-1], brk[1:], strict=False):
+        u = u0 + s * (u1 - u0)
+        u[-1] = np.nextafter(u1, u0)            # the span's own end (left of the knot)
+        out.append(np.linalg.solve(M, bs(u)))
+    return np.array(out)
+
+
+@pytest.mark.parametrize("name, which", [
+    ("path64/0", "end"),      # next subpath starts with a relative m: its moveto goes absolute
+    ("path64/3", "mid"),
+    ("path70/1", "end"),      # subpaths continued by "m0 0" pieces
+    ("path98/5", "mid"),      # 23 subpaths in 124 moveto pieces, relative commands
+    ("path98/20", "end"),
+])
+def test_untouched_subpaths_keep_their_text(tmp_path, name, which):
+    """In a path with several subpaths, writing back one changed subpath leaves the text of
+    every other subpath as it was (trimesh's MIL.svg: relative commands, 3 decimals), the
+    file outside the d attribute byte for byte, and svgpathtools reads exactly the same
+    segments for every other subpath."""
+    src = DATA / "real" / "trimesh" / "MIL.svg"
+    recs = read_curves(src)
+    r = next(x for x in recs if x.name == name)
+    j = r.source["subpath"]
+    q = np.array(r.curve.control_points)
+    q[-1 if which == "end" else len(q) // 2] += [0.7, -0.3]
+    moved = r.curve.replace(control_points=q)
+    out = tmp_path / "out.svg"
+    write_curves(out, [x.with_curve(moved) if x is r else x for x in recs], template=src)
+    raw0, raw1 = src.read_bytes(), out.read_bytes()
+    el_id = name.split("/")[0].encode()
+    d0, a0, b0 = _d_span(raw0, el_id)
+    d1, a1, b1 = _d_span(raw1, el_id)
+    assert raw0[:a0] == raw1[:a1] and raw0[b0:] == raw1[b1:]
+    subs0 = spt.parse_path(d0).continuous_subpaths()
+    subs1 = spt.parse_path(d1).continuous_subpaths()
+    assert len(subs0) == len(subs1)
+    for k, (s0, s1) in enumerate(zip(subs0, subs1, strict=False)):
+        if k != j:
+            assert list(s0) == list(s1), k            # exactly the same segments
+    # the changed subpath has the new geometry, at the element's 3 decimals
+    got = np.array([[[z.real, z.imag] for z in (g.start, g.control1, g.control2, g.end)]
+                    for g in subs1[j]])
+    np.testing.assert_allclose(got, _span_beziers(moved), rtol=0, atol=5e-4 + 1e-9)
+    # text: the moveto pieces before and after the changed subpath's own pieces are those
+    # of the input, except a relative moveto right after it when its end point moved
+    p0, p1 = _moveto_pieces(d0), _moveto_pieces(d1)
+    own = sum(1 for p in _piece_subpaths(d0) if p == j)
+    assert _piece_subpaths(d0).index(j) == _piece_subpaths(d1).index(j)
+    first = _piece_subpaths(d0).index(j)
+    assert p0[:first] == p1[:first]
+    after0, after1 = p0[first + own:], p1[first + 1:]
+    assert len(after0) == len(after1)
+    for i, (x, y) in enumerate(zip(after0, after1, strict=False)):
+        if x != y:
+            # the written end of the new text is not the float the relative moveto was
+            # counted from (an end moved, or rounded to the element's decimals): the same
+            # absolute point, the rest of the piece verbatim
+            assert i == 0 and x[0] == "m" and y[0] == "M", (x, y)
+            rest_x = re.sub(r"^m\s*[-+]?[\d.e-]+[\s,]*[-+]?[\d.e-]+\s*", "", x)
+            rest_y = re.sub(r"^M\s*[-+]?[\d.e-]+[\s,]*[-+]?[\d.e-]+\s*(l\s*)?", "", y)
+            assert rest_x == rest_y
+    assert "".join(p1[first:first + 1]).count("M") == 1   # the new text of subpath j
+
+
+def _piece_subpaths(d):
+    """For each moveto piece of ``d``, the continuous subpath its segments belong to
+    (test-side: every prefix of the text parsed by svgpathtools)."""
+    cuts = [m.start() for m in re.finditer("[Mm]", d)] + [len(d)]
+    ends = np.cumsum([len(s) for s in spt.parse_path(d).continuous_subpaths()])
+    return [int(np.searchsorted(ends, len(spt.parse_path(d[:b])) - 1, side="right"))
+            for b in cuts[1:]]

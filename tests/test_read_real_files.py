@@ -313,11 +313,19 @@ def test_dxf_unsupported_skipped_kept_untouched_and_strict(tmp_path):
     res = _run("fair", p, "-o", tmp_path / "s.dxf", "--tol", "0.01", "--strict")
     assert res.exit_code == 1 and "without --strict" in res.output
     assert not (tmp_path / "s.dxf").exists()
-    # a file holding only unsupported entities: no curves, and the message says why
+    # a file holding only unsupported entities: nothing to fair, written back unchanged
+    # (exit 0, the note says why); --strict refuses it
     doc = ezdxf.new("R2010")
     doc.modelspace().add_rational_spline([(0, 0), (1, 2), (3, 2), (4, 0)], [1, 0.5, 2, 1])
     doc.saveas(tmp_path / "only.dxf")
     res = _run("fair", tmp_path / "only.dxf", "-o", tmp_path / "x.dxf")
+    assert res.exit_code == 0 and "1 unsupported entity skipped" in res.output
+    assert "nothing to fair" in res.output
+    assert (tmp_path / "x.dxf").read_bytes() == (tmp_path / "only.dxf").read_bytes()
+    res = _run("fair", tmp_path / "only.dxf", "-o", tmp_path / "y.dxf", "--strict")
+    assert res.exit_code == 1 and not (tmp_path / "y.dxf").exists()
+    # to another format there is nothing to write: refused, saying why
+    res = _run("fair", tmp_path / "only.dxf", "-o", tmp_path / "z.json")
     assert res.exit_code == 1 and "1 unsupported entity skipped" in res.output
 
 

@@ -443,13 +443,21 @@ def test_step_round_trip(tmp_path, name):
     assert kept >= len(lines0) - 12 * len(changed) - sum(len(_pts(r.curve)) for r in changed)
 
 
-def test_iges_unchanged_bytes_and_refusal(tmp_path):
+def test_iges_unchanged_bytes_and_refusal(tmp_path, monkeypatch):
     """OCC131-6.igs: OCC builds its free edges from the 2-D curves of a curve on a surface
     (142, preferred representation 1), converted to 3-D; no 126 entity of the file holds the
-    curve that is read, so a faired curve cannot be written into the file: it is refused and
-    nothing is written. Written back unchanged, the file is the same bytes."""
+    curve that is read. The reader skips such edges (tests/test_iges_surface_curve.py); read
+    with that check switched off, a faired curve still cannot be written into the file: the
+    writer refuses and nothing is written. Written back unchanged, the file is the same
+    bytes."""
     pytest.importorskip("OCP")
+    import curvefair.io.occ as occ
+
     src = OCC / "OCC131-6.igs"
+    with pytest.warns(UserWarning, match="bound to a surface"):
+        with pytest.raises(FileFormatError, match="no curves"):
+            read_curves(src, on_unsupported="skip")
+    monkeypatch.setattr(occ, "_iges_surface_bound", lambda *a, **k: "")
     recs = _read(src)
     assert len(recs) == 3
     out = tmp_path / "same.igs"

@@ -287,3 +287,56 @@ def test_new_curve_into_an_r12_template(tmp_path):
     assert doc.dxfversion >= "AC1015"
     assert sum(e.dxftype() == "SPLINE" for e in doc.modelspace()) == 3
     assert _dense_distance(new, read_curves(out)[-1].curve, 4000) <= 1e-9
+
+
+def test_cli_report_after_figures_are_those_of_the_file_read_back(tmp_path, monkeypatch):
+    """The CLI's wiring of rescaled_report: ``curvefair fair clarky.dat`` with the fairing
+    replaced by moves of 0.98 tol in random directions (every data point within tol, but the
+    curve re-interpolated through them strays beyond tol, so the CLI scales the moves). The
+    JSON report's after-figures, point moves and deviation are those of the written file read
+    back: analyze() of it, numpy on its points, and a cKDTree distance between dense samples
+    (independent of the report's own deviation search)."""
+    import dataclasses
+    import json
+
+    from click.testing import CliRunner
+
+    import curvefair
+    from curvefair import analyze
+    from curvefair.cli import main
+
+    src = DATA / "clarky.dat"
+    rec = read_curves(src)[0]
+    tol = 1e-4
+    real_fair = curvefair.fair
+
+    def fake_fair(curve, *a, **k):
+        res = real_fair(curve, "poliakoff", tol=tol, max_steps=5)
+        return dataclasses.replace(res, curve=_moved_points(rec, 0.98 * tol, 7).curve)
+
+    monkeypatch.setattr(curvefair, "fair", fake_fair)
+    out, rep_path = tmp_path / "c.dat", tmp_path / "r.json"
+    res = CliRunner().invoke(main, ["fair", str(src), "-o", str(out), "--tol", str(tol),
+                                    "--report", str(rep_path)])
+    assert res.exit_code == 0, res.output
+    assert "scaled down" in res.stderr
+    report = json.loads(rep_path.read_text())
+    (s,) = report["output_check"]["move_scale"]
+    assert 0.5 < s < 1.0
+    row = report["curves"][0]["report"]
+    back = read_curves(out)[0]
+    a = analyze(back.curve)
+    assert row["move_scale"] == s and "recomputed" in row["after_figures"]
+    assert row["energy_after"] == a.energy2 and row["extrema_after"] == a.extrema
+    assert row["inflections_after"] == a.inflections
+    p0, p1 = np.asarray(rec.points), np.asarray(back.points)
+    assert row["max_point_displacement"] == pytest.approx(
+        np.linalg.norm(p1 - p0, axis=1).max(), rel=1e-12)
+    assert row["n_moved"] == int(np.count_nonzero(np.any(p1 != p0, axis=1)))
+    # the deviation: the report's figure, the on-disk figure and an independent one agree
+    indep = _dense_distance(rec.curve, back.curve)
+    assert row["max_deviation"] <= tol and row["on_disk_deviation"] <= tol
+    assert row["max_deviation"] == pytest.approx(indep, rel=1e-3)
+    assert row["on_disk_deviation"] == pytest.approx(indep, rel=1e-3)
+    # (and the fake fair's own moves, unscaled, would have read back beyond tol)
+    assert row["max_point_displacement"] < 0.98 * tol

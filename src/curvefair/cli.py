@@ -384,10 +384,21 @@ def _warnings_to_stderr(quiet: bool, prefix: str = "",
                 _warn(msg, quiet)
 
 
+class _AllSkipped(Exception):
+    """Every curve entity of the file was skipped as unsupported (``n`` of them)."""
+
+    def __init__(self, n: int, message: str) -> None:
+        super().__init__(message)
+        self.n = n
+
+
 def _read(path: str, corner_angle: float | None, strict: bool = False,
-          quiet: bool = False, glyphs: str | None = None) -> list[Any]:
+          quiet: bool = False, glyphs: str | None = None,
+          all_skipped_ok: bool = False) -> list[Any]:
     """The records of a file; entities curvefair cannot represent are skipped with a warning
-    (kept untouched on write-back) unless ``strict``, which refuses the file."""
+    (kept untouched on write-back) unless ``strict``, which refuses the file. With
+    ``all_skipped_ok``, a file whose every curve entity was skipped raises
+    :class:`_AllSkipped` (the caller writes it back unchanged) instead of failing."""
     from . import read_curves
 
     _format_of(path)  # a CLI message (the API's names format=, which the CLI lacks)
@@ -399,6 +410,8 @@ def _read(path: str, corner_angle: float | None, strict: bool = False,
                                **cast(dict[str, Any], {} if glyphs is None else {"glyphs": glyphs}))
     except CurvefairError as exc:
         skipped = sum(": skipped " in w for w in seen)
+        if skipped and all_skipped_ok and "no curves in the" in str(exc):
+            raise _AllSkipped(skipped, str(exc)) from None
         if skipped:
             raise InputFailure(f"{exc} ({skipped} unsupported entit"
                                f"{'y' if skipped == 1 else 'ies'} skipped"
@@ -408,6 +421,30 @@ def _read(path: str, corner_angle: float | None, strict: bool = False,
             raise InputFailure(f"{exc}; without --strict the curvefair command skips it with "
                                "a warning") from None
         raise
+
+
+def _write_unchanged(infile: str, out: str, report: str | None, n_skipped: int,
+                     quiet: bool) -> None:
+    """A file holding only entities curvefair cannot fair (each skipped with a warning, kept
+    untouched on write-back): nothing to fair; OUT is the input's bytes, exit 0."""
+    import shutil
+
+    from .io import atomic_path
+
+    with _user_errors():
+        if not (os.path.exists(out) and os.path.samefile(infile, out)):   # not --in-place
+            with atomic_path(out) as tmp:
+                shutil.copyfile(infile, tmp)
+        if report is not None:
+            _write_json(report, {
+                "curvefair": __version__, "input": os.path.abspath(infile),
+                "output": os.path.abspath(out), "n_curves": 0, "n_failed": 0,
+                "n_skipped_unsupported": n_skipped, "output_written": True,
+                "output_check": None, "curves": []})
+    if not quiet:
+        click.echo(f"Note: {infile}: nothing to fair ({n_skipped} unsupported entit"
+                   f"{'y' if n_skipped == 1 else 'ies'} skipped, see the warnings); "
+                   f"{out} written unchanged", err=True)
 
 
 def _nothing_to_fair(rec: Any) -> bool:
@@ -980,7 +1017,12 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
             out_fmt: str = detect_format(out)
         except CurvefairError:
             out_fmt = in_fmt
-        records = _read(infile, _corner(corner_angle, no_corners), strict, quiet, glyphs)
+        try:
+            records = _read(infile, _corner(corner_angle, no_corners), strict, quiet, glyphs,
+                            all_skipped_ok=out_fmt == in_fmt)
+        except _AllSkipped as exc:
+            _write_unchanged(infile, out, report, exc.n, quiet)
+            return
     _check_protect_range(records, user_protect)
     from . import fair
     from .io._verify import write_checked

@@ -470,6 +470,7 @@ _NOISE_MIN_POINTS = 10
 _NOISE_ALTERNATION = 0.3
 _NOISE_MAX_REL = 0.01
 _NOISE_CHORDS = 6.0
+_NOISE_SCALES = (1.0, 2.0, 4.0)
 
 
 def noise_scale(points: FloatArray, closed: bool) -> float:
@@ -514,24 +515,12 @@ def noise_scale(points: FloatArray, closed: bool) -> float:
     return sigma
 
 
-def corner_turning(points: FloatArray, closed: bool) -> FloatArray:
-    """Turning angle in degrees at every point, measured at the scale of the data's noise.
-
-    Without noise (:func:`noise_scale` is 0) this is :func:`turning_angles`: the angle between
-    the chords to the two neighbours. On a noisy list the two chords run from ``p_i`` to the
-    nearest points before and after it that are at least ``6 sigma`` away, so a turn between
-    two samples closer than the noise is not a corner, while a real tangent break (which
-    persists at every scale) still is; a point whose chord cannot reach that length before an
-    end of an open list gets 0, and of a run of neighbours turning by the same corner only the
-    one turning most keeps its angle.
-    """
-    p = np.asarray(points, dtype=float)
+def _chord_turns(p: FloatArray, closed: bool, Lmin: float) -> FloatArray:
+    """Turning angle (degrees) at every point between the chords to the nearest points before
+    and after it at least ``Lmin`` away; NaN where a chord cannot reach that length before an
+    end of an open list (or half-way round a closed one)."""
     m = p.shape[0]
-    sigma = noise_scale(p, closed)
-    if sigma == 0.0:
-        return turning_angles(p, closed)
-    Lmin = _NOISE_CHORDS * sigma
-    out = np.zeros(m)
+    out = np.full(m, np.nan)
     idx = range(m) if closed else range(1, m - 1)
     for i in idx:
         ends = []
@@ -551,6 +540,35 @@ def corner_turning(points: FloatArray, closed: bool) -> FloatArray:
         a, b = p[i] - p[ends[0]], p[ends[1]] - p[i]
         na, nb = float(np.linalg.norm(a)), float(np.linalg.norm(b))
         out[i] = np.degrees(np.arccos(np.clip(float(a @ b) / (na * nb), -1.0, 1.0)))
+    return out
+
+
+def corner_turning(points: FloatArray, closed: bool) -> FloatArray:
+    """Turning angle in degrees at every point, measured at the scale of the data's noise.
+
+    Without noise (:func:`noise_scale` is 0) this is :func:`turning_angles`: the angle between
+    the chords to the two neighbours. On a noisy list the two chords run from ``p_i`` to the
+    nearest points before and after it that are at least ``L`` away, for ``L = 6, 12`` and
+    ``24 sigma``, and the turn is the smallest of those: a turn between samples closer than
+    the noise is not a corner, and the noise's share of the turn falls as ``sigma / L``, while
+    a real tangent break persists at every scale. A point whose chords reach fewer than two of
+    those lengths before an end of an open list gets 0 (a corner that close to an end cannot
+    be told from noise), and of a run of neighbours turning by the same corner only the one
+    turning most keeps its angle.
+    """
+    p = np.asarray(points, dtype=float)
+    m = p.shape[0]
+    sigma = noise_scale(p, closed)
+    if sigma == 0.0:
+        return turning_angles(p, closed)
+    out = np.full(m, np.inf)
+    reached = np.zeros(m, dtype=int)
+    for mult in _NOISE_SCALES:
+        ang = _chord_turns(p, closed, mult * _NOISE_CHORDS * sigma)
+        ok = ~np.isnan(ang)
+        out[ok] = np.minimum(out[ok], ang[ok])
+        reached += ok
+    out = np.where(reached >= 2, out, 0.0)
     # one corner per run of turning neighbours: keep the local maxima
     keep = np.ones(m, dtype=bool)
     prev, nxt = np.roll(out, 1), np.roll(out, -1)

@@ -209,6 +209,7 @@ def read(path: str | os.PathLike[str], *, on_unsupported: str = "raise",
     fmt = _fmt_of(path)
     shape = _read_shape(path, fmt, f"reading {fmt.upper()} files")
     records: list[CurveRecord] = []
+    model: dict[str, Any] = {}           # the IGES text's entities, parsed once when needed
     for k, edge in enumerate(_free_edges(shape)):
         try:
             curve, z = _bspline_of_edge(edge)
@@ -223,10 +224,47 @@ def read(path: str | os.PathLike[str], *, on_unsupported: str = "raise",
             continue
         except CurvefairError as exc:
             raise FileFormatError(f"edge {k}: {exc}", path) from None
+        if fmt == "iges":
+            why = _iges_surface_bound(path, edge, k, model)
+            if why:
+                msg = f"edge {k}: unsupported {why}"
+                if on_unsupported == "raise":
+                    raise FileFormatError(msg + " (read_curves(..., on_unsupported='skip') "
+                                          "skips it)", path)
+                warnings.warn(f"{os.fspath(path)}: skipped {msg}; kept untouched", UserWarning,
+                              stacklevel=3)
+                continue
         src = {"format": fmt, "path": os.path.abspath(path), "index": len(records), "edge": k,
                "z": z}
         records.append(CurveRecord(curve, f"edge{k}", "bspline", src))
     return records
+
+
+def _iges_surface_bound(path: object, edge: Any, k: int, model: dict[str, Any]) -> str:
+    """Why the free edge ``k`` cannot be faired in this IGES file, or "": OCC built it from
+    a curve on a surface (142) whose preferred representation is its 2-D curve on the
+    surface, not from a free 126 entity. A faired 3-D curve is off that surface (by up to
+    tol), so it could be written neither as the 142's image of its 2-D curve nor as its
+    model-space curve without making the 142 contradict itself."""
+    try:
+        if not model:
+            with open(os.fspath(path), "rb") as fh:  # type: ignore[call-overload]
+                model.update(_iges_model(fh.read().decode("latin-1")) or {"bad": True})
+        bs, _trsf = _orig_curve(edge)
+    except (_Refuse, OSError, LookupError, ValueError, IndexError):
+        model.setdefault("bad", True)
+        return ""
+    if "cands" not in model:
+        return ""
+    mod = model
+    local, knots, p = _local_poles(bs)
+    if any(_match(c[2], c[3], c[4], local, knots, p) is not None for c in mod["cands"]):
+        return ""
+    note = _surface_curve_note(mod["ents"], mod["params"])
+    if not note:
+        return ""
+    return ("curve bound to a surface: no free 126 entity holds it" + note
+            + "; a faired 3-D curve would leave its surface")
 
 
 def _geom(curve: BSplineCurve, z: float | None) -> Any:
@@ -524,6 +562,7 @@ class _Patch:
         self.k = k
         self.rec = rec
         bs, self.trsf = _orig_curve(edge)
+        self.old_geom = bs
         self.old_local, self.old_knots, self.p = _local_poles(bs)
         curve = bspline_of(rec.curve, "write_curves")
         # poles the fairing did not move keep their text exactly
@@ -532,8 +571,10 @@ class _Patch:
             np.array_equal(curve.knots, orig.knots) else np.zeros(a.shape[0], dtype=bool)
         new_glob, self.new_knots, self.new_p = _new_poles(curve, rec.source.get("z"))
         self.new_local = _apply(self.trsf, new_glob, inverse=True)
-        if curve.closed or bs.IsPeriodic():
-            raise _Refuse(f"edge {k} is a periodic curve")
+        self.periodic = bool(curve.closed or bs.IsPeriodic())
+        if self.periodic != bool(bs.IsPeriodic()):
+            raise _Refuse(f"edge {k}: a periodic curve faired into an open one or back")
+        self.geom = _geom(curve, rec.source.get("z"))
 
     def raw_poles(self, scale: float) -> FloatArray:
         return self.new_local / scale
@@ -679,38 +720,54 @@ def _patch_step(text: str, patches: list[_Patch]) -> str:
 
     cands = []
     for i, _, _, b in inst:
-        if not b.lstrip().startswith("B_SPLINE_CURVE_WITH_KNOTS"):
-            continue
         try:
-            _, args = _step_parse(b)
-            pids = [int(a[1:]) for a in args[2]]
-            raw = np.array([point(q) for q in pids])
-            if raw.shape[1] != 3:
+            cur = _StepBSpline.of(b)
+            if cur is None:
                 continue
-            mults = [int(v) for v in args[6]]
-            kv = [float(v) for v in args[7]]
+            pids = cur.pole_ids()
+            raw = np.array([point(q) for q in pids])
+            if raw.ndim != 2 or raw.shape[1] != 3:
+                continue
+            flat = cur.flat_knots(len(pids))
         except (ValueError, KeyError, IndexError, TypeError):
             continue
-        flat = np.repeat(kv, mults)
-        cands.append((i, args, pids, raw, flat, int(args[1])))
+        cands.append((i, cur, pids, raw, flat, cur.degree))
+    trims: dict[int, list[tuple[int, str, list[Any]]]] = {}
+    for i, _, _, b in inst:
+        if b.lstrip().startswith("TRIMMED_CURVE"):
+            try:
+                name, targs = _step_parse(b)
+                trims.setdefault(int(targs[1][1:]), []).append((i, name, targs))
+            except (ValueError, IndexError):
+                continue
     next_id = max(by_id) + 1
     edits: dict[int, str] = {}
     new_lines: list[str] = []
     for pa in patches:
         hits = [(c, s) for c in cands
-                if (s := _match(c[3], c[4], c[5], pa.old_local, pa.old_knots, pa.p)) is not None]
+                if (s := _match(_unwrapped(c[3], pa), c[4], c[5], pa.old_local, pa.old_knots,
+                                pa.p)) is not None]
         if len(hits) != 1:
             raise _Refuse(f"edge {pa.k}: {'no' if not hits else len(hits)} "
-                          "B_SPLINE_CURVE_WITH_KNOTS instance(s) hold its curve as OCC read "
-                          "it")
-        (cid, args, pids, raw, flat, _), scale = hits[0]
+                          "B-spline curve instance(s) hold its curve as OCC read it")
+        (cid, cur, pids, raw, flat, _), scale = hits[0]
         if cid in edits:
             raise _Refuse(f"edge {pa.k}: its curve #{cid} is shared with another faired edge")
         new = pa.raw_poles(scale)
         nknots = pa.raw_knots(flat)
+        kept = pa.kept
+        if pa.periodic:      # Part 42 lists a closed curve's first poles again at its end
+            wrap = len(pids) - pa.old_local.shape[0]
+            if new.shape[0] != pa.old_local.shape[0]:
+                raise _Refuse(f"edge {pa.k}: a periodic curve with a new number of poles")
+            new = np.vstack([new, new[:wrap]])
+            kept = np.r_[kept, kept[:wrap]]
+        for tid, _tname, targs in trims.get(cid, []):
+            edits.update(_trim_edits(tid, targs, pa, scale, flat, nknots, by_id, refs, point,
+                                     edits))
         new_ids: list[str] = []
         for j, q in enumerate(new):
-            if j < len(pids) and (pa.kept[j] or np.array_equal(q, raw[j])):
+            if j < len(pids) and (kept[j] or np.array_equal(q, raw[j])):
                 new_ids.append(f"#{pids[j]}")
                 continue
             label = names.get(pids[j], "''") if j < len(pids) else "''"
@@ -725,15 +782,10 @@ def _patch_step(text: str, patches: list[_Patch]) -> str:
         for q in pids[len(new):]:
             if refs.get(q, 0) == 1:
                 edits[q] = ""               # an unshared pole no longer used: removed
-        a = list(args)
-        a[1] = str(pa.new_p)
-        a[2] = new_ids
-        if not np.array_equal(nknots, flat):
-            kk, mm = _mults(nknots)
-            a[6] = [str(v) for v in mm]
-            a[7] = [_num(v) for v in kk]
-        if a != list(args):
-            edits[cid] = "B_SPLINE_CURVE_WITH_KNOTS(" + _step_join(a) + ")"
+        new_body = cur.render(pa.new_p, new_ids,
+                              None if np.array_equal(nknots, flat) else nknots)
+        if new_body is not None:
+            edits[cid] = new_body
     out = []
     last = 0
     for i, s, e, b in inst:
@@ -750,6 +802,235 @@ def _patch_step(text: str, patches: list[_Patch]) -> str:
         at = _step_data_end(result)
         result = result[:at] + "\n".join(new_lines) + "\n" + result[at:]
     return result
+
+
+def _unwrapped(raw: FloatArray, pa: _Patch) -> FloatArray:
+    """The file's pole list of a closed curve without the repeated first poles (Part 42
+    lists ``n + p`` poles of a periodic curve that OCC holds with ``n``), else as it is."""
+    n = pa.old_local.shape[0]
+    if pa.periodic and raw.shape[0] > n and np.array_equal(raw[n:], raw[:raw.shape[0] - n]):
+        return raw[:n]
+    return raw
+
+
+class _StepBSpline:
+    """A B-spline curve instance of a STEP file in any of its Part 42 forms: the simple
+    ``B_SPLINE_CURVE_WITH_KNOTS``, ``QUASI_UNIFORM_CURVE``, ``UNIFORM_CURVE``,
+    ``BEZIER_CURVE`` (knots implied by the subtype, ISO 10303-42 sec. 4.4.6 / 8.3), or a
+    complex instance of ``B_SPLINE_CURVE`` with ``B_SPLINE_CURVE_WITH_KNOTS`` and a
+    ``RATIONAL_B_SPLINE_CURVE`` whose weights are all 1 (the same polynomial curve).
+
+    The control-point list is edited in place; the knots are written only when they
+    changed (a subtype with implied knots then becomes a ``B_SPLINE_CURVE_WITH_KNOTS`` of
+    the same name)."""
+
+    IMPLIED = ("QUASI_UNIFORM_CURVE", "UNIFORM_CURVE", "BEZIER_CURVE")
+
+    def __init__(self, kind: str, parts: list[tuple[str, list[Any]]]) -> None:
+        self.kind = kind
+        self.parts = parts
+
+    @classmethod
+    def of(cls, body: str) -> _StepBSpline | None:
+        b = body.lstrip()
+        if b.startswith("("):
+            parts = _step_parse_complex(b)
+            names = [n for n, _ in parts]
+            if "B_SPLINE_CURVE" not in names or "B_SPLINE_CURVE_WITH_KNOTS" not in names \
+                    or not set(names) <= {"BOUNDED_CURVE", "B_SPLINE_CURVE", "CURVE",
+                                          "B_SPLINE_CURVE_WITH_KNOTS", "REPRESENTATION_ITEM",
+                                          "GEOMETRIC_REPRESENTATION_ITEM",
+                                          "RATIONAL_B_SPLINE_CURVE"}:
+                return None
+            if "RATIONAL_B_SPLINE_CURVE" in names:
+                w = dict(parts)["RATIONAL_B_SPLINE_CURVE"][0]
+                if not all(float(v) == 1.0 for v in w):
+                    return None             # a rational curve: not read, so never matched
+            return cls("complex", parts)
+        for kind in ("B_SPLINE_CURVE_WITH_KNOTS",) + cls.IMPLIED:
+            if b.startswith(kind) and re.match(kind + r"\s*\(", b):
+                return cls(kind, [_step_parse(b)])
+        return None
+
+    def _bs(self) -> list[Any]:
+        """Arguments (degree, poles, form, closed, self_intersect) of the B-spline part."""
+        if self.kind == "complex":
+            return dict(self.parts)["B_SPLINE_CURVE"]
+        return self.parts[0][1][1:]
+
+    @property
+    def degree(self) -> int:
+        return int(self._bs()[0])
+
+    def pole_ids(self) -> list[int]:
+        return [int(a[1:]) for a in self._bs()[1]]
+
+    def flat_knots(self, n: int) -> FloatArray:
+        p = self.degree
+        if self.kind == "complex":
+            k = dict(self.parts)["B_SPLINE_CURVE_WITH_KNOTS"]
+            return np.repeat([float(v) for v in k[1]], [int(v) for v in k[0]])
+        if self.kind == "B_SPLINE_CURVE_WITH_KNOTS":
+            a = self.parts[0][1]
+            return np.repeat([float(v) for v in a[7]], [int(v) for v in a[6]])
+        if self.kind == "UNIFORM_CURVE":
+            return np.arange(n + p + 1, dtype=float) - p
+        if self.kind == "BEZIER_CURVE":
+            return np.r_[np.zeros(p + 1), np.ones(p + 1)]
+        return np.r_[np.zeros(p), np.arange(n - p + 1, dtype=float), np.full(p, n - p)]
+
+    def render(self, p: int, ids: list[str], knots: FloatArray | None) -> str | None:
+        """The instance's new body, or None when nothing changed."""
+        bs = list(self._bs())
+        new_bs = [str(p), ids] + bs[2:]
+        kk, mm = _mults(knots) if knots is not None else ([], [])
+        if self.kind == "complex":
+            parts = []
+            for name, args in self.parts:
+                if name == "B_SPLINE_CURVE":
+                    args = new_bs
+                elif name == "B_SPLINE_CURVE_WITH_KNOTS" and knots is not None:
+                    args = [[str(v) for v in mm], [_num(v) for v in kk]] + list(args[2:])
+                elif name == "RATIONAL_B_SPLINE_CURVE" and len(args[0]) != len(ids):
+                    args = [["1."] * len(ids)]
+                parts.append((name, args))
+            if parts == self.parts:
+                return None
+            return "(" + "\n".join(f"{n}({_step_join(a)})" for n, a in parts) + ")"
+        name, args = self.parts[0]
+        a = [args[0]] + new_bs
+        if knots is not None:
+            if name != "B_SPLINE_CURVE_WITH_KNOTS":
+                name, a = "B_SPLINE_CURVE_WITH_KNOTS", a + [[], [], ".UNSPECIFIED."]
+            a[6] = [str(v) for v in mm]
+            a[7] = [_num(v) for v in kk]
+        if name == self.parts[0][0] and a == list(args):
+            return None
+        return f"{name}(" + _step_join(a) + ")"
+
+
+def _step_parse_complex(body: str) -> list[tuple[str, list[Any]]]:
+    """``(A(..) B(..) ...)`` -> [(A, args), (B, args), ...] (a complex instance, Part 21
+    sec. 11.2.5.3)."""
+    inner = body.strip()
+    if not (inner.startswith("(") and inner.endswith(")")):
+        raise ValueError("not a complex instance")
+    inner = inner[1:-1]
+    out = []
+    i = 0
+    while inner[i:].strip():
+        m = re.compile(r"\s*([A-Z_][A-Z0-9_]*)\s*\(").match(inner, i)
+        if m is None:
+            raise ValueError("bad complex instance")
+        depth, j = 0, m.end() - 1
+        while True:
+            c = inner[j]
+            if c == "'":
+                j = inner.index("'", j + 1)
+                while inner.startswith("''", j):
+                    j = inner.index("'", j + 2)
+            elif c == "(":
+                depth += 1
+            elif c == ")":
+                depth -= 1
+                if depth == 0:
+                    break
+            j += 1
+        out.append(_step_parse(inner[m.start(1):j + 1]))
+        i = j + 1
+    return out
+
+
+def _bare_real(v: Any) -> bool:
+    if not isinstance(v, str) or v.startswith(("#", "$", ".", "'")):
+        return False
+    try:
+        float(v)
+    except ValueError:
+        return False
+    return True
+
+
+def _trim_edits(tid: int, targs: list[Any], pa: _Patch, scale: float, flat: FloatArray,
+                nknots: FloatArray, by_id: dict[int, tuple[int, int, str]],
+                refs: dict[int, int], point: Any, edits: dict[int, str]) -> dict[int, str]:
+    """Edits that keep a ``TRIMMED_CURVE`` of a faired basis curve consistent: parameter
+    trims stay (the basis keeps its parameterisation; a trim at an end of the domain follows
+    the end when the knots changed), a cartesian-point trim becomes the faired curve's point
+    at the trim's parameter (the point is edited when only this trim refers to it; a trim
+    given by a point alone is at an end of the domain, OCC having read the whole basis)."""
+    out: dict[int, str] = {}
+    params: list[float | None] = []
+    for sel in (targs[2], targs[3]):
+        vals = [float(v[1][0]) for v in sel if isinstance(v, tuple)
+                and v[0] == "PARAMETER_VALUE"]
+        vals += [float(v) for v in sel if _bare_real(v)]   # "(0.E0)": written by some
+        params.append(vals[0] if vals else None)
+    a = list(targs)
+    placed: dict[int, FloatArray] = {}
+    changed_knots = not np.array_equal(nknots, flat)
+    lo, hi = flat[pa.p], flat[-pa.p - 1]
+    forward = str(targs[4]).strip() != ".F."
+    for k, sel in ((2, targs[2]), (3, targs[3])):
+        u = params[k - 2]
+        if u is None:
+            # cartesian trims only: OCC read the edge over the basis's whole domain (else the
+            # reader skips it as trimmed), so the trims are its ends, in the sense given
+            u = float(lo if (k == 2) == forward else hi)
+        if changed_knots:
+            if u not in (lo, hi):
+                raise _Refuse(f"trimmed curve #{tid}: the faired knots move its trim "
+                              f"parameter {u!r}")
+            nu = nknots[pa.new_p] if u == lo else nknots[-pa.new_p - 1]
+        else:
+            nu = u
+        # the OCC parameter of the trim: the file's parameterisation mapped affinely
+        t = pa.new_knots[0] + (nu - nknots[0]) * (
+            (pa.new_knots[-1] - pa.new_knots[0]) / max(nknots[-1] - nknots[0], 1e-300))
+        q = pa.geom.Value(float(t))
+        q0 = pa.old_geom.Value(float(pa.old_knots[0] + (u - flat[0]) * (
+            (pa.old_knots[-1] - pa.old_knots[0]) / max(flat[-1] - flat[0], 1e-300))))
+        still = (q.X(), q.Y(), q.Z()) == (q0.X(), q0.Y(), q0.Z())   # the curve did not move there
+        local = _apply(pa.trsf, np.array([[q.X(), q.Y(), q.Z()]]), inverse=True)[0] / scale
+        new_sel: list[Any] = []
+        for v in sel:
+            if isinstance(v, tuple) and v[0] == "PARAMETER_VALUE":
+                new_sel.append(v if nu == u else ("PARAMETER_VALUE", [_num(nu)]))
+            elif _bare_real(v):
+                new_sel.append(v if nu == u else _num(nu))
+            elif isinstance(v, str) and v.startswith("#"):
+                pid = int(v[1:])
+                old = point(pid)
+                if old.shape != local.shape:
+                    raise _Refuse(f"trimmed curve #{tid}: trim point #{pid} is not 3-D")
+                if (still or np.array_equal(old, local)) and pid not in placed:
+                    placed[pid] = local
+                    new_sel.append(v)
+                    continue
+                text = "(" + ",".join(_num(x) for x in local) + ")"
+                if pid in placed:
+                    # one point for both trims (the ends of a closed curve): the same point
+                    # to rounding, else the trims contradict each other
+                    size = max(float(np.abs(local).max()), 1.0)
+                    if float(np.abs(placed[pid] - local).max()) > 1e-12 * size:
+                        raise _Refuse(f"trimmed curve #{tid}: trim point #{pid} names two "
+                                      "different points of the faired curve")
+                    new_sel.append(v)
+                    continue
+                placed[pid] = local
+                own = sum(1 for w in (targs[2] + targs[3]) if w == v)
+                if refs.get(pid, 0) != own or pid in edits:
+                    raise _Refuse(f"trimmed curve #{tid}: its trim point #{pid} is shared "
+                                  "with other entities")
+                _name, pargs = _step_parse(by_id[pid][2])
+                out[pid] = f"CARTESIAN_POINT({pargs[0]},{text})"
+                new_sel.append(v)
+            else:
+                new_sel.append(v)
+        a[k] = new_sel
+    if a != list(targs):
+        out[tid] = "TRIMMED_CURVE(" + _step_join(a) + ")"
+    return out
 
 
 def _step_data_end(text: str) -> int:
@@ -811,7 +1092,10 @@ def _iges_real(s: str) -> float:
     return float(s.replace("D", "E").replace("d", "e")) if s else 0.0
 
 
-def _patch_iges(text: str, patches: list[_Patch]) -> str:
+def _iges_model(text: str) -> dict[str, Any]:
+    """The sections, directory entries, parameter blocks and the free 126 entities (those
+    under no face: trimmed surface 144, bounded surface 143, BRep edge list 504) of an IGES
+    text, for matching OCC's edges to the file's entities."""
     lines, nl = _iges_sections(text)
     sec = {c: [ln for ln in lines if len(ln) >= 73 and ln[72] == c] for c in "SGDPT"}
     pd, rd = _iges_delims(sec["G"])
@@ -902,6 +1186,15 @@ def _patch_iges(text: str, patches: list[_Patch]) -> str:
         if not np.all(w == w[0]):
             continue
         cands.append((d, f, raw, knots, m, c0))
+    return {"nl": nl, "sec": sec, "pd": pd, "rd": rd, "de": de, "blocks": blocks,
+            "order": order, "ents": ents, "params": params, "cands": cands}
+
+
+def _patch_iges(text: str, patches: list[_Patch]) -> str:
+    mod = _iges_model(text)
+    nl, sec, pd, rd, de = mod["nl"], mod["sec"], mod["pd"], mod["rd"], mod["de"]
+    blocks, order, ents, params, cands = (mod["blocks"], mod["order"], mod["ents"],
+                                          mod["params"], mod["cands"])
     new_blocks = dict(blocks)
     done: set[int] = set()
     first = sec["P"][0] if sec["P"] else " " * 80
@@ -916,6 +1209,8 @@ def _patch_iges(text: str, patches: list[_Patch]) -> str:
                           "edge from another entity, e.g. a curve on a surface (142)"
                           + _surface_curve_note(ents, params))
         (d, f, raw, knots, m, c0), scale = hits[0]
+        if pa.periodic:
+            raise _Refuse(f"edge {pa.k} is a periodic curve")
         if d in done:
             raise _Refuse(f"edge {pa.k}: entity {d} is shared with another faired edge")
         done.add(d)

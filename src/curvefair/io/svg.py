@@ -42,8 +42,11 @@ With ``template=`` the source bytes are copied and only the ``d`` attribute of t
 elements whose curves changed (the ``points`` of a polygon/polyline, ``x1 y1 x2 y2`` of a
 line; a changed ``<rect>`` is refused) is rewritten, at the byte offsets the XML parser
 (expat) reports for the element, so text inside comments or CDATA is never edited
-(absolute ``M``/``L``/``C``/``Z`` commands, every other subpath of the element as it was,
-in the element's own coordinates; everything else in the file byte for byte). A
+(the changed subpath's own text replaced by absolute ``M``/``L``/``C``/``Z`` commands in the
+element's own coordinates; the text of every other subpath of the element kept verbatim,
+except that a relative ``m`` right after a replaced subpath whose end point is not the
+float it was counted from is written as the same absolute ``M``; everything else in the
+file byte for byte). A
 B-spline is written as its cubic Bezier pieces (one per knot span: the same number of
 segments as read when the knots are unchanged). Without a template, a new SVG holding one
 ``<path>`` per curve (cubic curves only: degree <= 3). Numbers of a rewritten element get the
@@ -528,6 +531,104 @@ def _d_original(sub: Any, spt: Any, decimals: int | None) -> str:
     return " ".join(out)
 
 
+_MOVETO_RE = re.compile(r"[Mm]")
+_NUM_RE = re.compile(r"[-+]?[0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?")
+
+
+def _subpath_spans(d: str, parsed: Any, spt: Any
+                   ) -> list[tuple[int, int, complex, complex]] | None:
+    """The text of each continuous subpath of ``d`` (svgpathtools' ``continuous_subpaths``
+    of ``parsed``): ``(start, end, current point before, current point after)`` with
+    ``d[start:end]`` its commands (trailing blanks excluded), or None when the text does not
+    split so (then the caller re-renders).
+
+    The text is cut before every moveto (``M``/``m``: SVG 1.1 sec. 8.3.3; only a moveto starts
+    a new subpath, so a discontinuity is always at a cut) and each piece parsed by
+    svgpathtools from the current point the previous pieces leave (a relative ``m`` is
+    relative to it); the pieces must give exactly the segments of the whole path. Pieces
+    whose segments join continuously (an ``m 0,0``) belong to one subpath."""
+    cuts = [m.start() for m in _MOVETO_RE.finditer(d)]
+    if not cuts or d[:cuts[0]].strip():
+        return None
+    cuts.append(len(d))
+    groups: list[tuple[int, int, complex, complex, list[Any]]] = []
+    cp = 0j
+    for a, b in zip(cuts[:-1], cuts[1:], strict=True):
+        try:
+            segs = list(spt.parse_path(d[a:b], current_pos=cp))
+        except Exception:  # noqa: BLE001 - svgpathtools raises several kinds; re-render
+            return None
+        if not segs:
+            return None
+        end = a + len(d[a:b].rstrip())
+        groups.append((a, end, cp, segs[-1].end, segs))
+        cp = segs[-1].end
+    flat = [g for grp in groups for g in grp[4]]
+    if len(flat) != len(parsed) or any(x != y for x, y in zip(flat, parsed, strict=True)):
+        return None
+    out: list[tuple[int, int, complex, complex]] = []
+    for a, b, before, after, segs in groups:
+        if out and segs[0].start == out[-1][3]:        # continuous: same subpath
+            out[-1] = (out[-1][0], b, out[-1][2], after)
+        else:
+            out.append((a, b, before, after))
+    if len(out) != len(parsed.continuous_subpaths()):
+        return None
+    return out
+
+
+def _splice_subpaths(d: str, parsed: Any, new: dict[int, str], spt: Any) -> str | None:
+    """``d`` with the text of subpath ``j`` replaced by ``new[j]`` and every other subpath's
+    text kept as it was, or None when ``d`` cannot be split into its subpaths.
+
+    A subpath that follows a replaced one and starts with a relative ``m`` is relative to
+    the current point the replaced one leaves; when that point changed, its moveto is
+    written absolute (``M x,y``, then ``l`` for implicit coordinate pairs after it, SVG 1.1
+    sec. 8.3.2), the rest of its text unchanged."""
+    spans = _subpath_spans(d, parsed, spt)
+    if spans is None:
+        return None
+    out: list[str] = []
+    pos = 0
+    moved = False
+    for j, (a, b, before, after) in enumerate(spans):
+        out.append(d[pos:a])
+        if j in new:
+            out.append(new[j])
+            try:
+                segs = list(spt.parse_path(new[j]))
+            except Exception:  # noqa: BLE001
+                return None
+            moved = not segs or segs[-1].end != after
+        else:
+            text = d[a:b]
+            if moved and text[0] == "m":
+                start = _subpath_start(text, before, spt)
+                if start is None:
+                    return None
+                nums = list(_NUM_RE.finditer(text, 1))
+                if len(nums) < 2:
+                    return None
+                rest = text[nums[1].end():]
+                head = f"M {_num(start.real, None)},{_num(start.imag, None)}"
+                if _NUM_RE.match(rest.lstrip(" \t\r\n,")):
+                    head += " l"
+                text = head + rest
+            out.append(text)
+            moved = False
+        pos = b
+    out.append(d[pos:])
+    return "".join(out)
+
+
+def _subpath_start(text: str, before: complex, spt: Any) -> complex | None:
+    try:
+        segs = list(spt.parse_path(text, current_pos=before))
+    except Exception:  # noqa: BLE001
+        return None
+    return segs[0].start if segs else None
+
+
 def _ctm(src: Any) -> np.ndarray | None:
     m = src.get("ctm")
     return None if m is None else np.asarray(m, dtype=float).reshape(2, 3)
@@ -718,11 +819,22 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
         # with precision="exact", when that rounding would break the tolerance on disk)
         dec = decimals if decimals is not None else (
             None if precision == "exact" else _decimals_of(d_text))
-        pieces = []
-        for j, sub in enumerate(originals):
-            d, ch = _record_d(subs[j], dec) if j in subs else ("", False)
-            pieces.append(d if ch else _d_original(sub, spt, None))
-        edit(node, "d", " ".join(pieces))
+        new_d = {j: d for j in subs for d, ch in [_record_d(subs[j], dec)] if ch}
+        sp = spans[node].get("d")
+        raw_d = raw[sp[0]:sp[1]].decode("utf-8") if sp is not None else ""
+        # splice into the attribute's own text (no entity references: the value is the text)
+        # or, failing that, into the parsed value; either keeps every other subpath verbatim
+        spliced = (_splice_subpaths(raw_d, parsed, new_d, spt)
+                   if sp is not None and "&" not in raw_d
+                   and _attr_value(raw, sp) == d_text else None)
+        if spliced is not None and sp is not None:
+            edits.append((sp[0], sp[1], spliced))
+            continue
+        spliced = _splice_subpaths(d_text, parsed, new_d, spt)
+        if spliced is None:        # text not split into subpaths: every subpath re-rendered
+            spliced = " ".join(new_d[j] if j in new_d else _d_original(sub, spt, None)
+                               for j, sub in enumerate(originals))
+        edit(node, "d", spliced)
     for a, b, new in sorted(edits, reverse=True):
         raw = raw[:a] + new.encode("utf-8") + raw[b:]
     if others:
