@@ -23,10 +23,10 @@ FULL = [
     ["bench_cheng_yu.py"],
     ["bench_knot_removal.py", "--sizes", "1000", "10000", "100000", "1000000", "--old-max", "100000"],
     ["bench_bspline_e2e.py"],
-    ["bench_call_cost.py"],
+    ["bench_call_cost.py", "--cpu"],  # CPU time: the machines are shared
     ["bench_io.py"],
     ["bench_plot.py"],
-    ["bench_dxf_entities.py", "1000", "10000"],  # entity counts: not given --sizes
+    ["bench_dxf_entities.py", "1000", "10000", "--cpu"],  # entity counts: not given --sizes
 ]
 # how each script takes sizes: "pos" positional, "--sizes" an option, "--n" one size (largest)
 SIZE_ARG = {"bench_analyze.py": "pos", "bench_fair_step.py": "--sizes",
@@ -68,10 +68,10 @@ QUICK = [
     ["bench_cheng_yu.py", "--sizes", "1000", "100000", "--steps", "10000", "--repeat", "1"],
     ["bench_knot_removal.py", "--sizes", "1000", "10000", "--repeat", "1"],
     ["bench_bspline_e2e.py", "--n", "100000"],
-    ["bench_call_cost.py", "1e3", "1e4", "--repeat", "1"],
+    ["bench_call_cost.py", "1e3", "1e4", "--repeat", "1", "--cpu"],
     ["bench_io.py", "--sizes", "1000", "10000"],
     ["bench_plot.py", "1e3", "--repeat", "1"],
-    ["bench_dxf_entities.py", "100"],
+    ["bench_dxf_entities.py", "100", "--cpu"],
 ]
 
 

@@ -98,3 +98,79 @@ def test_primed_power_forms_equal_separate_ones(degree, closed, dim):
     assert T.prime_power_forms(c, other) is None
     h = cf.interpolate_cubic(P)
     assert T.prime_power_forms(h, h) is None
+
+
+def test_readonly_of_strided_views_is_one_frozen_copy():
+    """``readonly`` of a strided or Fortran-ordered view: the same values in C order, in memory
+    nobody can make writeable (an immutable ``bytes`` base), the source untouched."""
+    from curvefair.curves.piecewise import readonly
+
+    rng = np.random.default_rng(3)
+    a = rng.normal(size=(50, 4, 3))
+    for view in (a[:, 0, :], a[1:, 2, 1], np.asfortranarray(a[:, :, 0]), a[::3, ::-1, :]):
+        r = readonly(view)
+        np.testing.assert_array_equal(r, np.array(view))
+        assert r.flags.c_contiguous and not r.flags.writeable
+        base = r
+        while isinstance(base, np.ndarray):
+            base = base.base
+        assert isinstance(base, bytes)
+        with pytest.raises(ValueError):
+            r.setflags(write=True)
+    assert readonly(r) is r  # already frozen: no copy
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_extent_reductions_equal_the_axis0_formulas(dim):
+    """``analysis._sampling._unit`` and ``fairing.joins._size`` reduce column by column; the
+    figures equal the axis-0 formulas they replaced (min/max are exact)."""
+    from curvefair.analysis._sampling import _unit
+    from curvefair.fairing.joins import _size
+
+    rng = np.random.default_rng(dim)
+    for scale in (1e-30, 1.0, 3e5, 1e30):
+        cw = scale * rng.normal(size=(257, 4, dim))
+        start = cw[:, 0, :]
+        diag = float(np.sqrt(np.sum((start.max(axis=0) - start.min(axis=0)) ** 2)))
+        assert _unit(cw) == float(2.0 ** int(np.clip(np.round(np.log2(diag)), -1000, 1000)))
+        pts = np.ascontiguousarray(cw[:, 1, :]) + 7.0 * scale
+        ref = max(float(np.ptp(pts, axis=0).max()), float(np.abs(pts).max()), 1e-300)
+        assert _size(pts) == ref
+
+
+def test_point_data_read_back_bound_meets_a_dense_hausdorff_distance(tmp_path):
+    """The write check of point data uses the O(n) per-span bound
+    (:func:`curvefair.analysis.matched_hermite_bound`): the figure it reports for faired DXF
+    polylines is at least their Hausdorff distance measured independently (scipy's natural
+    CubicSpline through the points read back with ezdxf, sampled 20,001 times per curve,
+    nearest neighbours with cKDTree) and the file holds within tol."""
+    ezdxf = pytest.importorskip("ezdxf")
+    from scipy.interpolate import CubicSpline
+    from scipy.spatial import cKDTree
+
+    rng = np.random.default_rng(5)
+    doc = ezdxf.new("R2010")
+    for k in range(3):
+        t = np.linspace(0.0, 20.0, 40)
+        P = np.c_[t, np.sin(t / 3 + k) * 4] + 0.02 * rng.normal(size=(40, 2))
+        doc.modelspace().add_lwpolyline([tuple(p) for p in P])
+    src, dst = tmp_path / "in.dxf", tmp_path / "out.dxf"
+    doc.saveas(src)
+    tol = 0.01
+    recs = cf.read_curves(src)
+    faired = [r.with_curve(cf.fair(r.curve, "poliakoff", tol=tol).curve) for r in recs]
+    check = cf.write_curves(dst, faired, template=src, tol=tol)
+
+    def dense(P: np.ndarray) -> np.ndarray:
+        u = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(P, axis=0), axis=1))]
+        return CubicSpline(u, P, bc_type="natural")(np.linspace(0.0, u[-1], 20001))
+
+    back = [np.array([(v[0], v[1]) for v in e.get_points("xy")])
+            for e in ezdxf.readfile(dst).modelspace().query("LWPOLYLINE")]
+    assert len(back) == len(recs) == len(check.deviations)
+    for r, q, d, kind in zip(recs, back, check.deviations, check.kinds, strict=True):
+        a, b = dense(np.asarray(r.curve.points)), dense(q)
+        h = max(cKDTree(b).query(a)[0].max(), cKDTree(a).query(b)[0].max())
+        spacing = np.linalg.norm(np.diff(a, axis=0), axis=1).max()
+        assert kind == "geometric upper bound"
+        assert h - spacing <= d <= tol

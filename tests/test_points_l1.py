@@ -217,7 +217,8 @@ def test_rebuilt_distance_matches_dense_hausdorff() -> None:
     times, nearest points both ways with scipy's cKDTree."""
     from scipy.spatial import cKDTree
 
-    from curvefair.fairing.points_l1 import _matched_bound, _rebuilt_distance
+    from curvefair.analysis import matched_hermite_bound as _matched_bound
+    from curvefair.fairing.points_l1 import _rebuilt_distance
 
     p = _noisy_arc(50, 1e-3, seed=11)
     tol = 4e-3

@@ -2,6 +2,7 @@
 
 Public: :func:`energy`, :func:`curvature`, :func:`curvature_derivative`, :func:`torsion`,
 :func:`analyze` (-> :class:`Analysis`), :func:`deviation` (-> :class:`Deviation`),
+:func:`matched_hermite_bound` (a cheap Hausdorff bound of two cubic Hermite curves),
 :func:`rank_bad_points` (-> list of :class:`RankedBadPoint`: the one bad-point ranking that
 ``curvefair analyze`` and the plots show); the discrete
 curvature of Cheng & Yu lives in :mod:`curvefair.analysis.discrete`.
@@ -9,7 +10,7 @@ curvature of Cheng & Yu lives in :mod:`curvefair.analysis.discrete`.
 
 from ._analyze import Analysis, analyze, derivative_jumps
 from ._curvature import curvature, curvature_derivative, torsion
-from ._deviation import Deviation, deviation
+from ._deviation import Deviation, deviation, matched_hermite_bound
 from ._energy import energy, segment_energies
 from ._ranking import RankedBadPoint, c0_pieces, rank_bad_points
 from .discrete import (
@@ -29,6 +30,7 @@ __all__ = [
     "torsion",
     "Deviation",
     "deviation",
+    "matched_hermite_bound",
     "energy",
     "segment_energies",
     "discrete_curvature",

@@ -308,8 +308,8 @@ def analyze(curve: object, *, quad_rtol: float = QUAD_RTOL) -> Analysis:
         # exact energies and jumps from the same compiled pass
         e2 = float(np.sum(smp.energies[:, 0]))
         e3 = float(np.sum(smp.energies[:, 1]))
-        jumps = smp.knots[ks, 0].copy()
-        top = smp.knots[ks, 1].copy()
+        jumps = _ro(smp.knots[ks, 0])  # one copy each, straight into frozen memory
+        top = _ro(smp.knots[ks, 1])
     else:  # a planar 3-D curve: energies and jumps from its own (3-D) coefficients
         e2 = float(np.sum(segment_energies(c, 2))) if degree >= 2 else 0.0
         e3 = float(np.sum(segment_energies(c, 3))) if degree >= 3 else 0.0
@@ -341,7 +341,7 @@ def analyze(curve: object, *, quad_rtol: float = QUAD_RTOL) -> Analysis:
                                       kstol * g * g, closed, ell_g, pos_g, 2)
 
     # -- Sapidis-Farin measure from the one-sided samples at the knots ----------------------
-    z = smp.knots[ks, 2].copy()
+    z = _ro(smp.knots[ks, 2])
     max_z, max_z_index = _argmax_or_none(z, jidx)
 
     return Analysis(
@@ -349,7 +349,7 @@ def analyze(curve: object, *, quad_rtol: float = QUAD_RTOL) -> Analysis:
         energy2=e2, energy3=e3, arc_length=float(smp.arc_length),
         dkds_energy=float(smp.dkds_energy), arc_length_error=float(smp.arc_length_error),
         dkds_energy_error=float(smp.dkds_energy_error),
-        jump_indices=_ro(jidx), jump_params=_ro(breaks[ks].copy()),
+        jump_indices=_ro(jidx), jump_params=_ro(breaks[ks]),
         jumps=_ro(jumps), max_jump=max_jump, max_jump_index=max_jump_index,
         top_order=int(degree), top_jumps=_ro(top), max_top_jump=max_top,
         sapidis=_ro(z), sapidis_sum=float(np.sum(z)), max_sapidis=max_z,

@@ -15,7 +15,7 @@ from ..curves.piecewise import PiecewiseCurve
 from ..errors import InputError
 from ._core import bernstein_matrix, check_curve, fields_to_dict, taylor_shift, to_bernstein
 
-__all__ = ["Deviation", "deviation", "DEVIATION_RTOL"]
+__all__ = ["Deviation", "deviation", "DEVIATION_RTOL", "matched_hermite_bound"]
 
 #: Relative accuracy of :attr:`Deviation.max_distance` (see :func:`deviation`).
 DEVIATION_RTOL = 1e-12
@@ -594,6 +594,59 @@ def geometric_upper_bound(curve_a: PiecewiseCurve, curve_b: PiecewiseCurve) -> f
         out = max(out, float(np.max(0.5 * (d[:-1] + d[1:] + arc))) if arc.size else
                   float(np.max(d)))
     return out
+
+
+#: values at 0, 1/3, 2/3, 1 -> Bernstein control points of a cubic
+_TO_BERNSTEIN = np.linalg.inv(np.array([[(1 - x) ** 3, 3 * x * (1 - x) ** 2, 3 * x * x * (1 - x),
+                                         x ** 3] for x in (0.0, 1 / 3, 2 / 3, 1.0)]))
+
+
+def matched_hermite_bound(a: Any, b: Any, pieces: int = 4) -> FloatArray:
+    """Per span, an upper bound of the Hausdorff distance of two cubic Hermite curves through
+    the same number of points.
+
+    Parameters
+    ----------
+    a, b : CubicHermite
+        Two curves with as many points (and parameters) each; their parameters may differ
+        (e.g. the chord lengths of moved points).
+    pieces : int
+        Sub-pieces per span bounded separately (more: a tighter bound).
+
+    Returns
+    -------
+    ndarray, shape (n_spans,)
+        ``max_t |b(t) - a(psi(t))|`` on each span, ``psi`` the piecewise-linear map of ``b``'s
+        parameters onto ``a``'s (point ``i`` to point ``i``): every point of either curve has
+        a point of the other within that distance, so the largest entry bounds the Hausdorff
+        distance. On each span ``a o psi - b`` is one cubic (Hermite data: the point
+        differences and the tangents, ``a``'s scaled by the span ratio); each sub-piece is
+        bounded by the norms of its Bernstein control points (convex hull property), up to
+        rounding of the coordinates (the result is enlarged by ``1e-12`` relative). O(n):
+        what the read-back check of a written point file uses before any sampling.
+    """
+    ua, ub = np.asarray(a.params), np.asarray(b.params)
+    ha, hb = np.diff(ua), np.diff(ub)
+    pa, pb = np.asarray(a.points), np.asarray(b.points)
+    ta, tb = np.asarray(a.tangents), np.asarray(b.tangents)
+    r = (ha / hb)[:, None]
+    d0, d1 = pa[:-1] - pb[:-1], pa[1:] - pb[1:]
+    # derivatives with respect to the span's unit parameter s = (t - t_i) / hb
+    m0 = ta[:-1] * r * hb[:, None] - tb[:-1] * hb[:, None]
+    m1 = ta[1:] * r * hb[:, None] - tb[1:] * hb[:, None]
+    best = np.zeros(len(ha))
+    k = np.arange(4) / 3.0
+    for j in range(pieces):
+        s = (j + k) / pieces
+        h00 = 2 * s ** 3 - 3 * s ** 2 + 1
+        h10 = s ** 3 - 2 * s ** 2 + s
+        h01 = -2 * s ** 3 + 3 * s ** 2
+        h11 = s ** 3 - s ** 2
+        vals = (d0[:, None, :] * h00[None, :, None] + m0[:, None, :] * h10[None, :, None]
+                + d1[:, None, :] * h01[None, :, None] + m1[:, None, :] * h11[None, :, None])
+        ctrl = np.einsum("kv,svd->skd", _TO_BERNSTEIN, vals)
+        best = np.maximum(best, np.sqrt(np.max(np.sum(ctrl * ctrl, axis=2), axis=1)))
+    return best * (1.0 + 1e-12)
 
 
 def _geometric(a: PiecewiseCurve, b: PiecewiseCurve) -> Deviation:

@@ -822,8 +822,10 @@ def _unit(cw: FloatArray) -> float:
     """The power of two nearest the diagonal of the segments' start points (1.0 if none)."""
     if cw.shape[0] == 0:
         return 1.0
-    start = cw[:, 0, :]
-    diag = float(np.sqrt(np.sum((start.max(axis=0) - start.min(axis=0)) ** 2)))
+    # per coordinate, 1-D reductions of the strided column (exact, as the reduction along
+    # axis 0 is, and several times faster at a million segments)
+    ext = np.array([cw[:, 0, d].max() - cw[:, 0, d].min() for d in range(cw.shape[2])])
+    diag = float(np.sqrt(np.sum(ext ** 2)))
     if not (np.isfinite(diag) and diag > 0.0):
         return 1.0
     return float(2.0 ** int(np.clip(np.round(np.log2(diag)), -1000, 1000)))

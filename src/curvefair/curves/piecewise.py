@@ -47,9 +47,9 @@ def readonly(arr: np.ndarray) -> np.ndarray:
     """
     if _frozen(arr):
         return arr
-    a = np.ascontiguousarray(arr)
-    out = np.frombuffer(a.tobytes(), dtype=a.dtype).reshape(a.shape)
-    return out
+    a = arr if isinstance(arr, np.ndarray) else np.asarray(arr)
+    # tobytes() copies any layout into C order: one copy, also for a strided view
+    return np.frombuffer(a.tobytes(), dtype=a.dtype).reshape(a.shape)
 
 
 def derivative_coefficients(coeffs: FloatArray, nu: int) -> FloatArray:

@@ -77,6 +77,7 @@ from scipy.interpolate import BSpline
 
 from .._typing import ArrayLike, FloatArray
 from .._validate import as_points, as_positive
+from ..analysis import matched_hermite_bound
 from ..curves.hermite import CubicHermite
 from ..curves.interpolate import interpolate_cubic
 from ..curves.parameterize import parameterize
@@ -140,6 +141,8 @@ class NaturalOperators:
     G: sp.csr_matrix
     Jm: sp.csr_matrix
     E: sp.csr_matrix
+    #: products that depend on the operators only, built once (see :func:`_energy_matrix`)
+    cache: dict[Any, Any] = field(default_factory=dict, compare=False, repr=False)
 
 
 def natural_operators(u: ArrayLike) -> NaturalOperators:
@@ -215,13 +218,16 @@ def _rows4(C: sp.spmatrix) -> tuple[np.ndarray, FloatArray]:
 
 def _tube_qp(K: sp.csr_matrix, A: sp.csr_matrix, x0: FloatArray, pts: FloatArray,
              rad: FloatArray, max_steps: int = 80, gap: float = 1e-9,
-             lam0: FloatArray | None = None) -> tuple[FloatArray, FloatArray, int, str]:
+             lam0: FloatArray | None = None,
+             rows: tuple[np.ndarray, FloatArray] | None = None
+             ) -> tuple[FloatArray, FloatArray, int, str]:
     """``min sum_a x_a^T K x_a`` s.t. ``|A_i x - p_i| <= rad_i`` from a strictly feasible ``x0``.
 
     ``A`` any constraint matrix whose rows are curve values (four consecutive non-zeros at
     most); the interior point runs compiled (:func:`curvefair.fairing._points_kernels.tube_ipm`).
     Returns ``(x, lam, steps, reason)``; ``lam`` the multipliers of ``f_i`` (scaled problem:
-    energy ``x^T K x / E0``, ``E0`` the energy of ``x0``). ``lam0`` warm-starts them.
+    energy ``x^T K x / E0``, ``E0`` the energy of ``x0``). ``lam0`` warm-starts them;
+    ``rows`` is ``_rows4(A)`` when the caller has it (the same ``A`` for every solve).
     """
     from . import _points_kernels as _pk
 
@@ -233,7 +239,7 @@ def _tube_qp(K: sp.csr_matrix, A: sp.csr_matrix, x0: FloatArray, pts: FloatArray
     if not E0 > 0:
         return x, np.zeros(m), 0, "zero_energy"
     Kb = _band_lower(K * (2.0 / E0), 5 * dim - 1)
-    start, W = _rows4(A)
+    start, W = _rows4(A) if rows is None else rows
     lam = np.ones(m) if lam0 is None else np.array(lam0, dtype=np.float64)
     steps, code = _pk.tube_ipm(Kb, start, W, np.ascontiguousarray(pts, dtype=np.float64),
                                np.ascontiguousarray(rad, dtype=np.float64), x, lam,
@@ -273,15 +279,24 @@ def _energy_matrix(ops: NaturalOperators, w: FloatArray, beta: float, P: FloatAr
     """Interleaved ``sum_k J_k^T W_k J_k + beta sum_k h_k g_k^T g_k`` with
     ``W_k = w_k (P_k + tau (I - P_k))`` (``P_k`` the projection on the normal space)."""
     dim = P.shape[1]
-    h = np.diff(ops.u)
     eye = np.eye(dim)
     Wk = w[:, None, None] * (P + tau * (eye[None] - P))
     Wb = _block_diag(Wk)
-    JI = sp.kron(ops.Jm, sp.identity(dim), format="csr")
+    # the interleaved jump operator and the E3 term depend on the parameters only: built
+    # once per problem (the same matrices every round, so bitwise the same sums)
+    JI = ops.cache.get(("JI", dim))
+    if JI is None:
+        JI = sp.kron(ops.Jm, sp.identity(dim), format="csr")
+        ops.cache[("JI", dim)] = JI
     K = JI.T @ Wb @ JI
     if beta > 0:
-        GI = sp.kron(ops.G, sp.identity(dim), format="csr")
-        K = K + beta * (GI.T @ sp.diags(np.repeat(h, dim)) @ GI)
+        E3 = ops.cache.get(("E3", dim))
+        if E3 is None:
+            h = np.diff(ops.u)
+            GI = sp.kron(ops.G, sp.identity(dim), format="csr")
+            E3 = GI.T @ sp.diags(np.repeat(h, dim)) @ GI
+            ops.cache[("E3", dim)] = E3
+        K = K + beta * E3
     return K.tocsr()
 
 
@@ -391,6 +406,7 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
         Y = np.vstack([pts, Bs @ xp])
     else:
         C, Y = ops.A, pts
+    rows4 = _rows4(C)  # the constraint rows' band, the same for every solve
     rad_p = np.where(held, 1e-4 * tolv, tolv - margin)
     rad_s = np.full(C.shape[0] - N, tolv - margin)
     j_before = float(_jump_norms(ops, xp).sum())
@@ -426,7 +442,7 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
             x, lam, st, reason = _tube_qp(K, C, x0, Y, rad, max_steps=max_steps,
                                           gap=1e-9 if last else round_gap,
                                           lam0=None if (lam is None or not warm_lam)
-                                          else np.maximum(lam, 1e-3))
+                                          else np.maximum(lam, 1e-3), rows=rows4)
             newton += st
             rounds_done += 1
             jn = _jump_norms(ops, x, Pn)
@@ -479,43 +495,6 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
     return PointsL1Result(q_out, curve, report)
 
 
-#: values at 0, 1/3, 2/3, 1 -> Bernstein control points of a cubic
-_TO_BERNSTEIN = np.linalg.inv(np.array([[(1 - x) ** 3, 3 * x * (1 - x) ** 2, 3 * x * x * (1 - x),
-                                         x ** 3] for x in (0.0, 1 / 3, 2 / 3, 1.0)]))
-
-
-def _matched_bound(a: CubicHermite, b: CubicHermite, pieces: int = 4) -> FloatArray:
-    """Per span, an upper bound of the Hausdorff distance of two cubic Hermite curves through
-    the same number of points: ``max_t |b(t) - a(psi(t))|`` with ``psi`` the piecewise-linear map of
-    ``b``'s parameters onto ``a``'s (point ``i`` to point ``i``). Every point of either curve
-    then has a point of the other within that distance. On each span ``a o psi - b`` is one
-    cubic (Hermite data: the point differences and the tangents, ``a``'s scaled by the span
-    ratio); its ``pieces`` sub-pieces are bounded by their Bernstein control points (convex
-    hull), up to rounding of the coordinates."""
-    ua, ub = np.asarray(a.params), np.asarray(b.params)
-    ha, hb = np.diff(ua), np.diff(ub)
-    pa, pb = np.asarray(a.points), np.asarray(b.points)
-    ta, tb = np.asarray(a.tangents), np.asarray(b.tangents)
-    r = (ha / hb)[:, None]
-    d0, d1 = pa[:-1] - pb[:-1], pa[1:] - pb[1:]
-    # derivatives with respect to the span's unit parameter s = (t - t_i) / hb
-    m0 = ta[:-1] * r * hb[:, None] - tb[:-1] * hb[:, None]
-    m1 = ta[1:] * r * hb[:, None] - tb[1:] * hb[:, None]
-    best = np.zeros(len(ha))
-    k = np.arange(4) / 3.0
-    for j in range(pieces):
-        s = (j + k) / pieces
-        h00 = 2 * s ** 3 - 3 * s ** 2 + 1
-        h10 = s ** 3 - 2 * s ** 2 + s
-        h01 = -2 * s ** 3 + 3 * s ** 2
-        h11 = s ** 3 - s ** 2
-        vals = (d0[:, None, :] * h00[None, :, None] + m0[:, None, :] * h10[None, :, None]
-                + d1[:, None, :] * h01[None, :, None] + m1[:, None, :] * h11[None, :, None])
-        ctrl = np.einsum("kv,svd->skd", _TO_BERNSTEIN, vals)
-        best = np.maximum(best, np.sqrt(np.max(np.sum(ctrl * ctrl, axis=2), axis=1)))
-    return best * (1.0 + 1e-12)
-
-
 def _polyline_distance(x: FloatArray, poly: FloatArray) -> FloatArray:
     """Distance of every row of ``x`` to the polyline ``poly`` (k-d tree: the segments next to
     the two nearest vertices)."""
@@ -536,11 +515,12 @@ def _polyline_distance(x: FloatArray, poly: FloatArray) -> FloatArray:
 
 def _rebuilt_distance(a: CubicHermite, b: CubicHermite, tol: float, dense: int = 32) -> float:
     """The Hausdorff distance of ``a`` and ``b`` (same number of points), as far as it matters
-    against ``tol``: the per-span upper bound :func:`_matched_bound` where it is within
+    against ``tol``: the per-span upper bound
+    :func:`curvefair.analysis.matched_hermite_bound` where it is within
     ``tol``; on the spans where it is not, both curves sampled ``dense`` times per span and
     measured against the other, sampled ``dense`` times per span on every span, as a
     polyline (exact to ``O(h^2 / dense^2)`` curvature terms)."""
-    per = _matched_bound(a, b)
+    per = matched_hermite_bound(a, b)
     bad = np.flatnonzero(per > tol)
     if bad.size == 0:
         return float(per.max()) if per.size else 0.0
