@@ -175,9 +175,9 @@ def _band_lower(K: sp.spmatrix, width: int) -> FloatArray:
     N = K.shape[0]
     Kc = K.tocoo()
     keep = (Kc.row >= Kc.col) & (Kc.row - Kc.col <= width)
-    Kb = np.zeros((N, width + 1))
-    np.add.at(Kb, (Kc.col[keep], Kc.row[keep] - Kc.col[keep]), Kc.data[keep])
-    return Kb
+    idx = Kc.col[keep].astype(np.int64) * (width + 1) + (Kc.row[keep] - Kc.col[keep])
+    return np.bincount(idx, weights=Kc.data[keep],
+                       minlength=N * (width + 1)).reshape(N, width + 1)
 
 
 def _tridiag(A: sp.csr_matrix) -> FloatArray:
@@ -187,9 +187,8 @@ def _tridiag(A: sp.csr_matrix) -> FloatArray:
     s = Ac.col - Ac.row + 1
     if np.any((s < 0) | (s > 2)):  # pragma: no cover - the natural cubic's A is tridiagonal
         raise AssertionError("collocation is not tridiagonal")
-    Aw = np.zeros((N, 3))
-    np.add.at(Aw, (Ac.row, s), Ac.data)
-    return Aw
+    return np.bincount(Ac.row.astype(np.int64) * 3 + s, weights=Ac.data,
+                       minlength=3 * N).reshape(N, 3)
 
 
 # ------------------------------------------------------------------------------------------
@@ -199,29 +198,35 @@ def _rows4(C: sp.spmatrix) -> tuple[np.ndarray, FloatArray]:
     """``(start, W)`` with ``C[i, start_i + s] = W[i, s]`` (``s = 0 .. 3``): every row of ``C``
     (curve values of a cubic B-spline) has its non-zeros in four consecutive columns."""
     Cc = sp.csr_matrix(C)
+    Cc.sum_duplicates()
     m, N = Cc.shape
-    Co = Cc.tocoo()
-    first = np.full(m, N, dtype=np.int64)
-    np.minimum.at(first, Co.row, Co.col)
-    first[first == N] = 0
+    counts = np.diff(Cc.indptr)
+    row = np.repeat(np.arange(m, dtype=np.int64), counts)
+    # canonical CSR: the first stored column of a row is its smallest
+    first = np.where(counts > 0, Cc.indices[np.minimum(Cc.indptr[:-1], max(Cc.nnz - 1, 0))],
+                     0)
     start = np.minimum(first, N - 4).astype(np.int64)
-    s = Co.col - start[Co.row]
+    s = Cc.indices - start[row]
     if np.any((s < 0) | (s > 3)):  # pragma: no cover - cubic B-spline rows span 4 columns
         raise AssertionError("constraint row wider than four coefficients")
-    W = np.zeros((m, 4))
-    np.add.at(W, (Co.row, s), Co.data)
+    W = np.bincount(row * 4 + s, weights=Cc.data, minlength=4 * m).reshape(m, 4)
     return start, W
 
 
 def _tube_qp(K: sp.csr_matrix, A: sp.csr_matrix, x0: FloatArray, pts: FloatArray,
              rad: FloatArray, max_steps: int = 80, gap: float = 1e-9,
-             lam0: FloatArray | None = None) -> tuple[FloatArray, FloatArray, int, str]:
+             lam0: FloatArray | None = None, stall: float = 0.0,
+             rows: tuple[np.ndarray, FloatArray] | None = None
+             ) -> tuple[FloatArray, FloatArray, int, str]:
     """``min sum_a x_a^T K x_a`` s.t. ``|A_i x - p_i| <= rad_i`` from a strictly feasible ``x0``.
 
     ``A`` any constraint matrix whose rows are curve values (four consecutive non-zeros at
     most); the interior point runs compiled (:func:`curvefair.fairing._points_kernels.tube_ipm`).
     Returns ``(x, lam, steps, reason)``; ``lam`` the multipliers of ``f_i`` (scaled problem:
-    energy ``x^T K x / E0``, ``E0`` the energy of ``x0``). ``lam0`` warm-starts them.
+    energy ``x^T K x / E0``, ``E0`` the energy of ``x0``). ``lam0`` warm-starts them. The
+    surrogate gap has a rounding floor that grows with the number of constraints: below
+    ``stall`` an iteration whose gap no longer halves in three steps counts as converged.
+    ``rows``: :func:`_rows4` of ``A`` when the caller has it.
     """
     from . import _points_kernels as _pk
 
@@ -233,11 +238,11 @@ def _tube_qp(K: sp.csr_matrix, A: sp.csr_matrix, x0: FloatArray, pts: FloatArray
     if not E0 > 0:
         return x, np.zeros(m), 0, "zero_energy"
     Kb = _band_lower(K * (2.0 / E0), 5 * dim - 1)
-    start, W = _rows4(A)
+    start, W = _rows4(A) if rows is None else rows
     lam = np.ones(m) if lam0 is None else np.array(lam0, dtype=np.float64)
     steps, code = _pk.tube_ipm(Kb, start, W, np.ascontiguousarray(pts, dtype=np.float64),
                                np.ascontiguousarray(rad, dtype=np.float64), x, lam,
-                               int(max_steps), float(gap))
+                               int(max_steps), float(gap), float(max(gap, stall)))
     if code == 0:
         reason = "converged"
     elif code == 1:
@@ -391,6 +396,7 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
         Y = np.vstack([pts, Bs @ xp])
     else:
         C, Y = ops.A, pts
+    rows = _rows4(C)
     rad_p = np.where(held, 1e-4 * tolv, tolv - margin)
     rad_s = np.full(C.shape[0] - N, tolv - margin)
     j_before = float(_jump_norms(ops, xp).sum())
@@ -425,6 +431,8 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
             last = r == nr - 1
             x, lam, st, reason = _tube_qp(K, C, x0, Y, rad, max_steps=max_steps,
                                           gap=1e-9 if last else round_gap,
+                                          stall=0.0 if last else 100.0 * round_gap,
+                                          rows=rows,
                                           lam0=None if (lam is None or not warm_lam)
                                           else np.maximum(lam, 1e-3))
             newton += st
