@@ -124,6 +124,71 @@ def _residuals(Kb, start, W, Y, t2, x, lam, tinv, v, fi, rd, rc):  # type: ignor
 
 
 @njit(cache=True)
+def _assemble(start, W, v, fi, lam, t2, a, L):  # type: ignore[no-untyped-def]
+    """``L += band(sum_i C_i^T B_i C_i)``, ``B_i = lam_i / t2_i I + ww_i a_i a_i^T`` with
+    ``a_i = v_i / t2_i`` (stored in ``a``) and ``ww_i = lam_i / (-f_i)``: the constraint part
+    of the Newton matrix of :func:`tube_ipm`."""
+    m, dim = v.shape
+    kd = L.shape[1] - 1
+    for i in range(m):
+        ww = lam[i] / (-fi[i])
+        d0 = lam[i] / t2[i]
+        for b in range(dim):
+            a[i, b] = v[i, b] / t2[i]
+        j0 = start[i]
+        for s2 in range(4):
+            w2 = W[i, s2]
+            if w2 == 0.0:
+                continue
+            for s1 in range(s2, 4):
+                w = W[i, s1] * w2
+                if w == 0.0:
+                    continue
+                for b in range(dim):
+                    r = (j0 + s2) * dim + b
+                    for aa in range(dim):
+                        k = (j0 + s1) * dim + aa - r
+                        if k >= 0 and k <= kd:
+                            bab = ww * a[i, aa] * a[i, b]
+                            if aa == b:
+                                bab += d0
+                            L[r, k] += w * bab
+
+
+@njit(cache=True)
+def _assemble2(start, W, v, fi, lam, t2, a, L):  # type: ignore[no-untyped-def]
+    """:func:`_assemble` for ``dim = 2`` without branches: the same products added in the
+    same order (a zero weight adds an exact zero), so the same band to the last bit."""
+    m = v.shape[0]
+    for i in range(m):
+        ww = lam[i] / (-fi[i])
+        d0 = lam[i] / t2[i]
+        a0 = v[i, 0] / t2[i]
+        a1 = v[i, 1] / t2[i]
+        a[i, 0] = a0
+        a[i, 1] = a1
+        b00 = ww * a0 * a0 + d0
+        b01 = ww * a1 * a0
+        b10 = ww * a0 * a1
+        b11 = ww * a1 * a1 + d0
+        j0 = start[i]
+        for s2 in range(4):
+            w2 = W[i, s2]
+            r = (j0 + s2) * 2
+            w = W[i, s2] * w2
+            L[r, 0] += w * b00
+            L[r, 1] += w * b01
+            L[r + 1, 0] += w * b11
+            for s1 in range(s2 + 1, 4):
+                w = W[i, s1] * w2
+                k = (s1 - s2) * 2
+                L[r, k] += w * b00
+                L[r, k + 1] += w * b01
+                L[r + 1, k - 1] += w * b10
+                L[r + 1, k] += w * b11
+
+
+@njit(cache=True)
 def tube_ipm(Kb, start, W, Y, rad, x, lam, max_steps, gap, stall):  # type: ignore[no-untyped-def]
     """Primal-dual interior point for ``min x^T K x / 2`` (``K`` the scaled energy, lower band
     ``Kb``) s.t. ``|C_i x - Y_i| <= rad_i``, from a strictly feasible ``x`` and positive ``lam``
@@ -198,29 +263,10 @@ def tube_ipm(Kb, start, W, Y, rad, x, lam, max_steps, gap, stall):  # type: igno
         hist[steps % 3] = eta
         # Newton matrix K + sum_i C_i^T B_i C_i, B_i = lam_i / t2_i I + ww_i a_i a_i^T
         L[:, :] = Kb
-        for i in range(m):
-            ww = lam[i] / (-fi[i])
-            d0 = lam[i] / t2[i]
-            for b in range(dim):
-                a[i, b] = v[i, b] / t2[i]
-            j0 = start[i]
-            for s2 in range(4):
-                w2 = W[i, s2]
-                if w2 == 0.0:
-                    continue
-                for s1 in range(s2, 4):
-                    w = W[i, s1] * w2
-                    if w == 0.0:
-                        continue
-                    for b in range(dim):
-                        r = (j0 + s2) * dim + b
-                        for aa in range(dim):
-                            k = (j0 + s1) * dim + aa - r
-                            if k >= 0 and k <= kd:
-                                bab = ww * a[i, aa] * a[i, b]
-                                if aa == b:
-                                    bab += d0
-                                L[r, k] += w * bab
+        if dim == 2:
+            _assemble2(start, W, v, fi, lam, t2, a, L)
+        else:
+            _assemble(start, W, v, fi, lam, t2, a, L)
         # rhs = -rd - C^T (a rc / f)
         for j in range(N):
             for b in range(dim):
