@@ -56,6 +56,61 @@ def assemble_newton(L0, Aw, B, dim, L):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
+def energy_band(jstart, JV, Wk, gstart, GV, gw, L):  # type: ignore[no-untyped-def]
+    """Lower band ``L[r, k] = K[r + k, r]`` (interleaved, ``kd = 5 dim - 1``) of
+    ``K = sum_k J_k^T Wk_k J_k + sum_k gw_k g_k^T g_k`` (``(x) I``): ``J_k`` the jump rows,
+    ``JV[k, s]`` at columns ``jstart_k + s`` (``s = 0 .. 4``), ``Wk`` their ``dim x dim``
+    weights; ``g_k`` the third-derivative rows (four columns from ``gstart_k``). ``L`` zeroed
+    first."""
+    nj, _, dim = Wk.shape
+    kd = L.shape[1] - 1
+    L[:, :] = 0.0
+    for k in range(nj):
+        j0 = jstart[k]
+        for s2 in range(5):
+            v2 = JV[k, s2]
+            if v2 == 0.0:
+                continue
+            for s1 in range(s2, 5):
+                w = JV[k, s1] * v2
+                if w == 0.0:
+                    continue
+                for b in range(dim):
+                    r = (j0 + s2) * dim + b
+                    for aa in range(dim):
+                        kk = (j0 + s1) * dim + aa - r
+                        if kk >= 0 and kk <= kd:
+                            L[r, kk] += w * Wk[k, aa, b]
+    for k in range(gstart.shape[0]):
+        j0 = gstart[k]
+        c = gw[k]
+        for s2 in range(4):
+            v2 = GV[k, s2] * c
+            for s1 in range(s2, 4):
+                w = GV[k, s1] * v2
+                kk = (s1 - s2) * dim
+                for b in range(dim):
+                    L[(j0 + s2) * dim + b, kk] += w
+    return 0
+
+
+@njit(cache=True)
+def band_quad(Kb, x):  # type: ignore[no-untyped-def]
+    """``x^T K x`` for the symmetric band ``Kb[r, k] = K[r + k, r]`` (``x`` 1-D)."""
+    n = x.shape[0]
+    kd = Kb.shape[1] - 1
+    s = 0.0
+    for r in range(n):
+        xr = x[r]
+        t = 0.5 * Kb[r, 0] * xr
+        kmax = min(kd, n - 1 - r)
+        for k in range(1, kmax + 1):
+            t += Kb[r, k] * x[r + k]
+        s += t * xr
+    return 2.0 * s
+
+
+@njit(cache=True)
 def _rows(start, W, x, out):  # type: ignore[no-untyped-def]
     """``out = C x`` (``x`` shape (N, dim), ``out`` shape (m, dim))."""
     m = start.shape[0]

@@ -194,9 +194,10 @@ def _tridiag(A: sp.csr_matrix) -> FloatArray:
 # ------------------------------------------------------------------------------------------
 # the interior point for one quadratic problem
 # ------------------------------------------------------------------------------------------
-def _rows4(C: sp.spmatrix) -> tuple[np.ndarray, FloatArray]:
-    """``(start, W)`` with ``C[i, start_i + s] = W[i, s]`` (``s = 0 .. 3``): every row of ``C``
-    (curve values of a cubic B-spline) has its non-zeros in four consecutive columns."""
+def _rows4(C: sp.spmatrix, width: int = 4) -> tuple[np.ndarray, FloatArray]:
+    """``(start, W)`` with ``C[i, start_i + s] = W[i, s]`` (``s = 0 .. width - 1``): every row
+    of ``C`` has its non-zeros in ``width`` consecutive columns (four for curve values of a
+    cubic B-spline, five for a third-derivative jump)."""
     Cc = sp.csr_matrix(C)
     Cc.sum_duplicates()
     m, N = Cc.shape
@@ -205,15 +206,34 @@ def _rows4(C: sp.spmatrix) -> tuple[np.ndarray, FloatArray]:
     # canonical CSR: the first stored column of a row is its smallest
     first = np.where(counts > 0, Cc.indices[np.minimum(Cc.indptr[:-1], max(Cc.nnz - 1, 0))],
                      0)
-    start = np.minimum(first, N - 4).astype(np.int64)
+    start = np.minimum(first, N - width).astype(np.int64)
     s = Cc.indices - start[row]
-    if np.any((s < 0) | (s > 3)):  # pragma: no cover - cubic B-spline rows span 4 columns
-        raise AssertionError("constraint row wider than four coefficients")
-    W = np.bincount(row * 4 + s, weights=Cc.data, minlength=4 * m).reshape(m, 4)
+    if np.any((s < 0) | (s >= width)):  # pragma: no cover - rows of the operators are banded
+        raise AssertionError(f"operator row wider than {width} coefficients")
+    W = np.bincount(row * width + s, weights=Cc.data, minlength=width * m).reshape(m, width)
     return start, W
 
 
-def _tube_qp(K: sp.csr_matrix, A: sp.csr_matrix, x0: FloatArray, pts: FloatArray,
+def _energy_band(ops: NaturalOperators, jrows: tuple[np.ndarray, FloatArray],
+                 grows: tuple[np.ndarray, FloatArray], w: FloatArray, beta: float,
+                 P: FloatArray, tau: float) -> FloatArray:
+    """The lower band (``kd = 5 dim - 1``) of :func:`_energy_matrix`, assembled directly from
+    the rows of ``Jm`` (``jrows``, :func:`_rows4` with width 5) and ``G`` (``grows``): no
+    sparse products, ``O(n)`` time and memory."""
+    from . import _points_kernels as _pk
+
+    dim = P.shape[1]
+    N = ops.A.shape[0]
+    eye = np.eye(dim)
+    Wk = np.ascontiguousarray(w[:, None, None] * (P + tau * (eye[None] - P)))
+    gw = beta * np.diff(ops.u) if beta > 0 else np.zeros(0)
+    gs = grows[0] if beta > 0 else np.zeros(0, dtype=np.int64)
+    L = np.empty((N * dim, 5 * dim))
+    _pk.energy_band(jrows[0], jrows[1], Wk, gs, grows[1], gw, L)
+    return L
+
+
+def _tube_qp(K: sp.csr_matrix | FloatArray, A: sp.csr_matrix, x0: FloatArray, pts: FloatArray,
              rad: FloatArray, max_steps: int = 80, gap: float = 1e-9,
              lam0: FloatArray | None = None, stall: float = 0.0,
              rows: tuple[np.ndarray, FloatArray] | None = None
@@ -226,7 +246,8 @@ def _tube_qp(K: sp.csr_matrix, A: sp.csr_matrix, x0: FloatArray, pts: FloatArray
     energy ``x^T K x / E0``, ``E0`` the energy of ``x0``). ``lam0`` warm-starts them. The
     surrogate gap has a rounding floor that grows with the number of constraints: below
     ``stall`` an iteration whose gap no longer halves in three steps counts as converged.
-    ``rows``: :func:`_rows4` of ``A`` when the caller has it.
+    ``rows``: :func:`_rows4` of ``A`` when the caller has it. ``K`` may be given as its lower
+    band (:func:`_energy_band`).
     """
     from . import _points_kernels as _pk
 
@@ -234,10 +255,11 @@ def _tube_qp(K: sp.csr_matrix, A: sp.csr_matrix, x0: FloatArray, pts: FloatArray
     m = pts.shape[0]
     x = np.array(x0, dtype=np.float64, order="C")
     xf = x.reshape(-1)
-    E0 = float(xf @ (K @ xf))
+    band = isinstance(K, np.ndarray)
+    E0 = float(_pk.band_quad(K, xf)) if band else float(xf @ (K @ xf))
     if not E0 > 0:
         return x, np.zeros(m), 0, "zero_energy"
-    Kb = _band_lower(K * (2.0 / E0), 5 * dim - 1)
+    Kb = K * (2.0 / E0) if band else _band_lower(K * (2.0 / E0), 5 * dim - 1)
     start, W = _rows4(A) if rows is None else rows
     lam = np.ones(m) if lam0 is None else np.array(lam0, dtype=np.float64)
     steps, code = _pk.tube_ipm(Kb, start, W, np.ascontiguousarray(pts, dtype=np.float64),
@@ -397,6 +419,7 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
     else:
         C, Y = ops.A, pts
     rows = _rows4(C)
+    jrows, grows = _rows4(ops.Jm, 5), _rows4(ops.G)
     rad_p = np.where(held, 1e-4 * tolv, tolv - margin)
     rad_s = np.full(C.shape[0] - N, tolv - margin)
     j_before = float(_jump_norms(ops, xp).sum())
@@ -424,7 +447,7 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
         # of the last one, with two more rounds
         nr = max(1, int(rounds)) if attempts == 1 else min(2, max(1, int(rounds)))
         for r in range(nr):
-            K = _energy_matrix(ops, w, b, Pn, tau)
+            K = _energy_band(ops, jrows, grows, w, b, Pn, tau)
             # strictly feasible start: the last solution pulled toward the input's curve
             x0 = xp + (warm * shrink) * (x - xp) if (r > 0 or attempts > 1) else xp
             shrink = 1.0
