@@ -81,7 +81,7 @@ def main() -> None:
               f"{tp:.3f} s cpu ({wp:.3f} wall, peak {mp_:.0f} MiB), ratio {tp / tc:.1f}; "
               f"{extra}", flush=True)
     ns = sorted(times)
-    for a, b in zip(ns, ns[1:]):
+    for a, b in zip(ns, ns[1:], strict=False):
         print(f"growth {a} -> {b}: {times[b] / times[a]:.2f}x for {b / a:.0f}x the points")
 
 

@@ -254,8 +254,9 @@ def tube_ipm(Kb, start, W, Y, rad, x, lam, max_steps, gap, stall):  # type: igno
 
     Returns ``(steps, code)``: code 0 converged (``max|rd| < 1e-8`` of its initial value and
     ``eta < gap``, or ``eta < stall`` and not halved over the last three steps: the rounding
-    floor of ``eta``, which grows with the number of constraints), 1 max_steps, 2 numerical (factorisation, non-finite step or no progress:
-    converged if ``eta < 1e-6``, reported by the caller).
+    floor of ``eta``, which grows with the number of constraints), 1 max_steps, 2 numerical
+    (factorisation, non-finite step or no progress: converged if ``eta < 1e-6``, reported by
+    the caller).
     """
     N, dim = x.shape
     m = Y.shape[0]
@@ -281,7 +282,6 @@ def tube_ipm(Kb, start, W, Y, rad, x, lam, max_steps, gap, stall):  # type: igno
     qa1 = np.empty(m)
     qa2 = np.empty(m)
     qc0 = np.empty(m)
-    tmp2 = np.empty((m, dim))
     R1 = np.empty((N, dim))
     R2 = np.empty((N, dim))
     _residuals(Kb, start, W, Y, t2, x, lam, 0.0, v, fi, rd, rc)
@@ -387,10 +387,13 @@ def tube_ipm(Kb, start, W, Y, rad, x, lam, max_steps, gap, stall):  # type: igno
             c2 = lam[i] / t2[i]
             for b in range(dim):
                 tmp[i, b] = c1 * v[i, b] + c2 * Cdx[i, b]
-                tmp2[i, b] = c1 * Cdx[i, b]
         _rows_t(start, W, tmp, R1)
+        for i in range(m):
+            c1 = dlam[i] / t2[i]
+            for b in range(dim):
+                tmp[i, b] = c1 * Cdx[i, b]
         R2[:, :] = 0.0
-        _rows_t(start, W, tmp2, R2)
+        _rows_t(start, W, tmp, R2)
         while st > 1e-14:
             ok = True
             r1 = 0.0

@@ -233,7 +233,7 @@ def _energy_band(ops: NaturalOperators, jrows: tuple[np.ndarray, FloatArray],
     return L
 
 
-def _tube_qp(K: sp.csr_matrix | FloatArray, A: sp.csr_matrix, x0: FloatArray, pts: FloatArray,
+def _tube_qp(K: sp.csr_matrix | FloatArray, A: sp.csr_matrix | None, x0: FloatArray, pts: FloatArray,
              rad: FloatArray, max_steps: int = 80, gap: float = 1e-9,
              lam0: FloatArray | None = None, stall: float = 0.0,
              rows: tuple[np.ndarray, FloatArray] | None = None
@@ -246,7 +246,7 @@ def _tube_qp(K: sp.csr_matrix | FloatArray, A: sp.csr_matrix, x0: FloatArray, pt
     energy ``x^T K x / E0``, ``E0`` the energy of ``x0``). ``lam0`` warm-starts them. The
     surrogate gap has a rounding floor that grows with the number of constraints: below
     ``stall`` an iteration whose gap no longer halves in three steps counts as converged.
-    ``rows``: :func:`_rows4` of ``A`` when the caller has it. ``K`` may be given as its lower
+    ``rows``: :func:`_rows4` of ``A`` when the caller has it (then ``A`` may be None). ``K`` may be given as its lower
     band (:func:`_energy_band`).
     """
     from . import _points_kernels as _pk
@@ -260,7 +260,10 @@ def _tube_qp(K: sp.csr_matrix | FloatArray, A: sp.csr_matrix, x0: FloatArray, pt
     if not E0 > 0:
         return x, np.zeros(m), 0, "zero_energy"
     Kb = K * (2.0 / E0) if band else _band_lower(K * (2.0 / E0), 5 * dim - 1)
-    start, W = _rows4(A) if rows is None else rows
+    if rows is None:
+        assert A is not None
+        rows = _rows4(A)
+    start, W = rows
     lam = np.ones(m) if lam0 is None else np.array(lam0, dtype=np.float64)
     steps, code = _pk.tube_ipm(Kb, start, W, np.ascontiguousarray(pts, dtype=np.float64),
                                np.ascontiguousarray(rad, dtype=np.float64), x, lam,
@@ -270,7 +273,9 @@ def _tube_qp(K: sp.csr_matrix | FloatArray, A: sp.csr_matrix, x0: FloatArray, pt
     elif code == 1:
         reason = "max_steps"
     else:
-        eta = float(-(lam @ (0.5 * (np.sum((A @ x - pts) ** 2, axis=1) / rad ** 2 - 1.0))))
+        Cx = np.empty((m, dim))
+        _pk._rows(start, W, x, Cx)
+        eta = float(-(lam @ (0.5 * (np.sum((Cx - pts) ** 2, axis=1) / rad ** 2 - 1.0))))
         reason = "converged" if eta < 1e-6 else "numerical"
     return x, lam, int(steps), reason
 
@@ -416,12 +421,15 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
         Bs = (BSpline.design_matrix(us, ops.t, 3) @ ops.E).tocsr()
         C = sp.vstack([ops.A, Bs]).tocsr()
         Y = np.vstack([pts, Bs @ xp])
+        del Bs
     else:
         C, Y = ops.A, pts
+    # the solver needs the rows of C only (four B-spline values each): no sparse matrix kept
     rows = _rows4(C)
+    rad_s = np.full(C.shape[0] - N, tolv - margin)
+    del C
     jrows, grows = _rows4(ops.Jm, 5), _rows4(ops.G)
     rad_p = np.where(held, 1e-4 * tolv, tolv - margin)
-    rad_s = np.full(C.shape[0] - N, tolv - margin)
     j_before = float(_jump_norms(ops, xp).sum())
     jn0 = _jump_norms(ops, xp)
     h = np.diff(u)
@@ -452,7 +460,7 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
             x0 = xp + (warm * shrink) * (x - xp) if (r > 0 or attempts > 1) else xp
             shrink = 1.0
             last = r == nr - 1
-            x, lam, st, reason = _tube_qp(K, C, x0, Y, rad, max_steps=max_steps,
+            x, lam, st, reason = _tube_qp(K, None, x0, Y, rad, max_steps=max_steps,
                                           gap=1e-9 if last else round_gap,
                                           stall=0.0 if last else 100.0 * round_gap,
                                           rows=rows,
