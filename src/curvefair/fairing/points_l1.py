@@ -176,8 +176,8 @@ def _band_lower(K: sp.spmatrix, width: int) -> FloatArray:
     Kc = K.tocoo()
     keep = (Kc.row >= Kc.col) & (Kc.row - Kc.col <= width)
     idx = Kc.col[keep].astype(np.int64) * (width + 1) + (Kc.row[keep] - Kc.col[keep])
-    return np.bincount(idx, weights=Kc.data[keep],
-                       minlength=N * (width + 1)).reshape(N, width + 1)
+    Kb = np.bincount(idx, weights=Kc.data[keep], minlength=N * (width + 1))
+    return cast(FloatArray, Kb.astype(np.float64, copy=False).reshape(N, width + 1))
 
 
 def _tridiag(A: sp.csr_matrix) -> FloatArray:
@@ -187,8 +187,8 @@ def _tridiag(A: sp.csr_matrix) -> FloatArray:
     s = Ac.col - Ac.row + 1
     if np.any((s < 0) | (s > 2)):  # pragma: no cover - the natural cubic's A is tridiagonal
         raise AssertionError("collocation is not tridiagonal")
-    return np.bincount(Ac.row.astype(np.int64) * 3 + s, weights=Ac.data,
-                       minlength=3 * N).reshape(N, 3)
+    Aw = np.bincount(Ac.row.astype(np.int64) * 3 + s, weights=Ac.data, minlength=3 * N)
+    return cast(FloatArray, Aw.astype(np.float64, copy=False).reshape(N, 3))
 
 
 # ------------------------------------------------------------------------------------------
@@ -210,8 +210,8 @@ def _rows4(C: sp.spmatrix, width: int = 4) -> tuple[np.ndarray, FloatArray]:
     s = Cc.indices - start[row]
     if np.any((s < 0) | (s >= width)):  # pragma: no cover - rows of the operators are banded
         raise AssertionError(f"operator row wider than {width} coefficients")
-    W = np.bincount(row * width + s, weights=Cc.data, minlength=width * m).reshape(m, width)
-    return start, W
+    W = np.bincount(row * width + s, weights=Cc.data, minlength=width * m)
+    return start, cast(FloatArray, W.astype(np.float64, copy=False).reshape(m, width))
 
 
 def _energy_band(ops: NaturalOperators, jrows: tuple[np.ndarray, FloatArray],
@@ -233,8 +233,8 @@ def _energy_band(ops: NaturalOperators, jrows: tuple[np.ndarray, FloatArray],
     return L
 
 
-def _tube_qp(K: sp.csr_matrix | FloatArray, A: sp.csr_matrix | None, x0: FloatArray, pts: FloatArray,
-             rad: FloatArray, max_steps: int = 80, gap: float = 1e-9,
+def _tube_qp(K: sp.csr_matrix | FloatArray, A: sp.csr_matrix | None, x0: FloatArray,
+             pts: FloatArray, rad: FloatArray, max_steps: int = 80, gap: float = 1e-9,
              lam0: FloatArray | None = None, stall: float = 0.0,
              rows: tuple[np.ndarray, FloatArray] | None = None
              ) -> tuple[FloatArray, FloatArray, int, str]:
@@ -246,8 +246,8 @@ def _tube_qp(K: sp.csr_matrix | FloatArray, A: sp.csr_matrix | None, x0: FloatAr
     energy ``x^T K x / E0``, ``E0`` the energy of ``x0``). ``lam0`` warm-starts them. The
     surrogate gap has a rounding floor that grows with the number of constraints: below
     ``stall`` an iteration whose gap no longer halves in three steps counts as converged.
-    ``rows``: :func:`_rows4` of ``A`` when the caller has it (then ``A`` may be None). ``K`` may be given as its lower
-    band (:func:`_energy_band`).
+    ``rows``: :func:`_rows4` of ``A`` when the caller has it (then ``A`` may be None); ``K``
+    may be given as its lower band (:func:`_energy_band`).
     """
     from . import _points_kernels as _pk
 
