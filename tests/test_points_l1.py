@@ -94,6 +94,26 @@ def test_tube_qp_matches_scipy_minimize_and_kkt() -> None:
     assert np.all(mu[off] <= 1e-6 * max(mu.max(), 1e-300))
 
 
+@pytest.mark.parametrize("dim, tau, beta", [(2, 1.0, 1e-3), (2, 0.1, 0.0), (3, 0.3, 1e-2)])
+def test_energy_band_matches_the_sparse_energy_matrix(dim: int, tau: float, beta: float) -> None:
+    """The band assembled directly from the operator rows (what the solver uses) against the
+    sparse products of _energy_matrix, and x^T K x from the band against the sparse product."""
+    from curvefair.fairing import _points_kernels as pk
+    from curvefair.fairing.points_l1 import _band_lower, _energy_band, _rows4
+
+    rng = np.random.default_rng(dim)
+    p = np.cumsum(rng.normal(size=(30, dim)), axis=0)
+    ops = natural_operators(_chord(p))
+    w = rng.uniform(0.5, 2.0, 28)
+    P = _normal_projections(p)
+    K = _energy_matrix(ops, w, beta, P, tau)
+    ref = _band_lower(K, 5 * dim - 1)
+    got = _energy_band(ops, _rows4(ops.Jm, 5), _rows4(ops.G), w, beta, P, tau)
+    np.testing.assert_allclose(got, ref, rtol=0.0, atol=1e-13 * np.abs(ref).max())
+    x = rng.normal(size=30 * dim)
+    assert abs(pk.band_quad(ref, x) - x @ (K @ x)) <= 1e-13 * abs(x @ (K @ x))
+
+
 def test_points_l1_tolerance_on_the_input_parameters() -> None:
     """The result is the natural cubic through q at the INPUT's parameters (scipy's
     CubicSpline), within tol of the input's at equal parameter (dense sampling), and

@@ -56,6 +56,61 @@ def assemble_newton(L0, Aw, B, dim, L):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
+def energy_band(jstart, JV, Wk, gstart, GV, gw, L):  # type: ignore[no-untyped-def]
+    """Lower band ``L[r, k] = K[r + k, r]`` (interleaved, ``kd = 5 dim - 1``) of
+    ``K = sum_k J_k^T Wk_k J_k + sum_k gw_k g_k^T g_k`` (``(x) I``): ``J_k`` the jump rows,
+    ``JV[k, s]`` at columns ``jstart_k + s`` (``s = 0 .. 4``), ``Wk`` their ``dim x dim``
+    weights; ``g_k`` the third-derivative rows (four columns from ``gstart_k``). ``L`` zeroed
+    first."""
+    nj, _, dim = Wk.shape
+    kd = L.shape[1] - 1
+    L[:, :] = 0.0
+    for k in range(nj):
+        j0 = jstart[k]
+        for s2 in range(5):
+            v2 = JV[k, s2]
+            if v2 == 0.0:
+                continue
+            for s1 in range(s2, 5):
+                w = JV[k, s1] * v2
+                if w == 0.0:
+                    continue
+                for b in range(dim):
+                    r = (j0 + s2) * dim + b
+                    for aa in range(dim):
+                        kk = (j0 + s1) * dim + aa - r
+                        if kk >= 0 and kk <= kd:
+                            L[r, kk] += w * Wk[k, aa, b]
+    for k in range(gstart.shape[0]):
+        j0 = gstart[k]
+        c = gw[k]
+        for s2 in range(4):
+            v2 = GV[k, s2] * c
+            for s1 in range(s2, 4):
+                w = GV[k, s1] * v2
+                kk = (s1 - s2) * dim
+                for b in range(dim):
+                    L[(j0 + s2) * dim + b, kk] += w
+    return 0
+
+
+@njit(cache=True)
+def band_quad(Kb, x):  # type: ignore[no-untyped-def]
+    """``x^T K x`` for the symmetric band ``Kb[r, k] = K[r + k, r]`` (``x`` 1-D)."""
+    n = x.shape[0]
+    kd = Kb.shape[1] - 1
+    s = 0.0
+    for r in range(n):
+        xr = x[r]
+        t = 0.5 * Kb[r, 0] * xr
+        kmax = min(kd, n - 1 - r)
+        for k in range(1, kmax + 1):
+            t += Kb[r, k] * x[r + k]
+        s += t * xr
+    return 2.0 * s
+
+
+@njit(cache=True)
 def _rows(start, W, x, out):  # type: ignore[no-untyped-def]
     """``out = C x`` (``x`` shape (N, dim), ``out`` shape (m, dim))."""
     m = start.shape[0]
@@ -124,7 +179,72 @@ def _residuals(Kb, start, W, Y, t2, x, lam, tinv, v, fi, rd, rc):  # type: ignor
 
 
 @njit(cache=True)
-def tube_ipm(Kb, start, W, Y, rad, x, lam, max_steps, gap):  # type: ignore[no-untyped-def]
+def _assemble(start, W, v, fi, lam, t2, a, L):  # type: ignore[no-untyped-def]
+    """``L += band(sum_i C_i^T B_i C_i)``, ``B_i = lam_i / t2_i I + ww_i a_i a_i^T`` with
+    ``a_i = v_i / t2_i`` (stored in ``a``) and ``ww_i = lam_i / (-f_i)``: the constraint part
+    of the Newton matrix of :func:`tube_ipm`."""
+    m, dim = v.shape
+    kd = L.shape[1] - 1
+    for i in range(m):
+        ww = lam[i] / (-fi[i])
+        d0 = lam[i] / t2[i]
+        for b in range(dim):
+            a[i, b] = v[i, b] / t2[i]
+        j0 = start[i]
+        for s2 in range(4):
+            w2 = W[i, s2]
+            if w2 == 0.0:
+                continue
+            for s1 in range(s2, 4):
+                w = W[i, s1] * w2
+                if w == 0.0:
+                    continue
+                for b in range(dim):
+                    r = (j0 + s2) * dim + b
+                    for aa in range(dim):
+                        k = (j0 + s1) * dim + aa - r
+                        if k >= 0 and k <= kd:
+                            bab = ww * a[i, aa] * a[i, b]
+                            if aa == b:
+                                bab += d0
+                            L[r, k] += w * bab
+
+
+@njit(cache=True)
+def _assemble2(start, W, v, fi, lam, t2, a, L):  # type: ignore[no-untyped-def]
+    """:func:`_assemble` for ``dim = 2`` without branches: the same products added in the
+    same order (a zero weight adds an exact zero), so the same band to the last bit."""
+    m = v.shape[0]
+    for i in range(m):
+        ww = lam[i] / (-fi[i])
+        d0 = lam[i] / t2[i]
+        a0 = v[i, 0] / t2[i]
+        a1 = v[i, 1] / t2[i]
+        a[i, 0] = a0
+        a[i, 1] = a1
+        b00 = ww * a0 * a0 + d0
+        b01 = ww * a1 * a0
+        b10 = ww * a0 * a1
+        b11 = ww * a1 * a1 + d0
+        j0 = start[i]
+        for s2 in range(4):
+            w2 = W[i, s2]
+            r = (j0 + s2) * 2
+            w = W[i, s2] * w2
+            L[r, 0] += w * b00
+            L[r, 1] += w * b01
+            L[r + 1, 0] += w * b11
+            for s1 in range(s2 + 1, 4):
+                w = W[i, s1] * w2
+                k = (s1 - s2) * 2
+                L[r, k] += w * b00
+                L[r, k + 1] += w * b01
+                L[r + 1, k - 1] += w * b10
+                L[r + 1, k] += w * b11
+
+
+@njit(cache=True)
+def tube_ipm(Kb, start, W, Y, rad, x, lam, max_steps, gap, stall):  # type: ignore[no-untyped-def]
     """Primal-dual interior point for ``min x^T K x / 2`` (``K`` the scaled energy, lower band
     ``Kb``) s.t. ``|C_i x - Y_i| <= rad_i``, from a strictly feasible ``x`` and positive ``lam``
     (both updated in place). Boyd & Vandenberghe sec. 11.7: surrogate gap ``eta = -f.lam``,
@@ -132,9 +252,11 @@ def tube_ipm(Kb, start, W, Y, rad, x, lam, max_steps, gap):  # type: ignore[no-u
     strictly feasible (``lam > 0``, every ``|C_i x - Y_i| < rad_i``) with a backtracking line
     search on the residual norm.
 
-    Returns ``(steps, code)``: code 0 converged (``eta < gap`` and ``max|rd| < 1e-8`` of its
-    initial value), 1 max_steps, 2 numerical (factorisation, non-finite step or no progress:
-    converged if ``eta < 1e-6``, reported by the caller).
+    Returns ``(steps, code)``: code 0 converged (``max|rd| < 1e-8`` of its initial value and
+    ``eta < gap``, or ``eta < stall`` and not halved over the last three steps: the rounding
+    floor of ``eta``, which grows with the number of constraints), 1 max_steps, 2 numerical
+    (factorisation, non-finite step or no progress: converged if ``eta < 1e-6``, reported by
+    the caller).
     """
     N, dim = x.shape
     m = Y.shape[0]
@@ -157,6 +279,11 @@ def tube_ipm(Kb, start, W, Y, rad, x, lam, max_steps, gap):  # type: ignore[no-u
     dlam = np.empty(m)
     x1 = np.empty((N, dim))
     lam1 = np.empty(m)
+    qa1 = np.empty(m)
+    qa2 = np.empty(m)
+    qc0 = np.empty(m)
+    R1 = np.empty((N, dim))
+    R2 = np.empty((N, dim))
     _residuals(Kb, start, W, Y, t2, x, lam, 0.0, v, fi, rd, rc)
     gscale = 0.0
     for j in range(N):
@@ -166,44 +293,35 @@ def tube_ipm(Kb, start, W, Y, rad, x, lam, max_steps, gap):  # type: ignore[no-u
         gscale = 1.0
     steps = 0
     code = 1
+    hist = np.full(3, np.inf)
     while steps < max_steps:
         eta = 0.0
         for i in range(m):
             eta -= fi[i] * lam[i]
         tinv = eta / (10.0 * m)
-        _residuals(Kb, start, W, Y, t2, x, lam, tinv, v, fi, rd, rc)
+        # v, f and rd are those of the current (x, lam); only rc depends on the centring
+        for i in range(m):
+            rc[i] = -lam[i] * fi[i] - tinv
         rdn = 0.0
         for j in range(N):
             for b in range(dim):
                 rdn = max(rdn, abs(rd[j, b]))
-        if eta < gap and rdn < 1e-8 * gscale:
-            code = 0
-            break
+        if rdn < 1e-8 * gscale:
+            if eta < gap:
+                code = 0
+                break
+            # the rounding floor of the gap (it grows with m): below ``stall`` and not halved
+            # in three steps, the iterate is optimal to the accuracy float64 gives
+            if eta < stall and eta > 0.5 * hist[steps % 3]:
+                code = 0
+                break
+        hist[steps % 3] = eta
         # Newton matrix K + sum_i C_i^T B_i C_i, B_i = lam_i / t2_i I + ww_i a_i a_i^T
         L[:, :] = Kb
-        for i in range(m):
-            ww = lam[i] / (-fi[i])
-            d0 = lam[i] / t2[i]
-            for b in range(dim):
-                a[i, b] = v[i, b] / t2[i]
-            j0 = start[i]
-            for s2 in range(4):
-                w2 = W[i, s2]
-                if w2 == 0.0:
-                    continue
-                for s1 in range(s2, 4):
-                    w = W[i, s1] * w2
-                    if w == 0.0:
-                        continue
-                    for b in range(dim):
-                        r = (j0 + s2) * dim + b
-                        for aa in range(dim):
-                            k = (j0 + s1) * dim + aa - r
-                            if k >= 0 and k <= kd:
-                                bab = ww * a[i, aa] * a[i, b]
-                                if aa == b:
-                                    bab += d0
-                                L[r, k] += w * bab
+        if dim == 2:
+            _assemble2(start, W, v, fi, lam, t2, a, L)
+        else:
+            _assemble(start, W, v, fi, lam, t2, a, L)
         # rhs = -rd - C^T (a rc / f)
         for j in range(N):
             for b in range(dim):
@@ -240,6 +358,9 @@ def tube_ipm(Kb, start, W, Y, rad, x, lam, max_steps, gap):  # type: ignore[no-u
                 a2 += Cdx[i, b] * Cdx[i, b]
                 a1 += v[i, b] * Cdx[i, b]
                 c0 += v[i, b] * v[i, b]
+            qa1[i] = a1
+            qa2[i] = a2
+            qc0[i] = c0
             c0 -= t2[i]
             dl = (rc[i] - lam[i] * adx) / fi[i]
             dlam[i] = dl
@@ -256,27 +377,50 @@ def tube_ipm(Kb, start, W, Y, rad, x, lam, max_steps, gap):  # type: ignore[no-u
         for i in range(m):
             rn += rc[i] * rc[i]
         rnorm = np.sqrt(rn)
+        # along the step the residual is a polynomial in its length s (K quadratic, the
+        # constraints quadratic in x): rd(s) = rd + s R1 + s^2 R2, |v_i(s)|^2 = c0 + 2 s a1
+        # + s^2 a2; the backtracking tests it without re-evaluating C x, and the accepted
+        # point is evaluated exactly (and rejected if rounding put it outside a ball)
+        _band_mv(Kb, dxf, R1.reshape(n))
+        for i in range(m):
+            c1 = dlam[i] / t2[i]
+            c2 = lam[i] / t2[i]
+            for b in range(dim):
+                tmp[i, b] = c1 * v[i, b] + c2 * Cdx[i, b]
+        _rows_t(start, W, tmp, R1)
+        for i in range(m):
+            c1 = dlam[i] / t2[i]
+            for b in range(dim):
+                tmp[i, b] = c1 * Cdx[i, b]
+        R2[:, :] = 0.0
+        _rows_t(start, W, tmp, R2)
         while st > 1e-14:
-            for j in range(N):
-                for b in range(dim):
-                    x1[j, b] = x[j, b] + st * dx[j, b]
-            for i in range(m):
-                lam1[i] = lam[i] + st * dlam[i]
-            _residuals(Kb, start, W, Y, t2, x1, lam1, tinv, v1, fi1, rd1, rc1)
             ok = True
+            r1 = 0.0
             for i in range(m):
-                if not fi1[i] < 0.0:
+                f1 = 0.5 * ((qc0[i] + st * (2.0 * qa1[i] + st * qa2[i])) / t2[i] - 1.0)
+                if not f1 < 0.0:
                     ok = False
                     break
+                c = -(lam[i] + st * dlam[i]) * f1 - tinv
+                r1 += c * c
             if ok:
-                r1 = 0.0
                 for j in range(N):
                     for b in range(dim):
-                        r1 += (rd1[j, b] / gscale) ** 2
-                for i in range(m):
-                    r1 += rc1[i] * rc1[i]
+                        r1 += ((rd[j, b] + st * (R1[j, b] + st * R2[j, b])) / gscale) ** 2
                 if np.sqrt(r1) <= (1.0 - 0.01 * st) * rnorm:
-                    break
+                    for j in range(N):
+                        for b in range(dim):
+                            x1[j, b] = x[j, b] + st * dx[j, b]
+                    for i in range(m):
+                        lam1[i] = lam[i] + st * dlam[i]
+                    _residuals(Kb, start, W, Y, t2, x1, lam1, tinv, v1, fi1, rd1, rc1)
+                    for i in range(m):
+                        if not fi1[i] < 0.0:
+                            ok = False
+                            break
+                    if ok:
+                        break
             st *= 0.5
         if st <= 1e-14:
             code = 2
@@ -284,5 +428,7 @@ def tube_ipm(Kb, start, W, Y, rad, x, lam, max_steps, gap):  # type: ignore[no-u
         x[:, :] = x1
         lam[:] = lam1
         fi[:] = fi1
+        v[:, :] = v1
+        rd[:, :] = rd1
         steps += 1
     return steps, code

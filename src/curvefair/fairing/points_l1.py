@@ -178,9 +178,9 @@ def _band_lower(K: sp.spmatrix, width: int) -> FloatArray:
     N = K.shape[0]
     Kc = K.tocoo()
     keep = (Kc.row >= Kc.col) & (Kc.row - Kc.col <= width)
-    Kb = np.zeros((N, width + 1))
-    np.add.at(Kb, (Kc.col[keep], Kc.row[keep] - Kc.col[keep]), Kc.data[keep])
-    return Kb
+    idx = Kc.col[keep].astype(np.int64) * (width + 1) + (Kc.row[keep] - Kc.col[keep])
+    Kb = np.bincount(idx, weights=Kc.data[keep], minlength=N * (width + 1))
+    return cast(FloatArray, Kb.astype(np.float64, copy=False).reshape(N, width + 1))
 
 
 def _tridiag(A: sp.csr_matrix) -> FloatArray:
@@ -190,35 +190,55 @@ def _tridiag(A: sp.csr_matrix) -> FloatArray:
     s = Ac.col - Ac.row + 1
     if np.any((s < 0) | (s > 2)):  # pragma: no cover - the natural cubic's A is tridiagonal
         raise AssertionError("collocation is not tridiagonal")
-    Aw = np.zeros((N, 3))
-    np.add.at(Aw, (Ac.row, s), Ac.data)
-    return Aw
+    Aw = np.bincount(Ac.row.astype(np.int64) * 3 + s, weights=Ac.data, minlength=3 * N)
+    return cast(FloatArray, Aw.astype(np.float64, copy=False).reshape(N, 3))
 
 
 # ------------------------------------------------------------------------------------------
 # the interior point for one quadratic problem
 # ------------------------------------------------------------------------------------------
-def _rows4(C: sp.spmatrix) -> tuple[np.ndarray, FloatArray]:
-    """``(start, W)`` with ``C[i, start_i + s] = W[i, s]`` (``s = 0 .. 3``): every row of ``C``
-    (curve values of a cubic B-spline) has its non-zeros in four consecutive columns."""
+def _rows4(C: sp.spmatrix, width: int = 4) -> tuple[np.ndarray, FloatArray]:
+    """``(start, W)`` with ``C[i, start_i + s] = W[i, s]`` (``s = 0 .. width - 1``): every row
+    of ``C`` has its non-zeros in ``width`` consecutive columns (four for curve values of a
+    cubic B-spline, five for a third-derivative jump)."""
     Cc = sp.csr_matrix(C)
+    Cc.sum_duplicates()
     m, N = Cc.shape
-    Co = Cc.tocoo()
-    first = np.full(m, N, dtype=np.int64)
-    np.minimum.at(first, Co.row, Co.col)
-    first[first == N] = 0
-    start = np.minimum(first, N - 4).astype(np.int64)
-    s = Co.col - start[Co.row]
-    if np.any((s < 0) | (s > 3)):  # pragma: no cover - cubic B-spline rows span 4 columns
-        raise AssertionError("constraint row wider than four coefficients")
-    W = np.zeros((m, 4))
-    np.add.at(W, (Co.row, s), Co.data)
-    return start, W
+    counts = np.diff(Cc.indptr)
+    row = np.repeat(np.arange(m, dtype=np.int64), counts)
+    # canonical CSR: the first stored column of a row is its smallest
+    first = np.where(counts > 0, Cc.indices[np.minimum(Cc.indptr[:-1], max(Cc.nnz - 1, 0))],
+                     0)
+    start = np.minimum(first, N - width).astype(np.int64)
+    s = Cc.indices - start[row]
+    if np.any((s < 0) | (s >= width)):  # pragma: no cover - rows of the operators are banded
+        raise AssertionError(f"operator row wider than {width} coefficients")
+    W = np.bincount(row * width + s, weights=Cc.data, minlength=width * m)
+    return start, cast(FloatArray, W.astype(np.float64, copy=False).reshape(m, width))
 
 
-def _tube_qp(K: sp.csr_matrix, A: sp.csr_matrix, x0: FloatArray, pts: FloatArray,
-             rad: FloatArray, max_steps: int = 80, gap: float = 1e-9,
-             lam0: FloatArray | None = None,
+def _energy_band(ops: NaturalOperators, jrows: tuple[np.ndarray, FloatArray],
+                 grows: tuple[np.ndarray, FloatArray], w: FloatArray, beta: float,
+                 P: FloatArray, tau: float) -> FloatArray:
+    """The lower band (``kd = 5 dim - 1``) of :func:`_energy_matrix`, assembled directly from
+    the rows of ``Jm`` (``jrows``, :func:`_rows4` with width 5) and ``G`` (``grows``): no
+    sparse products, ``O(n)`` time and memory."""
+    from . import _points_kernels as _pk
+
+    dim = P.shape[1]
+    N = ops.A.shape[0]
+    eye = np.eye(dim)
+    Wk = np.ascontiguousarray(w[:, None, None] * (P + tau * (eye[None] - P)))
+    gw = beta * np.diff(ops.u) if beta > 0 else np.zeros(0)
+    gs = grows[0] if beta > 0 else np.zeros(0, dtype=np.int64)
+    L = np.empty((N * dim, 5 * dim))
+    _pk.energy_band(jrows[0], jrows[1], Wk, gs, grows[1], gw, L)
+    return L
+
+
+def _tube_qp(K: sp.csr_matrix | FloatArray, A: sp.csr_matrix | None, x0: FloatArray,
+             pts: FloatArray, rad: FloatArray, max_steps: int = 80, gap: float = 1e-9,
+             lam0: FloatArray | None = None, stall: float = 0.0,
              rows: tuple[np.ndarray, FloatArray] | None = None
              ) -> tuple[FloatArray, FloatArray, int, str]:
     """``min sum_a x_a^T K x_a`` s.t. ``|A_i x - p_i| <= rad_i`` from a strictly feasible ``x0``.
@@ -226,8 +246,11 @@ def _tube_qp(K: sp.csr_matrix, A: sp.csr_matrix, x0: FloatArray, pts: FloatArray
     ``A`` any constraint matrix whose rows are curve values (four consecutive non-zeros at
     most); the interior point runs compiled (:func:`curvefair.fairing._points_kernels.tube_ipm`).
     Returns ``(x, lam, steps, reason)``; ``lam`` the multipliers of ``f_i`` (scaled problem:
-    energy ``x^T K x / E0``, ``E0`` the energy of ``x0``). ``lam0`` warm-starts them;
-    ``rows`` is ``_rows4(A)`` when the caller has it (the same ``A`` for every solve).
+    energy ``x^T K x / E0``, ``E0`` the energy of ``x0``). ``lam0`` warm-starts them. The
+    surrogate gap has a rounding floor that grows with the number of constraints: below
+    ``stall`` an iteration whose gap no longer halves in three steps counts as converged.
+    ``rows``: :func:`_rows4` of ``A`` when the caller has it (then ``A`` may be None); ``K``
+    may be given as its lower band (:func:`_energy_band`).
     """
     from . import _points_kernels as _pk
 
@@ -235,21 +258,27 @@ def _tube_qp(K: sp.csr_matrix, A: sp.csr_matrix, x0: FloatArray, pts: FloatArray
     m = pts.shape[0]
     x = np.array(x0, dtype=np.float64, order="C")
     xf = x.reshape(-1)
-    E0 = float(xf @ (K @ xf))
+    band = isinstance(K, np.ndarray)
+    E0 = float(_pk.band_quad(K, xf)) if band else float(xf @ (K @ xf))
     if not E0 > 0:
         return x, np.zeros(m), 0, "zero_energy"
-    Kb = _band_lower(K * (2.0 / E0), 5 * dim - 1)
-    start, W = _rows4(A) if rows is None else rows
+    Kb = K * (2.0 / E0) if band else _band_lower(K * (2.0 / E0), 5 * dim - 1)
+    if rows is None:
+        assert A is not None
+        rows = _rows4(A)
+    start, W = rows
     lam = np.ones(m) if lam0 is None else np.array(lam0, dtype=np.float64)
     steps, code = _pk.tube_ipm(Kb, start, W, np.ascontiguousarray(pts, dtype=np.float64),
                                np.ascontiguousarray(rad, dtype=np.float64), x, lam,
-                               int(max_steps), float(gap))
+                               int(max_steps), float(gap), float(max(gap, stall)))
     if code == 0:
         reason = "converged"
     elif code == 1:
         reason = "max_steps"
     else:
-        eta = float(-(lam @ (0.5 * (np.sum((A @ x - pts) ** 2, axis=1) / rad ** 2 - 1.0))))
+        Cx = np.empty((m, dim))
+        _pk._rows(start, W, x, Cx)
+        eta = float(-(lam @ (0.5 * (np.sum((Cx - pts) ** 2, axis=1) / rad ** 2 - 1.0))))
         reason = "converged" if eta < 1e-6 else "numerical"
     return x, lam, int(steps), reason
 
@@ -404,11 +433,15 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
         Bs = (BSpline.design_matrix(us, ops.t, 3) @ ops.E).tocsr()
         C = sp.vstack([ops.A, Bs]).tocsr()
         Y = np.vstack([pts, Bs @ xp])
+        del Bs
     else:
         C, Y = ops.A, pts
-    rows4 = _rows4(C)  # the constraint rows' band, the same for every solve
-    rad_p = np.where(held, 1e-4 * tolv, tolv - margin)
+    # the solver needs the rows of C only (four B-spline values each): no sparse matrix kept
+    rows = _rows4(C)
     rad_s = np.full(C.shape[0] - N, tolv - margin)
+    del C
+    jrows, grows = _rows4(ops.Jm, 5), _rows4(ops.G)
+    rad_p = np.where(held, 1e-4 * tolv, tolv - margin)
     j_before = float(_jump_norms(ops, xp).sum())
     jn0 = _jump_norms(ops, xp)
     h = np.diff(u)
@@ -434,15 +467,17 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
         # of the last one, with two more rounds
         nr = max(1, int(rounds)) if attempts == 1 else min(2, max(1, int(rounds)))
         for r in range(nr):
-            K = _energy_matrix(ops, w, b, Pn, tau)
+            K = _energy_band(ops, jrows, grows, w, b, Pn, tau)
             # strictly feasible start: the last solution pulled toward the input's curve
             x0 = xp + (warm * shrink) * (x - xp) if (r > 0 or attempts > 1) else xp
             shrink = 1.0
             last = r == nr - 1
-            x, lam, st, reason = _tube_qp(K, C, x0, Y, rad, max_steps=max_steps,
+            x, lam, st, reason = _tube_qp(K, None, x0, Y, rad, max_steps=max_steps,
                                           gap=1e-9 if last else round_gap,
+                                          stall=0.0 if last else 100.0 * round_gap,
+                                          rows=rows,
                                           lam0=None if (lam is None or not warm_lam)
-                                          else np.maximum(lam, 1e-3), rows=rows4)
+                                          else np.maximum(lam, 1e-3))
             newton += st
             rounds_done += 1
             jn = _jump_norms(ops, x, Pn)
@@ -495,9 +530,11 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
     return PointsL1Result(q_out, curve, report)
 
 
-def _polyline_distance(x: FloatArray, poly: FloatArray) -> FloatArray:
+def _polyline_distance(x: FloatArray, poly: FloatArray,
+                       seg_ok: np.ndarray | None = None) -> FloatArray:
     """Distance of every row of ``x`` to the polyline ``poly`` (k-d tree: the segments next to
-    the two nearest vertices)."""
+    the two nearest vertices); ``seg_ok[j]`` False leaves segment ``poly[j] -> poly[j + 1]``
+    out (a polyline of several pieces: every vertex is still on a segment of its own piece)."""
     from scipy.spatial import cKDTree
 
     _, idx = cKDTree(poly).query(x, k=2)
@@ -509,7 +546,10 @@ def _polyline_distance(x: FloatArray, poly: FloatArray) -> FloatArray:
             d = b - a
             dd = np.maximum(np.sum(d * d, axis=1), 1e-300)
             s = np.clip(np.sum((x - a) * d, axis=1) / dd, 0.0, 1.0)
-            best = np.minimum(best, np.linalg.norm(x - a - s[:, None] * d, axis=1))
+            dist = np.linalg.norm(x - a - s[:, None] * d, axis=1)
+            if seg_ok is not None:
+                dist = np.where(seg_ok[i0], dist, np.inf)
+            best = np.minimum(best, dist)
     return best
 
 
@@ -518,24 +558,39 @@ def _rebuilt_distance(a: CubicHermite, b: CubicHermite, tol: float, dense: int =
     against ``tol``: the per-span upper bound
     :func:`curvefair.analysis.matched_hermite_bound` where it is within
     ``tol``; on the spans where it is not, both curves sampled ``dense`` times per span and
-    measured against the other, sampled ``dense`` times per span on every span, as a
-    polyline (exact to ``O(h^2 / dense^2)`` curvature terms)."""
+    measured against the other, sampled ``dense`` times per span, as a polyline (exact to
+    ``O(h^2 / dense^2)`` curvature terms). The other curve is sampled only on the spans within
+    ``4 max(bound)`` (chord length along ``a``'s points) of a refined span: the matched point
+    is within the bound, so the nearest point is within twice of it; a nearest point left out
+    could only make the figure larger, never smaller than the true distance."""
     per = matched_hermite_bound(a, b)
     bad = np.flatnonzero(per > tol)
     if bad.size == 0:
         return float(per.max()) if per.size else 0.0
     fr = np.arange(dense + 1) / dense
+    ns = per.size
+    cum = np.r_[0.0, np.cumsum(np.sqrt(np.sum(np.diff(np.asarray(a.points), axis=0) ** 2,
+                                              axis=1)))]
+    reach = 4.0 * float(per[bad].max())
+    lo = np.maximum(np.searchsorted(cum, cum[bad] - reach, side="left") - 1, 0)
+    hi = np.minimum(np.searchsorted(cum, cum[bad + 1] + reach, side="right"), ns)
+    mark = np.cumsum(np.bincount(lo, minlength=ns + 1) - np.bincount(hi, minlength=ns + 1))
+    near = np.flatnonzero(mark[:ns] > 0)
 
     def samples(c: CubicHermite, spans: np.ndarray) -> FloatArray:
         u = np.asarray(c.params)
         t = (u[spans, None] + np.diff(u)[spans, None] * fr[None, :]).reshape(-1)
         return np.asarray(c(np.clip(t, u[0], u[-1])))
 
-    all_spans = np.arange(len(per))
-    pa, pb = samples(a, all_spans), samples(b, all_spans)
+    # segments of the sampled polyline: inside a span, or between the samples of two
+    # consecutive spans (the same point); never across a gap between sampled spans
+    inner = np.ones((near.size, dense + 1), dtype=bool)
+    inner[:, -1] = np.r_[near[1:] == near[:-1] + 1, False]
+    seg_ok = inner.reshape(-1)
+    pa, pb = samples(a, near), samples(b, near)
     worst = float(np.max(per[per <= tol])) if np.any(per <= tol) else 0.0
-    worst = max(worst, float(_polyline_distance(samples(b, bad), pa).max()),
-                float(_polyline_distance(samples(a, bad), pb).max()))
+    worst = max(worst, float(_polyline_distance(samples(b, bad), pa, seg_ok).max()),
+                float(_polyline_distance(samples(a, bad), pb, seg_ok).max()))
     return worst
 
 
@@ -560,8 +615,9 @@ def _accepts(curve: Any) -> bool:
 
 
 #: the largest point count for which ``points-l1`` is the default (its interior point is
-#: O(n) but not yet compiled end to end: about 1.5 ms per point on the 2-core benchmark
-#: machine, see docs/benchmarks.md); longer point lists default to ``poliakoff``
+#: O(n) per Newton step but takes about 200 steps: about 0.2 ms of CPU per point on the
+#: 2-core benchmark machine, see docs/benchmarks.md); longer point lists default to
+#: ``poliakoff``
 DEFAULT_MAX_POINTS = 20_000
 
 #: whether ``points-l1`` is registered as a default at all: True, for the curves :func:`_prefer`
