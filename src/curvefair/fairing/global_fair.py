@@ -203,8 +203,8 @@ def _ranges_start(fn: Callable[[int, int], Any], lo: int, hi: int
 
 class _Prefault:
     """Map the pages of a new work array on the worker thread while the calling thread does
-    other work (first touch costs about 0.35 ms per MB here: 45 ms for the 128 MB Newton band
-    at 1e6 points). :meth:`join` before the array is first used: the calling thread zeroes
+    other work (a page's first touch is a kernel fault; figures in docs/benchmarks.md).
+    :meth:`join` before the array is first used: the calling thread zeroes
     the chunks the worker has not claimed and waits only for those it has started. Only the
     speed depends on how the work is shared (the array is zeroed either way and then
     overwritten before it is read)."""
@@ -955,7 +955,7 @@ def _ssn_work(n: int, dim: int, prefault: bool = False
               ) -> tuple[dict[str, FloatArray], _Prefault | None]:
     """Work arrays of :func:`_active_set_newton` (zeroed), carved from one buffer; with
     ``prefault`` its pages are mapped (zeroed) on the worker thread meanwhile (first touch
-    costs about 0.35-0.5 ms per MB here: 80 MB, ~35 ms, for a planar curve with 1e6 points).
+    of a page is a kernel fault: figures in docs/benchmarks.md).
     Planar blocks ``B`` (isotropic: the semismooth Newton writes only their diagonal, whose
     two entries are equal) are a strided view of ``2 n + 1`` doubles ``0, b_0, 0, b_1, 0, ...``:
     ``B[i, a, a] = b_i``, ``B[i, 0, 1] = B[i, 1, 0] = 0`` (16 MB instead of 32 at 1e6)."""
