@@ -5,7 +5,7 @@ natural ends. Timed, best of ``--repeat``:
 
 * ``interpolate_quintic``: the whole public call (validation, parameters, banded Hermite solve,
   the ``QuinticHermite``);
-* ``hermite solve``: only its derivative solve (``_quintic_hermite_data``);
+* ``hermite solve``: only its derivative solve (``quintic_hermite_data``);
 * peer: ``make_interp_spline(t, pts, k=5, bc_type=natural)`` plus evaluating ``r'`` and
   ``r''`` at the data parameters -- the same output, as the previous implementation got it.
 
@@ -29,7 +29,7 @@ import numpy as np
 from scipy.interpolate import make_interp_spline
 
 from curvefair import interpolate_quintic, parameterize
-from curvefair.curves.interpolate import _quintic_hermite_data
+from curvefair.curves.interpolate import quintic_hermite_data
 
 
 def data(n: int, seed: int = 0) -> np.ndarray:
@@ -85,7 +85,7 @@ def main() -> None:
         pts = data(n)
         t = parameterize(pts)
         t_pub = best(lambda: interpolate_quintic(pts), args.repeat)  # noqa: B023
-        t_core = best(lambda: _quintic_hermite_data(pts, t, z, z, False), args.repeat)  # noqa: B023
+        t_core = best(lambda: quintic_hermite_data(pts, t, z, z, False), args.repeat)  # noqa: B023
         t_sp = best(lambda: scipy_derivs(pts, t), args.repeat)  # noqa: B023
         lp = line(n)
         tl = parameterize(lp)

@@ -26,7 +26,7 @@ from scipy.interpolate import make_interp_spline
 from scipy.linalg import null_space
 
 import curvefair as cf
-from curvefair.curves.interpolate import _quintic_hermite_data
+from curvefair.curves.interpolate import quintic_hermite_data
 from curvefair.errors import InputError
 
 
@@ -209,7 +209,7 @@ def test_general_end_conditions_of_the_internal_solver():
                     continue
                 left = [(o, rng.normal(size=3)) for o in lo]
                 right = [(o, rng.normal(size=3)) for o in ro]
-                d1, d2 = _quintic_hermite_data(pts, t, left, right, False)
+                d1, d2 = quintic_hermite_data(pts, t, left, right, False)
                 e1, e2 = _scipy_derivs(t, pts, (left, right))
                 assert _rel(d1, e1) < 1e-9 and _rel(d2, e2) < 1e-9, (n, lo, ro)
 

@@ -229,7 +229,7 @@ def case_args(rng, p, closed, n):
     kw = {}
     r = rng.integers(0, 4)
     if r == 1:
-        kw["tol"] = float(rng.choice([0.0, 1e-3, 0.01, 0.05]))
+        kw["tol"] = float(rng.choice([1e-6, 1e-3, 0.01, 0.05]))
     elif r >= 2:
         kw["tol"] = float(rng.choice([0.02, 0.2, 1.0]))
     if not closed and rng.integers(0, 2):

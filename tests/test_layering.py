@@ -96,8 +96,6 @@ KNOWN = {
     "cli -> io._verify.rescaled_report",
     "fairing._tolerance -> curves.bspline._power_form_kernel",
     "fairing._tolerance -> curves.bspline._power_form_pair_kernel",
-    "fairing.cheng_yu -> analysis.discrete._cubic_bspline",
-    "fairing.local_hermite -> curves.interpolate._quintic_hermite_data",
     "fairing.pipeline -> curves.bspline._as_degree",
     "fairing.pipeline -> curves.bspline._closed_data",
     "fonts -> io._common.CurveRecord",
@@ -108,11 +106,7 @@ KNOWN = {
     "io._verify -> analysis._deviation._point_displacement",
     "io._verify -> analysis._deviation.geometric_upper_bound",
     "io._verify -> fairing._tolerance.point_report",
-    "io._verify -> fairing.fair._analysis_block",
     "steps -> fairing._hermite_kernels",
-    "steps -> fairing._hermite_data.distinct_data",
-    "steps -> fairing._hermite_data.rebuild",
-    "steps -> fairing._hermite_data.uniform_spacing",
 }
 
 

@@ -256,7 +256,9 @@ def _check_option_values(method: str | None, options: dict[str, Any]) -> None:
     for key, val in options.items():
         for name in names:
             try:
-                par = inspect.signature(METHODS[name].driver).parameters.get(key)
+                spec = METHODS[name]
+                fn = spec.solver if spec.solver is not None else spec.driver
+                par = inspect.signature(fn).parameters.get(key)
             except (TypeError, ValueError):
                 continue
             if par is None or par.kind is par.VAR_KEYWORD:

@@ -27,9 +27,9 @@ import numpy as np
 from .curves.hermite import CubicHermite, HermiteSpline, QuinticHermite
 from .errors import InputError
 from .fairing import _hermite_kernels as _k
-from .fairing._hermite_data import distinct_data, rebuild, uniform_spacing
 from .fairing.cheng_yu import cheng_yu  # (Cheng & Yu, cubic B-splines)
 from .fairing.eck_hadenfeld import eck_hadenfeld  # (Eck & Hadenfeld, B-splines)
+from .fairing.hermite_data import distinct_data, rebuild, uniform_spacing
 from .fairing.knot_removal import knot_removal  # (Farin, B-splines)
 
 __all__ = ["kjellander", "poliakoff", "wang_cao", "wang_quintic", "uniform_spacing",

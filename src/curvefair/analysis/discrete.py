@@ -148,7 +148,7 @@ def _discrete_curvature_core(prev: FloatArray, cur: FloatArray, nxt: FloatArray,
 # --------------------------------------------------------------------------------------------
 # second discrete curvature of the control polygon of a cubic B-spline
 # --------------------------------------------------------------------------------------------
-def _cubic_bspline(curve: Any, what: str) -> Any:
+def check_cubic_bspline(curve: Any, what: str) -> Any:
     """Check that ``curve`` is a cubic :class:`~curvefair.BSplineCurve` and return it."""
     from ..curves.bspline import BSplineCurve
 
@@ -326,7 +326,7 @@ def second_discrete_curvature(curve: Any) -> SecondDiscreteCurvature:
     >>> bool(np.allclose(s.K, s.K[0])), bool(np.allclose(s.second_difference, 0))
     (True, True)
     """
-    curve = _cubic_bspline(curve, "second_discrete_curvature")
+    curve = check_cubic_bspline(curve, "second_discrete_curvature")
     ctrl = np.asarray(curve.control_points, dtype=float)
     n = ctrl.shape[0]
     closed = bool(curve.closed)

@@ -424,15 +424,17 @@ class BSplineCurve(PiecewiseCurve):
 
     @classmethod
     def _trusted(cls, control_points: FloatArray, knots: FloatArray, degree: int,
-                 closed: bool) -> "BSplineCurve":
+                 closed: bool, *, same_knots_as: "BSplineCurve | None" = None
+                 ) -> "BSplineCurve":
         """A curve from arrays the caller has built valid (float64 ``(n, dim)`` finite control
-        points it owns, a full valid knot vector): no checks, no copies (both made read-only)."""
+        points it owns, a full valid knot vector): no checks, no copies (both made read-only).
+        ``same_knots_as``: a curve with these very knots, whose Gram matrices are shared."""
         out = cls.__new__(cls)
         out._ctrl = readonly(control_points)
         out._knots = readonly(knots)
         out.degree = int(degree)
         out._closed = bool(closed)
-        out._gram_cache = {}
+        out._gram_cache = {} if same_knots_as is None else same_knots_as._gram_cache
         return out
 
     # -- validation -------------------------------------------------------------------------

@@ -291,7 +291,7 @@ def _solve(ab: FloatArray, lo: int, up: int, rhs: FloatArray) -> FloatArray:
     return y
 
 
-def _quintic_hermite_data(pts: FloatArray, t: FloatArray, left: Any, right: Any,
+def quintic_hermite_data(pts: FloatArray, t: FloatArray, left: Any, right: Any,
                           periodic: bool) -> tuple[FloatArray, FloatArray]:
     """First and second derivatives at ``t`` of the C4 quintic spline through ``pts``.
 
@@ -459,7 +459,7 @@ def interpolate_quintic(points: ArrayLike, param: str | ArrayLike = "chord", bc:
         if naks == 1 and n < 4:
             raise InputError(f"a quintic spline with one not-a-knot end needs at least 4 points, "
                              f"got {n}")
-    d1, d2 = _quintic_hermite_data(pts, t, left, right, periodic)
+    d1, d2 = quintic_hermite_data(pts, t, left, right, periodic)
     if periodic:
         d1[-1] = d1[0]
         d2[-1] = d2[0]

@@ -19,6 +19,7 @@ from .fair import (
     method_options,
     register_method,
 )
+from .problem import FairingProblem, Outcome, make_problem
 from .stop import STOP_REASONS, StopReason
 
 __all__ = [
@@ -26,6 +27,9 @@ __all__ = [
     "FairingResult",
     "FairingHistory",
     "DriverOutput",
+    "Outcome",
+    "FairingProblem",
+    "make_problem",
     "MethodSpec",
     "METHODS",
     "register_method",

@@ -596,7 +596,7 @@ def _clamped_move(P, D, h, orig, k, method, degree, spline, hstep, tol, delta, e
         delta[c] = P[k, c] + delta[c]
     want = np.sqrt(want)
     clamped = False
-    if tol > 0.0:
+    if tol < np.inf:
         tol_eff = tol * (1.0 - 1e-12)
         for _ in range(8):
             off = 0.0

@@ -15,21 +15,24 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .._jit import njit
 from .._typing import FloatArray
-from .._validate import as_nonnegative, as_step_count, parse_clamp
+from .._validate import as_nonnegative, as_step_count
 from ..analysis.discrete import (
-    _cubic_bspline,
+    check_cubic_bspline,
     corner_cut_ratios,
     second_discrete_curvature,
 )
 from ..errors import InputError
 from .ranking import tt_build, tt_top, tt_update
 from .stop import StopReason
+
+if TYPE_CHECKING:
+    from .problem import FairingProblem, Outcome
 
 __all__ = ["cheng_yu", "cheng_yu_driver", "CYResult"]
 
@@ -114,7 +117,7 @@ def _step_factor(Q, Q0, m0, m1, r0, r1, a, b, pair, e, tmp0, tmp1):  # type: ign
     """Largest ``s = 1 - d`` in ``[0, 1]`` with the error bound kept on all of ``[0, s]``
     (one point: closed form; two points: sampled, then bisected). The returned ``s`` satisfies
     the bound as computed."""
-    if e < 0.0:  # no bound
+    if e == np.inf:  # no bound
         return 1.0
     e = e * (1.0 - 1e-12)  # margin: the bound then survives any re-rounding of the distance
     if not pair:
@@ -176,7 +179,7 @@ def _step_factor(Q, Q0, m0, m1, r0, r1, a, b, pair, e, tmp0, tmp1):  # type: ign
 def _plan(Q, Q0, W, n, closed, m0, pair, e, dfix, new0, new1):  # type: ignore[no-untyped-def]
     """New positions of ``Q[m0]`` (and ``Q[m0+1]`` if ``pair``); returns the factor ``d`` used.
 
-    ``e < 0`` means no bound; ``dfix >= 0`` forces the factor.
+    ``e = inf`` means no bound; ``dfix >= 0`` forces the factor.
     """
     dim = Q.shape[1]
     m1 = (m0 + 1) % n if closed else m0 + 1
@@ -304,14 +307,14 @@ def cheng_yu(curve: Any, m: int, e: float | None = None, pair: bool = False, *,
     >>> bool(cheng_yu(c, 4).control_points[4, 1] == 0.0)   # d = 0: the E_2 minimiser
     True
     """
-    curve = _cubic_bspline(curve, "cheng_yu")
+    curve = check_cubic_bspline(curve, "cheng_yu")
     n = curve.n_ctrl
     closed = bool(curve.closed)
     pair = bool(pair)
     m = _as_index(m, n, closed, pair)
     if e is not None and d is not None:
         raise InputError("give either the error bound e or the factor d, not both")
-    ebound = -1.0
+    ebound = np.inf
     dfix = -1.0
     if e is not None:
         try:
@@ -330,7 +333,7 @@ def cheng_yu(curve: Any, m: int, e: float | None = None, pair: bool = False, *,
     Q = np.array(curve.control_points, dtype=float)
     Q0 = _original_points(original, curve)
     moved = [m, (m + 1) % n] if pair else [m]
-    if ebound > 0:
+    if ebound < np.inf:
         for j in moved:
             dist = float(np.linalg.norm(Q[j] - Q0[j]))
             if dist > ebound * (1 + 1e-12):
@@ -608,25 +611,6 @@ def _run(Q, Q0, W, lw, mw, closed, planar, movable, e, eps, max_steps,  # type: 
     return steps, reason
 
 
-_CLAMP_POINTS = {"none": 0, "g0": 1, "g1": 2, "g2": 3}
-
-
-def _movable(curve: Any, clamp: Any, protect: Iterable[int]) -> np.ndarray:
-    """Control points the driver may move: not clamped (open curves), not protected."""
-    n = curve.n_ctrl
-    counts = [_CLAMP_POINTS[c] for c in parse_clamp(clamp)]
-    mask = np.ones(n, dtype=np.bool_)
-    if not curve.closed:  # closed curves have no ends: the clamp is ignored
-        mask[: counts[0]] = False
-        if counts[1]:
-            mask[n - counts[1]:] = False
-    for i in protect:
-        if isinstance(i, bool) or not isinstance(i, (int, np.integer)) or not 0 <= int(i) < n:
-            raise InputError(f"protect index {i!r} is out of range [0, {n - 1}]")
-        mask[int(i)] = False
-    return mask
-
-
 _STOP: dict[int, StopReason] = {_NONE_LEFT: "no_improvement", _EPS: "eps", _CONVERGED: "converged",
          _MAX_STEPS: "max_steps"}
 
@@ -726,13 +710,24 @@ def cheng_yu_driver(curve: Any, *, tol: float | None = None, eps: float = 1e-8,
     >>> bool(res.indicator_after < res.indicator_before)
     True
     """
-    curve = _cubic_bspline(curve, "method 'cheng-yu' (Cheng & Yu's second discrete curvature)")
+    from .problem import make_problem
+
+    curve = check_cubic_bspline(curve, "method 'cheng-yu' (Cheng & Yu's second discrete curvature)")
+    prob = make_problem(curve, tol=tol, eps=as_nonnegative(eps, "eps"), max_steps=max_steps,
+                        clamp=clamp, protect=protect)
+    return _solve(prob, pair=pair, relative=relative)
+
+
+def _solve(problem: FairingProblem, *, pair: bool, relative: bool) -> CYResult:
+    from .problem import eps_threshold
+
+    curve = check_cubic_bspline(problem.curve,
+                           "method 'cheng-yu' (Cheng & Yu's second discrete curvature)")
     n = curve.n_ctrl
     closed = bool(curve.closed)
-    e = as_nonnegative(tol, "tol", none_means=-1.0, window=True)  # -1: no tolerance
-    epsv = as_nonnegative(eps, "eps")
-    max_steps = as_step_count(max_steps, default=100 * n)
-    mask = _movable(curve, clamp, protect)
+    e = problem.tol
+    max_steps = as_step_count(problem.max_steps, default=100 * n)
+    mask = problem.movable
     sdc = second_discrete_curvature(curve)  # validates (raises at a true corner)
     knots = np.asarray(curve.knots, dtype=float)
     lw, mw = corner_cut_ratios(knots, n, closed)
@@ -745,7 +740,10 @@ def cheng_yu_driver(curve: Any, *, tol: float | None = None, eps: float = 1e-8,
     Q0 = Q.copy()
     W = np.ascontiguousarray(curve.gram_band(2), dtype=float)
     x0 = sdc.indicator
-    eps_abs = epsv * x0 if relative else epsv
+    if relative:
+        _, eps_abs = eps_threshold(problem.eps, x0, 1e-8)
+    else:
+        eps_abs = 0.0 if problem.eps is None else problem.eps
     hist = np.zeros(int(max_steps) + 1)
     moves = np.zeros((int(max_steps), 4))
     planar = Q.shape[1] == 2
@@ -768,36 +766,31 @@ def cheng_yu_driver(curve: Any, *, tol: float | None = None, eps: float = 1e-8,
 # --------------------------------------------------------------------------------------------
 # registration with curvefair.fair
 # --------------------------------------------------------------------------------------------
-def _fair_driver(curve: Any, *, tol: float | None = None, eps: float | None = None,
-                 max_steps: int | None = None, clamp: Any = ("g0", "g0"),
-                 protect: Iterable[int] = frozenset(), pair: bool = True,
-                 relative: bool | None = None) -> Any:
-    """``fair(curve, "cheng-yu", ...)``: :func:`cheng_yu_driver` wrapped for the registry.
+def solve(problem: FairingProblem, *, pair: bool = True, relative: bool = True) -> Outcome:
+    """Cheng & Yu as a solver of ``problem`` (``fair(curve, "cheng-yu", ...)``).
 
-    ``eps=None`` means ``1e-8`` relative to the input's fairing indicator; an explicit ``eps``
-    is absolute (compared with ``z_i = D_i**2``) unless ``relative=True`` is passed.
+    ``eps`` is relative to the input's fairing indicator ``x = sum D_i**2`` (default ``1e-8``);
+    ``relative=False`` makes it an absolute threshold on ``z_i = D_i**2`` (default 0).
     """
     from ..analysis.discrete import bad_points
-    from .fair import DriverOutput, FairingHistory
+    from .problem import FairingHistory, Outcome
 
-    if eps is None:
-        epsv, rel = 1e-8, True if relative is None else bool(relative)
-    else:
-        epsv, rel = float(eps), False if relative is None else bool(relative)
-    res = cheng_yu_driver(curve, tol=tol, eps=epsv, relative=rel, max_steps=max_steps,
-                          clamp=clamp, protect=protect, pair=pair)
+    res = _solve(problem, pair=bool(pair), relative=bool(relative))
     h = res.history
-    history = FairingHistory.from_arrays(h["index"][1:], h["z"][1:], h["displacement"][1:])
+    history = FairingHistory.from_arrays(h["index"][1:], h["z"][1:], h["displacement"][1:],
+                                         "control point")
     extra = {
         "indicator_before": res.indicator_before,
         "indicator_after": res.indicator_after,
         "pair_steps": int(np.sum(h["n_moved"] == 2)),
-        "bad_points_before": len(bad_points(curve)),
+        "bad_points_before": len(bad_points(problem.curve)),
         "bad_points_after": len(bad_points(res.curve)),
     }
-    return DriverOutput(res.curve, res.steps, res.stop_reason, history, eps=res.threshold,
-                        max_steps=100 * curve.n_ctrl if max_steps is None else int(max_steps),
-                        extra=extra)
+    epsv = (1e-8 if relative else 0.0) if problem.eps is None else problem.eps
+    n = problem.curve.n_ctrl  # type: ignore[attr-defined]
+    return Outcome(res.curve, res.steps, res.stop_reason, history, eps=epsv,
+                   max_steps=100 * n if problem.max_steps is None else problem.max_steps,
+                   extra=extra, eps_absolute=res.threshold)
 
 
 def _register() -> None:
@@ -813,7 +806,7 @@ def _register() -> None:
     register_method(MethodSpec(
         name="cheng-yu",
         curve_types=(BSplineCurve,),
-        driver=_fair_driver,
+        solver=solve,
         accepts=lambda c: c.degree == 3,
         summary="Cheng & Yu: move the worst bad control points (second discrete curvature) "
                 "towards the local E2 minimiser within the tolerance",

@@ -18,17 +18,20 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
 from .._jit import njit
 from .._typing import FloatArray
-from .._validate import as_nonnegative, as_step_count, check_finite, choice, parse_clamp
+from .._validate import as_step_count, check_finite, choice, parse_clamp
 from ..curves.bspline import BSplineCurve, band_energy, band_residual, residual_row
 from ..errors import InputError
 from ._prefetch import prefetch
 from .stop import StopReason
+
+if TYPE_CHECKING:
+    from .problem import FairingProblem, Outcome
 
 __all__ = [
     "eck_hadenfeld",
@@ -77,9 +80,6 @@ def check_schedule(schedule: object) -> str:
     return choice(schedule, SCHEDULES, "schedule")
 
 
-CLAMP_POINTS = {"none": 0, "g0": 1, "g1": 2, "g2": 3}
-
-
 def movable_mask(curve: BSplineCurve, clamp: Any = (None, None),
                  protect: Iterable[int] = ()) -> np.ndarray:
     """Boolean mask of the control points a method may move.
@@ -91,16 +91,11 @@ def movable_mask(curve: BSplineCurve, clamp: Any = (None, None),
     both ends. Closed curves have no ends: the clamp is ignored.
     ``protect``: control-point indices that never move.
     """
+    from .problem import fixed_mask
+
     n = curve.n_ctrl
-    counts = [CLAMP_POINTS[c] for c in parse_clamp(clamp)]
-    mask = np.ones(n, dtype=bool)
-    if not curve.closed:
-        mask[: counts[0]] = False
-        if counts[1]:
-            mask[n - counts[1]:] = False
-    for i in protect:
-        mask[check_index(i, n, "protect index")] = False
-    return mask
+    prot = [check_index(i, n, "protect index") for i in protect]
+    return ~fixed_mask(curve, parse_clamp(clamp), prot)
 
 
 # ------------------------------------------------------------------------------------------
@@ -396,7 +391,7 @@ def _eh_loop(X, z, Wu, pat, upat, ulo, uhi, D, p, closed, tol, eps_abs, max_step
     ``Wu[pat[i]]`` (rows shared by equal knot patterns), and every row ``ulo <= i < uhi`` is
     ``Wu[upat]`` (the longest run of one pattern: the uniform interior, whose ``pat`` entries are
     then never read). Everything is written out in this one function: calling numba functions
-    with array arguments costs reference counting per call, which dominated an earlier version.
+    with array arguments costs reference counting per call.
 
     4-ary tournament tree over blocks of 8 control points, one array ``T`` of (value, index)
     pairs (the index stored as a float, exact below 2**53; a node's 4 children are one 64-byte
@@ -408,8 +403,7 @@ def _eh_loop(X, z, Wu, pat, upat, ulo, uhi, D, p, closed, tol, eps_abs, max_step
     their one or two blocks rescanned and the ancestors repaired (level by level as a contiguous
     range until the range is one node, then along its path with the node carried in registers,
     which keeps a store-to-load round trip off every level): ``O(p + log N)`` per step. At 1e6
-    points the 4-ary tree touches 9 cache lines per path instead of the binary tree's 17 (15 %
-    more steps per second; the binary carried climb was as fast as this one only in cache).
+    points the 4-ary tree touches 9 cache lines per path instead of the binary tree's 17.
 
     On large curves the step is bound by memory latency (the next point is usually far away).
     The data of the runner-up (which is the next point whenever this move does not change its
@@ -420,22 +414,10 @@ def _eh_loop(X, z, Wu, pat, upat, ulo, uhi, D, p, closed, tol, eps_abs, max_step
     cache; walking the whole path cost more than the prefetch saved), which finds it unless it
     shares the winner's subtree 3 levels down. Prefetches never change results.
 
-    Measured limits at 1e6 points (2-core shared VM, DRAM latency ~160 ns by pointer chase,
-    ~100 ns already at 8 MB): a step costs ~170-190 ns, ~60 ns in cache; without the runner-up
-    prefetch 4.0 instead of 5.8 M steps/s. The runner-up is the next point in 95 % of the first
-    300k steps (65 % over 3M, the rest almost all local moves, 2 % far misses), and prefetching
-    from a recorded oracle one step ahead is no faster: the one-ahead guess is as good as it
-    gets. An oracle two steps ahead is 20-25 % faster, but every computed two-ahead guess tried
-    (best outside the top-level paths of the winner and the runner-up: 88 % right early, 55 %
-    over 2M steps; cheaper one-path variants) cost as much as it saved (-7 .. +5 %), as did
-    storing the move with ``z`` (no candidate recomputation per step: 0 % at 1e6), a shorter
-    carried chain in the climb (one select per level against the siblings' precomputed best:
-    -7 .. -14 %) and a parallel runner-up walk (0 %).
-
     ``hist`` (shape (cap, 3)) receives (index, z, displacement) of the first ``cap`` steps.
     ``T`` is the tree's storage, shape ``(>= 2 P, 2)`` (:func:`_tree_buffer`): allocated by
-    numpy, which asks for transparent huge pages on large arrays (numba's allocator does not,
-    and first-touch faults of 4 KiB pages cost ~25 ms per 50 MB), and 64-byte aligned.
+    numpy, which asks for transparent huge pages on large arrays (numba's allocator does not:
+    fewer first-touch page faults), and 64-byte aligned.
     Returns (steps, total energy drop, stop code, number of history rows).
     """
     n = X.shape[0]
@@ -930,18 +912,9 @@ def eck_hadenfeld_fair(curve: BSplineCurve, *, l: int = 2, tol: float | None = N
         Stop when the largest ranking number is below ``eps * E_l(input)``
         (``eps_relative=True``; default ``1e-4 / n``, i.e. ``1e-4`` of the mean energy per
         control point, which gives the same local accuracy for every ``n``) or below ``eps``
-        (``eps_relative=False``; default 0). On noisy data most steps after the first few per
-        control point are the slow Gauss-Seidel drift of the long waves within the tolerance:
-        a 1e6-point interpolant of noisy samples (``benchmarks/bench_bspline_e2e.py``) takes
-        21 steps per control point at the default, 5 at ``3e-4 / n`` and 2.5 at
-        ``1e-3 / n``, ending 1.2 % and 1.7 % higher in ``E_2``; against csaps' smoothing
-        spline at the same maximum deviation it is fairer in both ``E_2`` and ``E_3`` up to
-        ``6e-4 / n`` (3.3 steps per control point) and slightly less fair in ``E_2`` from
-        ``7e-4 / n`` (ratio 1.0001; ``1e-3 / n``: 1.001, ``E_3`` 1.035). The default is kept:
-        over 54 data sets of three curve families (``benchmarks/bench_eh_stopping.py``) every
-        larger threshold ends less fair (``6e-4 / n``: ``E_2`` +1.5 % median on that
-        benchmark's family, +11 % median and up to 2.1x on long waves, where even the default
-        stops far from the loop's limit; pass a smaller ``eps`` there).
+        (``eps_relative=False``; default 0). Larger thresholds take fewer steps and end less
+        fair; the trade-off is measured in docs/benchmarks.md ("Eck-Hadenfeld: threshold and
+        schedule").
     max_steps : int or None
         Step cap (default ``100 n``).
     clamp : (left, right)
@@ -956,17 +929,10 @@ def eck_hadenfeld_fair(curve: BSplineCurve, *, l: int = 2, tol: float | None = N
         - every control point whose ranking number is at least the threshold, in index order,
         then again every neighbour of a moved point whose number may have reached it, until
         none does (see ``_eh_sweep``). Same step, same tolerance, same stopping test (when
-        it stops, no ranking number is above the threshold); only the order differs. The
-        sweep reads memory in order instead of jumping across the curve: at 1e6 control
-        points 3-5x the steps per second (``benchmarks/bench_bspline_eh_steps.py``). It takes
-        up to 1.7x the steps at the same ``eps`` and ends as fair or fairer: over 54 noisy
-        data sets equal on sines, 2-3 % lower ``E_3`` on a spiral and far fairer on long
-        waves (``E_2`` -7..-15 %, ``E_3`` about 1/100 relative to csaps at equal deviation,
-        ``benchmarks/bench_eh_stopping.py --schedules ranking sweep``); the ranking list
-        leaves every ranking number just below the threshold, the sweep most of them far
-        below. 1e6 noisy points, tol 0.3, against csaps at equal maximum deviation
-        (``benchmarks/bench_bspline_e2e.py``): sweep at ``eps = 3e-4 / n`` 0.59x csaps' time,
-        ``E_2`` 0.996 and ``E_3`` 0.910 of csaps'; ranking list at the default 3.7x.
+        it stops, no ranking number is above the threshold); only the order differs: the
+        sweep reads memory in order instead of jumping across the curve, and leaves most
+        ranking numbers far below the threshold where the ranking list leaves them just
+        below it (measurements: docs/benchmarks.md, "Eck-Hadenfeld: threshold and schedule").
 
     Returns
     -------
@@ -998,24 +964,51 @@ def eck_hadenfeld_fair(curve: BSplineCurve, *, l: int = 2, tol: float | None = N
     >>> bool(res.energy_after < res.energy_before)
     True
     """
-    curve = check_bspline(curve)
+    from .problem import make_problem
+
+    prob = make_problem(check_bspline(curve), tol=tol, eps=eps, max_steps=max_steps,
+                        clamp=clamp, protect=protect)
+    out = solve(prob, l=l, eps_relative=eps_relative, history_max=history_max,
+                schedule=schedule)
+    h = out.history
+    assert h is not None
+    hist = np.column_stack([h.index.astype(np.float64), h.measure, h.displacement])
+    return EHResult(cast(BSplineCurve, out.curve), out.steps, out.stop_reason,
+                    out.extra["energy_l_before"], out.extra["energy_l_after"],
+                    cast(float, out.eps_absolute), hist.reshape(-1, 3))
+
+
+def solve(problem: FairingProblem, *, l: int = 2, eps_relative: bool = True,  # noqa: E741
+          history_max: int = 1_000_000, schedule: str = "sweep") -> Outcome:
+    """Eck & Hadenfeld as a solver of ``problem`` (``fair(curve, "eck-hadenfeld")``).
+
+    ``problem.eps`` is relative to ``E_l(input)`` (default :func:`default_eps`);
+    ``eps_relative=False`` makes it an absolute threshold on the ranking numbers (default 0).
+    The order defaults to ``"sweep"`` here, :func:`eck_hadenfeld_fair` keeps the paper's
+    ranking list (docs/benchmarks.md, "Eck-Hadenfeld schedule").
+    """
+    from .problem import FairingHistory, Outcome, eps_threshold
+
+    curve = check_bspline(problem.curve)
     lv = check_l(l, curve.degree)
     n = curve.n_ctrl
-    tolv = as_nonnegative(tol, "tol", none_means=np.inf, window=True)
-    epsv = (default_eps(n) if eps_relative else 0.0) if eps is None else as_nonnegative(eps, "eps")
-    max_steps = as_step_count(max_steps, default=100 * n)
+    tolv = problem.tol
+    max_steps = as_step_count(problem.max_steps, default=100 * n)
     history_max = as_step_count(history_max, "history_max", default=1_000_000)
     if not isinstance(eps_relative, (bool, np.bool_)):
         raise InputError(f"eps_relative must be True or False, got {eps_relative!r}")
     sched = check_schedule(schedule)
-    mask = movable_mask(curve, clamp, protect)
+    mask = problem.movable
     W = np.ascontiguousarray(curve.gram_band(lv))
     dim = curve.dim
     d = np.ascontiguousarray(curve.control_points)
     X = _aligned_empty((n, 3 * dim))  # [d | g = G d | d original]
     z = _aligned_empty((n,))
     e0 = float(_setup_state(W, curve.degree, curve.closed, d, mask, X, z))
-    eps_abs = epsv * e0 if eps_relative else epsv
+    if eps_relative:
+        epsv, eps_abs = eps_threshold(problem.eps, e0, default_eps(n))
+    else:
+        epsv = eps_abs = 0.0 if problem.eps is None else problem.eps
     hist = np.zeros((int(min(history_max, max_steps)), 3))
     Wu, pat, upat, ulo, uhi = band_patterns(W)
     if sched == "ranking":
@@ -1029,8 +1022,7 @@ def eck_hadenfeld_fair(curve: BSplineCurve, *, l: int = 2, tol: float | None = N
                                           np.empty(n, dtype=np.uint8))
     # the loop keeps every coordinate finite and the knots are the input's: no re-validation
     out = BSplineCurve._trusted(np.ascontiguousarray(X[:, :dim]), curve.knots, curve.degree,
-                                curve.closed)
-    out._gram_cache = curve._gram_cache  # same knots: the Gram matrices are shared
+                                curve.closed, same_knots_as=curve)
     e1 = _energy(out, W)
     if not np.isfinite(e1):
         check_finite(out.control_points, "control_points")
@@ -1042,47 +1034,27 @@ def eck_hadenfeld_fair(curve: BSplineCurve, *, l: int = 2, tol: float | None = N
         elif eps_abs > 0.0 and zfree > 0.0:
             reason = "eps"
     # a view: the rows never written were never touched (np.zeros maps them lazily)
-    return EHResult(out, int(steps), reason, e0, e1, eps_abs, hist[:nh])
+    h = hist[:nh]
+    history = FairingHistory.from_arrays(h[:, 0].astype(np.int64), h[:, 1], h[:, 2],
+                                         "control point")
+    return Outcome(
+        curve=out, steps=int(steps), stop_reason=reason, history=history, eps=epsv,
+        max_steps=int(max_steps), eps_absolute=eps_abs,
+        extra={"l": int(l), "schedule": sched, "energy_l_before": e0, "energy_l_after": e1,
+               "eps_relative": bool(eps_relative), "eps_absolute": eps_abs,
+               "history_truncated": bool(steps > h.shape[0])})
 
 
 # ------------------------------------------------------------------------------------------
 # registration with fair()
 # ------------------------------------------------------------------------------------------
-def _driver(curve: BSplineCurve, *, tol: float | None, eps: float | None, max_steps: int | None,
-            clamp: Any, protect: Iterable[int], l: int = 2,  # noqa: E741
-            eps_relative: bool = True, history_max: int = 1_000_000,
-            schedule: str = "sweep") -> Any:
-    """``fair(curve, "eck-hadenfeld")``: the paper's step, tolerance and stopping test; the
-    order defaults to ``"sweep"``, chosen from the benchmarks (as fair or fairer on all 54 data
-    sets of ``benchmarks/bench_eh_stopping.py``, 3-5x the steps per second at 1e6 control
-    points). ``eck_hadenfeld_fair`` itself keeps the paper's ranking list as its default, and
-    ``schedule="ranking"`` selects it here."""
-    from .fair import DriverOutput, FairingHistory
-
-    res = eck_hadenfeld_fair(curve, l=l, tol=tol, eps=eps, eps_relative=eps_relative,
-                             max_steps=max_steps, clamp=clamp, protect=protect,
-                             history_max=history_max, schedule=schedule)
-    h = res.history
-    hist = FairingHistory.from_arrays(h[:, 0].astype(np.int64), h[:, 1], h[:, 2])
-    n = curve.n_ctrl
-    return DriverOutput(
-        curve=res.curve, steps=res.steps, stop_reason=res.stop_reason, history=hist,
-        eps=(default_eps(n) if eps_relative else 0.0) if eps is None else eps,
-        max_steps=100 * n if max_steps is None else max_steps,
-        extra={"l": int(l), "schedule": check_schedule(schedule),
-               "energy_l_before": res.energy_before,
-               "energy_l_after": res.energy_after, "eps_relative": bool(eps_relative),
-               "eps_absolute": res.eps_absolute,
-               "history_truncated": bool(res.steps > h.shape[0])})
-
-
 def _register() -> None:
     from .fair import MethodSpec, register_method
 
     register_method(MethodSpec(
         name="eck-hadenfeld",
         curve_types=(BSplineCurve,),
-        driver=_driver,
+        solver=solve,
         summary="Eck & Hadenfeld: move control points to their energy-minimising positions "
                 "(E_l, l=2|3), within tol of the original; default schedule=sweep (the same "
                 "steps in Gauss-Seidel order, as fair or fairer on 54 benchmark data sets), "

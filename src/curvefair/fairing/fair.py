@@ -8,6 +8,7 @@ points moved and how far, the largest deviation of the curve).
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import inspect
 import math
@@ -22,7 +23,7 @@ from .._typing import FloatArray
 from ..curves.piecewise import PiecewiseCurve, readonly
 from ..errors import InputError
 from ..interop import as_curve as _as_curve
-from .stop import StopReason
+from .problem import FairingHistory, FairingProblem, Outcome, make_problem
 
 if TYPE_CHECKING:
     from ..curves.bspline import BSplineCurve
@@ -30,6 +31,8 @@ if TYPE_CHECKING:
 __all__ = [
     "MethodSpec",
     "DriverOutput",
+    "Outcome",
+    "FairingProblem",
     "FairingHistory",
     "FairingResult",
     "FairingReport",
@@ -49,89 +52,8 @@ MODES = ("spline", "hermite")
 # ----------------------------------------------------------------------------------------------
 # data classes
 # ----------------------------------------------------------------------------------------------
-@dataclass(frozen=True, eq=False)
-class FairingHistory:
-    """What each step of a fairing loop did, as compact arrays (one entry per step).
-
-    Attributes
-    ----------
-    step : ndarray of int64, shape (s,)
-        Step number, 1-based.
-    index : ndarray of int64, shape (s,)
-        The data point (control point) moved, 0-based.
-    measure : ndarray of float64, shape (s,)
-        Its ranking measure just before the move (e.g. the third-derivative jump).
-    displacement : ndarray of float64, shape (s,)
-        Length of that move.
-    """
-
-    step: np.ndarray
-    index: np.ndarray
-    measure: np.ndarray
-    displacement: np.ndarray
-
-    @classmethod
-    def from_arrays(cls, index: Iterable[int], measure: Iterable[float],
-                    displacement: Iterable[float]) -> "FairingHistory":
-        """Build from per-step arrays; step numbers are ``1 .. len(index)``."""
-        idx = np.asarray(index, dtype=np.int64).reshape(-1)
-        meas = np.asarray(measure, dtype=np.float64).reshape(-1)
-        disp = np.asarray(displacement, dtype=np.float64).reshape(-1)
-        if not idx.shape == meas.shape == disp.shape:
-            raise InputError("history arrays must have the same length, got "
-                             f"{idx.shape[0]}, {meas.shape[0]}, {disp.shape[0]}")
-        arrs = [np.arange(1, idx.shape[0] + 1, dtype=np.int64), idx, meas, disp]
-        return cls(*[readonly(a) for a in arrs])
-
-    @classmethod
-    def empty(cls) -> "FairingHistory":
-        return cls.from_arrays([], [], [])
-
-    def __len__(self) -> int:
-        return int(self.index.shape[0])
-
-    def to_dict(self) -> dict[str, list[Any]]:
-        """Plain lists (JSON-serialisable; non-finite measures become None)."""
-        return {
-            "step": self.step.tolist(),
-            "index": self.index.tolist(),
-            "measure": [_finite_or_none(v) for v in self.measure.tolist()],
-            "displacement": [_finite_or_none(v) for v in self.displacement.tolist()],
-        }
-
-
-@dataclass
-class DriverOutput:
-    """What a method's driver returns to :func:`fair`.
-
-    Attributes
-    ----------
-    curve : PiecewiseCurve
-        The faired curve (same type as the input).
-    steps : int
-        Steps taken (moves actually made).
-    stop_reason : str
-        ``"eps"`` (largest measure below eps), ``"max_steps"``, ``"tolerance"`` (every remaining
-        move above eps is blocked by the tolerance or protection), ``"converged"`` (every
-        remaining move is ~0), or a method-specific reason.
-    history : FairingHistory or None
-    eps, max_steps : optional
-        The effective values when the driver chose defaults (reported).
-    extra : dict
-        Method-specific report entries (JSON-serialisable).
-    curve_within_tol : bool
-        The method promises the whole curve within ``tol`` (not only the data points):
-        :func:`fair` then certifies the curve deviation and scales the moves back if needed.
-    """
-
-    curve: PiecewiseCurve
-    steps: int
-    stop_reason: StopReason
-    history: FairingHistory | None = None
-    eps: float | None = None
-    max_steps: int | None = None
-    extra: dict[str, Any] = field(default_factory=dict)
-    curve_within_tol: bool = True
+#: What a method returns to :func:`fair`: the one outcome type (:class:`.problem.Outcome`).
+DriverOutput = Outcome
 
 
 @dataclass(frozen=True)
@@ -144,11 +66,15 @@ class MethodSpec:
         The ``method=`` name.
     curve_types : tuple of type
         Curve classes the method accepts.
-    driver : callable
-        ``driver(curve, *, tol, eps, max_steps, clamp, protect, **options) -> DriverOutput``;
-        ``clamp`` is a ``(left, right)`` pair of ``"g0" | "g1" | "g2"``, ``protect`` a frozenset
-        of 0-based data-point indices (control points for B-splines; a closed Hermite curve's seam
-        is index 0).
+    driver : callable or None
+        ``driver(curve, *, tol, eps, max_steps, clamp, protect, **options) -> Outcome``, the
+        keyword form (``tol=None`` for no tolerance, ``clamp`` a ``(left, right)`` pair,
+        ``protect`` a frozenset of 0-based data-point indices: control points for B-splines;
+        a closed Hermite curve's seam is index 0). With a ``solver`` it is derived from it.
+    solver : callable or None
+        ``solver(problem, **options) -> Outcome``: the method as a solver of a
+        :class:`~curvefair.fairing.problem.FairingProblem`, its keyword parameters its options.
+        :func:`fair` calls the solver when there is one, else the driver.
     summary : str
         One line for listings.
     source : str
@@ -179,9 +105,9 @@ class MethodSpec:
 
     name: str
     curve_types: tuple[type, ...]
-    driver: Callable[..., DriverOutput]
-    summary: str
-    source: str
+    driver: Callable[..., Outcome] = field(default_factory=lambda: _no_driver)
+    summary: str = ""
+    source: str = ""
     default: bool = False
     modes: tuple[str, ...] = ("spline",)
     accepts: Callable[[Any], bool] | None = None
@@ -190,6 +116,41 @@ class MethodSpec:
     default_options: dict[str, Any] | Callable[[Any], dict[str, Any]] = field(
         default_factory=dict)
     default_reason: str = ""
+    solver: Callable[..., Outcome] | None = None
+
+    def __post_init__(self) -> None:
+        if self.driver is None:  # spelled out by a caller
+            object.__setattr__(self, "driver", _no_driver)
+        if self.solver is None and self.driver is _no_driver:
+            raise InputError(f"method {self.name!r} needs a solver or a driver")
+        if self.driver is _no_driver:
+            object.__setattr__(self, "driver", functools.partial(
+                _solver_as_driver, cast("Callable[..., Outcome]", self.solver)))
+
+    def run(self, problem: FairingProblem, options: dict[str, Any]) -> Outcome:
+        """Solve ``problem`` with this method (its solver, else its driver)."""
+        if self.solver is not None:
+            return self.solver(problem, **options)
+        kw = dict(options)
+        if self.modes != ("spline",):
+            kw["mode"] = problem.mode
+        return self.driver(problem.curve, tol=problem.tol_or_none, eps=problem.eps,
+                           max_steps=problem.max_steps, clamp=problem.clamp,
+                           protect=problem.protect, **kw)
+
+
+def _no_driver(*args: Any, **kwargs: Any) -> Outcome:  # placeholder until __post_init__
+    raise TypeError("MethodSpec without a driver")
+
+
+def _solver_as_driver(solver: Callable[..., Outcome], curve: PiecewiseCurve, *,
+                      tol: float | None, eps: float | None, max_steps: int | None,
+                      clamp: tuple[str, str], protect: frozenset[int], mode: str = "spline",
+                      **options: Any) -> Outcome:
+    """The keyword (driver) form of a solver: the problem built from already checked values."""
+    prob = FairingProblem(curve, math.inf if tol is None else float(tol), eps, max_steps,
+                          tuple(clamp), frozenset(protect), mode, dict(options))  # type: ignore[arg-type]
+    return solver(prob, **options)
 
 
 class FairingReport(dict):  # type: ignore[type-arg]
@@ -271,12 +232,12 @@ def _driver_options(spec: MethodSpec) -> tuple[dict[str, Any], bool]:
     (:data:`_STANDARD_ARGS`) and keywords bound by a :func:`functools.partial` driver are not
     options. A driver whose signature cannot be read is taken to accept anything.
     """
+    fn = spec.solver if spec.solver is not None else spec.driver
     try:
-        sig = inspect.signature(spec.driver)
+        sig = inspect.signature(fn)  # type: ignore[arg-type]
     except (TypeError, ValueError):
         return {}, True
-    bound = (set(spec.driver.keywords) if isinstance(spec.driver, functools.partial)
-             else set())
+    bound = set(fn.keywords) if isinstance(fn, functools.partial) else set()
     opts: dict[str, Any] = {}
     var_kw = False
     for k, p in enumerate(sig.parameters.values()):
@@ -396,33 +357,6 @@ def normalize_clamp(clamp: object) -> tuple[str, str]:
     return parse_clamp(clamp)
 
 
-def normalize_protect(protect: object, curve: PiecewiseCurve) -> frozenset[int]:
-    """Validate protected data-point indices; a closed Hermite curve maps ``n-1`` to the seam 0."""
-    n_stored = (int(curve.control_points.shape[0]) if hasattr(curve, "control_points")  # type: ignore[attr-defined]
-                else int(np.asarray(curve.points).shape[0]))  # type: ignore[attr-defined]
-    seam_alias = curve.closed and not hasattr(curve, "control_points")
-    if protect is None:
-        return frozenset()
-    if isinstance(protect, (int, np.integer)) and not isinstance(protect, bool):
-        items: list[object] = [protect]
-    else:
-        try:
-            items = list(protect)  # type: ignore[call-overload]
-        except TypeError:
-            raise InputError(f"protect must be a sequence of point indices, got {protect!r}"
-                             ) from None
-    out = set()
-    for v in items:
-        if isinstance(v, bool) or not isinstance(v, (int, np.integer)):
-            raise InputError(f"protect must contain integer point indices, got {v!r}")
-        i = int(v)
-        if not 0 <= i < n_stored:
-            raise InputError(f"protect index {i} is out of range: the curve has {n_stored} "
-                             f"data points (valid: 0 .. {n_stored - 1})")
-        out.add(0 if (seam_alias and i == n_stored - 1) else i)
-    return frozenset(out)
-
-
 def _default_method(curve: PiecewiseCurve, clamp: object = "g0") -> MethodSpec:
     # a default with an ``accepts`` condition that holds is more specific than one without
     # (e.g. 'points-l1' for open cubic Hermite point data, 'poliakoff' for the closed ones),
@@ -451,7 +385,9 @@ def _default_method(curve: PiecewiseCurve, clamp: object = "g0") -> MethodSpec:
     raise InputError(f"no fairing method is registered for {type(curve).__name__}")
 
 
-def _analysis_block(curve: PiecewiseCurve) -> dict[str, Any]:
+def analysis_block(curve: PiecewiseCurve) -> dict[str, Any]:
+    """The report's figures of one curve (:func:`curvefair.analyze`): energies, largest jumps,
+    Sapidis sum, ``int (dkappa/ds)^2 ds``, inflection and curvature-extremum counts."""
     from ..analysis import analyze
 
     a = analyze(curve)
@@ -467,6 +403,9 @@ def _analysis_block(curve: PiecewiseCurve) -> dict[str, Any]:
         "inflections": int(len(inf)) if not isinstance(inf, (int, np.integer)) else int(inf),
         "extrema": int(len(ext)) if not isinstance(ext, (int, np.integer)) else int(ext),
     }
+
+
+_analysis_block = analysis_block  # the former name (used inside the fairing package)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -504,9 +443,12 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
         left outside ``np.linalg.norm(moved - original) <= tol`` back along its move and
         certifies the curve deviation on the difference curve.
     eps : float >= 0, optional
-        Stop when the largest ranking measure is below ``eps``; ``0`` runs until ``max_steps``
-        or until the tolerance blocks every move. Default: method-specific (relative to the
-        initial largest measure; see the method's notes).
+        Stop when the method's ranking measure falls below ``eps`` times its initial fairness
+        measure ``R`` (the same meaning for every method: the largest initial bad-point measure
+        for the Hermite methods and knot removal, ``E_l(input)`` for eck-hadenfeld and global,
+        the indicator ``sum D_i**2`` for cheng-yu; table in :mod:`curvefair.fairing.problem`).
+        ``0`` runs until ``max_steps`` or until the tolerance blocks every move. Default:
+        method-specific. The report gives ``eps`` and the threshold ``eps_absolute``.
     max_steps : int >= 0, optional
         Step cap (default method-specific).
     clamp : {"none", "g0", "g1", "g2"} (any case) or (left, right)
@@ -608,20 +550,20 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
             f"method {spec.name!r} needs a {' or '.join(t.__name__ for t in spec.curve_types)}, "
             f"got {type(curve).__name__}; methods for this curve: "
             + ", ".join(repr(m) for m in available_methods(curve)))
-    from .._validate import as_nonnegative, as_positive, as_step_count
+    from .._validate import as_nonnegative
 
-    tol_v = as_positive(tol, "tol", allow_none=True, window=True)
-    eps_v = None if eps is None else as_nonnegative(eps, "eps")
-    if max_steps is not None:
-        max_steps = as_step_count(max_steps, default=0)
-    clamp_pair = normalize_clamp(clamp)
+    # the one parse of the shared options (curvefair.fairing.problem)
+    problem = make_problem(curve, tol=tol, eps=eps, max_steps=max_steps, clamp=clamp,
+                           protect=protect, mode=mode, options=options)
+    tol_v = problem.tol_or_none
+    eps_v, clamp_pair, prot = problem.eps, problem.clamp, problem.protect
+    max_steps = problem.max_steps
     from ..curves.bspline import BSplineCurve
 
     if ("none" in clamp_pair and not isinstance(curve, BSplineCurve)
             and not getattr(curve, "closed", False)):
         raise InputError(f"clamp 'none' is not available for method {spec.name!r}: the methods "
                          "for point data always keep the end points; use 'g0', 'g1' or 'g2'")
-    prot = normalize_protect(protect, curve)
     if not isinstance(mode, str) or mode not in MODES:
         raise InputError(f"unknown mode {mode!r}; valid values are: "
                          + ", ".join(repr(m) for m in MODES))
@@ -629,9 +571,6 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
         raise InputError(f"method {spec.name!r} supports mode "
                          + " or ".join(repr(m) for m in spec.modes) + f", got {mode!r}")
     _check_options(spec, options)
-    kwargs = dict(options)
-    if spec.modes != ("spline",):
-        kwargs["mode"] = mode
 
     from . import joins as _joins
 
@@ -639,45 +578,50 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
         raise InputError(f"unknown joins {joins!r}; valid values are: 'keep', 'free'")
     g1_deg = _joins.DEFAULT_G1_ANGLE if g1_angle is None else as_nonnegative(g1_angle,
                                                                             "g1_angle")
-    before = _analysis_block(curve)
+    before = analysis_block(curve)
     jp = (_joins.plan(curve, clamp_pair, prot, g1_deg, tol_v) if joins == "keep"
           else _joins.JoinPlan(curve, prot, clamp_pair))
-    tol_w = None if tol_v is None else tol_v - jp.margin
-    out = spec.driver(jp.curve, tol=tol_w, eps=eps_v, max_steps=max_steps, clamp=jp.clamp,
-                      protect=jp.protect, **kwargs)
-    if not isinstance(out, DriverOutput):
-        raise TypeError(f"driver of {spec.name!r} returned {type(out).__name__}, "
-                        "expected DriverOutput")
+
+    def solve(plan: Any, tol_w: float | None) -> Outcome:
+        # the method solves the problem on the join plan's curve (joins held, tol shared)
+        sub = dataclasses.replace(problem, curve=plan.curve,
+                                  tol=math.inf if tol_w is None else tol_w,
+                                  clamp=plan.clamp, protect=frozenset(plan.protect))
+        res = spec.run(sub, dict(options))
+        if not isinstance(res, Outcome):
+            raise TypeError(f"driver of {spec.name!r} returned {type(res).__name__}, "
+                            "expected DriverOutput")
+        return res
+
+    out = solve(jp, None if tol_v is None else tol_v - jp.margin)
     if not jp.restorable(out.curve):  # the method changed the knots: hold the joins instead
         jp = _joins.plan(curve, clamp_pair, prot, g1_deg, tol_v, allow_reduce=False)
-        tol_w = tol_v
-        out = spec.driver(jp.curve, tol=tol_w, eps=eps_v, max_steps=max_steps, clamp=jp.clamp,
-                          protect=jp.protect, **kwargs)
+        out = solve(jp, tol_v)
     new = jp.restore(out.curve)
     if jp.reduced and out.history is not None and len(out.history):
         h = out.history
         out.history = FairingHistory.from_arrays(jp.original_index(h.index), h.measure,
-                                                 h.displacement)
+                                                 h.displacement, h.counts)
     from ._tolerance import enforce_tolerance, point_report, prime_power_forms
 
     # a B-spline result on the input's knots: its power form (for the analysis) and the
     # difference curve's (for the certificate below) share one pass over the spans
     primed = prime_power_forms(curve, new)
-    after = _analysis_block(new)
+    after = analysis_block(new)
     guard_info: dict[str, Any] = {"kept": "output"}
     if guard and (after["inflections"] > before["inflections"]
                   or after["extrema"] > before["extrema"]):
         from ._guard import never_worse
 
         new, after, guard_info = never_worse(curve, new, before, after, jp, out.curve,
-                                             _analysis_block)
+                                             analysis_block)
     # the one final guarantee every result passes through (after the joins are restored and
     # the never-worse guard chose): data points within tol in float64 (pulled back if rounding
     # put one outside), curve deviation certified on the difference curve
     checked, cert = enforce_tolerance(curve, new, tol_v, curve_bound=out.curve_within_tol,
                                       primed=primed)
     if checked is not new:
-        new, after = checked, _analysis_block(checked)
+        new, after = checked, analysis_block(checked)
 
     p0 = data_points(curve)
     moved_idx, disp, max_disp, max_idx = point_report(curve, new)
@@ -721,6 +665,7 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
         "tolerance_guard": {"pulled_back": cert.pulled_back, "scale": cert.scale},
         "tol": tol_v,
         "eps": out.eps if out.eps is not None else eps_v,
+        "eps_absolute": out.eps_absolute,
         "max_steps": out.max_steps if out.max_steps is not None else max_steps,
         "clamp": list(clamp_pair),
         "protect": sorted(prot),

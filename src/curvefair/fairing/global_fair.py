@@ -27,23 +27,25 @@ from __future__ import annotations
 import os
 import threading
 import warnings
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterable
 from concurrent.futures import ThreadPoolExecutor
-from contextlib import contextmanager
 from dataclasses import dataclass
 from functools import partial
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import scipy.sparse as sp
 
 from .._typing import FloatArray
-from .._validate import as_nonnegative, as_step_count
+from .._validate import as_step_count
 from ..curves.bspline import BSplineCurve, band_energy
 from ..errors import InputError
 from . import _global_kernels as _k
-from .eck_hadenfeld import check_bspline, movable_mask
+from .eck_hadenfeld import check_bspline
 from .stop import StopReason
+
+if TYPE_CHECKING:
+    from .problem import FairingProblem, Outcome
 
 __all__ = ["global_fair", "GlobalResult", "energy_matrix"]
 
@@ -84,45 +86,6 @@ def energy_matrix(curve: BSplineCurve, l: Any = 2) -> sp.csr_matrix:  # noqa: E7
         G = Gk if G is None else G + Gk
     assert G is not None  # _weights raises when no weight is positive
     return G.tocsr()
-
-
-try:  # numpy's switch for madvise(MADV_HUGEPAGE) on new arrays (private; absent: no-op)
-    from numpy._core import multiarray as _np_ma
-except ImportError:  # numpy < 2
-    from numpy.core import multiarray as _np_ma  # type: ignore[no-redef]
-_HUGE_LOCK = threading.Lock()
-_HUGE_DEPTH = [0, True]
-
-
-@contextmanager
-def _small_pages() -> Iterator[None]:
-    """Allocate without transparent huge pages while solving.
-
-    numpy advises the kernel to back every large array by 2 MiB pages; with the common setting
-    ``transparent_hugepage/defrag = madvise`` the first touch of such an array can stall on
-    memory compaction. The work arrays here (the band factor alone has ``n dim^2 (p + 1)``
-    doubles: 128 MB for a planar cubic with 1e6 points) are allocated once per call and
-    streamed a few times, so ordinary pages are cheaper: measured at 1e6 points, a cold call
-    2.75 s -> 2.0 s, the first touch of the 128 MB factor 0.36 s -> 0.10 s. Only speed is
-    affected; the previous setting is restored (re-entrant, thread-safe)."""
-    get = getattr(_np_ma, "_get_madvise_hugepage", None)
-    put = getattr(_np_ma, "_set_madvise_hugepage", None)
-    if get is None or put is None:
-        yield
-        return
-    with _HUGE_LOCK:
-        if _HUGE_DEPTH[0] == 0:
-            _HUGE_DEPTH[1] = bool(get())
-            put(False)
-        _HUGE_DEPTH[0] += 1
-    try:
-        yield
-    finally:
-        with _HUGE_LOCK:
-            _HUGE_DEPTH[0] -= 1
-            if _HUGE_DEPTH[0] == 0:
-                put(_HUGE_DEPTH[1])
-
 
 
 def _absmax(a: FloatArray) -> float:
@@ -240,8 +203,8 @@ def _ranges_start(fn: Callable[[int, int], Any], lo: int, hi: int
 
 class _Prefault:
     """Map the pages of a new work array on the worker thread while the calling thread does
-    other work (first touch costs about 0.35 ms per MB here: 45 ms for the 128 MB Newton band
-    at 1e6 points). :meth:`join` before the array is first used: the calling thread zeroes
+    other work (a page's first touch is a kernel fault; figures in docs/benchmarks.md).
+    :meth:`join` before the array is first used: the calling thread zeroes
     the chunks the worker has not claimed and waits only for those it has started. Only the
     speed depends on how the work is shared (the array is zeroed either way and then
     overwritten before it is read)."""
@@ -582,7 +545,7 @@ def global_fair(curve: BSplineCurve, *, tol: float | None = None, l: Any = 2,  #
        rejection, x0.3 per accepted step, 0 below 1e-6 of its start): few active points leave
        soft directions (points sliding along their tangents, inactive points moving freely)
        in which the plain step diverges; with under 2 % (or 100) of the points active at the
-       first rejection the interior point takes over at once (measured: faster there);
+       first rejection the interior point takes over at once (faster there);
     1. start from the smoothing solve ``(2G/E(o) + mu_0 I) d = mu_0 o`` (one banded solve,
        ``mu_0`` = 1 % of the mean diagonal);
     2. Mehrotra predictor-corrector interior point with slacks ``s_i = -f_i`` (Nocedal & Wright,
@@ -602,8 +565,7 @@ def global_fair(curve: BSplineCurve, *, tol: float | None = None, l: Any = 2,  #
     ``(degree + 1) dim - 1``, coordinates interleaved) factorised by a compiled band
     ``U D U^T`` (open curves) or band Cholesky bordered by a small Schur complement (closed
     curves, cyclic band): ``O(n)`` per iteration,
-    typically 4-8 Newton iterations after the ADMM start, 10-20 with the interior point (1e6
-    planar cubic control points: 0.77-0.84 s on one core, 0.56-0.63 s with a second core free).
+    typically 4-8 Newton iterations after the ADMM start, 10-20 with the interior point.
     Planar curves split the per-point passes of every Newton iteration (evaluation,
     right-hand side, back-rotation, update) into point ranges shared by the calling thread and
     one worker thread (when the process may use 2 or more CPUs and the curve has at least
@@ -614,10 +576,9 @@ def global_fair(curve: BSplineCurve, *, tol: float | None = None, l: Any = 2,  #
     the pages of the Newton work arrays are mapped on it during the ADMM start, and the final
     pull-in onto the balls is split too); the
     ranges write disjoint points, so the result is bitwise the same as on one thread, and the
-    calling thread never waits for a chunk the worker has not started (at 1e6 points: 0.91 ->
-    0.73-0.79 s with the second core free; with it busy in a spinning process 0-7 % slower
-    than one thread; the environment variable ``CURVEFAIR_THREADS=1``, read at import, switches
-    it off). The convergence test is the same
+    calling thread never waits for a chunk the worker has not started (the environment variable
+    ``CURVEFAIR_THREADS=1``, read at import, switches it off; timings: docs/benchmarks.md,
+    "Global fairing: threads and page size"). The convergence test is the same
     on every path (the warm start and reused factorisations change only the speed). Converged
     means: dual residual below ``1e-10`` of
     ``|grad F(o)|_inf``, every point within ``tol (1 + 1e-12)`` (then projected onto its ball),
@@ -638,19 +599,19 @@ def global_fair(curve: BSplineCurve, *, tol: float | None = None, l: Any = 2,  #
     >>> bool(res.energy_after < res.energy_before), res.stop_reason
     (True, 'converged')
     """
-    with _small_pages():
-        return _global_fair(curve, tol, l, clamp, protect, gap, max_steps)
+    from .problem import make_problem
+
+    prob = make_problem(check_bspline(curve), tol=tol, max_steps=max_steps, clamp=clamp,
+                        protect=protect)
+    return _global_fair(prob, l, gap)
 
 
-def _global_fair(curve: BSplineCurve, tol: float | None, l: Any,  # noqa: E741
-                 clamp: Any, protect: Iterable[int], gap: float,
-                 max_steps: int | None) -> GlobalResult:
-    curve = check_bspline(curve)
+def _global_fair(problem: FairingProblem, l: Any, gap: float) -> GlobalResult:  # noqa: E741
+    curve = check_bspline(problem.curve)
     w = _weights(l, curve.degree)
-    if tol is not None:  # (None: unconstrained; none_means only words the message "... or None")
-        tolv = as_nonnegative(tol, "tol", none_means=np.inf, window=True)
-    max_steps = as_step_count(max_steps, default=500)
-    mask = movable_mask(curve, clamp, protect)
+    tol, tolv = problem.tol_or_none, problem.tol
+    max_steps = as_step_count(problem.max_steps, default=500)
+    mask = problem.movable
     p = curve.degree
     closed = curve.closed
     band = _band_storage(curve.n_ctrl, curve.dim, p, closed)
@@ -677,9 +638,8 @@ def _global_fair(curve: BSplineCurve, tol: float | None, l: Any,  # noqa: E741
     free = np.flatnonzero(mask)
     if free.size == 0:
         return GlobalResult(curve, E0, E0, lam, 0, "no_movable_point", free)
-    if E0 <= 0.0 or (tol is not None and tolv == 0.0):
-        return GlobalResult(curve, E0, E0, lam, 0, "zero_energy" if E0 <= 0 else "converged",
-                            np.zeros(0, dtype=np.int64))
+    if E0 <= 0.0:
+        return GlobalResult(curve, E0, E0, lam, 0, "zero_energy", np.zeros(0, dtype=np.int64))
     if max_steps == 0:  # no iteration (not even the start or the unconstrained solve)
         return GlobalResult(curve, E0, E0, lam, 0, "max_steps", np.zeros(0, dtype=np.int64))
     # F = E / E0: grad F = kron(K, I) d with K = W ks, never formed: every kernel reads the
@@ -995,7 +955,7 @@ def _ssn_work(n: int, dim: int, prefault: bool = False
               ) -> tuple[dict[str, FloatArray], _Prefault | None]:
     """Work arrays of :func:`_active_set_newton` (zeroed), carved from one buffer; with
     ``prefault`` its pages are mapped (zeroed) on the worker thread meanwhile (first touch
-    costs about 0.35-0.5 ms per MB here: 80 MB, ~35 ms, for a planar curve with 1e6 points).
+    of a page is a kernel fault: figures in docs/benchmarks.md).
     Planar blocks ``B`` (isotropic: the semismooth Newton writes only their diagonal, whose
     two entries are equal) are a strided view of ``2 n + 1`` doubles ``0, b_0, 0, b_1, 0, ...``:
     ``B[i, a, a] = b_i``, ``B[i, 0, 1] = B[i, 1, 0] = 0`` (16 MB instead of 32 at 1e6)."""
@@ -1149,22 +1109,25 @@ def _ssn_loop(system: _System, g0: FloatArray, free: np.ndarray, tol: float, v: 
 # ------------------------------------------------------------------------------------------
 # registration with fair()
 # ------------------------------------------------------------------------------------------
-def _driver(curve: BSplineCurve, *, tol: float | None, eps: float | None, max_steps: int | None,
-            clamp: Any, protect: Iterable[int], l: Any = 2) -> Any:  # noqa: E741
-    from .fair import DriverOutput, FairingHistory
+def solve(problem: FairingProblem, *, l: Any = 2) -> Outcome:  # noqa: E741
+    """The global minimiser as a solver of ``problem`` (``fair(curve, "global")``): ``eps`` is
+    the interior point's ``gap``, relative to ``E(input)`` (default ``1e-13``, at least
+    ``1e-16``); ``max_steps`` caps the Newton iterations (default 500). The history lists each
+    moved control point once (measure 0: a simultaneous solve ranks nothing)."""
+    from .problem import FairingHistory, Outcome
 
-    gap = 1e-13 if eps is None else max(float(eps), 1e-16)
-    max_steps = 500 if max_steps is None else max_steps  # 0: no iteration, the input returned
-    res = global_fair(curve, tol=tol, l=l, clamp=clamp, protect=protect, gap=gap,
-                      max_steps=max_steps)
-    p0 = np.asarray(curve.control_points)
+    gap = 1e-13 if problem.eps is None else max(float(problem.eps), 1e-16)
+    max_steps = 500 if problem.max_steps is None else problem.max_steps
+    res = _global_fair(problem, l, gap)
+    curve = problem.curve
+    p0 = np.asarray(curve.control_points)  # type: ignore[attr-defined]
     p1 = np.asarray(res.curve.control_points)
     moved = np.flatnonzero(np.any(p0 != p1, axis=1))
     disp = np.sqrt(np.sum((p1[moved] - p0[moved]) ** 2, axis=1))
-    hist = FairingHistory.from_arrays(moved, np.zeros(moved.size), disp)
-    return DriverOutput(
+    hist = FairingHistory.from_arrays(moved, np.zeros(moved.size), disp, "control point")
+    return Outcome(
         curve=res.curve, steps=res.iterations, stop_reason=res.stop_reason, history=hist,
-        eps=gap, max_steps=max_steps,
+        eps=gap, max_steps=max_steps, eps_absolute=gap * res.energy_before,
         extra={"l": l if isinstance(l, (int, np.integer)) else str(l),
                "energy_l_before": res.energy_before, "energy_l_after": res.energy_after,
                "n_active": int(res.active.size),
@@ -1177,7 +1140,7 @@ def _register() -> None:
     register_method(MethodSpec(
         name="global",
         curve_types=(BSplineCurve,),
-        driver=_driver,
+        solver=solve,
         summary="Global minimiser of E_l (l=2, 3 or a blend) over all free control points, "
                 "each within tol of the original (convex QP, interior point, banded solves)",
         source="the problem of Eck & Hadenfeld (seed 003 eq. (12)) solved for all points at "

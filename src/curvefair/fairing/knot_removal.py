@@ -14,18 +14,21 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal, cast
 
 import numpy as np
 
 from .._jit import njit
 from .._typing import FloatArray
-from .._validate import as_nonnegative, as_step_count
+from .._validate import as_step_count
 from ..curves.bspline import BSplineCurve, basis_derivatives
 from ..errors import InputError
-from .eck_hadenfeld import check_bspline, movable_mask
+from .eck_hadenfeld import check_bspline
 from .ranking import tt_build, tt_update, tt_update_range
 from .stop import StopReason
+
+if TYPE_CHECKING:
+    from .problem import FairingProblem, Outcome
 
 __all__ = ["knot_removal", "knot_jumps", "interior_knots", "knot_removal_fair", "KRResult"]
 
@@ -414,26 +417,62 @@ def knot_removal_fair(curve: BSplineCurve, *, variant: Variant = "one-point",
     >>> bool(res.sum_after < res.sum_before)
     True
     """
-    curve = check_bspline(curve)
+    from .problem import make_problem
+
+    prob = make_problem(check_bspline(curve), tol=tol, eps=eps, max_steps=max_steps,
+                        clamp=clamp, protect=protect)
+    out = solve(prob, variant=variant, eps_relative=eps_relative, on_tol=on_tol)
+    h = out.history
+    assert h is not None
+    hist = np.column_stack([h.index.astype(np.float64), h.measure, h.displacement])
+    return KRResult(cast(BSplineCurve, out.curve), out.steps, out.stop_reason,
+                    out.extra["sum_jump_before"], out.extra["sum_jump_after"],
+                    hist.reshape(-1, 3), out.extra["blocked_knots"], out.extra["sum_tracked"])
+
+
+def solve(problem: FairingProblem, *, variant: Variant = "one-point",
+          eps_relative: bool = True, on_tol: str = "skip") -> Outcome:
+    """Knot removal as a solver of ``problem`` (``fair(curve, "knot-removal")``): ``eps``
+    relative to the largest initial jump ``max z_j`` (default ``1e-6``; ``eps_relative=False``:
+    absolute, default 0). The history counts knots (index ``j`` of the knot vector)."""
+    from .problem import FairingHistory, Outcome, eps_threshold
+
+    curve = check_bspline(problem.curve)
     if not isinstance(variant, str) or variant not in VARIANTS:
         raise InputError(f"unknown variant {variant!r}; valid values are: "
                          + ", ".join(repr(v) for v in VARIANTS))
     if on_tol not in ("skip", "stop"):
         raise InputError(f"on_tol must be 'skip' or 'stop', got {on_tol!r}")
-    tolv = as_nonnegative(tol, "tol", none_means=np.inf, window=True)
-    mask = movable_mask(curve, clamp, protect)
+    tolv = problem.tol
+    mask = problem.movable
     kd = _KnotData(curve)
     js = kd.js
     nk = js.size
     d = np.array(curve.control_points)
     orig = d.copy()
-    max_steps = as_step_count(max_steps, default=10 * nk)
+    max_steps = as_step_count(problem.max_steps, default=10 * nk)
+
+    def outcome(c: BSplineCurve, steps: int, reason: StopReason, hist: FloatArray,
+                epsv: float, eps_abs: float | None, sums: tuple[float, float, float],
+                blocked: list[int]) -> Outcome:
+        history = FairingHistory.from_arrays(hist[:, 0].astype(np.int64), hist[:, 1],
+                                             hist[:, 2], "knot")
+        return Outcome(
+            curve=c, steps=steps, stop_reason=reason, history=history, eps=epsv,
+            max_steps=max_steps, eps_absolute=eps_abs,
+            extra={"variant": variant, "sum_jump_before": sums[0], "sum_jump_after": sums[1],
+                   "sum_tracked": sums[2], "blocked_knots": blocked,
+                   "history_index_is": "knot index j"})
+
     if nk == 0:
-        return KRResult(curve, 0, "no_knots", 0.0, 0.0, np.zeros((0, 3)))
+        e0 = (1e-6 if eps_relative else 0.0) if problem.eps is None else problem.eps
+        return outcome(curve, 0, "no_knots", np.zeros((0, 3)), e0, None, (0.0, 0.0, 0.0), [])
     z = kd.jumps(d)
     sum0 = float(z.sum())
-    epsv = (1e-6 if eps_relative else 0.0) if eps is None else as_nonnegative(eps, "eps")
-    eps_abs = epsv * float(z.max()) if eps_relative else epsv
+    if eps_relative:
+        epsv, eps_abs = eps_threshold(problem.eps, float(z.max()), 1e-6)
+    else:
+        epsv = eps_abs = 0.0 if problem.eps is None else problem.eps
     floor = ROUNDING_FLOOR * float(z.max())
     out, steps, reason, total, hist, blocked = _run_loop(curve, kd, d, orig, mask, variant,
                                                          tolv, eps_abs, max_steps, on_tol, z,
@@ -444,7 +483,8 @@ def knot_removal_fair(curve: BSplineCurve, *, variant: Variant = "one-point",
         pos = np.searchsorted(js, np.asarray(blocked, dtype=np.int64))
         if float(kd.jumps(d, pos).max()) > eps_abs:
             reason = "tolerance"
-    return KRResult(out, steps, reason, sum0, float(kd.jumps(d).sum()), hist, blocked, total)
+    return outcome(out, steps, reason, hist, epsv, eps_abs,
+                   (sum0, float(kd.jumps(d).sum()), total), blocked)
 
 
 _REASONS: tuple[StopReason, ...] = ("max_steps", "tolerance", "eps", "no_decrease")
@@ -878,33 +918,13 @@ def _kr_loop(d, orig, mask, tol, p, n, closed, js, pos, C, right, left2, ctrl, a
 # ------------------------------------------------------------------------------------------
 # registration with fair()
 # ------------------------------------------------------------------------------------------
-def _driver(curve: BSplineCurve, *, tol: float | None, eps: float | None, max_steps: int | None,
-            clamp: Any, protect: Iterable[int], variant: Variant = "one-point",
-            eps_relative: bool = True, on_tol: str = "skip") -> Any:
-    from .fair import DriverOutput, FairingHistory
-
-    res = knot_removal_fair(curve, variant=variant, tol=tol, eps=eps, eps_relative=eps_relative,
-                            max_steps=max_steps, clamp=clamp, protect=protect,
-                            on_tol=on_tol)  # type: ignore[arg-type]
-    h = res.history
-    # history index: the knot index j (the control points moved are listed in the report)
-    hist = FairingHistory.from_arrays(h[:, 0].astype(np.int64), h[:, 1], h[:, 2])
-    return DriverOutput(
-        curve=res.curve, steps=res.steps, stop_reason=res.stop_reason, history=hist,
-        eps=(1e-6 if eps_relative else 0.0) if eps is None else eps,
-        max_steps=10 * interior_knots(curve).size if max_steps is None else max_steps,
-        extra={"variant": variant, "sum_jump_before": res.sum_before,
-               "sum_jump_after": res.sum_after, "blocked_knots": res.blocked,
-               "history_index_is": "knot index j"})
-
-
 def _register() -> None:
     from .fair import MethodSpec, register_method
 
     register_method(MethodSpec(
         name="knot-removal",
         curve_types=(BSplineCurve,),
-        driver=_driver,
+        solver=solve,
         summary="Farin / Sapidis-Farin: remove and reinsert the knot with the largest jump of "
                 "d kappa/ds, while the sum of jumps decreases, within tol",
         source="seed 004 (lecture notes) eqs. (8.19)-(8.36); one-point formulas in ERRATA",

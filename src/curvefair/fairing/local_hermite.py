@@ -115,14 +115,15 @@ from scipy.interpolate import CubicSpline
 
 from .._typing import FloatArray
 from ..curves.hermite import CubicHermite, HermiteSpline, QuinticHermite
-from ..curves.interpolate import _quintic_hermite_data
+from ..curves.interpolate import quintic_hermite_data
 from ..errors import InputError
 from . import _hermite_kernels as _k
-from ._hermite_data import distinct_data, rebuild, uniform_spacing
-from .fair import DriverOutput, FairingHistory, MethodSpec, register_method
+from .fair import MethodSpec, register_method
+from .hermite_data import distinct_data, rebuild, uniform_spacing
+from .problem import FairingHistory, FairingProblem, Outcome, eps_threshold
 from .stop import StopReason
 
-__all__ = ["hermite_driver", "prepare", "hold_zone_cubic", "spline_derivatives"]
+__all__ = ["hermite_solve", "hermite_driver", "prepare", "hold_zone_cubic", "spline_derivatives"]
 
 _THR = 2.0**-56
 _W0 = {3: 32, 5: 48}  # 0.27**32, 0.43**48 < 2**-56 on uniform parameters
@@ -183,7 +184,7 @@ def spline_derivatives(curve: HermiteSpline, P: FloatArray, clamp: tuple[str, st
         # accurate: relative errors up to 1e-6 in r', r'' on nearly straight data)
         ends: tuple[Any, Any] = (None, None) if curve.closed else (_end_bc(curve, clamp[0], 0),
                                                   _end_bc(curve, clamp[1], -1))
-        ders = list(_quintic_hermite_data(pts, t, *ends, curve.closed))
+        ders = list(quintic_hermite_data(pts, t, *ends, curve.closed))
     D = np.stack(ders, axis=1)
     if curve.closed:
         D = D[:-1]
@@ -377,7 +378,7 @@ def prepare(curve: HermiteSpline, *, method: str, tol: float | None, eps: float 
     m0 = float(meas[eligible].max()) if eligible.any() else 0.0
     # 1 % in amplitude: an energy is quadratic in the move, the other measures linear
     rel = 1e-4 if mname == "energy" else 1e-2
-    eps_eff = rel * m0 if eps is None else float(eps)
+    eps_rel, eps_eff = eps_threshold(eps, m0, rel)
     n_elig = int(eligible.sum())
     max_eff = 20 * n_elig + 1000 if max_steps is None else int(max_steps)
     scale = float(np.abs(P).max()) + float(np.ptp(P, axis=0).max())
@@ -390,14 +391,15 @@ def prepare(curve: HermiteSpline, *, method: str, tol: float | None, eps: float 
     if spline and closed and nd * nb <= _DENSE_MAX:
         Hinv = _dense_inverse(nd, nb, h, degree)
     args = (P, D, h, P.copy(), closed, degree, code, spline, hstep, eligible,
-            -1.0 if tol is None else float(tol), eps_eff, max_eff, floor,
+            np.inf if tol is None else float(tol), eps_eff, max_eff, floor,
             K0, pe, q, fixed, Hinv, _W0[degree], _WMAX, _THR, meas, values, tv, ti,
             blocked, block_measure, mcode)
     return {"args": args, "extra": extra, "held": held, "eligible": eligible, "m0": m0,
             "floor0": 8.0 * np.finfo(float).eps * scale,
             "measure_name": mname,
             "P0": P.copy(), "D0": D.copy(),
-            "eps": eps_eff, "max_steps": max_eff, "n_elig": n_elig, "measure": meas,
+            "eps": eps_eff, "eps_rel": eps_rel, "max_steps": max_eff, "n_elig": n_elig,
+            "measure": meas,
             "P": P, "D": D, "spline": spline, "degree": degree, "nd": nd, "Hinv": Hinv}
 
 
@@ -481,11 +483,11 @@ def _enforce_curve_tol(curve: HermiteSpline, st: dict[str, Any], tol: float,
     return float(s), float(d)
 
 
-def hermite_driver(curve: HermiteSpline, *, method: str, tol: float | None, eps: float | None,
-                   max_steps: int | None, clamp: tuple[str, str], protect: frozenset[int],
-                   mode: str = "spline", tol_on: str = "curve", measure: str | None = None,
-                   **options: Any) -> DriverOutput:
-    """Driver of the four Hermite methods (see the module docstring); called by :func:`fair`.
+def hermite_solve(problem: FairingProblem, *, method: str, tol_on: str = "curve",
+                  measure: str | None = None, **options: Any) -> Outcome:
+    """The four Hermite methods as solvers of ``problem`` (see the module docstring); called
+    by :func:`fair`. ``problem.eps`` is relative to the largest initial bad-point measure
+    (default ``1e-2``, ``1e-4`` for an energy measure: 1 % in amplitude).
 
     ``tol_on="curve"`` (default) keeps the whole output curve within ``tol`` of the input
     (step 6 of the module docstring); ``tol_on="points"`` bounds only the data points, as the
@@ -501,8 +503,11 @@ def hermite_driver(curve: HermiteSpline, *, method: str, tol: float | None, eps:
 
     choice(tol_on, ("curve", "points"), "tol_on")
     t0 = time.perf_counter()
-    kw: dict[str, Any] = dict(method=method, eps=eps, max_steps=max_steps, clamp=clamp,
-                              protect=protect, mode=mode, measure=measure)
+    curve = cast(HermiteSpline, problem.curve)
+    tol, protect = problem.tol_or_none, problem.protect
+    kw: dict[str, Any] = dict(method=method, eps=problem.eps, max_steps=problem.max_steps,
+                              clamp=problem.clamp, protect=protect, mode=problem.mode,
+                              measure=measure)
     point_tol = tol
     snap = None
     for attempt in range(_CURVE_TOL_RERUNS + 1):
@@ -572,10 +577,20 @@ def hermite_driver(curve: HermiteSpline, *, method: str, tol: float | None, eps:
     if spline:
         extra["window_max_points"] = int(nd if Hinv.shape[0] else max_window)
         extra["window_truncations"] = int(n_trunc)
-    return DriverOutput(new, int(steps), reason,
-                        FairingHistory.from_arrays(h_idx, h_meas, h_disp),
-                        eps=eps_eff, max_steps=st["max_steps"], extra=extra,
-                        curve_within_tol=tol_on == "curve")
+    return Outcome(new, int(steps), reason,
+                   FairingHistory.from_arrays(h_idx, h_meas, h_disp, "data point"),
+                   eps=st["eps_rel"], max_steps=st["max_steps"], extra=extra,
+                   curve_within_tol=tol_on == "curve", eps_absolute=eps_eff)
+
+
+#: The former name of :func:`hermite_solve` (keyword form, as ``MethodSpec.driver``).
+def hermite_driver(curve: HermiteSpline, *, method: str, tol: float | None, eps: float | None,
+                   max_steps: int | None, clamp: tuple[str, str], protect: frozenset[int],
+                   mode: str = "spline", **options: Any) -> Outcome:
+    """:func:`hermite_solve` with the shared options as keywords (already checked)."""
+    prob = FairingProblem(curve, np.inf if tol is None else float(tol), eps, max_steps,
+                          clamp, frozenset(protect), mode, dict(options))
+    return hermite_solve(prob, method=method, **options)
 
 
 _SPECS = [
@@ -604,6 +619,7 @@ _DEFAULT_REASON = {
 }
 
 for _name, _types, _default, _summary, _source in _SPECS:
-    register_method(MethodSpec(_name, _types, partial(hermite_driver, method=_name), _summary,
-                               _source, default=_default, modes=("spline", "hermite"),
+    register_method(MethodSpec(_name, _types, summary=_summary, source=_source,
+                               solver=partial(hermite_solve, method=_name),
+                               default=_default, modes=("spline", "hermite"),
                                default_reason=_DEFAULT_REASON.get(_name, "")))

@@ -1,6 +1,6 @@
 """Why a fairing method stopped: the one vocabulary of ``stop_reason``.
 
-Every method (through :class:`~curvefair.fairing.DriverOutput` and the report of
+Every method (through :class:`~curvefair.fairing.problem.Outcome` and the report of
 :func:`~curvefair.fair`) and every method result type (``EHResult``, ``KRResult``,
 ``CYResult``, ``GlobalResult``, the points-l1 report) says why it stopped with one of
 :data:`STOP_REASONS`:

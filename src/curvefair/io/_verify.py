@@ -437,10 +437,10 @@ def rescaled_report(report: dict[str, Any], original: Any, written: Any,
     """
     from ..analysis import deviation
     from ..fairing._tolerance import point_report
-    from ..fairing.fair import _analysis_block
+    from ..fairing.fair import analysis_block
 
     out = dict(report)
-    after = _analysis_block(written)
+    after = analysis_block(written)
     redone = []
     for k, v in after.items():
         out[f"{k}_after"] = v
