@@ -243,9 +243,7 @@ def goal_lines(tabs_rb: dict[str, "Table"], tool: str = "cf:points-l1") -> list[
         L += [f"- Ground truth, rebuilt curves: `{_tool_label(tool)}` reaches the true extrema "
               f"count on {h}/{n} (goal >= 55; best peer `{_tool_label(bp)}` {hp}/{n}), the "
               f"true inflection count on {hi}/{n_inf} (goal >= 66); median distance to the "
-              f"true curve {_fmt(d)} tol (best peer {_fmt(dp)})."
-              + (" Closed curves are n/a for this method and count as misses."
-                 if tool == "cf:points-l1" else ""), ""]
+              f"true curve {_fmt(d)} tol (best peer {_fmt(dp)}).", ""]
     for name, t, goal in (("Airfoils", af, "median <= 0.35, p90 <= 0.7"),
                           ("Glyph runs", gl, "median <= 0.2")):
         if t.cases and tool in t.tools:
@@ -253,7 +251,7 @@ def goal_lines(tabs_rb: dict[str, "Table"], tool: str = "cf:points-l1") -> list[
             bp = best_real_tool(t, "peer:")
             rp = t.ratio(bp, "extrema") if bp else []
             L += [f"- {name}, rebuilt curves: extrema ratio to the input median / p90 "
-                  f"{_fmt(_q(r, 0.5))} / {_fmt(_q(r, 0.9))} over {len(r)} open curves (goal "
+                  f"{_fmt(_q(r, 0.5))} / {_fmt(_q(r, 0.9))} over {len(r)} curves (goal "
                   f"{goal}); best peer `{_tool_label(bp)}` {_fmt(_q(rp, 0.5))} / "
                   f"{_fmt(_q(rp, 0.9))}.", ""]
     if pf.cases and tool in pf.tools:
@@ -651,7 +649,8 @@ def write_page(rows: list[dict[str, Any]], cases: list[C.Case], info: dict[str, 
 
 #: the generated part of the page lies between these two lines; whatever is before the first
 #: and after the second is written by hand (e.g. other benchmarks' tables) and kept
-BEGIN = "<!-- bench-quality: generated, begin (make bench-quality rewrites up to the end marker) -->"
+BEGIN = ("<!-- bench-quality: generated, begin (make bench-quality rewrites up to the end "
+         "marker) -->")
 END = "<!-- bench-quality: generated, end (hand-written sections may follow) -->"
 
 

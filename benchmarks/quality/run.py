@@ -469,14 +469,13 @@ def read_csv(path: Path) -> list[dict[str, Any]]:
                 for r in csv.DictReader(f)]
 
 
-def merge_rows(new: list[dict[str, Any]], old: list[dict[str, Any]], cases: list[C.Case],
-               rerun: set[str]) -> tuple[list[dict[str, Any]], int]:
-    """``new`` (the tools in ``rerun`` and the interpolant) plus the rows of ``old`` for the
-    other tools, on the cases of ``cases`` only, in the run's order; and the number reused."""
+def merge_rows(new: list[dict[str, Any]], old: list[dict[str, Any]], cases: list[C.Case]
+               ) -> tuple[list[dict[str, Any]], int]:
+    """``new`` plus the rows of ``old`` for every (case, tool) ``new`` does not have, on the
+    cases of ``cases`` only, in the run's order; and the number reused."""
     names = {c.name for c in cases}
     have = {(r["case"], r["tool"]) for r in new}
-    keep = [r for r in old if r["case"] in names and r["tool"] not in rerun
-            and (r["case"], r["tool"]) not in have]
+    keep = [r for r in old if r["case"] in names and (r["case"], r["tool"]) not in have]
     rows = new + keep
     key = {c.name: j for j, c in enumerate(cases)}
     tool_order = {t: j for j, t in enumerate(all_tools())}
@@ -526,6 +525,7 @@ def main(argv: list[str] | None = None) -> int:
         af = C.airfoil_cases(args.airfoils or 240)
         gl = C.glyph_cases(args.glyphs or 80)
         pf = C.point_file_cases()
+    page_cases = gt + af + gl + pf
     if args.only:
         keep = set(args.only)
         gt, af, gl, pf = [c if n in keep else [] for n, c in
@@ -541,7 +541,9 @@ def main(argv: list[str] | None = None) -> int:
     if args.reuse is not None:
         if not args.tools:
             ap.error("--reuse needs --tools (the tools to run again)")
-        rows, reused = merge_rows(rows, read_csv(args.reuse), cases, set(args.tools))
+        # the page covers every corpus; the rows this run made replace the earlier ones
+        cases = page_cases
+        rows, reused = merge_rows(rows, read_csv(args.reuse), cases)
     if args.img is None:
         page = ROOT / "docs" / "benchmarks.md"
         args.img = (ROOT / "docs" / "img" / "bench" if args.out.resolve() == page.resolve()
@@ -549,7 +551,9 @@ def main(argv: list[str] | None = None) -> int:
     args.csv.parent.mkdir(parents=True, exist_ok=True)
     write_csv(rows, args.csv)
 
-    cmd = "make bench-quality" if not args.quick else "python benchmarks/quality/run.py --quick"
+    given = sys.argv[1:] if argv is None else list(argv)
+    cmd = ("make bench-quality" if not given else
+           "python benchmarks/quality/run.py " + " ".join(given))
     info = {
         "command": cmd,
         "date": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
@@ -562,10 +566,11 @@ def main(argv: list[str] | None = None) -> int:
         "csv": os.path.relpath(args.csv, args.out.parent),
     }
     if reused:
-        info["reused"] = (f"{reused} rows of the tools other than "
-                          f"{', '.join('`' + t + '`' for t in args.tools)} are those of the "
-                          f"earlier full run in `{args.reuse.name}`, rerun here on the same "
-                          "corpus")
+        info["reused"] = (f"{reused} rows come from the earlier run in `{args.reuse}`; "
+                          "this run made the rows of "
+                          + ", ".join("`" + t + "`" for t in args.tools)
+                          + (f" on {', '.join(args.only)}" if args.only else "")
+                          + " (and the input interpolant's)")
     report.write_page(rows, cases, info, args.out, args.img)
     n_viol = sum(int(r.get("violation") or 0) for r in rows if r["tool"].startswith("cf:"))
     print(f"wrote {args.out} and {args.csv} in {elapsed:.0f} s; "
