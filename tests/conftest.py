@@ -40,6 +40,7 @@ COMPILED_FILES = frozenset({
     "test_eck_hadenfeld.py",
     "test_global_fair.py",
     "test_points_l1.py",
+    "test_points_l1_closed.py",
     "test_ranking.py",
     "test_fair_loop.py",
     "test_bspline_small_curves.py",

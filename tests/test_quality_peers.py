@@ -157,3 +157,47 @@ def test_run_all_survives_a_crashing_tool(monkeypatch):
     bad = [r for r in rows if not r["ok"]]
     assert [(r["case"], r["tool"]) for r in bad] == [(victim, "cf:poliakoff")]
     assert "crashed" in bad[0]["error"]
+
+
+def test_page_keeps_hand_written_sections(tmp_path):
+    """``make bench-quality`` rewrites only the part of docs/benchmarks.md between its markers:
+    text before and after them survives a rewrite; a page without markers is refused (before
+    the run, by ``run.main``, so no run is lost), and the committed page has them."""
+    import report as Rp
+
+    page = tmp_path / "b.md"
+    Rp.write_generated(page, "# Generated\n\nrun 1")
+    text = page.read_text()
+    assert text.startswith(Rp.BEGIN) and "run 1" in text
+    page.write_text(text + "\n## Hand-written\n\nkept table\n")
+    Rp.write_generated(page, "# Generated\n\nrun 2")
+    text = page.read_text()
+    assert "run 2" in text and "run 1" not in text
+    assert text.index(Rp.END) < text.index("## Hand-written") < text.index("kept table")
+    page.write_text("# A page written by hand\n")
+    with pytest.raises(Rp.PageError):
+        Rp.write_generated(page, "# Generated")
+    assert page.read_text() == "# A page written by hand\n"
+    committed = (Path(__file__).resolve().parents[1] / "docs" / "benchmarks.md").read_text()
+    Rp.splice(committed, "")  # raises if the committed page lost its markers
+    tail = committed[committed.index(Rp.END):]
+    assert "## Glyph outlines read from the font itself" in tail
+
+
+def test_cli_default_tool_counts_the_written_file():
+    """``cf:cli-default`` runs ``curvefair fair`` and measures the file it wrote: its points
+    are within tol of the input, and its curve is the chord-length natural cubic through
+    them (recomputed here from the file's numbers)."""
+    import run as R
+
+    case = C.point_file_cases(instances=1, levels=(1e-3,))[1]
+    curve, w, rep = R.run_cli_default(case)
+    assert rep["method"] == "points-l1"
+    assert np.max(np.linalg.norm(w - case.points, axis=1)) <= case.tol
+    from scipy.interpolate import CubicSpline
+
+    u = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(w, axis=0), axis=1))]
+    ref = CubicSpline(u, w, bc_type="natural")
+    t = np.linspace(curve.domain[0], curve.domain[1], 777)
+    s = u[0] + (t - curve.domain[0]) * (u[-1] - u[0]) / (curve.domain[1] - curve.domain[0])
+    assert np.max(np.abs(np.asarray(curve(t)) - ref(s))) < 1e-9 * case.scale

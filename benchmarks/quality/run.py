@@ -84,7 +84,58 @@ def curvefair_tools() -> list[tuple[str, str, dict[str, Any]]]:
         for suffix, kw in VARIANTS.get(m, []):
             out.append((f"cf:{m}/{suffix}", m, kw))
     out.append((POINTS_TOOL, "fair_points", {}))
+    out.append((CLI_TOOL, "cli", {}))
     return out
+
+
+# ``curvefair fair in.csv -o out.csv --tol T`` as a user runs it: the points written to a CSV
+# file (shortest exact decimals), the command's own defaults (reader, corner split, default
+# method per curve kind, read-back check), the written file read back
+CLI_TOOL = "cf:cli-default"
+
+
+def run_cli_default(case: C.Case) -> tuple[cf.PiecewiseCurve, np.ndarray, dict[str, Any]]:
+    """``curvefair fair`` with its defaults on ``case``'s points (airfoils as a Selig ``.dat``
+    file, the rest as CSV); returns the curve rebuilt from the written file (the chord-length
+    natural, closed: periodic, cubic through every written point, as for every other tool's
+    rebuilt columns; the command itself splits a list at its corners), the written points,
+    and the method(s) used."""
+    import json
+    import tempfile
+
+    from click.testing import CliRunner
+
+    from curvefair.cli import main as cli_main
+
+    pts = np.asarray(case.points, dtype=float)
+    rows = np.vstack([pts, pts[:1]]) if case.closed else pts
+    # airfoils as Selig .dat files (name line, then "x y"), everything else as CSV
+    dat = case.corpus == "airfoils"
+    ext, sep = (".dat", " ") if dat else (".csv", ",")
+    with tempfile.TemporaryDirectory() as d:
+        src, dst, rep = (os.path.join(d, n) for n in ("in" + ext, "out" + ext, "report.json"))
+        with open(src, "w") as f:
+            f.write(("FOIL\n" if dat else "")
+                    + "".join(sep.join(repr(float(v)) for v in r) + "\n" for r in rows))
+        res = CliRunner().invoke(cli_main, ["fair", src, "-o", dst, "--tol", repr(case.tol),
+                                            "--report", rep, "--quiet"])
+        if res.exit_code != 0 or not os.path.exists(dst):
+            raise RuntimeError(f"curvefair fair exit {res.exit_code}: "
+                               f"{(res.output or '')[-200:]} {res.exception!r}")
+        w = np.loadtxt(dst, delimiter=None if dat else ",", skiprows=1 if dat else 0, ndmin=2)
+        with open(rep) as f:
+            report = json.load(f)
+    if case.closed:
+        w = w[:-1]
+    methods = sorted({str((c.get("report") or {}).get("method", c.get("status")))
+                      for c in report.get("curves", [])})
+    if case.closed:
+        rb = cf.interpolate_cubic(np.vstack([w, w[:1]]), "chord", "periodic")
+    else:
+        rb = cf.interpolate_cubic(w, "chord", "natural")
+    return rb, w, {"method": "+".join(methods)}
+
+
 
 
 # ``curvefair.fair_points`` works on the points themselves (no start curve to move): the
@@ -105,6 +156,8 @@ def run_tool(case: C.Case, tool: str) -> Any:
         return initial_curve("poliakoff", case.points, case.closed)[0]
     if tool == POINTS_TOOL:
         return run_fair_points(case)[0]
+    if tool == CLI_TOOL:
+        return run_cli_default(case)[0]
     for name, method, kw in curvefair_tools():
         if name == tool:
             c0, _ = initial_curve(method, case.points, case.closed)
@@ -246,6 +299,21 @@ def run_case(case: C.Case, tools: list[str] | None = None) -> list[dict[str, Any
             if tool == POINTS_TOOL:
                 curve, u, rep = run_fair_points(case)
                 rep = dict(rep, steps=rep["iterations"])
+            elif tool == CLI_TOOL:
+                curve, w, rep = run_cli_default(case)
+                dt = time.perf_counter() - t0
+                d = np.linalg.norm(w - pts, axis=1)
+                i = int(np.argmax(d))
+                row.update(ok=1, time_s=dt, dev=float(d[i]), dev_index=i,
+                           dev_over_tol=float(d[i]) / case.tol,
+                           violation=int(d[i] > case.tol * (1 + 1e-9)),
+                           stop_reason=rep["method"])
+                # the curve read back is the rebuilt one: both column sets are the file's
+                m = metrics(case, curve)
+                row.update(m)
+                row.update({k + "_rb": v for k, v in m.items()})
+                rows.append(row)
+                continue
             else:
                 c0, u = initial_curve(method, pts, case.closed)
                 spec = REGISTERED_METHODS[method]
@@ -394,6 +462,27 @@ def write_csv(rows: list[dict[str, Any]], path: Path) -> None:
             w.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in r.items()})
 
 
+def read_csv(path: Path) -> list[dict[str, Any]]:
+    """The rows of :func:`write_csv` (values as text; the report converts them)."""
+    with open(path, newline="") as f:
+        return [{k: v for k, v in r.items() if v != ""} | {"case": r["case"], "tool": r["tool"]}
+                for r in csv.DictReader(f)]
+
+
+def merge_rows(new: list[dict[str, Any]], old: list[dict[str, Any]], cases: list[C.Case]
+               ) -> tuple[list[dict[str, Any]], int]:
+    """``new`` plus the rows of ``old`` for every (case, tool) ``new`` does not have, on the
+    cases of ``cases`` only, in the run's order; and the number reused."""
+    names = {c.name for c in cases}
+    have = {(r["case"], r["tool"]) for r in new}
+    keep = [r for r in old if r["case"] in names and (r["case"], r["tool"]) not in have]
+    rows = new + keep
+    key = {c.name: j for j, c in enumerate(cases)}
+    tool_order = {t: j for j, t in enumerate(all_tools())}
+    rows.sort(key=lambda r: (key[r["case"]], tool_order.get(r["tool"], 999)))
+    return rows, len(keep)
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help="a tiny subset (about a minute)")
@@ -411,11 +500,20 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--only", nargs="+", default=None,
                     choices=("ground-truth", "airfoils", "glyphs", "point-files"),
                     help="run these corpora only (a partial page)")
+    ap.add_argument("--reuse", type=Path, default=None, metavar="RESULTS.csv",
+                    help="with --tools: the rows of every other tool are taken from this "
+                         "earlier full run's CSV (same corpus), so that a change to one method "
+                         "reruns that method only; the page says so")
     ap.add_argument("--tools", nargs="+", default=None,
                     help="run these tools only (names as in the tables, e.g. cf:points-l1 "
                          "peer:scipy-splprep; the input interpolant always runs)")
     args = ap.parse_args(argv)
 
+    import report
+
+    if args.out.exists():
+        # before the run, not after it: a page whose hand-written sections cannot be kept
+        report.splice(args.out.read_text(), "")
     t_start = time.perf_counter()
     if args.quick:
         gt = C.ground_truth_cases(instances=args.instances or 1, levels=(1e-3,))
@@ -427,6 +525,7 @@ def main(argv: list[str] | None = None) -> int:
         af = C.airfoil_cases(args.airfoils or 240)
         gl = C.glyph_cases(args.glyphs or 80)
         pf = C.point_file_cases()
+    page_cases = gt + af + gl + pf
     if args.only:
         keep = set(args.only)
         gt, af, gl, pf = [c if n in keep else [] for n, c in
@@ -438,6 +537,13 @@ def main(argv: list[str] | None = None) -> int:
           f"{len(all_tools())} tools; {args.jobs} processes", flush=True)
     rows = run_all(cases, args.jobs, args.tools)
     elapsed = time.perf_counter() - t_start
+    reused = 0
+    if args.reuse is not None:
+        if not args.tools:
+            ap.error("--reuse needs --tools (the tools to run again)")
+        # the page covers every corpus; the rows this run made replace the earlier ones
+        cases = page_cases
+        rows, reused = merge_rows(rows, read_csv(args.reuse), cases)
     if args.img is None:
         page = ROOT / "docs" / "benchmarks.md"
         args.img = (ROOT / "docs" / "img" / "bench" if args.out.resolve() == page.resolve()
@@ -445,9 +551,9 @@ def main(argv: list[str] | None = None) -> int:
     args.csv.parent.mkdir(parents=True, exist_ok=True)
     write_csv(rows, args.csv)
 
-    import report
-
-    cmd = "make bench-quality" if not args.quick else "python benchmarks/quality/run.py --quick"
+    given = sys.argv[1:] if argv is None else list(argv)
+    cmd = ("make bench-quality" if not given else
+           "python benchmarks/quality/run.py " + " ".join(given))
     info = {
         "command": cmd,
         "date": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
@@ -459,6 +565,12 @@ def main(argv: list[str] | None = None) -> int:
         "quick": args.quick,
         "csv": os.path.relpath(args.csv, args.out.parent),
     }
+    if reused:
+        info["reused"] = (f"{reused} rows come from the earlier run in `{args.reuse}`; "
+                          "this run made the rows of "
+                          + ", ".join("`" + t + "`" for t in args.tools)
+                          + (f" on {', '.join(args.only)}" if args.only else "")
+                          + " (and the input interpolant's)")
     report.write_page(rows, cases, info, args.out, args.img)
     n_viol = sum(int(r.get("violation") or 0) for r in rows if r["tool"].startswith("cf:"))
     print(f"wrote {args.out} and {args.csv} in {elapsed:.0f} s; "

@@ -81,14 +81,24 @@ def cases() -> list[tuple[str, str, str, dict[str, Any]]]:
     """``(case_id, curve_name, method, options)`` for every recorded case."""
     from curvefair.fairing import available_methods
 
+    pairs = [(cname, m) for cname, c in curves().items() for m in available_methods(c)]
+    # the (curve, method) pairs already in the fixture keep their order, hence their option
+    # picks; a pair that a later registration adds (a method accepting a new curve kind) comes
+    # after them and is recorded on its own, without moving any recorded case
+    known: list[tuple[str, str]] = []
+    if FIXTURE.exists():
+        with np.load(FIXTURE, allow_pickle=False) as z:
+            order = json.loads(z["meta"].tobytes().decode("utf-8"))["order"]
+        for cid in order:
+            cname, m, _ = cid.split("|")
+            if (cname, m) not in known:
+                known.append((cname, m))
+    pairs = [pq for pq in known if pq in pairs] + [pq for pq in pairs if pq not in known]
     out = []
-    j = 0
-    for cname, c in curves().items():
-        for m in available_methods(c):
-            picks = [0] + [1 + (j + 4 * i) % (len(OPTIONS) - 1) for i in range(3)]
-            j += 1
-            for k in picks:
-                out.append((f"{cname}|{m}|{k}", cname, m, OPTIONS[k]))
+    for j, (cname, m) in enumerate(pairs):
+        picks = [0] + [1 + (j + 4 * i) % (len(OPTIONS) - 1) for i in range(3)]
+        for k in picks:
+            out.append((f"{cname}|{m}|{k}", cname, m, OPTIONS[k]))
     return out
 
 

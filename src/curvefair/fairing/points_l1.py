@@ -46,6 +46,24 @@ factorised by the band Cholesky kernel of :mod:`curvefair.fairing._global_kernel
 time and memory per Newton step. The whole loop (residuals, assembly, factorisation, step
 length, line search) runs compiled, :func:`curvefair.fairing._points_kernels.tube_ipm`.
 
+Jump costs and the choice among them. The L1 norm weighs every jump alike, so on data whose
+spacing varies 1:100 (an airfoil's leading edge) the dense end's jumps -- ``(h_max /
+h_min)^3`` larger for the same noise -- dominate it. ``scale`` sets per-jump costs ``c_k`` in
+``sum_k c_k |J_k|`` (:func:`_jump_costs`): ``"spacing"``, ``c_k = hbar_k^3`` (the jump measured
+by the move that would undo it), ``"input"``, ``c_k = 1 / median_9(|J(p)|)_k`` (against the
+noise around it); the reweighting becomes ``w_k = c_k^2 / (c_k |J_k| + delta)``. No single
+cost wins everywhere (measured on the quality benchmark's airfoils and point files), so the
+driver (``select``, default 3 up to ``SELECT_MAX_POINTS``) solves with each and keeps the
+result whose written points rebuild -- chord-length natural cubic, as a reader does -- into
+the fewest curvature extrema (then inflections).
+
+Closed point lists. The periodic cubic through the points (``closed=True``) is a cubic
+B-spline on the parameters extended periodically, coefficients wrapping
+(:func:`periodic_operators`): the same unknowns (one per point), every point's jump, and
+matrices banded with corner terms. Reordered ``0, N-1, 1, N-2, ...`` (:func:`_zigzag`) they
+are ordinary bands of twice the width; the interior point (:func:`_tube_qp_cyclic`, the same
+steps in numpy) factorises each Newton matrix in that order with LAPACK's band Cholesky.
+
 Parameters and the tolerance. The problem is solved at the input's own parameters ``u``
 (chord lengths of the input points for a point file) and the result is the natural cubic
 through ``q`` at those parameters, on the input's domain: the difference ``S_q - S_p`` is the
@@ -173,6 +191,41 @@ def natural_operators(u: ArrayLike) -> NaturalOperators:
     return NaturalOperators(u, t, A, G, Jm, E)
 
 
+def periodic_operators(u: ArrayLike) -> NaturalOperators:
+    """The operators of :class:`NaturalOperators` for the periodic cubic through ``N`` points at
+    parameters ``u`` (``N + 1`` values, ``u_N`` the parameter of the closing point, N >= 3).
+
+    The periodic cubic is a cubic B-spline on the knots ``u`` extended by three spans at each
+    side by the period ``P = u_N - u_0``; its ``N + 3`` coefficients wrap,
+    ``c_{N + s} = c_s`` (``s = 0, 1, 2``), leaving ``x = (c_0 .. c_{N-1})``, one unknown per
+    point (``E`` maps ``x`` to the ``N + 3`` coefficients). ``A`` (N x N): the values at
+    ``u_0 .. u_{N-1}``, cyclic tridiagonal; ``G`` (N x N): ``S'''`` on span ``[u_k, u_{k+1}]``;
+    ``Jm`` (N x N): the jump ``S'''(u_k+) - S'''(u_k-)`` at every point, cyclic (``k = 0``:
+    span 0 minus span ``N - 1``). The matrices are banded with corner terms (the wrap).
+    """
+    u = np.asarray(u, dtype=float)
+    N = u.shape[0] - 1
+    P = u[-1] - u[0]
+    t = np.r_[u[N - 3:N] - P, u, u[1:4] + P]
+    rows = np.r_[np.arange(N), N + np.arange(3)]
+    cols = np.r_[np.arange(N), np.arange(3)]
+    E = sp.csr_matrix((np.ones(N + 3), (rows, cols)), shape=(N + 3, N))
+    # the knots t[3] .. t[N + 3] are u_0 .. u_N: basis j is non-zero on (t_j, t_{j+4})
+    Bd = BSpline.design_matrix(u[:-1], t, 3).tocsr()  # (N, N + 3)
+    A = (Bd @ E).tocsr()
+    D1 = _diff_op(t, N + 3, 3, 0)
+    D2 = _diff_op(t, N + 2, 2, 1)
+    D3 = _diff_op(t, N + 1, 1, 2)
+    G3 = (D3 @ D2 @ D1 @ E).tocsr()  # (N, N): degree-0 coefficient j on (t_{j+3}, t_{j+4})
+    G = G3
+    k = np.arange(N)
+    Dj = sp.csr_matrix((np.r_[np.ones(N), -np.ones(N)], (np.r_[k, k], np.r_[k, (k - 1) % N])),
+                       shape=(N, N))
+    Jm = (Dj @ G).tocsr()
+    A.eliminate_zeros()
+    return NaturalOperators(u, t, A, G, Jm, E)
+
+
 def _band_lower(K: sp.spmatrix, width: int) -> FloatArray:
     """``Kb[j, o] = K[j + o, j]`` for ``o = 0 .. width``."""
     N = K.shape[0]
@@ -283,6 +336,123 @@ def _tube_qp(K: sp.csr_matrix | FloatArray, A: sp.csr_matrix | None, x0: FloatAr
     return x, lam, int(steps), reason
 
 
+def _zigzag(N: int) -> np.ndarray:
+    """Positions ``pos[j]`` of the order ``0, N-1, 1, N-2, 2, ...``: indices at cyclic
+    distance ``d`` end at most ``2 d`` apart, so a cyclic band of half-width ``b`` becomes an
+    ordinary band of half-width ``2 b`` (no fill-in outside it)."""
+    pos = np.empty(N, dtype=np.int64)
+    j = np.arange((N + 1) // 2)
+    pos[j] = 2 * j
+    r = np.arange(N // 2)
+    pos[N - 1 - r] = 2 * r + 1
+    return pos
+
+
+def _tube_qp_cyclic(K: sp.csr_matrix, C: sp.csr_matrix, x0: FloatArray, pts: FloatArray,
+                    rad: FloatArray, max_steps: int = 80, gap: float = 1e-9,
+                    lam0: FloatArray | None = None
+                    ) -> tuple[FloatArray, FloatArray, int, str]:
+    """:func:`_tube_qp` for closed curves: the same primal-dual interior point (Boyd &
+    Vandenberghe sec. 11.7, the steps of
+    :func:`curvefair.fairing._points_kernels.tube_ipm`), in numpy, for a ``K`` and constraint
+    rows ``C`` that wrap around (cyclic band). Each Newton matrix is put in the order of
+    :func:`_zigzag`, where it is an ordinary band, and factorised by LAPACK's band Cholesky:
+    ``O(n)`` per step."""
+    from scipy.linalg import cho_solve_banded, cholesky_banded
+
+    N, dim = x0.shape
+    m = pts.shape[0]
+    n = N * dim
+    x = np.array(x0, dtype=np.float64)
+    xf = x.reshape(-1)
+    E0 = float(xf @ (K @ xf))
+    if not E0 > 0:
+        return x, np.zeros(m), 0, "zero_energy"
+    Ks = (K * (2.0 / E0)).tocsr()
+    Cc = sp.csr_matrix(C)
+    CI = sp.kron(Cc, sp.identity(dim), format="csr")
+    pos = (_zigzag(N)[:, None] * dim + np.arange(dim)[None, :]).reshape(-1)
+    Pm = sp.csr_matrix((np.ones(n), (pos, np.arange(n))), shape=(n, n))
+    t2 = rad * rad
+    lam = np.ones(m) if lam0 is None else np.array(lam0, dtype=np.float64)
+
+    def resid(x: FloatArray, lam: FloatArray, tinv: float
+              ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        v = Cc @ x - pts
+        fi = 0.5 * (np.sum(v * v, axis=1) / t2 - 1.0)
+        rc = -lam * fi - tinv
+        rd = (Ks @ x.reshape(-1)).reshape(N, dim) + Cc.T @ ((lam / t2)[:, None] * v)
+        return v, fi, rd, rc
+
+    v, fi, rd, rc = resid(x, lam, 0.0)
+    gscale = float(np.abs(rd).max()) or 1.0
+    steps = 0
+    code = 1
+    while steps < max_steps:
+        eta = float(-(fi @ lam))
+        tinv = eta / (10.0 * m)
+        v, fi, rd, rc = resid(x, lam, tinv)
+        if eta < gap and float(np.abs(rd).max()) < 1e-8 * gscale:
+            code = 0
+            break
+        ww = lam / (-fi)
+        a = v / t2[:, None]
+        blocks = ww[:, None, None] * a[:, :, None] * a[:, None, :] \
+            + (lam / t2)[:, None, None] * np.eye(dim)[None]
+        M = Ks + CI.T @ _block_diag(blocks) @ CI
+        Mp = (Pm @ M @ Pm.T).tocoo()
+        low = Mp.row >= Mp.col
+        kd = int(np.max(Mp.row[low] - Mp.col[low]))
+        ab = np.zeros((kd + 1, n))
+        np.add.at(ab, (Mp.row[low] - Mp.col[low], Mp.col[low]), Mp.data[low])
+        rhs = -rd - Cc.T @ ((rc / fi)[:, None] * a)
+        try:
+            cb = cholesky_banded(ab, lower=True)
+        except np.linalg.LinAlgError:
+            code = 2
+            break
+        dxp = cho_solve_banded((cb, True), Pm @ rhs.reshape(-1))
+        dx = (Pm.T @ dxp).reshape(N, dim)
+        if not np.all(np.isfinite(dx)):
+            code = 2
+            break
+        Cdx = Cc @ dx
+        adx = np.sum(a * Cdx, axis=1)
+        dlam = (rc - lam * adx) / fi
+        neg = dlam < 0
+        smax = min(1.0, float(np.min(-lam[neg] / dlam[neg]))) if np.any(neg) else 1.0
+        a2 = np.sum(Cdx * Cdx, axis=1)
+        a1 = np.sum(v * Cdx, axis=1)
+        c0 = np.sum(v * v, axis=1) - t2
+        ok2 = a2 > 0
+        disc = np.maximum(a1[ok2] ** 2 - a2[ok2] * c0[ok2], 0.0)
+        tmax = float(np.min((-a1[ok2] + np.sqrt(disc)) / a2[ok2])) if np.any(ok2) else np.inf
+        st = min(0.99 * smax, 0.99 * tmax)
+        rnorm = np.sqrt(float(np.sum((rd / gscale) ** 2) + np.sum(rc * rc)))
+        while st > 1e-14:
+            x1 = x + st * dx
+            lam1 = lam + st * dlam
+            v1, fi1, rd1, rc1 = resid(x1, lam1, tinv)
+            if np.all(fi1 < 0.0):
+                r1 = np.sqrt(float(np.sum((rd1 / gscale) ** 2) + np.sum(rc1 * rc1)))
+                if r1 <= (1.0 - 0.01 * st) * rnorm:
+                    break
+            st *= 0.5
+        if st <= 1e-14:
+            code = 2
+            break
+        x, lam, fi = x1, lam1, fi1
+        steps += 1
+    if code == 0:
+        reason = "converged"
+    elif code == 1:
+        reason = "max_steps"
+    else:
+        eta = float(-(lam @ (0.5 * (np.sum((Cc @ x - pts) ** 2, axis=1) / t2 - 1.0))))
+        reason = "converged" if eta < 1e-6 else "numerical"
+    return x, lam, int(steps), reason
+
+
 # ------------------------------------------------------------------------------------------
 # the method
 # ------------------------------------------------------------------------------------------
@@ -295,9 +465,10 @@ def _jump_norms(ops: NaturalOperators, x: FloatArray, P: FloatArray | None = Non
     return np.sqrt(np.sum(J * J, axis=1))
 
 
-def _normal_projections(q: FloatArray) -> FloatArray:
-    """``I - t_k t_k^T`` at every interior point, ``t_k`` the unit central chord direction."""
-    d = q[2:] - q[:-2]
+def _normal_projections(q: FloatArray, closed: bool = False) -> FloatArray:
+    """``I - t_k t_k^T`` at every interior point (closed: every point), ``t_k`` the unit
+    central chord direction."""
+    d = np.roll(q, -1, axis=0) - np.roll(q, 1, axis=0) if closed else q[2:] - q[:-2]
     t = d / np.maximum(np.linalg.norm(d, axis=1), 1e-300)[:, None]
     dim = q.shape[1]
     return np.eye(dim)[None] - t[:, :, None] * t[:, None, :]
@@ -337,12 +508,41 @@ def _block_diag(W: FloatArray) -> sp.csr_matrix:
     return sp.csr_matrix((W.reshape(-1), (r, c)), shape=(k * dim, k * dim))
 
 
+def _jump_costs(scale: str, u: FloatArray, ops: NaturalOperators, xp: FloatArray,
+                P: FloatArray) -> FloatArray:
+    """The cost ``c_k`` of the jump at interior parameter ``u_k`` in ``sum_k c_k |J_k|``.
+
+    ``"none"``: 1. ``"spacing"``: ``hbar_k^3``, ``hbar_k`` the mean of the two spans at
+    ``u_k`` -- a move ``m`` of one point changes the jumps next to it by about
+    ``6 m / h^3``, so this measures every jump by the move that would undo it (where the
+    points are dense, e.g. an airfoil's leading edge, the same noise makes jumps ``(h_TE /
+    h_LE)^3`` larger). ``"input"``: ``1 / s_k``, ``s_k`` the running median (9 knots) of the
+    input's own jumps, i.e. each jump measured against the noise around it."""
+    n_int = ops.Jm.shape[0]
+    if scale == "none":
+        return np.ones(n_int)
+    if scale == "spacing":
+        h = np.diff(u)
+        hb = 0.5 * (h[:-1] + h[1:]) if n_int == h.shape[0] - 1 else 0.5 * (h + np.roll(h, 1))
+        c = hb ** 3
+    elif scale == "input":
+        from scipy.ndimage import median_filter
+
+        j0 = _jump_norms(ops, xp, P)
+        sm = median_filter(j0, size=min(9, max(1, n_int)), mode="nearest")
+        c = 1.0 / np.maximum(sm, 1e-12 * max(float(sm.max()), 1e-300))
+    else:
+        raise InputError(f"scale must be 'none', 'spacing' or 'input', got {scale!r}")
+    return c / float(c.max())
+
+
 def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
               hold: Iterable[int] | ArrayLike = (), rounds: int = 5, delta: float = 1e-5,
               beta: float = 1e-6,
               tau: float = 1.0, max_steps: int = 80, curve_tol: bool = True,
               samples: int = 3, max_attempts: int = 4, warm: float = 0.9,
-              round_gap: float = 1e-6, warm_lam: bool = True) -> PointsL1Result:
+              round_gap: float = 1e-6, warm_lam: bool = True,
+              scale: str = "none", closed: bool = False) -> PointsL1Result:
     """The natural cubic through moved points with the sparsest third-derivative jumps.
 
     Parameters
@@ -377,6 +577,12 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
     samples : int
         Curve samples per span (equally spaced inside it) constrained like the data points:
         ``|S_q(s) - S_p(s)| <= tol``; the certified bound then rarely needs the final scaling.
+    scale : {"none", "spacing", "input"}
+        Per-jump costs ``c_k`` of the L1 norm ``sum_k c_k |J_k|`` (module docstring,
+        :func:`_jump_costs`).
+    closed : bool
+        ``points`` are the ``N`` distinct points of a closed list (no repeated closing point;
+        ``params`` then has ``N + 1`` values): the periodic cubic (:func:`periodic_operators`).
 
     Returns
     -------
@@ -398,14 +604,21 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
     tolv = as_positive(tol, "tol")
     assert tolv is not None
     N, dim = pts.shape
-    u_in = parameterize(pts, "chord" if params is None else params)
+    bc = "periodic" if closed else "natural"
+    # a closed list: the N distinct points, parameters N + 1 (the closing point's last)
+    u_in = parameterize(np.vstack([pts, pts[:1]]) if closed else pts,
+                        "chord" if params is None else params)
+
+    def spline(q: FloatArray, u: Any) -> CubicHermite:
+        return interpolate_cubic(np.vstack([q, q[:1]]) if closed else q, u, bc)
+
     held = np.zeros(N, dtype=bool)
     for i in np.asarray(list(cast(Iterable[int], hold)), dtype=int).reshape(-1):
         if not -N <= i < N:
             raise InputError(f"hold index {i} out of range for {N} points")
         held[i] = True
     p_in = pts
-    ref_in = interpolate_cubic(p_in, u_in, "natural")
+    ref_in = spline(p_in, u_in)
     # solved on centred, unit-size data (conditioning; a tol of 1e300 or 1e-300 must not
     # overflow): a radius beyond 1e6 sizes binds nothing, one below 1e-12 moves nothing
     centre = 0.5 * (pts.max(axis=0) + pts.min(axis=0))
@@ -421,41 +634,55 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
     tolv = min(tolv / size, 1e6)
     margin = min(0.25 * tolv, 1e-9 * tolv + 64.0 * np.finfo(float).eps * float(np.abs(pts).max()))
     # the parameters, affinely onto the chord length of the unit-size data (conditioning)
-    chord = float(np.sum(np.sqrt(np.sum(np.diff(pts, axis=0) ** 2, axis=1))))
+    chord = float(np.sum(np.sqrt(np.sum(np.diff(np.vstack([pts, pts[:1]]) if closed else pts,
+                                                axis=0) ** 2, axis=1))))
     u = (u_in - u_in[0]) * (chord / (u_in[-1] - u_in[0]))
-    ops = natural_operators(u)
-    xp = _solve_tri(ops.A, pts)  # the input's natural cubic at these parameters
     ns = max(0, int(samples))
-    if ns:
-        fr = np.arange(1, ns + 1) / (ns + 1.0)
-        us = (u[:-1, None] + np.diff(u)[:, None] * fr[None, :]).reshape(-1)
-        us = np.clip(us, u[0], u[-1])
-        Bs = (BSpline.design_matrix(us, ops.t, 3) @ ops.E).tocsr()
-        C = sp.vstack([ops.A, Bs]).tocsr()
-        Y = np.vstack([pts, Bs @ xp])
-        del Bs
-    else:
-        C, Y = ops.A, pts
-    # the solver needs the rows of C only (four B-spline values each): no sparse matrix kept
-    rows = _rows4(C)
+
+    def setup(u: FloatArray) -> tuple[NaturalOperators, FloatArray, Any, FloatArray, float]:
+        """Operators at parameters ``u``, the input's natural cubic ``xp`` there, the
+        constraint rows ``C`` (data points, then ``ns`` samples per span) with their
+        centres ``Y``, and the E3 weight ``b``."""
+        ops = periodic_operators(u) if closed else natural_operators(u)
+        xp = _solve(ops.A, pts, closed)  # the input's cubic at these parameters
+        if ns:
+            fr = np.arange(1, ns + 1) / (ns + 1.0)
+            us = (u[:-1, None] + np.diff(u)[:, None] * fr[None, :]).reshape(-1)
+            us = np.clip(us, u[0], u[-1])
+            Bs = (BSpline.design_matrix(us, ops.t, 3) @ ops.E).tocsr()
+            C = sp.vstack([ops.A, Bs]).tocsr()
+            Y = np.vstack([pts, Bs @ xp])
+        else:
+            C, Y = ops.A, pts
+        jn0 = _jump_norms(ops, xp)
+        h = np.diff(u)
+        e3 = float(np.sum(h[:, None] * (ops.G @ xp) ** 2))
+        jj = float(np.sum(jn0 * jn0))
+        b = beta * jj / e3 if e3 > 0 and jj > 0 else beta
+        return ops, xp, C, Y, b
+
+    ops, xp, C, Y, b = setup(u)
+    # open curves: the compiled solver needs the rows of C only (four B-spline values each)
+    # and the energy's band (no sparse matrix kept); closed ones wrap around (numpy solver)
+    rows = None if closed else _rows4(C)
     rad_s = np.full(C.shape[0] - N, tolv - margin)
-    del C
-    jrows, grows = _rows4(ops.Jm, 5), _rows4(ops.G)
+    if not closed:
+        C = None  # freed: the rows are all the solver needs
+        jrows, grows = _rows4(ops.Jm, 5), _rows4(ops.G)
     rad_p = np.where(held, 1e-4 * tolv, tolv - margin)
     j_before = float(_jump_norms(ops, xp).sum())
-    jn0 = _jump_norms(ops, xp)
-    h = np.diff(u)
-    e3 = float(np.sum(h[:, None] * (ops.G @ xp) ** 2))
-    jj = float(np.sum(jn0 * jn0))
-    b = beta * jj / e3 if e3 > 0 and jj > 0 else beta
-    Pn = _normal_projections(pts)
+    Pn = _normal_projections(pts, closed)
     newton = 0
     rounds_done = 0
     attempts = 0
     curve_dev = None
-    ref = interpolate_cubic(p_in, "chord", "natural") if curve_tol else None
+    ref = spline(p_in, "chord") if curve_tol else None
     reason = "converged"
-    w = np.ones(N - 2)
+    # per-jump cost c_k of the L1 norm sum_k c_k |J_k| (see ``scale``)
+    cost = _jump_costs(scale, u, ops, xp, Pn)
+    nj = cost.shape[0]
+    w = cost * cost
+    w *= nj / float(w.sum())
     x = xp
     lam = None
     floor = None
@@ -467,24 +694,29 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
         # of the last one, with two more rounds
         nr = max(1, int(rounds)) if attempts == 1 else min(2, max(1, int(rounds)))
         for r in range(nr):
-            K = _energy_band(ops, jrows, grows, w, b, Pn, tau)
+            K = (_energy_matrix(ops, w, b, Pn, tau) if closed
+                 else _energy_band(ops, jrows, grows, w, b, Pn, tau))
             # strictly feasible start: the last solution pulled toward the input's curve
             x0 = xp + (warm * shrink) * (x - xp) if (r > 0 or attempts > 1) else xp
             shrink = 1.0
             last = r == nr - 1
-            x, lam, st, reason = _tube_qp(K, None, x0, Y, rad, max_steps=max_steps,
-                                          gap=1e-9 if last else round_gap,
-                                          stall=0.0 if last else 100.0 * round_gap,
-                                          rows=rows,
-                                          lam0=None if (lam is None or not warm_lam)
-                                          else np.maximum(lam, 1e-3))
+            if closed:
+                x, lam, st, reason = _tube_qp_cyclic(
+                    K, C, x0, Y, rad, max_steps=max_steps, gap=1e-9 if last else round_gap,
+                    lam0=None if (lam is None or not warm_lam) else np.maximum(lam, 1e-3))
+            else:
+                x, lam, st, reason = _tube_qp(
+                    K, None, x0, Y, rad, max_steps=max_steps, gap=1e-9 if last else round_gap,
+                    stall=0.0 if last else 100.0 * round_gap, rows=rows,
+                    lam0=None if (lam is None or not warm_lam) else np.maximum(lam, 1e-3))
             newton += st
             rounds_done += 1
-            jn = _jump_norms(ops, x, Pn)
+            z = cost * _jump_norms(ops, x, Pn)
             if floor is None:
-                floor = delta * float(jn.max()) if jn.size and jn.max() > 0 else 1.0
-            w = 1.0 / (jn + floor)
-            w *= (N - 2) / float(w.sum())
+                floor = delta * float(z.max()) if z.size and z.max() > 0 else 1.0
+            # sum_k w_k |J_k|^2 with w_k = c_k^2 / (z_k + floor) majorises sum_k z_k
+            w = cost * cost / (z + floor)
+            w *= nj / float(w.sum())
         q = ops.A @ x
         q[held] = pts[held]
         # back to the data's units; float64 tolerance: pull back anything rounding put
@@ -492,7 +724,7 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
         q_out = centre + size * q
         q_out[held] = p_in[held]
         q_out, pulled = _pull_back(p_in, q_out, tol_out)
-        curve = interpolate_cubic(np.array(q_out), u_in, "natural")
+        curve = spline(np.array(q_out), u_in)
         # equal parameter: the certified bound of the difference curve S_{q - p}; where it
         # exceeds tol (the interpolant of alternating moves overshoots between its samples),
         # the radii are shrunk by the excess and the problem solved again (a re-solve keeps
@@ -505,7 +737,7 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
             # input's chord-length interpolant
             # (:func:`_rebuilt_distance`: an O(n) bound, sampled where it is not sharp; the
             # geometric distance of :func:`curvefair.deviation` takes seconds at 10,000 points)
-            rebuilt: Any = interpolate_cubic(np.array(q_out), "chord", "natural")
+            rebuilt: Any = spline(np.array(q_out), "chord")
             curve_dev = _rebuilt_distance(ref, rebuilt, tol_out)
             if curve_dev > tol_out:
                 shrink = min(shrink, 0.98 * tol_out / curve_dev)
@@ -516,8 +748,8 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
     # equal parameter: certified on the difference curve, every move scaled if needed
     curve_e, cert = enforce_tolerance(ref_in, curve, tol_out, curve_bound=True)
     curve = cast(CubicHermite, curve_e)
-    q_out = np.array(curve.points)
-    x1 = _solve_tri(ops.A, (q_out - centre) / size)
+    q_out = np.array(curve.points)[:N]
+    x1 = _solve(ops.A, (q_out - centre) / size, closed)
     dev = np.sqrt(np.sum((q_out - p_in) ** 2, axis=1))
     report = {"rounds": rounds_done, "newton_steps": newton, "stop_reason": reason,
               "n_active": int(np.sum(dev > (1.0 - 1e-6) * tol_out)),
@@ -594,6 +826,26 @@ def _rebuilt_distance(a: CubicHermite, b: CubicHermite, tol: float, dense: int =
     return worst
 
 
+def _solve(A: sp.csr_matrix, rhs: FloatArray, closed: bool) -> FloatArray:
+    """``A^{-1} rhs``: :func:`_solve_tri`, or for the cyclic tridiagonal ``A`` of a closed
+    curve the same banded solve in the order of :func:`_zigzag` (half-bandwidth 4)."""
+    if not closed:
+        return _solve_tri(A, rhs)
+    from scipy.linalg import solve_banded
+
+    N = A.shape[0]
+    pos = _zigzag(N)
+    Ac = A.tocoo()
+    r, c = pos[Ac.row], pos[Ac.col]
+    kl = ku = int(np.max(np.abs(r - c)))
+    ab = np.zeros((kl + ku + 1, N))
+    np.add.at(ab, (ku + r - c, c), Ac.data)
+    y = np.empty_like(np.asarray(rhs, dtype=float))
+    y[pos] = rhs
+    z = solve_banded((kl, ku), ab, y)
+    return np.asarray(z[pos])
+
+
 def _solve_tri(A: sp.csr_matrix, rhs: FloatArray) -> FloatArray:
     """``A^{-1} rhs`` for the tridiagonal collocation (LAPACK banded solve)."""
     from scipy.linalg import solve_banded
@@ -611,7 +863,7 @@ def _solve_tri(A: sp.csr_matrix, rhs: FloatArray) -> FloatArray:
 # registration with fair()
 # ------------------------------------------------------------------------------------------
 def _accepts(curve: Any) -> bool:
-    return isinstance(curve, CubicHermite) and not curve.closed and curve.n_points >= 4
+    return isinstance(curve, CubicHermite) and curve.n_points >= (5 if curve.closed else 4)
 
 
 #: the largest point count for which ``points-l1`` is the default (its interior point is
@@ -625,6 +877,16 @@ DEFAULT_MAX_POINTS = 20_000
 #: False leaves ``poliakoff`` the default for point data
 DEFAULT_ENABLED = True
 
+#: up to this many points ``fair(curve, "points-l1")`` runs 10 reweighting rounds and solves
+#: with three jump costs (``select=3``: the call's own, ``"spacing"``, ``"input"``), keeping
+#: the one whose written points rebuild into the fewest curvature extrema; longer lists get
+#: one solve of 5 rounds (about a third of the time)
+SELECT_MAX_POINTS = 5_000
+
+#: whether ``points-l1`` is also the default for closed point lists (chord-length periodic
+#: cubics, e.g. a CSV whose last row repeats the first); False: ``poliakoff``
+DEFAULT_CLOSED = True
+
 
 def _is_natural_chord_interpolant(curve: CubicHermite) -> bool:
     """Whether ``curve`` is the chord-length natural cubic through its points (what a point
@@ -633,7 +895,8 @@ def _is_natural_chord_interpolant(curve: CubicHermite) -> bool:
     from ..curves.interpolate import interpolate_cubic
 
     try:
-        ref = interpolate_cubic(curve.points, "chord", "natural")
+        ref = interpolate_cubic(curve.points, "chord",
+                                "periodic" if curve.closed else "natural")
     except InputError:
         return False
     t, r = np.asarray(curve.params), np.asarray(ref.params)
@@ -650,9 +913,10 @@ def _is_natural_chord_interpolant(curve: CubicHermite) -> bool:
 def _has_natural_ends(curve: CubicHermite) -> bool:
     """Whether ``curve`` is the natural cubic spline through its points at its own parameters
     (zero second derivative at both ends, C2): the curve :func:`points_l1` returns for
-    unmoved points."""
+    unmoved points (closed: the periodic cubic)."""
     try:
-        ref = interpolate_cubic(curve.points, np.asarray(curve.params), "natural")
+        ref = interpolate_cubic(curve.points, np.asarray(curve.params),
+                                "periodic" if curve.closed else "natural")
     except InputError:
         return False
     d, dr = np.asarray(curve.tangents), np.asarray(ref.tangents)
@@ -662,18 +926,16 @@ def _has_natural_ends(curve: CubicHermite) -> bool:
 
 def _prefer(curve: Any) -> bool:
     return (_accepts(curve) and curve.n_points <= DEFAULT_MAX_POINTS
+            and (DEFAULT_CLOSED or not curve.closed)
             and _is_natural_chord_interpolant(curve))
 
 
 def _driver(curve: CubicHermite, *, tol: float | None, eps: float | None,
-            max_steps: int | None, clamp: Any, protect: Any, rounds: int = 5,
+            max_steps: int | None, clamp: Any, protect: Any, rounds: int | None = None,
             delta: float = 1e-5, curve_tol: bool = True, samples: int = 3,
-            backoff: int = 4) -> Any:
+            backoff: int = 4, scale: str = "none", select: int | None = None) -> Any:
     from .fair import DriverOutput, FairingHistory
 
-    if curve.closed:
-        raise InputError("method 'points-l1' handles open curves only (a closed point list: "
-                         "use 'poliakoff' or 'wang-cao')")
     if tol is None:
         # no bound on the moves: the convex problem has no tube to work in (its minimiser
         # would be a straight line); the local Poliakoff loop is run instead, and said so
@@ -684,9 +946,11 @@ def _driver(curve: CubicHermite, *, tol: float | None, eps: float | None,
         out.extra["points_l1"] = "no tol given: the poliakoff loop was run instead"
         return out
     n = curve.n_points
-    if n < 4:
-        raise InputError(f"method 'points-l1' needs at least 4 points, got {n}")
-    if any(c in ("g1", "g2") for c in clamp):
+    closed = bool(curve.closed)
+    if n < (5 if closed else 4):
+        raise InputError(f"method 'points-l1' needs at least 4 points, got "
+                         f"{n - 1 if closed else n} distinct")
+    if not closed and any(c in ("g1", "g2") for c in clamp):
         # g1 and g2 hold the end tangent (g2 the curvature too): the natural cubic's end
         # tangent depends on every moved point, so it cannot be held exactly
         raise InputError(f"method 'points-l1' rebuilds the natural cubic through the moved "
@@ -694,23 +958,64 @@ def _driver(curve: CubicHermite, *, tol: float | None, eps: float | None,
                          f"clamp 'g0' (the ends stay natural: zero curvature, before and "
                          f"after), or 'poliakoff' for a G1/G2 clamp")
     if not _has_natural_ends(curve):
-        raise InputError("method 'points-l1' returns the natural cubic through the moved "
-                         "points on the input's parameters: this curve's ends are not natural "
-                         "(not-a-knot or clamped), so the result would differ from it even "
-                         "where nothing moves; use 'poliakoff' or 'wang-cao'")
-    hold = set(int(i) for i in protect) | {0, n - 1}
+        raise InputError("method 'points-l1' returns the natural (closed: periodic) cubic "
+                         "through the moved points on the input's parameters: this curve is "
+                         "not that spline through its points (not-a-knot or clamped ends, "
+                         "or not C2), so the result would differ from it even where nothing "
+                         "moves; use 'poliakoff' or 'wang-cao'")
+    if closed:
+        # no ends; the closing point is point 0
+        hold = {int(i) % (n - 1) for i in protect}
+    else:
+        hold = set(int(i) for i in protect) | {0, n - 1}
     steps = 80 if max_steps is None else int(max_steps)
-    p0 = np.asarray(curve.points)
+    p_all = np.asarray(curve.points)
+    p0 = p_all[:-1] if closed else p_all
     if steps == 0:
         return DriverOutput(curve=curve, steps=0, stop_reason="max_steps",
                             history=FairingHistory.empty(), curve_within_tol=False)
-    def solve(t: float) -> PointsL1Result:
+    # ``select`` formulations, the call's own first, then the jump costs of
+    # :func:`_jump_costs` it does not use (defaults: SELECT_MAX_POINTS)
+    small = n <= SELECT_MAX_POINTS
+    if rounds is None:
+        rounds = 10 if small else 5
+    if select is None:
+        select = 3 if small else 1
+    variants: list[dict[str, Any]] = [{"scale": scale, "rounds": rounds}]
+    for sc in ("spacing", "input", "none"):
+        if len(variants) < max(1, int(select)) and sc != scale:
+            variants.append({"scale": sc, "rounds": 5})
+    chosen = variants[0]
+
+    def solve(t: float, v: dict[str, Any] | None = None) -> PointsL1Result:
+        v = chosen if v is None else v
         return points_l1(p0, t, params=np.asarray(curve.params), hold=sorted(hold),
-                         rounds=rounds, delta=delta, max_steps=steps, curve_tol=curve_tol,
-                         samples=samples)
+                         rounds=int(v["rounds"]), delta=delta, max_steps=steps,
+                         curve_tol=curve_tol, samples=samples, scale=str(v["scale"]),
+                         closed=closed)
 
     res = solve(tol)
     total = int(res.report["newton_steps"])
+    if len(variants) > 1:
+        # the formulation whose written points rebuild into the curve with the fewest
+        # curvature extrema (then inflections) wins: that curve is what a reader of the
+        # file gets, and the jump norm is only a proxy for its extrema
+        from .fair import _analysis_block
+
+        def rebuilt_counts(r: PointsL1Result) -> tuple[int, int]:
+            a = _analysis_block(interpolate_cubic(
+                np.vstack([r.points, r.points[:1]]) if closed else np.array(r.points),
+                "chord", "periodic" if closed else "natural"))
+            return int(a["extrema"]), int(a["inflections"])
+
+        best = rebuilt_counts(res)
+        for v in variants[1:]:
+            r2 = solve(tol, v)
+            total += int(r2.report["newton_steps"])
+            c2 = rebuilt_counts(r2)
+            if c2 < best:
+                res, best, chosen = r2, c2, v
+        res.report["variant"] = dict(chosen)
     # tolerance back-off: in a wide tube (a few tenths of a percent of the size and more)
     # the sparsest jumps can take a shape whose curvature crosses zero where the input's does
     # not (naca2412.dat at tol 0.01 chord: 3 -> 6 inflections, on the flat aft surfaces);
@@ -757,7 +1062,7 @@ def _register() -> None:
                 "parameter) so that their natural cubic on the input's parameters -- and the "
                 "one rebuilt from the written file -- has the sparsest third-derivative jumps "
                 "(reweighted L1, banded interior point, O(n)). "
-                "Default for open point data up to 20,000 points.",
+                "Default for point data (open or closed) up to 20,000 points.",
         source="convex problem over the data points of the natural cubic interpolant; "
                "reweighted L1 (Candes, Wakin & Boyd 2008); interior point (Boyd & "
                "Vandenberghe sec. 11.7)",
@@ -766,11 +1071,10 @@ def _register() -> None:
         accepts=_accepts,
         prefer=_prefer,
         clamps=("g0", "none"),
-        default_reason="default for point files (open chord-length natural cubics, up to "
-                       "20,000 points): on the 6 airfoil files of tests/data at tol 1e-4 of the "
-                       "size, 51 curvature extrema in all on the curve rebuilt from the written "
-                       "points (input 127, poliakoff 91); bench-quality not rerun since the "
-                       "result moved onto the input's parameters",
+        default_reason="default for point files (chord-length natural or periodic cubics, up to "
+                       "20,000 points): fewest curvature extrema on the curve rebuilt from the "
+                       "written points of the tools in docs/benchmarks_default.md (240 UIUC "
+                       "airfoils at tol 1e-4 chord, five point-file families)",
     ))
 
 
