@@ -63,7 +63,7 @@ from .errors import CurvefairError, InputError
 if TYPE_CHECKING:
     from .io import FormatName
 
-__all__ = ["fair_files", "fair_file", "plan_inputs", "Job", "file_sha256", "options_digest",
+__all__ = ["fair_files", "fair_file", "fair_chunked", "plan_inputs", "Job", "file_sha256", "options_digest",
            "parse_methods", "REPORT_DIR"]
 
 #: Folder (inside the output folder) holding the per-file reports and the run report.
@@ -1003,6 +1003,77 @@ def fair_files(paths: str | Sequence[str], out_dir: str | os.PathLike[str], clie
         atomic_write(dest, json.dumps(run, indent=2, allow_nan=False) + "\n")
         run["run_report"] = dest
     return run
+
+
+def fair_chunked(source: str | os.PathLike[str], out: str | os.PathLike[str], *, tol: float,
+                 chunk: int = 5000, overlap: int = 64, hold: int = 16, client: Any = None,
+                 jobs: int | None = None, method: str | None = None, clamp: Any = "g0",
+                 corner_angle: float | None = 60.0,
+                 progress: Callable[[int, int], None] | None = None,
+                 report: str | os.PathLike[str] | None = None, **options: Any
+                 ) -> dict[str, Any]:
+    """Fair one open point list too large for memory in overlapping chunks; write ``out``.
+
+    ``source`` is a point file (``.csv``, ``.txt``, ``.xyz``, ``.pts``, ``.dat`` columns, or a
+    ``.npy`` array of shape (n, 2) or (n, 3), memory-mapped); ``out`` a point file too (text:
+    the input's separator and header, every number in the shortest form that reads back
+    exactly; comments are not copied; ``.npy``: float64). Chunk ``k`` (rows ``k chunk ..``)
+    is faired by :func:`curvefair.fair` on its rows extended by ``overlap`` rows each side,
+    holding the ``hold`` rows either side of each join in both neighbouring fairs, and kept
+    on its own rows; the file written is read back in chunks and measured like a single-file
+    run of point data (moves scaled down where the curve read back exceeds ``tol``); nothing
+    is written unless all of it is within ``tol``. Memory stays bounded by a few windows.
+    The algorithm, the G2 bound at the joins and the on-disk rule: :mod:`curvefair._chunked`.
+
+    Parameters
+    ----------
+    tol : float > 0
+        Every point moves at most ``tol`` (exactly, in float64) and the curve read back from
+        ``out`` is within ``tol`` of the input's (Hausdorff distance, per chunk).
+    chunk, overlap, hold : int
+        Rows per chunk (>= ``2 overlap + 2``), rows of context each side, rows held each side
+        of a join (<= ``overlap - 2``).
+    client : distributed.Client, optional
+        Run the chunks on this Dask cluster (the windows travel with the tasks); None: local
+        processes (``jobs``, default the core count; 1: this process). Same bytes either way.
+    method, clamp, **options
+        As for :func:`curvefair.fair` (``eps``, ``max_steps``, ``mode``, method options);
+        ``clamp`` applies at the curve's two ends.
+    corner_angle : float or None
+        A turn of this many degrees or more at a row is a corner, where the single-file reader
+        splits the list: refused (InputError naming the row). None: read through corners.
+    progress : callable, optional
+        ``progress(done, total)`` after each chunk faired and each chunk measured.
+    report : path, optional
+        Also write the report there as JSON.
+
+    Returns
+    -------
+    dict
+        ``n_points``, ``n_chunks``, ``max_deviation`` (read back), ``max_point_displacement``,
+        ``chunks`` (per chunk: rows, window, method, steps, its own certificate
+        ``max_deviation``, ``on_disk_deviation``, ``move_scale``), ``joins`` (per join: the
+        tangent angle and relative curvature difference between the two fairs and against
+        the curve read back), ``joins_g2_max`` and ``g2_tol``.
+
+    Raises
+    ------
+    InputError
+        Bad arguments, an unreadable or unsuitable file (named with its row or line), or a
+        result that cannot be brought within ``tol`` (nothing written).
+    """
+    from ._chunked import fair_chunked as _run
+
+    rep = _run(source, out, tol=tol, chunk=chunk, overlap=overlap, hold=hold, client=client,
+               jobs=jobs, method=method, clamp=clamp, corner_angle=corner_angle,
+               progress=progress, **options)
+    rep["curvefair"] = __version__
+    if report is not None:
+        from .fairing.fair import jsonable
+        from .io import atomic_write
+
+        atomic_write(report, json.dumps(jsonable(rep), indent=2, allow_nan=False) + "\n")
+    return rep
 
 
 def spool_stdin(fmt: str | None, folder: str) -> str:
