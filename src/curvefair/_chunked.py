@@ -310,16 +310,20 @@ def _held(ch: Chunk, hold: int) -> list[int]:
 
 
 def fair_chunk(ch: Chunk, pts: np.ndarray, tol: float, method: str | None, hold: int,
-               clamp: tuple[str, str], options: Mapping[str, Any]) -> dict[str, Any]:
+               clamp: tuple[str, str], options: Mapping[str, Any],
+               protect: tuple[int, ...] = ()) -> dict[str, Any]:
     """Fair one window; return its core's points, its report and the tangent / curvature of
-    its faired curve at its joins."""
+    its faired curve at its joins. ``protect``: global row indices that never move."""
     from . import fair, interpolate_cubic
+    from .batch import _test_delay
 
+    _test_delay()
     curve = interpolate_cubic(pts, "chord", "natural")
     left = clamp[0] if ch.w0 == 0 else "g0"
     right = clamp[1] if ch.n > 0 and ch.w1 >= ch.n else "g0"
-    res = fair(curve, method, tol=tol, clamp=(left, right), protect=_held(ch, hold),
-               **dict(options))
+    mine = [i - ch.w0 for i in protect if ch.w0 <= i < ch.w1]
+    res = fair(curve, method, tol=tol, clamp=(left, right),
+               protect=sorted(set(_held(ch, hold)) | set(mine)), **dict(options))
     c = res.curve
     P, T, U = (np.asarray(c.points), np.asarray(c.tangents),  # type: ignore[attr-defined]
                np.asarray(c.params))  # type: ignore[attr-defined]
@@ -349,7 +353,10 @@ def fair_chunk(ch: Chunk, pts: np.ndarray, tol: float, method: str | None, hold:
 def measure_chunk(ch: Chunk, orig: np.ndarray, new: np.ndarray) -> dict[str, Any]:
     """The core of ``ch`` read back: Hausdorff distance between the curves through ``new``
     and ``orig`` on the window, restricted to the core (segments ``start .. stop``), the
-    largest point move, and the read-back curve's tangent / curvature at the joins."""
+    largest point move, and the read-back curve's tangent / curvature at the joins.
+    The refined geometric distance (:func:`curvefair.deviation`, ``kind="geometric"``, as
+    :mod:`curvefair.io._verify` measures point data whose cheap bound exceeds ``tol``; that
+    bound is about half a sample gap above it, more than the room a fair to ``tol`` leaves)."""
     from . import CubicHermite, deviation, interpolate_cubic
 
     a = interpolate_cubic(orig, "chord", "natural")
@@ -359,7 +366,8 @@ def measure_chunk(ch: Chunk, orig: np.ndarray, new: np.ndarray) -> dict[str, Any
     for c in (a, b):
         P, T, U = c.points, c.tangents, c.params
         cores.append(CubicHermite(P[lo:hi + 1], T[lo:hi + 1], U[lo:hi + 1]))
-    d = deviation(cores[0], cores[1], kind="geometric")
+    dist = float(deviation(cores[0], cores[1], kind="geometric").max_distance)
+    kind = "geometric"
     moved = np.linalg.norm(new[lo:ch.stop - ch.w0] - orig[lo:ch.stop - ch.w0], axis=1)
     frames = {}
     Pb, Tb, Ub = np.asarray(b.points), np.asarray(b.tangents), np.asarray(b.params)
@@ -367,7 +375,7 @@ def measure_chunk(ch: Chunk, orig: np.ndarray, new: np.ndarray) -> dict[str, Any
         if 0 < j and (ch.n <= 0 or j < ch.n):
             t, k = _frame(Pb, Tb, Ub, j - ch.w0)
             frames[j] = (t.tolist(), k, float(Ub[-1] - Ub[0]))
-    return {"deviation": float(d.max_distance), "frames": frames,
+    return {"deviation": dist, "kind": kind, "frames": frames,
             "max_point_displacement": float(moved.max()) if moved.size else 0.0}
 
 
@@ -502,7 +510,7 @@ def fair_chunked(source: str | os.PathLike[str], out: str | os.PathLike[str], *,
                  chunk: int = DEFAULT_CHUNK, overlap: int = DEFAULT_OVERLAP,
                  hold: int = DEFAULT_HOLD, client: Any = None, jobs: int | None = None,
                  method: str | None = None, clamp: Any = "g0",
-                 corner_angle: float | None = 60.0,
+                 corner_angle: float | None = 60.0, protect: Any = (),
                  progress: Callable[[int, int], None] | None = None,
                  **options: Any) -> dict[str, Any]:
     """See :func:`curvefair.batch.fair_chunked`."""
@@ -523,6 +531,12 @@ def fair_chunked(source: str | os.PathLike[str], out: str | os.PathLike[str], *,
     if 2 * overlap + 2 > chunk:
         raise InputError(f"chunk ({chunk}) must be at least 2 (overlap + 1) = "
                          f"{2 * overlap + 2}")
+    try:
+        prot = tuple(sorted({int(i) for i in protect}))
+    except (TypeError, ValueError):
+        raise InputError(f"protect must be row indices, got {protect!r}") from None
+    if prot and prot[0] < 0:
+        raise InputError(f"protect: row {prot[0]} is negative (rows are 0-based)")
     clamp_pair = parse_clamp(clamp)
     if "none" in clamp_pair:
         raise InputError("clamp 'none' is not available for point data: the ends stay")
@@ -562,9 +576,9 @@ def fair_chunked(source: str | os.PathLike[str], out: str | os.PathLike[str], *,
         temps.append(writer.path)
 
         def tasks() -> Iterator[tuple[Any, ...]]:
-            yield (first[0], first[1], tol_v, method, hold, clamp_pair, options)
+            yield (first[0], first[1], tol_v, method, hold, clamp_pair, options, prot)
             for ch, pts in gen:
-                yield (ch, pts, tol_v, method, hold, clamp_pair, options)
+                yield (ch, pts, tol_v, method, hold, clamp_pair, options, prot)
 
         chunks: list[Chunk] = []
         for args, res in runner.map(fair_chunk, tasks()):
@@ -578,6 +592,9 @@ def fair_chunked(source: str | os.PathLike[str], out: str | os.PathLike[str], *,
             tick()
         writer.close()
         est = len(chunks)
+        if prot and prot[-1] >= n_total:
+            raise InputError(f"protect: row {prot[-1]} is out of range (the file has "
+                             f"{n_total} rows)")
         fair_file = writer.path
         # 2. read back, measure, scale where needed, until every core is within tol
         scales = [1.0] * len(chunks)
@@ -585,7 +602,8 @@ def fair_chunked(source: str | os.PathLike[str], out: str | os.PathLike[str], *,
         notes: list[str] = []
         measured: list[dict[str, Any]] = []
         for attempt in range(_MAX_SHRINK + 1):
-            measured = _measure_file(runner, src, current, chunks, chunk, overlap, tick)
+            measured = _measure_file(runner, src, current, chunks, chunk, overlap, tol_v,
+                                     tick)
             over = [k for k, m in enumerate(measured) if not m["deviation"] <= tol_v]
             if not over:
                 break
@@ -632,6 +650,7 @@ def fair_chunked(source: str | os.PathLike[str], out: str | os.PathLike[str], *,
         joins.append(row)
     for rep, m, s in zip(chunk_reports, measured, scales, strict=True):
         rep["on_disk_deviation"] = m["deviation"]
+        rep["on_disk_deviation_kind"] = m["kind"]
         rep["move_scale"] = s
         rep["on_disk_max_point_displacement"] = m["max_point_displacement"]
     g2 = max((max(r.get("tangent_angle", 0.0), r.get("curvature_rel", 0.0),
@@ -684,7 +703,8 @@ class _rows:
 
 
 def _measure_file(runner: _Runner, src: str, written: str, chunks: list[Chunk], chunk: int,
-                  overlap: int, tick: Callable[[], None]) -> list[dict[str, Any]]:
+                  overlap: int, tol: float, tick: Callable[[], None]
+                  ) -> list[dict[str, Any]]:
     """:func:`measure_chunk` for every chunk of the written file against the input."""
     ga = windows(PointStream(src).blocks(max(1024, chunk)), chunk, overlap, src, None)
     gb = windows(PointStream(written).blocks(max(1024, chunk)), chunk, overlap, written, None)

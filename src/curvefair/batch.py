@@ -553,8 +553,9 @@ def _read(path: str, opts: Mapping[str, Any], notes: list[str] | None = None,
 
 
 def _test_delay() -> None:
-    """Test hook: ``CURVEFAIR_TEST_FILE_DELAY`` seconds of sleep before each file's write (the
-    worker-killed-mid-run test needs files that take long enough to be caught running)."""
+    """Test hook: ``CURVEFAIR_TEST_FILE_DELAY`` seconds of sleep before each file's write and
+    each chunk's fair (the worker-killed-mid-run tests need tasks that take long enough to be
+    caught running)."""
     d = os.environ.get("CURVEFAIR_TEST_FILE_DELAY")
     if d:
         time.sleep(float(d))
@@ -590,7 +591,9 @@ def _fair_file(infile: str, outfile: str | None, options: Mapping[str, Any] | No
 
     ``outfile`` None or ``dry_run``: nothing is written (the report says what would change).
     ``report``: also write the report there (atomically). ``progress(event, value)`` is called
-    with ``("curves", n)`` once the file is read and ``("curve", 1)`` after each curve.
+    with ``("curves", n)`` once the file is read, ``("phase", (done, total))`` after each phase
+    of a curve's :func:`curvefair.fair` (its ``progress``), ``("curve", 1)`` after each curve,
+    and ``("write", 0)`` / ``("write", 1)`` around the checked write.
     ``status`` is ``"ok"``, ``"failed"`` (nothing written: unreadable input, every selected
     curve failed, or the written file would not read back within ``tol``), ``"partial"`` (some
     curves failed: written with those unchanged) or ``"dry-run"``.
@@ -639,12 +642,17 @@ def _fair_file(infile: str, outfile: str | None, options: Mapping[str, Any] | No
             prot = sorted(set(_local_protect(rec, opts["protect"])) | set(shared[i]))
             if shared[i]:
                 row["shared_points_held"] = len(shared[i])
+            phase = None
+            if progress is not None:
+                def phase(done: int, total: int, _p: Any = progress) -> None:
+                    _p("phase", (done, total))
             try:
                 with warnings.catch_warnings(record=True) as caught:
                     warnings.simplefilter("always")
                     res = fair(rec.curve, method, tol=opts["tol"], eps=opts["eps"],
                                max_steps=opts["max_steps"], clamp=opts["clamp"], protect=prot,
-                               mode=opts["mode"], **dict(opts["method_options"]))
+                               mode=opts["mode"], progress=phase,
+                               **dict(opts["method_options"]))
                 notes = list(dict.fromkeys(str(w.message) for w in caught))
             except CurvefairError as exc:
                 row.update(status="failed", error=str(exc))
@@ -669,6 +677,8 @@ def _fair_file(infile: str, outfile: str | None, options: Mapping[str, Any] | No
         rep["error"] = "every selected curve failed; nothing written"
     else:
         _test_delay()
+        if progress is not None:
+            progress("write", 0)
         try:
             check = _write(outfile, faired, records, infile, fmt_in, fmt_out, opts,
                            in_place=_file_key(outfile) == _file_key(infile))
@@ -682,6 +692,8 @@ def _fair_file(infile: str, outfile: str | None, options: Mapping[str, Any] | No
             rep["output_check"] = _jsonable(check.to_dict())
             rep["output_sha256"] = file_sha256(outfile)
             rep["status"] = "partial" if failed else "ok"
+        if progress is not None:
+            progress("write", 1)
     rep["time_s"] = time.perf_counter() - t0
     return _finish(rep, report, dry_run)
 
@@ -1008,7 +1020,7 @@ def fair_files(paths: str | Sequence[str], out_dir: str | os.PathLike[str], clie
 def fair_chunked(source: str | os.PathLike[str], out: str | os.PathLike[str], *, tol: float,
                  chunk: int = 5000, overlap: int = 64, hold: int = 16, client: Any = None,
                  jobs: int | None = None, method: str | None = None, clamp: Any = "g0",
-                 corner_angle: float | None = 60.0,
+                 corner_angle: float | None = 60.0, protect: Iterable[int] = (),
                  progress: Callable[[int, int], None] | None = None,
                  report: str | os.PathLike[str] | None = None, **options: Any
                  ) -> dict[str, Any]:
@@ -1042,6 +1054,8 @@ def fair_chunked(source: str | os.PathLike[str], out: str | os.PathLike[str], *,
     corner_angle : float or None
         A turn of this many degrees or more at a row is a corner, where the single-file reader
         splits the list: refused (InputError naming the row). None: read through corners.
+    protect : iterable of int
+        Rows (0-based) that never move.
     progress : callable, optional
         ``progress(done, total)`` after each chunk faired and each chunk measured.
     report : path, optional
@@ -1066,7 +1080,7 @@ def fair_chunked(source: str | os.PathLike[str], out: str | os.PathLike[str], *,
 
     rep = _run(source, out, tol=tol, chunk=chunk, overlap=overlap, hold=hold, client=client,
                jobs=jobs, method=method, clamp=clamp, corner_angle=corner_angle,
-               progress=progress, **options)
+               protect=protect, progress=progress, **options)
     rep["curvefair"] = __version__
     if report is not None:
         from .fairing.fair import jsonable
