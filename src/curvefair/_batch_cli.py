@@ -396,9 +396,10 @@ def batch_options(f: Any) -> Any:
     f = _selection_options(f)
     f = click.option("--hold-shared", is_flag=True,
                      help="Hull networks: hold every point that coincides with a point of "
-                          "another curve of the file, and the control points of B-spline "
-                          "spans where two B-splines cross (station / longitudinal "
-                          "intersections stay shared).")(f)
+                          "another curve of the file, and where two curves cross elsewhere "
+                          "the control points of the B-spline span or the vertices around "
+                          "the point-data segment (station / longitudinal intersections "
+                          "stay shared).")(f)
     f = click.option("--shared-distance", type=click.FloatRange(min=0), metavar="D",
                      help="--hold-shared: points closer than D coincide [default: 1e-9 times "
                           "the drawing's diagonal].")(f)

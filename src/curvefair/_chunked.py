@@ -309,6 +309,20 @@ def _held(ch: Chunk, hold: int) -> list[int]:
     return sorted(i - ch.w0 for i in out)
 
 
+def _one_blas_thread() -> Any:
+    """BLAS limited to one thread for the duration (threadpoolctl, when installed).
+
+    A multithreaded BLAS splits long dot products (OpenBLAS: above 10,000 elements, e.g. the
+    energy of a 5,000-point window in points-l1) by its thread count, so the rounding -- and
+    the bytes written -- would depend on the worker's cores and environment (Dask workers set
+    ``OPENBLAS_NUM_THREADS=1``); a chunk is small, and the parallelism is across chunks."""
+    try:
+        from threadpoolctl import threadpool_limits
+    except ImportError:  # pragma: no cover - threadpoolctl comes with the dask extra
+        return contextlib.nullcontext()
+    return threadpool_limits(limits=1, user_api="blas")
+
+
 def fair_chunk(ch: Chunk, pts: np.ndarray, tol: float, method: str | None, hold: int,
                clamp: tuple[str, str], options: Mapping[str, Any],
                protect: tuple[int, ...] = ()) -> dict[str, Any]:
@@ -322,8 +336,9 @@ def fair_chunk(ch: Chunk, pts: np.ndarray, tol: float, method: str | None, hold:
     left = clamp[0] if ch.w0 == 0 else "g0"
     right = clamp[1] if ch.n > 0 and ch.w1 >= ch.n else "g0"
     mine = [i - ch.w0 for i in protect if ch.w0 <= i < ch.w1]
-    res = fair(curve, method, tol=tol, clamp=(left, right),
-               protect=sorted(set(_held(ch, hold)) | set(mine)), **dict(options))
+    with _one_blas_thread():
+        res = fair(curve, method, tol=tol, clamp=(left, right),
+                   protect=sorted(set(_held(ch, hold)) | set(mine)), **dict(options))
     c = res.curve
     P, T, U = (np.asarray(c.points), np.asarray(c.tangents),  # type: ignore[attr-defined]
                np.asarray(c.params))  # type: ignore[attr-defined]
@@ -357,6 +372,12 @@ def measure_chunk(ch: Chunk, orig: np.ndarray, new: np.ndarray) -> dict[str, Any
     The refined geometric distance (:func:`curvefair.deviation`, ``kind="geometric"``, as
     :mod:`curvefair.io._verify` measures point data whose cheap bound exceeds ``tol``; that
     bound is about half a sample gap above it, more than the room a fair to ``tol`` leaves)."""
+
+    with _one_blas_thread():
+        return _measure(ch, orig, new)
+
+
+def _measure(ch: Chunk, orig: np.ndarray, new: np.ndarray) -> dict[str, Any]:
     from . import CubicHermite, deviation, interpolate_cubic
 
     a = interpolate_cubic(orig, "chord", "natural")

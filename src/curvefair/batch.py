@@ -30,9 +30,11 @@ Hull networks
 splines) that lies within ``shared_distance`` of a point of another curve of the same file
 (default ``1e-9`` times the drawing's bounding-box diagonal): station / longitudinal
 intersections of an offsets table stay where they are in both curves, so the network stays
-connected. Where two B-spline records cross inside a knot span (at no control point of
-either), :func:`shared_crossings` finds the crossing and holds the ``degree + 1`` control
-points of the span in each curve, which keeps the crossing point exactly in both.
+connected. Where two records cross elsewhere (inside a B-spline's knot span, between two
+vertices of point data), :func:`shared_crossings` finds the crossing and holds the points
+that make it: the ``degree + 1`` control points of the span of a B-spline (the crossing
+stays exactly), the vertices around the segment of point data (it stays to about
+``1.5e-5`` of the moves beyond them).
 """
 
 from __future__ import annotations
@@ -428,29 +430,73 @@ def _held_shared(records: Sequence[Any], distance: float | None) -> list[list[in
     return [sorted(set(a) | set(b)) for a, b in zip(pts, cross, strict=True)]
 
 
+#: Point data: vertices held on each side of a crossing's segment (see :func:`shared_crossings`).
+SHARED_HOLD = 8
+
+
+def _is_spline(curve: Any) -> bool:
+    from .curves.bspline import BSplineCurve
+
+    return isinstance(curve, BSplineCurve)
+
+
+def _is_points(curve: Any) -> bool:
+    """An interpolating Hermite curve (point data): vertices ``points`` at ``params``."""
+    from .curves.hermite import HermiteSpline
+
+    return isinstance(curve, HermiteSpline)
+
+
+def _hermite_support(curve: Any, u: float, m: int) -> set[int]:
+    """Data-point indices of the ``m`` vertices on each side of the segment holding ``u``
+    (both segments when ``u`` is within rounding of a vertex), wrapped for a closed curve."""
+    t = np.asarray(curve.params)
+    lo, hi = float(t[0]), float(t[-1])
+    n = t.shape[0]
+    n_data = n - 1 if curve.closed else n
+    out: set[int] = set()
+    eps = 1e-12 * max(hi - lo, 1e-300)
+    for v in {u - eps, u, u + eps}:
+        v = min(max(v, lo), hi)
+        seg = min(max(int(np.searchsorted(t, v, side="right")) - 1, 0), n - 2)
+        for i in range(seg - m + 1, seg + m + 1):
+            if curve.closed:
+                out.add(i % n_data)
+            elif 0 <= i < n:
+                out.add(i)
+    return out
+
+
 def shared_crossings(records: Sequence[Any], distance: float | None = None
                      ) -> list[list[int]]:
-    """For every B-spline record, the control points to hold so that each place where it
-    meets another B-spline record of the file -- a crossing inside a knot span, not at a
-    control point -- stays where it is in both curves.
+    """For every B-spline and point-data record, the points to hold so that each place where
+    it meets another such record of the file -- a crossing inside a knot span or between two
+    vertices, not at a shared point -- stays where it is in both curves.
 
     Two curves meet at ``(u, v)`` when ``|A(u) - B(v)| <= distance`` (default ``1e-9`` times
-    the bounding-box diagonal of all control points). Candidates are the local minima along
+    the bounding-box diagonal of all their points). Candidates are the local minima along
     ``A``'s samples (16 per span) of the distance to ``B``'s nearest sample, refined by
-    Gauss-Newton on ``A(u) - B(v)`` (scipy ``least_squares``, bounded to the domains). Holding
-    the ``degree + 1`` control points whose basis functions are non-zero at ``u`` keeps
-    ``A(u)`` exactly (``A(u) = sum_i N_i(u) P_i``), and the same at ``v`` in ``B``: the
-    crossing point is unchanged in both, so the network stays connected. Point-data records
-    (interpolating Hermite curves, re-interpolated after every step) are not handled here;
-    their shared vertices are held by :func:`shared_points`.
+    Gauss-Newton on ``A(u) - B(v)`` (scipy ``least_squares``, bounded to the domains).
+
+    What is held, per curve:
+
+    - B-spline: the ``degree + 1`` control points whose basis functions are non-zero at
+      ``u``; ``A(u) = sum_i N_i(u) P_i`` is then exactly unchanged.
+    - Point data (interpolating Hermite curves: point lists, polylines, airfoils; the curve
+      is re-interpolated through the points after every step and on reading): the
+      :data:`SHARED_HOLD` vertices on each side of the segment holding ``u``. The segment
+      depends on its two end vertices and their tangents, and the C2 spline's tangents on the
+      other vertices with a weight that falls by ``2 - sqrt 3`` (about 0.27) per vertex for
+      even spacing (at least 1/2 for any spacing: the tangent system is diagonally
+      dominant; de Boor, A Practical Guide to Splines, ch. IV), so a move of ``d`` outside
+      the held vertices shifts the crossing by about ``0.27^SHARED_HOLD d``, ``1.5e-5 d``.
     """
     from scipy.optimize import least_squares
     from scipy.spatial import cKDTree
 
-    from .curves.bspline import BSplineCurve
-
     out: list[set[int]] = [set() for _ in records]
-    idx = [k for k, r in enumerate(records) if isinstance(r.curve, BSplineCurve)]
+    idx = [k for k, r in enumerate(records)
+           if _is_spline(r.curve) or (_is_points(r.curve) and len(r.curve.params) >= 2)]
     if len(idx) < 2:
         return [[] for _ in records]
     dim = max(records[k].curve.dim for k in idx)
@@ -459,8 +505,12 @@ def shared_crossings(records: Sequence[Any], distance: float | None = None
         x = np.atleast_2d(x)
         return np.c_[x, np.zeros((x.shape[0], dim - x.shape[1]))] if x.shape[1] < dim else x
 
+    def support(curve: Any, u: float) -> set[int]:
+        return (_span_support(curve, u) if _is_spline(curve)
+                else _hermite_support(curve, u, SHARED_HOLD))
+
     if distance is None:
-        allp = np.vstack([pad(np.asarray(records[k].curve.control_points)) for k in idx])
+        allp = np.vstack([pad(np.asarray(_curve_points(records[k].curve))) for k in idx])
         distance = 1e-9 * float(np.linalg.norm(allp.max(axis=0) - allp.min(axis=0)))
     samp = {k: _samples(records[k].curve) for k in idx}
     trees = {k: cKDTree(pad(samp[k][1])) for k in idx}
@@ -498,8 +548,8 @@ def shared_crossings(records: Sequence[Any], distance: float | None = None
                        for s0, s1 in seen):
                     continue
                 seen.append((u, v))
-                out[a].update(_span_support(ca, u))
-                out[b].update(_span_support(cb, v))
+                out[a].update(support(ca, u))
+                out[b].update(support(cb, v))
     return [sorted(o) for o in out]
 
 
