@@ -113,9 +113,9 @@ def _progress(enabled: bool, n_files: int) -> Iterator[Any]:
                 prog.advance(files, value)
             elif what == "phase":  # within one curve: curvefair.fair's phases
                 done, total = value
+                phase = PHASE_NAMES[min(max(done, 1), len(PHASE_NAMES)) - 1]
                 prog.update(within, completed=done, total=total, visible=True,
-                            description=f"{os.path.basename(name)}: "
-                                        f"{PHASE_NAMES[min(max(done, 1), len(PHASE_NAMES)) - 1]} done")
+                            description=f"{os.path.basename(name)}: {phase} done")
             elif what == "write":
                 prog.update(within, completed=value, total=1, visible=True,
                             description=f"{os.path.basename(name)}: write and read back")

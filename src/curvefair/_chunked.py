@@ -317,7 +317,7 @@ def _one_blas_thread() -> Any:
     the bytes written -- would depend on the worker's cores and environment (Dask workers set
     ``OPENBLAS_NUM_THREADS=1``); a chunk is small, and the parallelism is across chunks."""
     try:
-        from threadpoolctl import threadpool_limits
+        from threadpoolctl import threadpool_limits  # type: ignore[import-untyped]
     except ImportError:  # pragma: no cover - threadpoolctl comes with the dask extra
         return contextlib.nullcontext()
     return threadpool_limits(limits=1, user_api="blas")

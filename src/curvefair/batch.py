@@ -34,7 +34,7 @@ connected. Where two records cross elsewhere (inside a B-spline's knot span, bet
 vertices of point data), :func:`shared_crossings` finds the crossing and holds the points
 that make it: the ``degree + 1`` control points of the span of a B-spline (the crossing
 stays exactly), the vertices around the segment of point data (it stays to about
-``1.5e-5`` of the moves beyond them).
+``2.7e-5`` of the moves beyond them).
 """
 
 from __future__ import annotations
@@ -65,8 +65,8 @@ from .errors import CurvefairError, InputError
 if TYPE_CHECKING:
     from .io import FormatName
 
-__all__ = ["fair_files", "fair_file", "fair_chunked", "plan_inputs", "Job", "file_sha256", "options_digest",
-           "parse_methods", "REPORT_DIR"]
+__all__ = ["fair_files", "fair_file", "fair_chunked", "plan_inputs", "Job", "file_sha256",
+           "options_digest", "parse_methods", "REPORT_DIR"]
 
 #: Folder (inside the output folder) holding the per-file reports and the run report.
 REPORT_DIR = ".curvefair"
@@ -483,13 +483,14 @@ def shared_crossings(records: Sequence[Any], distance: float | None = None
     - B-spline: the ``degree + 1`` control points whose basis functions are non-zero at
       ``u``; ``A(u) = sum_i N_i(u) P_i`` is then exactly unchanged.
     - Point data (interpolating Hermite curves: point lists, polylines, airfoils; the curve
-      is re-interpolated through the points after every step and on reading): the
-      :data:`SHARED_HOLD` vertices on each side of the segment holding ``u``. The segment
+      is re-interpolated through the points after every step and on reading): a crossing at
+      one of its vertices (within ``distance``) holds that vertex, which keeps it exactly;
+      else the :data:`SHARED_HOLD` vertices on each side of the segment holding ``u``. The segment
       depends on its two end vertices and their tangents, and the C2 spline's tangents on the
       other vertices with a weight that falls by ``2 - sqrt 3`` (about 0.27) per vertex for
       even spacing (at least 1/2 for any spacing: the tangent system is diagonally
       dominant; de Boor, A Practical Guide to Splines, ch. IV), so a move of ``d`` outside
-      the held vertices shifts the crossing by about ``0.27^SHARED_HOLD d``, ``1.5e-5 d``.
+      the held vertices shifts the crossing by about ``0.27^SHARED_HOLD d``, ``2.7e-5 d``.
     """
     from scipy.optimize import least_squares
     from scipy.spatial import cKDTree
@@ -506,8 +507,17 @@ def shared_crossings(records: Sequence[Any], distance: float | None = None
         return np.c_[x, np.zeros((x.shape[0], dim - x.shape[1]))] if x.shape[1] < dim else x
 
     def support(curve: Any, u: float) -> set[int]:
-        return (_span_support(curve, u) if _is_spline(curve)
-                else _hermite_support(curve, u, SHARED_HOLD))
+        if _is_spline(curve):
+            return _span_support(curve, u)
+        # an interpolating curve passes through its vertices: a crossing at one is held by
+        # holding that vertex alone (two curves sharing a vertex: what shared_points holds)
+        P = np.asarray(curve.points)
+        d = np.linalg.norm(pad(P) - pad(np.asarray(curve(np.array([u])))), axis=1)
+        i = int(np.argmin(d))
+        if d[i] <= distance:
+            n_data = P.shape[0] - 1 if curve.closed else P.shape[0]
+            return {i % n_data}
+        return _hermite_support(curve, u, SHARED_HOLD)
 
     if distance is None:
         allp = np.vstack([pad(np.asarray(_curve_points(records[k].curve))) for k in idx])
