@@ -409,3 +409,31 @@ def test_scheduler_without_distributed_names_the_extra(tmp_path, monkeypatch):
     assert r.exit_code == 1, r.output
     assert "'distributed'" in r.output and "pip install 'curvefair[dask]'" in r.output
     assert not (tmp_path / "out").exists() or not any((tmp_path / "out").rglob("*.*"))
+
+
+def test_name_and_handle_patterns_select_curves(tmp_path: Path):
+    import ezdxf
+
+    from curvefair.io import CurveRecord
+
+    write_curves(tmp_path / "named.json",
+                 [CurveRecord(interpolate_bspline(_wavy(12, seed=k)), name=nm)
+                  for k, nm in enumerate(("station_1", "station_2", "keel"))])
+    r = _run(["fair", "named.json", "-o", "sel.json", "--tol", "0.05", "--name", "station_*"],
+             tmp_path)
+    assert r.exit_code == 0, r.output
+    before = {c["name"]: np.asarray(c["control_points"]) for c in
+              json.loads((tmp_path / "named.json").read_text())["curves"]}
+    after = {c["name"]: np.asarray(c["control_points"]) for c in
+             json.loads((tmp_path / "sel.json").read_text())["curves"]}
+    np.testing.assert_array_equal(after["keel"], before["keel"])
+    assert all(not np.array_equal(after[k], before[k]) for k in ("station_1", "station_2"))
+    # a DXF handle read by ezdxf selects exactly that entity
+    _dxf_two_layers(tmp_path / "two.dxf")
+    deck = next(e.dxf.handle for e in ezdxf.readfile(tmp_path / "two.dxf").modelspace()
+                if e.dxf.layer == "DECK")
+    r = _run(["fair", "two.dxf", "-o", "h.dxf", "--tol", "0.05", "--handle", deck], tmp_path)
+    assert r.exit_code == 0, r.output
+    b, a = _dxf_control_points(tmp_path / "two.dxf"), _dxf_control_points(tmp_path / "h.dxf")
+    np.testing.assert_array_equal(a["HULL"], b["HULL"])
+    assert not np.array_equal(a["DECK"], b["DECK"])
