@@ -437,3 +437,26 @@ def test_name_and_handle_patterns_select_curves(tmp_path: Path):
     b, a = _dxf_control_points(tmp_path / "two.dxf"), _dxf_control_points(tmp_path / "h.dxf")
     np.testing.assert_array_equal(a["HULL"], b["HULL"])
     assert not np.array_equal(a["DECK"], b["DECK"])
+
+
+def test_id_pattern_selects_svg_elements_by_their_id(tmp_path: Path):
+    from xml.etree import ElementTree as ET
+
+    def path_d(k: int) -> str:
+        p = _wavy(10, seed=k) * 10.0 + [0.0, 30.0 * k]
+        return "M " + " L ".join(f"{x:.4f},{y:.4f}" for x, y in p)
+
+    (tmp_path / "two.svg").write_text(
+        '<svg xmlns="http://www.w3.org/2000/svg" width="120" height="80">'
+        f'<path id="frame_7" d="{path_d(0)}" fill="none" stroke="black"/>'
+        f'<path id="keel" d="{path_d(1)}" fill="none" stroke="black"/></svg>')
+    r = _run(["fair", "two.svg", "-o", "sel.svg", "--tol", "0.3", "--id", "frame_*"], tmp_path)
+    assert r.exit_code == 0, r.output
+
+    def ds(p: Path) -> dict[str, str]:
+        return {e.get("id"): e.get("d") for e in ET.parse(p).getroot().iter()
+                if e.tag.endswith("path")}
+
+    before, after = ds(tmp_path / "two.svg"), ds(tmp_path / "sel.svg")
+    assert after["keel"] == before["keel"]  # not selected: written back as it was
+    assert after["frame_7"] != before["frame_7"]
