@@ -437,7 +437,12 @@ class _Runner:
             if self.client is not None:
                 return self.client.submit(fn, *args, pure=False)
             if self.pool is not None:
-                return self.pool.submit(fn, *args)
+                import concurrent.futures as cf
+
+                try:
+                    return self.pool.submit(fn, *args)
+                except cf.process.BrokenProcessPool:  # a worker died: the rest run here
+                    return None
             return None
 
         def result(args: tuple[Any, ...], fut: Any) -> Any:
