@@ -537,7 +537,7 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
         knots whose least-squares refit stays within ``tol / 2``, then the method under the
         rest of the tolerance; ``report["structure"]``). Other curves: no effect.
     progress : callable, optional
-        ``progress(done, total)`` after each phase of the call, ``total`` = :data:`PHASES`
+        ``progress(done, total)`` after each phase of the call, ``total`` = ``PHASES``
         (4): the analysis before, the method's fairing, the analysis after (and the
         never-worse guard), the tolerance certificate. For progress within one long curve;
         the method itself is not interrupted.
