@@ -254,3 +254,40 @@ def test_point_stream_reads_header_comments_and_separators(tmp_path: Path):
     (blk,) = list(s.blocks(10))
     assert blk.tolist() == [[1, 2, 3], [4, 5, 6], [7, 8, 9]]
     assert s.header == "name of it" and s.sep == " " and s.n_rows == 3
+
+
+def test_a_core_read_back_over_tol_gets_its_moves_scaled(tmp_path: Path, monkeypatch):
+    """The rewrite path: the measure of chunk 1 is made to say 2 tol once; that core is
+    written again with its moves scaled (p0 + s (p - p0), unmoved rows exact), the others
+    byte-identical, and everything is measured again."""
+    import curvefair._chunked as ck
+
+    P = _noisy(1200)
+    src = tmp_path / "p.csv"
+    np.savetxt(src, P, delimiter=",")
+    plain = fair_chunked(src, tmp_path / "a.csv", tol=TOL, chunk=400, overlap=20, hold=5,
+                         jobs=1)
+    real = ck.measure_chunk
+    calls = {"n": 0}
+
+    def inflated(ch, orig, new):
+        m = real(ch, orig, new)
+        if ch.index == 1 and calls["n"] == 0:
+            calls["n"] += 1
+            m = dict(m, deviation=2.0 * TOL)
+        return m
+
+    monkeypatch.setattr(ck, "measure_chunk", inflated)
+    rep = fair_chunked(src, tmp_path / "b.csv", tol=TOL, chunk=400, overlap=20, hold=5,
+                       jobs=1)
+    assert plain["n_chunks"] == rep["n_chunks"] == 3
+    s = rep["chunks"][1]["move_scale"]
+    assert s == pytest.approx(0.995 / 2.0) and rep["notes"]
+    A = np.loadtxt(tmp_path / "a.csv", delimiter=",")
+    B = np.loadtxt(tmp_path / "b.csv", delimiter=",")
+    assert np.array_equal(A[:400], B[:400]) and np.array_equal(A[800:], B[800:])
+    same = np.all(A[400:800] == P[400:800], axis=1)
+    np.testing.assert_array_equal(B[400:800][same], P[400:800][same])
+    np.testing.assert_allclose(B[400:800], P[400:800] + s * (A[400:800] - P[400:800]),
+                               rtol=0, atol=1e-12)
+    assert np.linalg.norm(B - P, axis=1).max() <= TOL
