@@ -409,3 +409,54 @@ def test_scheduler_without_distributed_names_the_extra(tmp_path, monkeypatch):
     assert r.exit_code == 1, r.output
     assert "'distributed'" in r.output and "pip install 'curvefair[dask]'" in r.output
     assert not (tmp_path / "out").exists() or not any((tmp_path / "out").rglob("*.*"))
+
+
+def test_name_and_handle_patterns_select_curves(tmp_path: Path):
+    import ezdxf
+
+    from curvefair.io import CurveRecord
+
+    write_curves(tmp_path / "named.json",
+                 [CurveRecord(interpolate_bspline(_wavy(12, seed=k)), name=nm)
+                  for k, nm in enumerate(("station_1", "station_2", "keel"))])
+    r = _run(["fair", "named.json", "-o", "sel.json", "--tol", "0.05", "--name", "station_*"],
+             tmp_path)
+    assert r.exit_code == 0, r.output
+    before = {c["name"]: np.asarray(c["control_points"]) for c in
+              json.loads((tmp_path / "named.json").read_text())["curves"]}
+    after = {c["name"]: np.asarray(c["control_points"]) for c in
+             json.loads((tmp_path / "sel.json").read_text())["curves"]}
+    np.testing.assert_array_equal(after["keel"], before["keel"])
+    assert all(not np.array_equal(after[k], before[k]) for k in ("station_1", "station_2"))
+    # a DXF handle read by ezdxf selects exactly that entity
+    _dxf_two_layers(tmp_path / "two.dxf")
+    deck = next(e.dxf.handle for e in ezdxf.readfile(tmp_path / "two.dxf").modelspace()
+                if e.dxf.layer == "DECK")
+    r = _run(["fair", "two.dxf", "-o", "h.dxf", "--tol", "0.05", "--handle", deck], tmp_path)
+    assert r.exit_code == 0, r.output
+    b, a = _dxf_control_points(tmp_path / "two.dxf"), _dxf_control_points(tmp_path / "h.dxf")
+    np.testing.assert_array_equal(a["HULL"], b["HULL"])
+    assert not np.array_equal(a["DECK"], b["DECK"])
+
+
+def test_id_pattern_selects_svg_elements_by_their_id(tmp_path: Path):
+    from xml.etree import ElementTree as ET
+
+    def path_d(k: int) -> str:
+        p = _wavy(10, seed=k) * 10.0 + [0.0, 30.0 * k]
+        return "M " + " L ".join(f"{x:.4f},{y:.4f}" for x, y in p)
+
+    (tmp_path / "two.svg").write_text(
+        '<svg xmlns="http://www.w3.org/2000/svg" width="120" height="80">'
+        f'<path id="frame_7" d="{path_d(0)}" fill="none" stroke="black"/>'
+        f'<path id="keel" d="{path_d(1)}" fill="none" stroke="black"/></svg>')
+    r = _run(["fair", "two.svg", "-o", "sel.svg", "--tol", "0.3", "--id", "frame_*"], tmp_path)
+    assert r.exit_code == 0, r.output
+
+    def ds(p: Path) -> dict[str, str]:
+        return {e.get("id"): e.get("d") for e in ET.parse(p).getroot().iter()
+                if e.tag.endswith("path")}
+
+    before, after = ds(tmp_path / "two.svg"), ds(tmp_path / "sel.svg")
+    assert after["keel"] == before["keel"]  # not selected: written back as it was
+    assert after["frame_7"] != before["frame_7"]

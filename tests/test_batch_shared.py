@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from click.testing import CliRunner
-from scipy.interpolate import BSpline
+from scipy.interpolate import BSpline, CubicSpline
 from scipy.optimize import fsolve
 
 from curvefair.batch import shared_crossings
@@ -105,3 +105,86 @@ def test_shared_crossings_finds_each_crossing_once():
     n_cross = int(np.count_nonzero(np.diff(np.sign(y)) != 0))
     assert n_cross >= 2
     assert 0 < len(held[0]) <= n_cross * 5 and 0 < len(held[1]) <= n_cross * 5
+
+
+# ------------------------------------------------------------------------------------------
+# point data (DXF polylines, re-interpolated on reading) crossing between vertices
+# ------------------------------------------------------------------------------------------
+def _polylines(path: Path) -> None:
+    doc = ezdxf.new("R2000")
+    msp = doc.modelspace()
+    n = 41
+    rng = np.random.default_rng(5)
+    x = np.linspace(0.0, 8.0, n)
+    a = np.c_[x, 0.5 * np.sin(x / 1.3) + 0.01 * rng.standard_normal(n)]
+    y = np.linspace(-2.03, 2.0, n)
+    b = np.c_[4.02 + 0.2 * np.sin(y) + 0.01 * rng.standard_normal(n), y]
+    for P in (a, b):
+        msp.add_lwpolyline(P.tolist(), format="xy")
+    doc.saveas(path)
+
+
+def _vertices(path: Path) -> list[np.ndarray]:
+    doc = ezdxf.readfile(path)
+    return [np.asarray([(p[0], p[1]) for p in e.get_points("xy")], dtype=float)
+            for e in doc.modelspace().query("LWPOLYLINE")]
+
+
+def _segment_crossing(A: np.ndarray, B: np.ndarray) -> tuple[int, int, float, float]:
+    """The first crossing of two polylines, by hand: segments i of A and k of B with
+    A_i + s (A_i+1 - A_i) = B_k + r (B_k+1 - B_k), 0 <= s, r <= 1 (Cramer's rule)."""
+    for i in range(len(A) - 1):
+        p, dp = A[i], A[i + 1] - A[i]
+        for k in range(len(B) - 1):
+            q, dq = B[k], B[k + 1] - B[k]
+            den = dp[0] * (-dq[1]) - dp[1] * (-dq[0])
+            if den == 0.0:
+                continue
+            w = q - p
+            s_ = (w[0] * (-dq[1]) - w[1] * (-dq[0])) / den
+            r_ = (dp[0] * w[1] - dp[1] * w[0]) / den
+            if 0.0 <= s_ <= 1.0 and 0.0 <= r_ <= 1.0:
+                return i, k, s_, r_
+    raise AssertionError("the polylines do not cross")
+
+
+def _chord_spline(P: np.ndarray) -> tuple[CubicSpline, np.ndarray]:
+    t = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(P, axis=0), axis=1))]
+    return CubicSpline(t, P, bc_type="natural"), t
+
+
+def _spline_crossing(A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """Where the C2 chord-length splines through A and B cross (what the file means),
+    started from the polylines' crossing."""
+    i, k, s_, r_ = _segment_crossing(A, B)
+    sa, ta = _chord_spline(A)
+    sb, tb = _chord_spline(B)
+    u0 = ta[i] + s_ * (ta[i + 1] - ta[i])
+    v0 = tb[k] + r_ * (tb[k + 1] - tb[k])
+    u, v = fsolve(lambda x: sa(x[0]) - sb(x[1]), [u0, v0], xtol=1e-13)
+    assert np.linalg.norm(sa(u) - sb(v)) <= 1e-11
+    return sa(u)
+
+
+def test_hold_shared_keeps_a_point_data_crossing_between_vertices(tmp_path: Path):
+    _polylines(tmp_path / "net.dxf")
+    A, B = _vertices(tmp_path / "net.dxf")
+    X = _spline_crossing(A, B)
+    # between vertices of both, far from every vertex
+    assert min(np.linalg.norm(np.r_[A, B] - X, axis=1)) > 0.02
+    tol = 0.05
+    r = _run(["fair", "net.dxf", "-o", "free.dxf", "--tol", str(tol)], tmp_path)
+    assert r.exit_code == 0, r.output
+    fa, fb = _vertices(tmp_path / "free.dxf")
+    moved_free = float(np.linalg.norm(_spline_crossing(fa, fb) - X))
+    assert moved_free > 0.05 * tol
+    r = _run(["fair", "net.dxf", "-o", "held.dxf", "--tol", str(tol), "--hold-shared"],
+             tmp_path)
+    assert r.exit_code == 0, r.output
+    ha, hb = _vertices(tmp_path / "held.dxf")
+    moved_held = float(np.linalg.norm(_spline_crossing(ha, hb) - X))
+    # the stated bound: about 0.27^8 of the moves beyond the held vertices (< tol)
+    assert moved_held <= 1e-3 * tol
+    for h, o in ((ha, A), (hb, B)):
+        d = np.linalg.norm(h - o, axis=1)
+        assert d.max() <= tol and np.count_nonzero(d) > len(o) // 2  # faired elsewhere

@@ -23,6 +23,10 @@ from . import batch as _batch
 from .errors import CurvefairError, MissingDependencyError
 
 EXIT_OK, EXIT_INPUT, EXIT_USAGE = 0, 1, 2
+#: Point files larger than this are faired in chunks (``--chunk``) without being asked.
+AUTO_CHUNK_BYTES = 256 << 20
+#: What :func:`curvefair.fair` has just finished when it reports phase 1, 2, 3, 4.
+PHASE_NAMES = ("analysis", "fairing", "analysis after", "certificate")
 
 
 class _Failure(click.ClickException):
@@ -98,6 +102,7 @@ def _progress(enabled: bool, n_files: int) -> Iterator[Any]:
                   transient=True) as prog:
         files = prog.add_task("files", total=n_files)
         curves = prog.add_task("curves", total=0)
+        within = prog.add_task("", total=None, visible=False)
 
         def event(name: str, what: str, value: Any) -> None:
             if what == "curves":
@@ -106,6 +111,18 @@ def _progress(enabled: bool, n_files: int) -> Iterator[Any]:
                 prog.advance(curves, value)
             elif what in ("file", "skipped"):
                 prog.advance(files, value)
+            elif what == "phase":  # within one curve: curvefair.fair's phases
+                done, total = value
+                phase = PHASE_NAMES[min(max(done, 1), len(PHASE_NAMES)) - 1]
+                prog.update(within, completed=done, total=total, visible=True,
+                            description=f"{os.path.basename(name)}: {phase} done")
+            elif what == "write":
+                prog.update(within, completed=value, total=1, visible=True,
+                            description=f"{os.path.basename(name)}: write and read back")
+            elif what == "chunk":  # within one chunked curve
+                done, total = value
+                prog.update(within, completed=done, total=total, visible=True,
+                            description=f"{os.path.basename(name)}: chunks")
 
         yield event
 
@@ -283,6 +300,84 @@ def _print_summary(jobs: Sequence[_batch.Job], reports: Sequence[Mapping[str, An
 
 
 # ------------------------------------------------------------------------------------------
+# one point list in chunks
+# ------------------------------------------------------------------------------------------
+def wants_chunks(paths: Sequence[str], chunk: int | None) -> bool:
+    """``--chunk`` given, or one input that only the chunked path reads (``.npy``) or that is
+    a point file larger than :data:`AUTO_CHUNK_BYTES`."""
+    from ._chunked import NPY_EXTS, TEXT_EXTS
+
+    if chunk is not None:
+        return True
+    if len(paths) != 1 or not os.path.isfile(paths[0]):
+        return False
+    ext = Path(paths[0]).suffix.lower()
+    return ext in NPY_EXTS or (ext in TEXT_EXTS and ext != ".dat"
+                               and os.path.getsize(paths[0]) > AUTO_CHUNK_BYTES)
+
+
+def fair_in_chunks(paths: Sequence[str], out: str | None, in_place: bool,
+                   options: Mapping[str, Any], extra: Mapping[str, Any], *, chunk: int | None,
+                   overlap: int | None, jobs: int | None, scheduler: str | None,
+                   report: str | None, quiet: bool, plot_path: str | None) -> None:
+    """``curvefair fair BIG -o OUT --tol T --chunk N``: :func:`curvefair.batch.fair_chunked`
+    with a progress bar over the chunks; exit 1 on bad input (nothing written)."""
+    from ._chunked import DEFAULT_CHUNK, DEFAULT_OVERLAP
+
+    if len(paths) != 1 or paths[0] == "-" or not os.path.isfile(paths[0]):
+        raise click.UsageError("--chunk fairs one point file (IN -o OUT)")
+    if out is None or out == "-" or in_place:
+        raise click.UsageError("--chunk needs -o OUT (a point file; not '-', not --in-place)")
+    if options.get("tol") is None:
+        raise click.UsageError("--chunk needs --tol (each chunk is faired within it)")
+    for opt, v in (("--plot", plot_path), ("--decimals", options.get("decimals")),
+                   ("--history", options.get("history") or None)):
+        if v is not None:
+            raise click.UsageError(f"{opt} does not apply with --chunk")
+    for key, v in extra.items():
+        if v:
+            raise click.UsageError(f"--{key.replace('_', '-')} does not apply with --chunk "
+                                   "(one point list)")
+    method = options.get("method")
+    if method is not None and "=" in method:
+        raise click.BadParameter("one method name with --chunk", param_hint="--method")
+    infile = paths[0]
+    from .cli import _check_outputs
+
+    _check_outputs([(infile, "IN")], [(out, "-o/--output"), (report, "--report")])
+    rep_path = report or os.path.join(os.path.dirname(os.path.abspath(out)), _batch.REPORT_DIR,
+                                      os.path.basename(out) + ".json")
+    client_cm: Any = _dask_client(scheduler) if scheduler else contextlib.nullcontext()
+    show = not quiet and sys.stderr.isatty()
+    kw = {k: options[k] for k in ("eps", "max_steps") if options.get(k) is not None}
+    if options.get("mode") not in (None, "spline"):
+        kw["mode"] = options["mode"]
+    with client_cm as client, _progress(show, 1) as event:
+        def prog(done: int, total: int) -> None:
+            if event is not None:
+                event(infile, "chunk", (done, total))
+        try:
+            os.makedirs(os.path.dirname(rep_path), exist_ok=True)
+            rep = _batch.fair_chunked(
+                infile, out, tol=options["tol"], chunk=chunk or DEFAULT_CHUNK,
+                overlap=overlap or DEFAULT_OVERLAP, client=client, jobs=jobs, method=method,
+                clamp=options.get("clamp", "g0"), corner_angle=options.get("corner_angle"),
+                protect=options.get("protect", ()), progress=prog, report=rep_path,
+                **kw, **dict(options.get("method_options") or {}))
+        except (CurvefairError, OSError) as exc:
+            raise _Failure(f"{infile}: {_batch._err(exc)}; nothing written") from None
+    if not quiet:
+        click.echo(f"wrote {out} from {infile} ({rep['n_points']} points in "
+                   f"{rep['n_chunks']} chunks; read back: max deviation "
+                   f"{rep['max_deviation']:.6g}, largest point move "
+                   f"{rep['max_point_displacement']:.6g}; joins G2 to "
+                   f"{rep['joins_g2_max']:.3g} (tolerance {rep['g2_tol']:g}); report "
+                   f"{rep_path})")
+        for note in rep.get("notes", []):
+            click.echo(f"Warning: {out}: {note}", err=True)
+
+
+# ------------------------------------------------------------------------------------------
 # options of `curvefair fair` for many files
 # ------------------------------------------------------------------------------------------
 def _selection_options(f: Any) -> Any:
@@ -301,9 +396,10 @@ def batch_options(f: Any) -> Any:
     f = _selection_options(f)
     f = click.option("--hold-shared", is_flag=True,
                      help="Hull networks: hold every point that coincides with a point of "
-                          "another curve of the file, and the control points of B-spline "
-                          "spans where two B-splines cross (station / longitudinal "
-                          "intersections stay shared).")(f)
+                          "another curve of the file, and where two curves cross elsewhere "
+                          "the control points of the B-spline span or the vertices around "
+                          "the point-data segment (station / longitudinal intersections "
+                          "stay shared).")(f)
     f = click.option("--shared-distance", type=click.FloatRange(min=0), metavar="D",
                      help="--hold-shared: points closer than D coincide [default: 1e-9 times "
                           "the drawing's diagonal].")(f)
@@ -323,6 +419,16 @@ def batch_options(f: Any) -> Any:
     f = click.option("--scheduler", metavar="ADDRESS",
                      help="Run the per-file work on this Dask distributed scheduler (e.g. "
                           "tcp://host:8786; the workers must see the same files).")(f)
+    f = click.option("--chunk", type=click.IntRange(min=10), metavar="N",
+                     help="Fair one point list (.csv/.txt/.xyz/.pts/.dat columns or a .npy "
+                          "array) in overlapping chunks of N points, read and written in "
+                          "blocks (bounded memory; for curves too large for one machine); "
+                          "each chunk is certified, the file is read back within --tol. "
+                          "Automatic for .npy inputs and point files over "
+                          f"{AUTO_CHUNK_BYTES >> 20} MiB [default N: 5000].")(f)
+    f = click.option("--overlap", type=click.IntRange(min=1), metavar="M",
+                     help="--chunk: points of context on each side of a chunk [default: "
+                          "64].")(f)
     f = click.option("--format", "in_format", metavar="FMT",
                      type=click.Choice(["points", "airfoil", "json", "dxf", "3dm", "svg",
                                         "iges", "step"]),

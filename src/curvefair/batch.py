@@ -30,9 +30,11 @@ Hull networks
 splines) that lies within ``shared_distance`` of a point of another curve of the same file
 (default ``1e-9`` times the drawing's bounding-box diagonal): station / longitudinal
 intersections of an offsets table stay where they are in both curves, so the network stays
-connected. Where two B-spline records cross inside a knot span (at no control point of
-either), :func:`shared_crossings` finds the crossing and holds the ``degree + 1`` control
-points of the span in each curve, which keeps the crossing point exactly in both.
+connected. Where two records cross elsewhere (inside a B-spline's knot span, between two
+vertices of point data), :func:`shared_crossings` finds the crossing and holds the points
+that make it: the ``degree + 1`` control points of the span of a B-spline (the crossing
+stays exactly), the vertices around the segment of point data (it stays to about
+``2.7e-5`` of the moves beyond them).
 """
 
 from __future__ import annotations
@@ -63,8 +65,8 @@ from .errors import CurvefairError, InputError
 if TYPE_CHECKING:
     from .io import FormatName
 
-__all__ = ["fair_files", "fair_file", "plan_inputs", "Job", "file_sha256", "options_digest",
-           "parse_methods", "REPORT_DIR"]
+__all__ = ["fair_files", "fair_file", "fair_chunked", "plan_inputs", "Job", "file_sha256",
+           "options_digest", "parse_methods", "REPORT_DIR"]
 
 #: Folder (inside the output folder) holding the per-file reports and the run report.
 REPORT_DIR = ".curvefair"
@@ -428,29 +430,74 @@ def _held_shared(records: Sequence[Any], distance: float | None) -> list[list[in
     return [sorted(set(a) | set(b)) for a, b in zip(pts, cross, strict=True)]
 
 
+#: Point data: vertices held on each side of a crossing's segment (see :func:`shared_crossings`).
+SHARED_HOLD = 8
+
+
+def _is_spline(curve: Any) -> bool:
+    from .curves.bspline import BSplineCurve
+
+    return isinstance(curve, BSplineCurve)
+
+
+def _is_points(curve: Any) -> bool:
+    """An interpolating Hermite curve (point data): vertices ``points`` at ``params``."""
+    from .curves.hermite import HermiteSpline
+
+    return isinstance(curve, HermiteSpline)
+
+
+def _hermite_support(curve: Any, u: float, m: int) -> set[int]:
+    """Data-point indices of the ``m`` vertices on each side of the segment holding ``u``
+    (both segments when ``u`` is within rounding of a vertex), wrapped for a closed curve."""
+    t = np.asarray(curve.params)
+    lo, hi = float(t[0]), float(t[-1])
+    n = t.shape[0]
+    n_data = n - 1 if curve.closed else n
+    out: set[int] = set()
+    eps = 1e-12 * max(hi - lo, 1e-300)
+    for v in {u - eps, u, u + eps}:
+        v = min(max(v, lo), hi)
+        seg = min(max(int(np.searchsorted(t, v, side="right")) - 1, 0), n - 2)
+        for i in range(seg - m + 1, seg + m + 1):
+            if curve.closed:
+                out.add(i % n_data)
+            elif 0 <= i < n:
+                out.add(i)
+    return out
+
+
 def shared_crossings(records: Sequence[Any], distance: float | None = None
                      ) -> list[list[int]]:
-    """For every B-spline record, the control points to hold so that each place where it
-    meets another B-spline record of the file -- a crossing inside a knot span, not at a
-    control point -- stays where it is in both curves.
+    """For every B-spline and point-data record, the points to hold so that each place where
+    it meets another such record of the file -- a crossing inside a knot span or between two
+    vertices, not at a shared point -- stays where it is in both curves.
 
     Two curves meet at ``(u, v)`` when ``|A(u) - B(v)| <= distance`` (default ``1e-9`` times
-    the bounding-box diagonal of all control points). Candidates are the local minima along
+    the bounding-box diagonal of all their points). Candidates are the local minima along
     ``A``'s samples (16 per span) of the distance to ``B``'s nearest sample, refined by
-    Gauss-Newton on ``A(u) - B(v)`` (scipy ``least_squares``, bounded to the domains). Holding
-    the ``degree + 1`` control points whose basis functions are non-zero at ``u`` keeps
-    ``A(u)`` exactly (``A(u) = sum_i N_i(u) P_i``), and the same at ``v`` in ``B``: the
-    crossing point is unchanged in both, so the network stays connected. Point-data records
-    (interpolating Hermite curves, re-interpolated after every step) are not handled here;
-    their shared vertices are held by :func:`shared_points`.
+    Gauss-Newton on ``A(u) - B(v)`` (scipy ``least_squares``, bounded to the domains).
+
+    What is held, per curve:
+
+    - B-spline: the ``degree + 1`` control points whose basis functions are non-zero at
+      ``u``; ``A(u) = sum_i N_i(u) P_i`` is then exactly unchanged.
+    - Point data (interpolating Hermite curves: point lists, polylines, airfoils; the curve
+      is re-interpolated through the points after every step and on reading): a crossing at
+      one of its vertices (within ``distance``) holds that vertex, which keeps it exactly;
+      else the :data:`SHARED_HOLD` vertices on each side of the segment holding ``u``. The segment
+      depends on its two end vertices and their tangents, and the C2 spline's tangents on the
+      other vertices with a weight that falls by ``2 - sqrt 3`` (about 0.27) per vertex for
+      even spacing (at least 1/2 for any spacing: the tangent system is diagonally
+      dominant; de Boor, A Practical Guide to Splines, ch. IV), so a move of ``d`` outside
+      the held vertices shifts the crossing by about ``0.27^SHARED_HOLD d``, ``2.7e-5 d``.
     """
     from scipy.optimize import least_squares
     from scipy.spatial import cKDTree
 
-    from .curves.bspline import BSplineCurve
-
     out: list[set[int]] = [set() for _ in records]
-    idx = [k for k, r in enumerate(records) if isinstance(r.curve, BSplineCurve)]
+    idx = [k for k, r in enumerate(records)
+           if _is_spline(r.curve) or (_is_points(r.curve) and len(r.curve.params) >= 2)]
     if len(idx) < 2:
         return [[] for _ in records]
     dim = max(records[k].curve.dim for k in idx)
@@ -459,8 +506,21 @@ def shared_crossings(records: Sequence[Any], distance: float | None = None
         x = np.atleast_2d(x)
         return np.c_[x, np.zeros((x.shape[0], dim - x.shape[1]))] if x.shape[1] < dim else x
 
+    def support(curve: Any, u: float) -> set[int]:
+        if _is_spline(curve):
+            return _span_support(curve, u)
+        # an interpolating curve passes through its vertices: a crossing at one is held by
+        # holding that vertex alone (two curves sharing a vertex: what shared_points holds)
+        P = np.asarray(curve.points)
+        d = np.linalg.norm(pad(P) - pad(np.asarray(curve(np.array([u])))), axis=1)
+        i = int(np.argmin(d))
+        if d[i] <= distance:
+            n_data = P.shape[0] - 1 if curve.closed else P.shape[0]
+            return {i % n_data}
+        return _hermite_support(curve, u, SHARED_HOLD)
+
     if distance is None:
-        allp = np.vstack([pad(np.asarray(records[k].curve.control_points)) for k in idx])
+        allp = np.vstack([pad(np.asarray(_curve_points(records[k].curve))) for k in idx])
         distance = 1e-9 * float(np.linalg.norm(allp.max(axis=0) - allp.min(axis=0)))
     samp = {k: _samples(records[k].curve) for k in idx}
     trees = {k: cKDTree(pad(samp[k][1])) for k in idx}
@@ -498,8 +558,8 @@ def shared_crossings(records: Sequence[Any], distance: float | None = None
                        for s0, s1 in seen):
                     continue
                 seen.append((u, v))
-                out[a].update(_span_support(ca, u))
-                out[b].update(_span_support(cb, v))
+                out[a].update(support(ca, u))
+                out[b].update(support(cb, v))
     return [sorted(o) for o in out]
 
 
@@ -553,8 +613,9 @@ def _read(path: str, opts: Mapping[str, Any], notes: list[str] | None = None,
 
 
 def _test_delay() -> None:
-    """Test hook: ``CURVEFAIR_TEST_FILE_DELAY`` seconds of sleep before each file's write (the
-    worker-killed-mid-run test needs files that take long enough to be caught running)."""
+    """Test hook: ``CURVEFAIR_TEST_FILE_DELAY`` seconds of sleep before each file's write and
+    each chunk's fair (the worker-killed-mid-run tests need tasks that take long enough to be
+    caught running)."""
     d = os.environ.get("CURVEFAIR_TEST_FILE_DELAY")
     if d:
         time.sleep(float(d))
@@ -590,7 +651,9 @@ def _fair_file(infile: str, outfile: str | None, options: Mapping[str, Any] | No
 
     ``outfile`` None or ``dry_run``: nothing is written (the report says what would change).
     ``report``: also write the report there (atomically). ``progress(event, value)`` is called
-    with ``("curves", n)`` once the file is read and ``("curve", 1)`` after each curve.
+    with ``("curves", n)`` once the file is read, ``("phase", (done, total))`` after each phase
+    of a curve's :func:`curvefair.fair` (its ``progress``), ``("curve", 1)`` after each curve,
+    and ``("write", 0)`` / ``("write", 1)`` around the checked write.
     ``status`` is ``"ok"``, ``"failed"`` (nothing written: unreadable input, every selected
     curve failed, or the written file would not read back within ``tol``), ``"partial"`` (some
     curves failed: written with those unchanged) or ``"dry-run"``.
@@ -639,12 +702,17 @@ def _fair_file(infile: str, outfile: str | None, options: Mapping[str, Any] | No
             prot = sorted(set(_local_protect(rec, opts["protect"])) | set(shared[i]))
             if shared[i]:
                 row["shared_points_held"] = len(shared[i])
+            phase = None
+            if progress is not None:
+                def phase(done: int, total: int, _p: Any = progress) -> None:
+                    _p("phase", (done, total))
             try:
                 with warnings.catch_warnings(record=True) as caught:
                     warnings.simplefilter("always")
                     res = fair(rec.curve, method, tol=opts["tol"], eps=opts["eps"],
                                max_steps=opts["max_steps"], clamp=opts["clamp"], protect=prot,
-                               mode=opts["mode"], **dict(opts["method_options"]))
+                               mode=opts["mode"], progress=phase,
+                               **dict(opts["method_options"]))
                 notes = list(dict.fromkeys(str(w.message) for w in caught))
             except CurvefairError as exc:
                 row.update(status="failed", error=str(exc))
@@ -669,6 +737,8 @@ def _fair_file(infile: str, outfile: str | None, options: Mapping[str, Any] | No
         rep["error"] = "every selected curve failed; nothing written"
     else:
         _test_delay()
+        if progress is not None:
+            progress("write", 0)
         try:
             check = _write(outfile, faired, records, infile, fmt_in, fmt_out, opts,
                            in_place=_file_key(outfile) == _file_key(infile))
@@ -682,6 +752,8 @@ def _fair_file(infile: str, outfile: str | None, options: Mapping[str, Any] | No
             rep["output_check"] = _jsonable(check.to_dict())
             rep["output_sha256"] = file_sha256(outfile)
             rep["status"] = "partial" if failed else "ok"
+        if progress is not None:
+            progress("write", 1)
     rep["time_s"] = time.perf_counter() - t0
     return _finish(rep, report, dry_run)
 
@@ -1003,6 +1075,79 @@ def fair_files(paths: str | Sequence[str], out_dir: str | os.PathLike[str], clie
         atomic_write(dest, json.dumps(run, indent=2, allow_nan=False) + "\n")
         run["run_report"] = dest
     return run
+
+
+def fair_chunked(source: str | os.PathLike[str], out: str | os.PathLike[str], *, tol: float,
+                 chunk: int = 5000, overlap: int = 64, hold: int = 16, client: Any = None,
+                 jobs: int | None = None, method: str | None = None, clamp: Any = "g0",
+                 corner_angle: float | None = 60.0, protect: Iterable[int] = (),
+                 progress: Callable[[int, int], None] | None = None,
+                 report: str | os.PathLike[str] | None = None, **options: Any
+                 ) -> dict[str, Any]:
+    """Fair one open point list too large for memory in overlapping chunks; write ``out``.
+
+    ``source`` is a point file (``.csv``, ``.txt``, ``.xyz``, ``.pts``, ``.dat`` columns, or a
+    ``.npy`` array of shape (n, 2) or (n, 3), memory-mapped); ``out`` a point file too (text:
+    the input's separator and header, every number in the shortest form that reads back
+    exactly; comments are not copied; ``.npy``: float64). Chunk ``k`` (rows ``k chunk ..``)
+    is faired by :func:`curvefair.fair` on its rows extended by ``overlap`` rows each side,
+    holding the ``hold`` rows either side of each join in both neighbouring fairs, and kept
+    on its own rows; the file written is read back in chunks and measured like a single-file
+    run of point data (moves scaled down where the curve read back exceeds ``tol``); nothing
+    is written unless all of it is within ``tol``. Memory stays bounded by a few windows.
+    The algorithm, the G2 bound at the joins and the on-disk rule: :mod:`curvefair._chunked`.
+
+    Parameters
+    ----------
+    tol : float > 0
+        Every point moves at most ``tol`` (exactly, in float64) and the curve read back from
+        ``out`` is within ``tol`` of the input's (Hausdorff distance, per chunk).
+    chunk, overlap, hold : int
+        Rows per chunk (>= ``2 overlap + 2``), rows of context each side, rows held each side
+        of a join (<= ``overlap - 2``).
+    client : distributed.Client, optional
+        Run the chunks on this Dask cluster (the windows travel with the tasks); None: local
+        processes (``jobs``, default the core count; 1: this process). Same bytes either way.
+    method, clamp, **options
+        As for :func:`curvefair.fair` (``eps``, ``max_steps``, ``mode``, method options);
+        ``clamp`` applies at the curve's two ends.
+    corner_angle : float or None
+        A turn of this many degrees or more at a row is a corner, where the single-file reader
+        splits the list: refused (InputError naming the row). None: read through corners.
+    protect : iterable of int
+        Rows (0-based) that never move.
+    progress : callable, optional
+        ``progress(done, total)`` after each chunk faired and each chunk measured.
+    report : path, optional
+        Also write the report there as JSON.
+
+    Returns
+    -------
+    dict
+        ``n_points``, ``n_chunks``, ``max_deviation`` (read back), ``max_point_displacement``,
+        ``chunks`` (per chunk: rows, window, method, steps, its own certificate
+        ``max_deviation``, ``on_disk_deviation``, ``move_scale``), ``joins`` (per join: the
+        tangent angle and relative curvature difference between the two fairs and against
+        the curve read back), ``joins_g2_max`` and ``g2_tol``.
+
+    Raises
+    ------
+    InputError
+        Bad arguments, an unreadable or unsuitable file (named with its row or line), or a
+        result that cannot be brought within ``tol`` (nothing written).
+    """
+    from ._chunked import fair_chunked as _run
+
+    rep = _run(source, out, tol=tol, chunk=chunk, overlap=overlap, hold=hold, client=client,
+               jobs=jobs, method=method, clamp=clamp, corner_angle=corner_angle,
+               protect=protect, progress=progress, **options)
+    rep["curvefair"] = __version__
+    if report is not None:
+        from .fairing.fair import jsonable
+        from .io import atomic_write
+
+        atomic_write(report, json.dumps(jsonable(rep), indent=2, allow_nan=False) + "\n")
+    return rep
 
 
 def spool_stdin(fmt: str | None, folder: str) -> str:

@@ -976,6 +976,20 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
                               mode=mode, method_option=method_option, report=report,
                               plot_path=plot_path, glyphs=glyphs, quiet=quiet)
         return
+    chunk, overlap = batch.pop("chunk", None), batch.pop("overlap", None)
+    from ._batch_cli import fair_in_chunks, wants_chunks
+
+    if wants_chunks(paths, chunk):
+        fair_in_chunks(paths, out, in_place, _batch_fair_options(
+            method, tol, eps, max_steps, clamp, protect, mode, method_option, decimals,
+            history, corner_angle, no_corners, strict, batch),
+            {k: batch[k] for k in ("layer", "name", "handle", "hold_shared", "shared_distance",
+                                   "resume", "dry_run", "diff", "in_format")},
+            chunk=chunk, overlap=overlap, jobs=batch["jobs"], scheduler=batch["scheduler"],
+            report=report, quiet=quiet, plot_path=plot_path)
+        return
+    if overlap is not None:
+        raise click.UsageError("--overlap goes with --chunk")
     if wants_batch(paths, out, method, batch):
         if glyphs:
             raise click.BadParameter("--glyphs works on one font file (IN, -o OUT)",
@@ -1033,8 +1047,20 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
     faired = []
     t0 = time.perf_counter()
     show_progress = not quiet and sys.stderr.isatty()
-    with _progress(len(records), show_progress) as prog:
+    from ._batch_cli import PHASE_NAMES
+    from .fairing.fair import PHASES
+
+    # one bar: PHASES steps per curve (curvefair.fair's progress) and one for the write
+    bar = contextlib.ExitStack()
+    prog = bar.enter_context(_progress(len(records) * PHASES + 1, show_progress))
+    with contextlib.nullcontext():
         for i, rec in enumerate(records):
+            phase = None
+            if prog is not None:
+                def phase(done: int, total: int, _i: int = i) -> None:
+                    prog[0].update(prog[1], completed=_i * PHASES + done,
+                                   description=f"curve {_i}: "
+                                               f"{PHASE_NAMES[max(done, 1) - 1]} done")
             label = _record_label(rec, i)
             row: dict[str, Any] = {"index": i, "label": label, "name": rec.name,
                                    "kind": rec.kind}
@@ -1045,14 +1071,14 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
                 faired.append(rec)
                 rows.append(row)
                 if prog is not None:
-                    prog[0].advance(prog[1])
+                    prog[0].update(prog[1], completed=(i + 1) * PHASES)
                 continue
             notes: list[str] = []
             try:
                 with _warnings_to_stderr(quiet, f"{infile}: curve {i} ({label}): ", notes):
                     res = fair(rec.curve, method, tol=tol, eps=eps, max_steps=max_steps,
                                clamp=clamp, protect=_local_protect(rec, user_protect),
-                               mode=mode, **options)
+                               mode=mode, progress=phase, **options)
             except CurvefairError as exc:
                 row.update(status="failed", error=str(exc))
                 faired.append(rec)
@@ -1065,12 +1091,14 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
                 faired.append(rec.with_curve(res.curve))
             rows.append(row)
             if prog is not None:
-                prog[0].advance(prog[1])
+                prog[0].update(prog[1], completed=(i + 1) * PHASES)
+    if prog is not None:
+        prog[0].update(prog[1], description="write and read back")
     failures = [r for r in rows if r["status"] == "failed"]
     wrote_out = len(failures) < len(rows)  # every curve failed: nothing to write
     check = None
     corner = _corner(corner_angle, no_corners)
-    with _user_errors(), _warnings_to_stderr(quiet):
+    with bar, _user_errors(), _warnings_to_stderr(quiet):
         if wrote_out:
             # written to a temporary file, read back and measured against the input; moved
             # onto OUT only when every curve read back is within tol
@@ -1078,6 +1106,8 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
                                   reader=lambda p: _read(p, corner, strict, True, glyphs),
                                   template=infile if out_fmt == in_fmt else None,
                                   format=out_fmt, overwrite=in_place, decimals=decimals)
+            if prog is not None:
+                prog[0].advance(prog[1])
             from .io._verify import rescaled_report
 
             kept_notes: list[str] = []

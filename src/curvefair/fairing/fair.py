@@ -46,6 +46,8 @@ __all__ = [
 ]
 
 CLAMPS = ("none", "g0", "g1", "g2")
+#: Phases of one :func:`fair` call reported to its ``progress`` callback.
+PHASES = 4
 MODES = ("spline", "hermite")
 
 
@@ -415,6 +417,7 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
          eps: float | None = None, max_steps: int | None = None, clamp: Any = "g0",
          protect: Iterable[int] = (), mode: str = "spline", joins: str = "keep",
          g1_angle: float | None = None, guard: bool = True, structure: str = "keep",
+         progress: Callable[[int, int], None] | None = None,
          **options: Any) -> FairingResult:
     """Fair a curve automatically: repeatedly apply a local step at the worst point.
 
@@ -479,6 +482,11 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
         points; ``"free"`` accepts fewer knots (:mod:`curvefair.fairing.structure`: the fewest
         knots whose least-squares refit stays within ``tol / 2``, then the method under the
         rest of the tolerance; ``report["structure"]``). Other curves: no effect.
+    progress : callable, optional
+        ``progress(done, total)`` after each phase of the call, ``total`` = ``PHASES``
+        (4): the analysis before, the method's fairing, the analysis after (and the
+        never-worse guard), the tolerance certificate. For progress within one long curve;
+        the method itself is not interrupted.
     **options
         Passed to the method's driver; :func:`method_options` lists each method's options and
         their defaults (e.g. ``schedule="sweep"`` for ``"eck-hadenfeld"``). An unknown name
@@ -528,17 +536,23 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
     curve = _as_curve(curve, "curve")  # scipy splines too (curvefair.interop.as_curve)
     if not isinstance(curve, PiecewiseCurve):
         raise InputError(f"curve must be a curvefair curve, got {type(curve).__name__}")
+    if progress is not None and not callable(progress):
+        raise InputError(f"progress must be a callable progress(done, total), got "
+                         f"{type(progress).__name__}")
     if structure not in ("keep", "free"):
         raise InputError(f"unknown structure {structure!r}; valid values are: 'keep', 'free'")
     if structure == "free" and hasattr(curve, "control_points"):
         from .._validate import as_positive as _pos
         from .structure import fair_new_structure
 
-        return fair_new_structure(
+        res = fair_new_structure(
             cast("BSplineCurve", curve), method,
             _pos(tol, "tol", allow_none=True, window=True), fair, eps=eps,
             max_steps=max_steps, clamp=clamp, protect=protect, mode=mode, joins=joins,
             g1_angle=g1_angle, guard=guard, **options)
+        if progress is not None:
+            progress(PHASES, PHASES)
+        return res
     if method is None:
         spec = _default_method(curve, clamp)
         dflt = spec.default_options
@@ -579,6 +593,8 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
     g1_deg = _joins.DEFAULT_G1_ANGLE if g1_angle is None else as_nonnegative(g1_angle,
                                                                             "g1_angle")
     before = analysis_block(curve)
+    if progress is not None:
+        progress(1, PHASES)
     jp = (_joins.plan(curve, clamp_pair, prot, g1_deg, tol_v) if joins == "keep"
           else _joins.JoinPlan(curve, prot, clamp_pair))
 
@@ -598,6 +614,8 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
         jp = _joins.plan(curve, clamp_pair, prot, g1_deg, tol_v, allow_reduce=False)
         out = solve(jp, tol_v)
     new = jp.restore(out.curve)
+    if progress is not None:
+        progress(2, PHASES)
     if jp.reduced and out.history is not None and len(out.history):
         h = out.history
         out.history = FairingHistory.from_arrays(jp.original_index(h.index), h.measure,
@@ -615,6 +633,8 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
 
         new, after, guard_info = never_worse(curve, new, before, after, jp, out.curve,
                                              analysis_block)
+    if progress is not None:
+        progress(3, PHASES)
     # the one final guarantee every result passes through (after the joins are restored and
     # the never-worse guard chose): data points within tol in float64 (pulled back if rounding
     # put one outside), curve deviation certified on the difference curve
@@ -622,6 +642,8 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
                                       primed=primed)
     if checked is not new:
         new, after = checked, analysis_block(checked)
+    if progress is not None:
+        progress(4, PHASES)
 
     p0 = data_points(curve)
     moved_idx, disp, max_disp, max_idx = point_report(curve, new)
