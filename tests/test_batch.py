@@ -139,6 +139,31 @@ def test_a_bad_file_fails_alone_and_the_exit_code_says_so(tmp_path: Path):
     assert bad["status"] == "failed" and "broken.csv:3" in bad["error"]
 
 
+def test_a_file_of_only_unsupported_entities_is_written_back_unchanged(tmp_path: Path):
+    # as for one file (test_read_real_files::test_dxf_unsupported_skipped_kept_untouched_and_
+    # strict): every curve entity skipped (a rational SPLINE) -> nothing to fair, the input's bytes,
+    # status ok; --strict fails that file alone
+    ezdxf = pytest.importorskip("ezdxf")
+    src = _tree(tmp_path)
+    doc = ezdxf.new("R2010")
+    doc.modelspace().add_rational_spline([(0, 0), (1, 2), (3, 2), (4, 0)], [1, 0.5, 2, 1])
+    doc.saveas(src / "only.dxf")
+    r = _run(["fair", "in", "-o", "out", "--tol", str(TOL), "-j", "1"], tmp_path)
+    assert r.exit_code == 0, r.output
+    out = tmp_path / "out"
+    assert (out / "only.dxf").read_bytes() == (src / "only.dxf").read_bytes()
+    run = json.loads((out / ".curvefair/run.json").read_text())
+    only = [f for f in run["files"] if f["input"].endswith("only.dxf")][0]
+    assert only["status"] == "ok" and only["n_curves"] == 0
+    rep = json.loads((tmp_path / only["report"]).read_text())   # the file's own report
+    assert rep["n_skipped_unsupported"] == 1 and "nothing to fair" in rep["note"]
+    assert any("rational" in w for w in rep["read_warnings"])
+    r = _run(["fair", "in", "-o", "strict", "--tol", str(TOL), "-j", "1", "--strict"], tmp_path)
+    assert r.exit_code == 1
+    assert not (tmp_path / "strict" / "only.dxf").exists()
+    assert (tmp_path / "strict" / "ex1.csv").is_file()
+
+
 def test_resume_skips_matching_outputs_and_redoes_changed_ones(tmp_path: Path):
     _tree(tmp_path)
     args = ["fair", "in", "-o", "out", "--tol", str(TOL), "-j", "1"]

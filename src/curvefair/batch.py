@@ -604,12 +604,23 @@ def _read(path: str, opts: Mapping[str, Any], notes: list[str] | None = None,
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        recs = read_curves(path, corner_angle=opts["corner_angle"],
-                           format=cast("FormatName | None", fmt),
-                           on_unsupported="raise" if opts["strict"] else "skip")
-    if notes is not None:
-        notes.extend(dict.fromkeys(str(w.message) for w in caught))
+        try:
+            recs = read_curves(path, corner_angle=opts["corner_angle"],
+                               format=cast("FormatName | None", fmt),
+                               on_unsupported="raise" if opts["strict"] else "skip")
+        finally:  # the skip warnings also when the file then holds no curve at all
+            if notes is not None:
+                notes.extend(dict.fromkeys(str(w.message) for w in caught))
     return recs
+
+
+def _all_skipped(exc: BaseException, notes: list[str], opts: Mapping[str, Any]) -> int:
+    """The number of skipped unsupported entities when ``exc`` says a file holds no curve
+    only because every curve entity in it was skipped (then it is written back unchanged, as
+    ``curvefair fair`` does for one file); 0 otherwise."""
+    if opts["strict"] or not isinstance(exc, CurvefairError) or "no curves in the" not in str(exc):
+        return 0
+    return sum(": skipped " in n for n in notes)
 
 
 def _test_delay() -> None:
@@ -665,6 +676,8 @@ def _fair_file(infile: str, outfile: str | None, options: Mapping[str, Any] | No
     t0 = time.perf_counter()
     rep: dict[str, Any] = {"curvefair": __version__, "input": infile, "output": outfile,
                            "status": "failed", "dry_run": bool(dry_run)}
+    read_notes: list[str] = []
+    fmt_in = fmt_out = ""
     try:
         fmt_in = detect_format(infile, in_format)
         fmt_out = out_format or (fmt_in if outfile is None
@@ -672,11 +685,30 @@ def _fair_file(infile: str, outfile: str | None, options: Mapping[str, Any] | No
         rep.update(format=fmt_out, input_sha256=file_sha256(infile),
                    options=_jsonable({k: opts[k] for k in OUTPUT_OPTIONS}),
                    options_sha256=options_digest(options or {}, fmt_out))
-        read_notes: list[str] = []
         records = _read(infile, opts, read_notes, fmt_in)
         if read_notes:
             rep["read_warnings"] = read_notes
     except (CurvefairError, OSError) as exc:
+        n_skipped = _all_skipped(exc, read_notes, opts)
+        if n_skipped and fmt_in and fmt_out == fmt_in:
+            # nothing curvefair can fair: the output is the input's bytes
+            rep.update(status="ok" if not dry_run else "dry-run", n_curves=0,
+                       n_skipped_unsupported=n_skipped, read_warnings=read_notes,
+                       note=f"nothing to fair ({n_skipped} unsupported entit"
+                            f"{'y' if n_skipped == 1 else 'ies'} skipped); written unchanged")
+            if outfile is not None and not dry_run:
+                import shutil
+
+                from .io import atomic_path
+
+                same = os.path.exists(outfile) and os.path.samefile(infile, outfile)
+                if not same:
+                    os.makedirs(os.path.dirname(os.path.abspath(outfile)), exist_ok=True)
+                    with atomic_path(outfile) as tmp:
+                        shutil.copyfile(infile, tmp)
+                rep["output_sha256"] = file_sha256(outfile)
+            rep["time_s"] = time.perf_counter() - t0
+            return _finish(rep, report, dry_run)
         rep["error"] = _err(exc)
         rep["time_s"] = time.perf_counter() - t0
         return _finish(rep, report, dry_run)
