@@ -305,9 +305,11 @@ def test_airfoil_point_file_within_tol_after_reinterpolation(tmp_path: Path):
     rep = json.loads((tmp_path / "r.json").read_text())
     on_disk = rep["output_check"]["max_deviation"]
     assert on_disk <= tol and rep["curves"][0]["report"]["on_disk_deviation"] == on_disk
-    # the stated figure is the distance of the re-read curve (to 1e-9 relative where both were
-    # maximised, else within the sampled bound's slack below it)
-    assert up - 2e-6 <= on_disk <= up * (1 + 1e-9)
+    # the stated figure is an upper bound of the re-read curve's distance (the per-span bound
+    # of analysis.matched_hermite_bound, labelled so): never below the distance (up to the
+    # sampled figure's slack), and sharp enough to be useful (within 5 % of it)
+    assert rep["output_check"]["kinds"] == ["geometric upper bound"]
+    assert up - 2e-6 <= on_disk <= 1.05 * up
     assert f"max deviation {on_disk:.6g}" in res.stdout
 
 

@@ -530,7 +530,10 @@ def _jump_costs(scale: str, u: FloatArray, ops: NaturalOperators, xp: FloatArray
 
         j0 = _jump_norms(ops, xp, P)
         sm = median_filter(j0, size=min(9, max(1, n_int)), mode="nearest")
-        c = 1.0 / np.maximum(sm, 1e-12 * max(float(sm.max()), 1e-300))
+        top = float(sm.max()) if sm.size else 0.0
+        if not top > 0:  # no jump anywhere (points on a line or a parabola): one cost
+            return np.ones(n_int)
+        c = 1.0 / np.maximum(sm, 1e-12 * top)  # the data are of unit size: top >> 1e-290
     else:
         raise InputError(f"scale must be 'none', 'spacing' or 'input', got {scale!r}")
     return c / float(c.max())
