@@ -8,11 +8,12 @@ tests/data/recorded_cases.npz: the faired curve's arrays, steps, stop_reason, th
 every report figure but the time.
 
 Comparison: integers, strings and flags exactly; float64 figures within ``1e-12`` relative
-(plus ``1e-14`` absolute for the curves' arrays and ``1e-9`` for report figures, where a
-smooth spline's knot jumps are rounding noise of ~1e-12; the curves are of unit size), so that
-the test holds on a CPU whose SIMD width changes the last bits (CI's second instruction set).
-``CURVEFAIR_RECORDED_EXACT=1`` compares the floats bit for bit: on the machine that recorded
-them, the results must be identical.
+(to each entry and to the array's largest entry), plus ``1e-14`` absolute for the curves'
+arrays and ``1e-9`` for report figures (a smooth spline's knot jumps are rounding noise of
+~1e-12; the curves are of unit size), so that the test holds on a CPU whose SIMD width changes
+the last bits (CI's second instruction set); the index of the largest move may differ between
+points that moved equally far. ``CURVEFAIR_RECORDED_EXACT=1`` compares the floats bit for
+bit: on the machine that recorded them, the results must be identical.
 
 Regenerating the fixture (``PYTHONPATH=src python tests/data/recorded_cases.py [CASE ...]``)
 is allowed only for a documented change of meaning, named with the cases it changes in
@@ -69,7 +70,10 @@ def _close(name: str, got: np.ndarray, want: np.ndarray, where: str,
         return
     g, w = got.reshape(-1), want.reshape(-1)
     err = np.abs(g - w)
-    lim = RTOL * np.abs(w) + atol
+    # relative to each entry and to the array's own scale (a small second derivative next to
+    # large ones carries the rounding of the large ones: seen under CI's second instruction set)
+    scale = float(np.abs(w).max()) if w.size else 0.0
+    lim = RTOL * (np.abs(w) + scale) + atol
     bad = np.flatnonzero(~(err <= lim))
     assert bad.size == 0, (f"{where}: {name} differs beyond {RTOL:g} relative at "
                            f"{bad[:5].tolist()}: {g[bad[:3]]} != {w[bad[:3]]}")
@@ -90,6 +94,16 @@ def test_recorded_case(cid, cname, method, options):
     missing = sorted(set(wr) - set(gr))
     assert not missing, f"{where}: report entries gone: {missing}"
     diff = {k: (gr[k], wr[k]) for k in wr if gr[k] != wr[k]}
+    if "max_point_index" in diff:
+        # the arg max of the moves: two points moved equally far (a closed curve's seam, or a
+        # rounding-level tie) may swap places on another CPU; both must be a largest move
+        pts = np.asarray(want["arrays"].get("curve.points",
+                                             want["arrays"].get("curve.control_points")))
+        c0 = rc.curve_arrays(_CURVES[cname])
+        p0 = c0.get("points", c0.get("control_points"))
+        d = np.linalg.norm(pts - np.asarray(p0)[:len(pts)], axis=1)
+        if all(d[i] >= d.max() * (1 - 1e-9) for i in diff["max_point_index"]):
+            del diff["max_point_index"]
     assert not diff, f"{where}: report entries differ (got, recorded): {diff}"
     # float figures by name (entries added since the recording are not compared)
     gnames, wnames = got["meta"]["float_names"], want["meta"]["float_names"]
