@@ -321,16 +321,19 @@ def _ufo_layer_contours(ufo: str, layer_name: str | None, glyphs: Sequence[str] 
     if glyphs is not None:
         want = set(glyphs)
         names = [g for g in names if g in want]
-    out = []
-    for g in names:
-        conts = []
-        for c in layer[g].contours:
-            try:
-                conts.append(ufo_contour(c.points))
-            except Unsupported as exc:
-                conts.append(exc)  # type: ignore[arg-type]
-        out.append((g, conts))
-    return out
+    return [(g, _ufo_glyph_contours(layer[g])) for g in names]
+
+
+def _ufo_glyph_contours(glyph: Any) -> list[Contour]:
+    """A UFO glyph's contours; one that cannot be represented stands as its
+    :class:`Unsupported` (skipped with a warning by the caller, kept on write)."""
+    conts = []
+    for c in glyph.contours:
+        try:
+            conts.append(ufo_contour(c.points))
+        except Unsupported as exc:
+            conts.append(exc)  # type: ignore[arg-type]
+    return conts
 
 
 def designspace_records(path: Any, glyphs: Sequence[str] | str | None, skip: Any
@@ -400,16 +403,7 @@ def font_contours(path: str | os.PathLike[str], glyphs: Sequence[str] | None = N
         font = _open_ufo(path)
         layer = font.layers.defaultLayer
         names = _select(_glyph_order(list(layer.keys()), font.glyphOrder), glyphs, path)
-        out = []
-        for g in names:
-            conts = []
-            for c in layer[g].contours:
-                try:
-                    conts.append(ufo_contour(c.points))
-                except Unsupported as exc:
-                    conts.append(exc)  # type: ignore[arg-type]
-            out.append((g, conts, {}))
-        return "ufo", out
+        return "ufo", [(g, _ufo_glyph_contours(layer[g]), {}) for g in names]
     font = _open_binary(path)
     names = _select(list(font.getGlyphOrder()), glyphs, path)
     get = _glyf_contours if "glyf" in font else _cff_contours
