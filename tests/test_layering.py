@@ -124,3 +124,23 @@ def test_steps_exports_every_documented_step():
     for name in ("kjellander", "poliakoff", "wang_cao", "wang_quintic", "eck_hadenfeld",
                  "knot_removal", "cheng_yu"):
         assert name in steps.__all__ and callable(getattr(steps, name)), name
+
+
+def test_every_method_module_imports_and_registers_a_method():
+    # fairing/__init__ imports METHOD_MODULES without a try: a missing module is an error,
+    # and each listed module registers at least one fair() method
+    import ast
+    import importlib
+    import inspect
+
+    import curvefair.fairing as fairing
+    from curvefair.fairing.fair import METHODS
+
+    tree = ast.parse(inspect.getsource(fairing))
+    assert not any(isinstance(n, ast.Try) for n in ast.walk(tree))
+    modules = {f"curvefair.fairing.{m}" for m in fairing.METHOD_MODULES}
+    for m in modules:
+        importlib.import_module(m)
+    # one method of each listed module is registered
+    for name in ("poliakoff", "eck-hadenfeld", "knot-removal", "global", "cheng-yu", "points-l1"):
+        assert name in METHODS, name

@@ -48,9 +48,5 @@ METHOD_MODULES = [
     "points_l1",
 ]
 
-for _name in METHOD_MODULES:
-    try:
-        importlib.import_module(f"{__name__}.{_name}")
-    except ModuleNotFoundError as _exc:  # a listed module not written yet: skip it, nothing else
-        if _exc.name != f"{__name__}.{_name}":
-            raise
+for _name in METHOD_MODULES:  # every listed module must import: a missing one is an error
+    importlib.import_module(f"{__name__}.{_name}")
