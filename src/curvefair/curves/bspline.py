@@ -274,10 +274,13 @@ def _gram_kernel(knots, p, spans, l, xq, wq, n, closed, W):  # type: ignore[no-u
 
 
 @njit(cache=True, inline="always")
-def residual_row(W, p, closed, x, i, a, interior):  # type: ignore[no-untyped-def]
-    """``(G x)_{i, a}`` in the difference form of :func:`band_residual`; ``interior``
-    (``p <= i < n - p``) skips the wrap tests. Inlined at numba IR level (no call with array
-    arguments in the callers' loops); the one place this sum is written."""
+def residual_row(W, ks, p, closed, x, i, a, interior):  # type: ignore[no-untyped-def]
+    """``((W ks) x)_{i, a}`` in the difference form of :func:`band_residual`,
+    ``sum_{o != 0} (W[i, p + o] ks) (x_{i+o} - x_i)``; ``ks = 1.0`` gives ``(G x)_{i, a}``
+    exactly (a product by 1 is exact), another ``ks`` the residual of the scaled band of the
+    global fairing. ``interior`` (``p <= i < n - p``) skips the wrap tests. Inlined at numba IR
+    level (no call with array arguments in the callers' loops); the one place this sum is
+    written."""
     n = x.shape[0]
     xi = x[i, a]
     acc = 0.0
@@ -289,7 +292,7 @@ def residual_row(W, p, closed, x, i, a, interior):  # type: ignore[no-untyped-de
             if not closed:
                 continue
             j = j + n if j < 0 else j - n
-        acc += W[i, p + o] * (x[j, a] - xi)
+        acc += (W[i, p + o] * ks) * (x[j, a] - xi)
     return acc
 
 
@@ -306,7 +309,29 @@ def band_residual(W, p, closed, x, out):  # type: ignore[no-untyped-def]
     for i in range(n):
         interior = i >= p and i + p < n
         for a in range(dim):
-            out[i, a] = residual_row(W, p, closed, x, i, a, interior)
+            out[i, a] = residual_row(W, 1.0, p, closed, x, i, a, interior)
+
+
+@njit(cache=True, inline="always")
+def energy_row(W, p, closed, x, i, e):  # type: ignore[no-untyped-def]
+    """``e`` less row ``i``'s terms of :func:`band_energy`, ``sum_{o=1..p} W[i, p + o]
+    |x_{i+o} - x_i|^2``, subtracted one by one (the caller's sum keeps its order of
+    operations). Inlined at numba IR level; the one place this sum is written."""
+    n, dim = x.shape
+    for o in range(1, p + 1):
+        j = i + o
+        if j >= n:
+            if not closed:
+                break
+            j -= n
+        w = W[i, p + o]
+        if w != 0.0:
+            d2 = 0.0
+            for a in range(dim):
+                t = x[j, a] - x[i, a]
+                d2 += t * t
+            e -= w * d2
+    return e
 
 
 @njit(cache=True)
@@ -314,22 +339,9 @@ def band_energy(W, p, closed, x):  # type: ignore[no-untyped-def]
     """``x^T G x`` summed over the coordinates, in difference form
     ``-sum_i sum_{o=1..p} W[i, p + o] |x_{i+o} - x_i|^2`` (see :func:`band_residual`): exact
     for ``l >= 1`` and free of the cancellation of large coordinates."""
-    n, dim = x.shape
     e = 0.0
-    for i in range(n):
-        for o in range(1, p + 1):
-            j = i + o
-            if j >= n:
-                if not closed:
-                    break
-                j -= n
-            w = W[i, p + o]
-            if w != 0.0:
-                d2 = 0.0
-                for a in range(dim):
-                    t = x[j, a] - x[i, a]
-                    d2 += t * t
-                e -= w * d2
+    for i in range(x.shape[0]):
+        e = energy_row(W, p, closed, x, i, e)
     return e
 
 

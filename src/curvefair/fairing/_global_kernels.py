@@ -29,6 +29,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._jit import njit
+from ..curves.bspline import residual_row
 
 # ------------------------------------------------------------------------------------------
 # assembly
@@ -577,23 +578,12 @@ def _krow(K, ks, p, closed, x, i, a, interior):  # type: ignore[no-untyped-def]
 def band_residual_scaled(W, ks, p, closed, x, out):  # type: ignore[no-untyped-def]
     """``out = (W ks) x`` per coordinate in the difference form of
     :func:`curvefair.curves.bspline.band_residual` (``sum_{o != 0} (W[i, p + o] ks) (x_{i+o} -
-    x_i)``, the same operations on the entries of the scaled band)."""
+    x_i)``, the same operations on the entries of the scaled band: :func:`residual_row`)."""
     n, dim = x.shape
     for i in range(n):
         interior = i >= p and i + p < n
         for a in range(dim):
-            xi = x[i, a]
-            acc = 0.0
-            for o in range(-p, p + 1):
-                if o == 0:
-                    continue
-                j = i + o
-                if not interior and (j < 0 or j >= n):
-                    if not closed:
-                        continue
-                    j = j + n if j < 0 else j - n
-                acc += (W[i, p + o] * ks) * (x[j, a] - xi)
-            out[i, a] = acc
+            out[i, a] = residual_row(W, ks, p, closed, x, i, a, interior)
 
 
 @njit(cache=True)

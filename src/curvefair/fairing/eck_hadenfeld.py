@@ -25,7 +25,7 @@ import numpy as np
 from .._jit import njit
 from .._typing import FloatArray
 from .._validate import as_step_count, check_finite, choice, parse_clamp
-from ..curves.bspline import BSplineCurve, band_energy, band_residual, residual_row
+from ..curves.bspline import BSplineCurve, band_energy, band_residual, energy_row, residual_row
 from ..errors import InputError
 from ._prefetch import prefetch
 from .stop import StopReason
@@ -796,7 +796,7 @@ def _largest_free_z(W, p, closed, d, mask):  # type: ignore[no-untyped-def]
         interior = i >= p and i + p < n
         gg = 0.0
         for a in range(dim):
-            acc = residual_row(W, p, closed, d, i, a, interior)
+            acc = residual_row(W, 1.0, p, closed, d, i, a, interior)
             gg += acc * acc
         v = gg / W[i, p]
         if first or v > best:
@@ -818,23 +818,11 @@ def _setup_state(W, p, closed, d, mask, X, z):  # type: ignore[no-untyped-def]
         interior = i >= p and i + p < n
         for a in range(dim):
             xi = d[i, a]
-            acc = residual_row(W, p, closed, d, i, a, interior)
+            acc = residual_row(W, 1.0, p, closed, d, i, a, interior)
             X[i, a] = xi
             X[i, dim + a] = acc
             X[i, 2 * dim + a] = xi
-        for o in range(1, p + 1):
-            j = i + o
-            if j >= n:
-                if not closed:
-                    break
-                j -= n
-            w = W[i, p + o]
-            if w != 0.0:
-                d2 = 0.0
-                for a in range(dim):
-                    t = d[j, a] - d[i, a]
-                    d2 += t * t
-                e -= w * d2
+        e = energy_row(W, p, closed, d, i, e)
         z[i] = 0.0 if mask[i] else -1.0
     return e
 
