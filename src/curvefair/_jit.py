@@ -25,6 +25,10 @@ inside the package, after 14 days unused in a shared cache (which may serve seve
 The first compilation into a new cache directory prints one line to stderr saying so
 (set ``CURVEFAIR_QUIET=1`` to silence it).
 
+This is the one module of curvefair that imports numba (and llvmlite): kernels elsewhere use
+:func:`njit` and :func:`prefetch` from here (``tests/test_layering.py`` checks it), so a change
+of numba's API is met in one file.
+
 The locator plugs into numba's documented-by-example cache machinery
 (``numba.core.caching.CacheImpl._locator_classes``), placed first so that it answers for
 curvefair's own files only; every other numba user in the process is unaffected.
@@ -44,11 +48,15 @@ from typing import Any
 
 import llvmlite
 import numba
+from llvmlite import ir as _ir
 from numba import config as _nb_config
 from numba import njit as _numba_njit
+from numba import types as _types
 from numba.core import caching as _caching
+from numba.core import cgutils as _cgutils
+from numba.extending import intrinsic as _intrinsic
 
-__all__ = ["njit", "cache_dir", "cache_key"]
+__all__ = ["njit", "prefetch", "cache_dir", "cache_key"]
 
 _PKG_DIR = os.path.dirname(os.path.abspath(__file__))
 _PREFIX = "curvefair-jit-"
@@ -215,3 +223,32 @@ def njit(*args: Any, **kwargs: Any) -> Any:
     if kwargs.get("cache") and _CACHE_DIR is None:
         kwargs["cache"] = False
     return _numba_njit(*args, **kwargs)
+
+
+@_intrinsic
+def prefetch(typingctx, arr, idx):  # type: ignore[no-untyped-def]
+    """Hint the CPU to load the cache line holding ``arr.flat[idx]`` (a C-contiguous array;
+    ``idx`` need not be in range: a prefetch never faults). ``llvm.prefetch``; no effect on
+    results.
+
+    Used by the ranking-list loops to fetch, one step ahead, the data of the control point
+    that will most probably be faired next (the runner-up of the tournament tree): on curves
+    too large for the caches the step is otherwise bound by memory latency."""
+    if not isinstance(arr, _types.Array):
+        return None
+    sig = _types.void(arr, _types.intp)
+
+    def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
+        aryty = signature.args[0]
+        ary = context.make_array(aryty)(context, builder, args[0])
+        ptr = builder.gep(ary.data, [args[1]])
+        i8p = _ir.IntType(8).as_pointer()
+        i32 = _ir.IntType(32)
+        fnty = _ir.FunctionType(_ir.VoidType(), [i8p, i32, i32, i32])
+        fn = _cgutils.get_or_insert_function(builder.module, fnty, "llvm.prefetch.p0")
+        # read, high temporal locality, data cache
+        builder.call(fn, [builder.bitcast(ptr, i8p), _ir.Constant(i32, 0), _ir.Constant(i32, 3),
+                          _ir.Constant(i32, 1)])
+        return context.get_dummy_value()
+
+    return sig, codegen

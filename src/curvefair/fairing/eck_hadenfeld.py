@@ -22,12 +22,11 @@ from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
-from .._jit import njit
+from .._jit import njit, prefetch
 from .._typing import FloatArray
 from .._validate import as_step_count, check_finite, choice, parse_clamp
 from ..curves.bspline import BSplineCurve, band_energy, band_residual, energy_row, residual_row
 from ..errors import InputError
-from ._prefetch import prefetch
 from .stop import StopReason
 
 if TYPE_CHECKING:
