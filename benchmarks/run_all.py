@@ -21,7 +21,8 @@ FULL = [
     ["bench_fair_step.py"],
     ["bench_bspline_eh_steps.py"],
     ["bench_cheng_yu.py"],
-    ["bench_knot_removal.py", "--sizes", "1000", "10000", "100000", "1000000", "--old-max", "100000"],
+    ["bench_knot_removal.py", "--sizes", "1000", "10000", "100000", "1000000",
+     "--old-max", "100000"],
     ["bench_bspline_e2e.py"],
     ["bench_call_cost.py", "--cpu"],  # CPU time: the machines are shared
     ["bench_io.py"],
@@ -64,7 +65,8 @@ def with_sizes(cmd: list[str], sizes: list[int]) -> list[str]:
 QUICK = [
     ["bench_analyze.py", "1e3", "1e4", "1e5", "--repeat", "3"],
     ["bench_fair_step.py", "--sizes", "1000", "100000", "--repeat", "3"],
-    ["bench_bspline_eh_steps.py", "--sizes", "1000", "100000", "--steps", "300000", "--repeat", "1"],
+    ["bench_bspline_eh_steps.py", "--sizes", "1000", "100000", "--steps", "300000",
+     "--repeat", "1"],
     ["bench_cheng_yu.py", "--sizes", "1000", "100000", "--steps", "10000", "--repeat", "1"],
     ["bench_knot_removal.py", "--sizes", "1000", "10000", "--repeat", "1"],
     ["bench_bspline_e2e.py", "--n", "100000"],

@@ -111,6 +111,40 @@ def test_glob_keeps_paths_below_the_glob_base_and_no_match_is_a_usage_error(tmp_
     assert not (tmp_path / "h").exists()
 
 
+def test_default_jobs_is_the_core_count_and_the_run_report_says_how_files_ran(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch):
+    import curvefair.batch as batch
+
+    _tree(tmp_path)
+    pools: list[int] = []
+    real_pool = batch._run_pool
+
+    def spy(jobs, todo, options, n, *args):  # type: ignore[no-untyped-def]
+        pools.append(n)
+        return real_pool(jobs, todo, options, n, *args)
+
+    monkeypatch.setattr(batch, "_run_pool", spy)
+    monkeypatch.setattr(batch.os, "cpu_count", lambda: 2)  # a 2-core machine, no -j given
+    r = _run(["fair", "in", "-o", "two", "--tol", str(TOL), "-q"], tmp_path)
+    assert r.exit_code == 0, r.output
+    run = json.loads((tmp_path / "two/.curvefair/run.json").read_text())
+    assert pools == [2]  # 3 files, 2 cores: a pool of 2 processes
+    assert (run["jobs"], run["processes"], run["scheduler"]) == (2, 2, None)
+    monkeypatch.setattr(batch.os, "cpu_count", lambda: 1)  # one core: this process
+    r = _run(["fair", "in", "-o", "one", "--tol", str(TOL), "-q"], tmp_path)
+    assert r.exit_code == 0, r.output
+    run1 = json.loads((tmp_path / "one/.curvefair/run.json").read_text())
+    assert pools == [2] and (run1["jobs"], run1["processes"]) == (1, 0)
+    r = _run(["fair", "in", "-o", "many", "--tol", str(TOL), "-q", "-j", "8"], tmp_path)
+    runj = json.loads((tmp_path / "many/.curvefair/run.json").read_text())
+    assert r.exit_code == 0 and pools == [2, 3]  # -j 8 for 3 files: 3 processes
+    assert (runj["jobs"], runj["processes"]) == (8, 3)
+    for name in ("one", "many"):  # same bytes however the files ran
+        a = {k: v for k, v in _snapshot(tmp_path / "two").items() if ".curvefair" not in k}
+        b = {k: v for k, v in _snapshot(tmp_path / name).items() if ".curvefair" not in k}
+        assert len(a) == 3 and a == b
+
+
 def test_output_that_is_an_input_is_refused_by_inode(tmp_path: Path):
     src = _tree(tmp_path)
     before = _snapshot(src)

@@ -196,7 +196,8 @@ def fair_many(paths: Sequence[str], out: str | None, in_place: bool, options: di
                        "complete, the others were not written (run again with --resume)",
                        err=True)
             raise SystemExit(128 + int(signum)) from None
-        run = _batch.run_report(jobs_list, reports, options, t0, dry_run)
+        run = _batch.run_report(jobs_list, reports, options, t0, dry_run, jobs_n=jobs,
+                                client=client)
         run_path = None
         if not dry_run and not (single or to_stdout):
             from .io import atomic_write

@@ -932,6 +932,24 @@ def _signals_raise() -> Iterator[None]:
                 signal.signal(sig, h)
 
 
+def default_jobs(jobs_n: int | None) -> int:
+    """The number of processes ``--jobs`` asks for: ``jobs_n``, or the core count when None."""
+    return jobs_n if jobs_n is not None else (os.cpu_count() or 1)
+
+
+def executor(jobs_n: int | None, n_todo: int, client: Any = None) -> dict[str, Any]:
+    """How :func:`run_jobs` runs ``n_todo`` files, as the run report records it: ``jobs``
+    (asked for, default the core count), ``processes`` (the pool's size; 0 when the files
+    run in this process: one file, or ``jobs`` 1) and ``scheduler`` (the Dask scheduler's
+    address, or None)."""
+    n = default_jobs(jobs_n)
+    if client is not None:
+        addr = getattr(getattr(client, "scheduler", None), "address", None)
+        return {"jobs": n, "processes": 0, "scheduler": str(addr) if addr else "dask"}
+    return {"jobs": n, "processes": 0 if n <= 1 or n_todo <= 1 else min(n, n_todo),
+            "scheduler": None}
+
+
 def run_jobs(jobs: Sequence[Job], options: Mapping[str, Any], *, jobs_n: int | None = None,
              client: Any = None, dry_run: bool = False, resume: bool = False,
              in_format: str | None = None,
@@ -954,7 +972,7 @@ def run_jobs(jobs: Sequence[Job], options: Mapping[str, Any], *, jobs_n: int | N
                 on_event(job.display, "skipped", 1)
         else:
             todo.append(k)
-    n = jobs_n if jobs_n is not None else (os.cpu_count() or 1)
+    n = default_jobs(jobs_n)
     try:
         with _signals_raise():
             if client is not None:
@@ -1044,8 +1062,10 @@ def _run_pool(jobs: Sequence[Job], todo: Sequence[int], options: Mapping[str, An
 
 
 def run_report(jobs: Sequence[Job], reports: Sequence[Mapping[str, Any]],
-               options: Mapping[str, Any], t0: float, dry_run: bool) -> dict[str, Any]:
-    """The run's report: options, counts and one summary per file."""
+               options: Mapping[str, Any], t0: float, dry_run: bool, *,
+               jobs_n: int | None = None, client: Any = None) -> dict[str, Any]:
+    """The run's report: options, how the files ran (:func:`executor`: ``jobs``,
+    ``processes``, ``scheduler``), counts and one summary per file."""
     files = [_summary(j, r) for j, r in zip(jobs, reports, strict=True)]
     for f, r in zip(files, reports, strict=True):
         if r.get("skipped"):
@@ -1053,6 +1073,7 @@ def run_report(jobs: Sequence[Job], reports: Sequence[Mapping[str, Any]],
     opts = _options(options)
     return {"curvefair": __version__, "dry_run": dry_run,
             "options": _jsonable({k: opts[k] for k in OUTPUT_OPTIONS}),
+            **executor(jobs_n, sum(not f.get("skipped") for f in files), client),
             "n_files": len(files),
             "n_ok": sum(f["status"] == "ok" and not f.get("skipped") for f in files),
             "n_skipped": sum(bool(f.get("skipped")) for f in files),
@@ -1098,7 +1119,7 @@ def fair_files(paths: str | Sequence[str], out_dir: str | os.PathLike[str], clie
     if any(j.input == "-" for j in plan):
         raise InputError("fair_files: '-' (stdin) is for the command line only")
     reps = run_jobs(plan, options, jobs_n=jobs, client=client, dry_run=dry_run, resume=resume)
-    run = run_report(plan, reps, options, t0, dry_run)
+    run = run_report(plan, reps, options, t0, dry_run, jobs_n=jobs, client=client)
     if not dry_run:
         from .io import atomic_write
 
