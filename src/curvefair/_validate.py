@@ -178,7 +178,8 @@ def check_points_range(arr: FloatArray, name: str) -> None:
     """Finite, magnitude ``<= MAX_MAGNITUDE`` and, unless all points are equal, an extent
     (largest per-coordinate range) ``>= MIN_EXTENT`` (see the module docstring). Whole-array
     and per-column minima and maxima (NaN propagates through them), no full-size temporaries
-    (numpy's ``max(axis=0)`` on an ``(n, 2)`` array is ~5x slower than per-column maxima)."""
+    (numpy's ``max(axis=0)`` on an ``(n, 2)`` array reduces across the short axis, which is
+    much slower than a contiguous reduction per column)."""
     if arr.size == 0:
         return
     hi_all = float(arr.max())

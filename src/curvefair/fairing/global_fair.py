@@ -788,10 +788,9 @@ def _solve_balls(system: _System, g0: FloatArray, free: np.ndarray, tol: float, 
 
 _SWITCH_GAP = 1e-5
 _RETRACT = True
-# 20 iterations, rho adapted once (after 10): at 1e6 points (sigma 0.05, tol 0.3) 5 Newton
-# factorisations instead of 4 (40 iterations, adapted every 10) for 20 fewer sweeps (~6 ms
-# each) and one ADMM refactorisation less; at 3e5 points the same Newton counts as 40 for
-# tol 0.1 and sigma 0.2, one more factorisation for sigma 0.01 / tol 0.05
+# ADMM warm start: 20 iterations, rho adapted once (after 10). A short warm start trades a
+# Newton factorisation at most for fewer O(n) sweeps and ADMM refactorisations (the measured
+# choice: CHANGELOG.md, docs/benchmarks.md)
 _ADMM_ITERS = 20  # 0: no ADMM warm start
 _ADMM_ADAPT = 10
 _ADMM_RHO0 = 0.03

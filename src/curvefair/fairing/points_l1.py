@@ -870,9 +870,8 @@ def _accepts(curve: Any) -> bool:
 
 
 #: the largest point count for which ``points-l1`` is the default (its interior point is
-#: O(n) per Newton step but takes about 200 steps: about 0.2 ms of CPU per point on the
-#: 2-core benchmark machine, see docs/benchmarks.md); longer point lists default to
-#: ``poliakoff``
+#: O(n) per Newton step but takes a few hundred steps, so its cost per point is large: the
+#: figures are in docs/benchmarks.md); longer point lists default to ``poliakoff``
 DEFAULT_MAX_POINTS = 20_000
 
 #: whether ``points-l1`` is registered as a default at all: True, for the curves :func:`_prefer`
