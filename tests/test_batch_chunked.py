@@ -254,6 +254,23 @@ def test_point_stream_reads_header_comments_and_separators(tmp_path: Path):
     (blk,) = list(s.blocks(10))
     assert blk.tolist() == [[1, 2, 3], [4, 5, 6], [7, 8, 9]]
     assert s.header == "name of it" and s.sep == " " and s.n_rows == 3
+    assert s.preamble == ["name of it", "# a comment"] and s.n_comments_dropped == 1
+
+
+def test_chunked_text_output_keeps_the_lines_before_the_first_row(tmp_path: Path):
+    P = _noisy(900)
+    src = tmp_path / "p.csv"
+    head = "# station 12, port side\n# units: m\n\nx,y\n"
+    rows = [f"{x!r},{y!r}\n" for x, y in P.tolist()]
+    src.write_text(head + "".join(rows[:450]) + "# mid-file note\n" + "".join(rows[450:]))
+    rep = fair_chunked(src, tmp_path / "o.csv", tol=TOL, chunk=400, overlap=20, hold=5,
+                       jobs=1)
+    text = (tmp_path / "o.csv").read_text()
+    assert text.startswith(head)  # comments, blank line and header, as they were
+    assert "mid-file note" not in text and rep["n_comments_dropped"] == 1
+    assert any("1 comment(s)" in n for n in rep["notes"])
+    Q = np.loadtxt(tmp_path / "o.csv", delimiter=",", comments="#", skiprows=4)
+    assert Q.shape == P.shape and np.linalg.norm(Q - P, axis=1).max() <= TOL
 
 
 def test_a_core_read_back_over_tol_gets_its_moves_scaled(tmp_path: Path, monkeypatch):

@@ -60,6 +60,7 @@ def test_local_cluster_same_bytes_and_a_killed_worker_loses_nothing(tmp_path: Pa
         client.wait_for_workers(2, timeout=120)
         run = fair_files([str(src)], tmp_path / "dask", client=client, tol=TOL)
         assert run["n_ok"] == N_FILES and run["n_failed"] == 0
+        assert run["scheduler"] == cluster.scheduler_address  # the run report says where
         assert _outputs(tmp_path / "dask") == _outputs(tmp_path / "ref")
         r = CliRunner().invoke(main, ["fair", str(src), "-o", str(tmp_path / "cli"), "--tol",
                                       str(TOL), "--scheduler", cluster.scheduler_address,

@@ -90,8 +90,11 @@ class PointStream:
     memory-mapped) or text columns (``# comments``, blank lines, one header line before the
     data; separators blanks, commas or semicolons).
 
-    Attributes after a full pass: ``n_rows``; ``header`` (text) and ``sep`` (the separator
-    written back) are known after the first block.
+    Attributes after a full pass: ``n_rows``; ``header`` (text), ``preamble`` (the lines before
+    the first row: the header, comments and blank lines, written back as they are) and ``sep``
+    (the separator written back) are known after the first block; ``n_comments_dropped``
+    counts the comments after the first row (a text chunk is written row by row: they are not
+    copied).
     """
 
     def __init__(self, path: str | os.PathLike[str]) -> None:
@@ -107,6 +110,8 @@ class PointStream:
         if not os.path.isfile(self.path):
             raise InputError(f"{self.path!r} does not exist")
         self.header: str | None = None
+        self.preamble: list[str] = []
+        self.n_comments_dropped = 0
         self.sep = ","
         self.dim: int | None = None
         self.n_rows: int | None = None
@@ -146,10 +151,16 @@ class PointStream:
     def _text_blocks(self, size: int) -> Iterator[np.ndarray]:
         rows: list[list[float]] = []
         n = 0
+        self.header, self.preamble, self.n_comments_dropped = None, [], 0
         with open(self.path, encoding="utf-8-sig", errors="strict") as f:
             try:
                 for ln, line in enumerate(f, start=1):
                     s = line.split("#", 1)[0].strip()
+                    if n == 0 and not rows and not s:
+                        self.preamble.append(line.rstrip("\r\n"))
+                        continue
+                    if "#" in line and n + len(rows) > 0:
+                        self.n_comments_dropped += 1
                     if not s:
                         continue
                     toks = _SPLIT.split(s)
@@ -158,6 +169,7 @@ class PointStream:
                     except ValueError:
                         if n == 0 and self.header is None and not rows:
                             self.header = line.rstrip("\r\n")
+                            self.preamble.append(self.header)
                             continue
                         raise FileFormatError(f"line {ln}: not a row of numbers: {s[:60]!r}",
                                               self.path, ln) from None
@@ -471,10 +483,12 @@ class _Runner:
 # writing in blocks
 # ------------------------------------------------------------------------------------------
 class _Writer:
-    """Rows appended in blocks to a temporary file (text: the input's separator and header,
-    numbers in the shortest form that reads back exactly; ``.npy``: float64)."""
+    """Rows appended in blocks to a temporary file (text: the input's separator and the lines
+    before its first row, numbers in the shortest form that reads back exactly; ``.npy``:
+    float64)."""
 
-    def __init__(self, dest: str, kind: str, dim: int, sep: str, header: str | None) -> None:
+    def __init__(self, dest: str, kind: str, dim: int, sep: str,
+                 preamble: list[str] | None) -> None:
         d = Path(dest)
         fd, self.path = tempfile.mkstemp(prefix="." + d.name + ".", suffix=d.suffix,
                                          dir=str(d.parent) or ".")
@@ -483,8 +497,8 @@ class _Writer:
         if kind == "npy":
             self._npy_header(10**12)
             self.hlen = self.f.tell()
-        elif header is not None:
-            self.f.write((header + "\n").encode())
+        elif preamble:
+            self.f.write("".join(line + "\n" for line in preamble).encode())
 
     def _npy_header(self, n: int) -> None:
         np.lib.format.write_array_header_1_0(
@@ -597,7 +611,7 @@ def fair_chunked(source: str | os.PathLike[str], out: str | os.PathLike[str], *,
         first = next(gen)
         dim = int(first[1].shape[1])
         writer = _Writer(dest, out_kind, dim, stream.sep if stream.kind == "text" else ",",
-                         stream.header if out_kind == "text" and stream.kind == "text"
+                         stream.preamble if out_kind == "text" and stream.kind == "text"
                          else None)
         temps.append(writer.path)
 
@@ -646,7 +660,7 @@ def fair_chunked(source: str | os.PathLike[str], out: str | os.PathLike[str], *,
                              f"{tol_v:g} (the curve re-interpolated through the written "
                              "points has new chord parameters); their moves were scaled "
                              "down until within tol")
-            w = _Writer(dest, out_kind, dim, writer.sep, stream.header
+            w = _Writer(dest, out_kind, dim, writer.sep, stream.preamble
                         if out_kind == "text" and stream.kind == "text" else None)
             temps.append(w.path)
             for ch, orig, faired in _lockstep(src, fair_file, chunks):
@@ -688,7 +702,11 @@ def fair_chunked(source: str | os.PathLike[str], out: str | os.PathLike[str], *,
             "max_deviation": max(m["deviation"] for m in measured),
             "max_point_displacement": max(m["max_point_displacement"] for m in measured),
             "joins_g2_max": g2, "g2_tol": G2_TOL, "joins_within_g2_tol": g2 <= G2_TOL,
-            "notes": notes, "chunks": chunk_reports, "joins": joins,
+            "n_comments_dropped": stream.n_comments_dropped,
+            "notes": notes + ([f"{stream.n_comments_dropped} comment(s) after the first row "
+                               "of the input were not copied (the lines before it were)"]
+                              if stream.n_comments_dropped else []),
+            "chunks": chunk_reports, "joins": joins,
             "time_s": time.perf_counter() - t0}
 
 

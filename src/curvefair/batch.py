@@ -1141,14 +1141,16 @@ def fair_chunked(source: str | os.PathLike[str], out: str | os.PathLike[str], *,
 
     ``source`` is a point file (``.csv``, ``.txt``, ``.xyz``, ``.pts``, ``.dat`` columns, or a
     ``.npy`` array of shape (n, 2) or (n, 3), memory-mapped); ``out`` a point file too (text:
-    the input's separator and header, every number in the shortest form that reads back
-    exactly; comments are not copied; ``.npy``: float64). Chunk ``k`` (rows ``k chunk ..``)
-    is faired by :func:`curvefair.fair` on its rows extended by ``overlap`` rows each side,
-    holding the ``hold`` rows either side of each join in both neighbouring fairs, and kept
-    on its own rows; the file written is read back in chunks and measured like a single-file
-    run of point data (moves scaled down where the curve read back exceeds ``tol``); nothing
-    is written unless all of it is within ``tol``. Memory stays bounded by a few windows.
-    The algorithm, the G2 bound at the joins and the on-disk rule: :mod:`curvefair._chunked`.
+    the input's separator, its lines before the first row (header, comments) as they are, every
+    number in the shortest form that reads back exactly; comments after the first row are not
+    copied, ``n_comments_dropped`` counts them; ``.npy``: float64). Chunk ``k`` (rows ``k chunk
+    ..``) is faired by :func:`curvefair.fair` on its rows extended by ``overlap`` rows each
+    side, holding the ``hold`` rows either side of each join in both neighbouring fairs, and
+    kept on its own rows; the file written is read back in chunks and measured like a
+    single-file run of point data (moves scaled down where the curve read back exceeds ``tol``);
+    nothing is written unless all of it is within ``tol``. Memory stays bounded by a few
+    windows. The algorithm, the G2 bound at the joins and the on-disk rule:
+    :mod:`curvefair._chunked`.
 
     Parameters
     ----------
