@@ -440,3 +440,53 @@ def test_g2_breaks_of_a_real_font_skip_its_line_to_curve_nodes():
     assert line_curve >= 3 and len(want) > 20
     assert not near and got == want
     assert any(f.rule == "kink" for f in found)
+
+
+def test_a_kinked_line_to_curve_node_marked_smooth_is_still_a_kink(tmp_path: Path):
+    """A smooth line-to-curve node of a real glyph (Lobster, made a UFO with font_to_ufo):
+    its handle turned 1 degree about the node off the line, the node still marked smooth.
+    Before the edit ``check`` reports nothing at that node (the G2 step from the line is by
+    design); after it, a kink of the angle computed here from the edited points."""
+    ufoLib2 = pytest.importorskip("ufoLib2")
+    from curvefair.fonts import font_to_ufo
+
+    lob = ROOT / "tests" / "data" / "real" / "fonttools" / "Lobster.subset.otf"
+    font_to_ufo(lob, tmp_path / "Z.ufo")
+    f = ufoLib2.Font.open(tmp_path / "Z.ufo")
+    hit = None
+    for g in f:
+        for ci, con in enumerate(g.contours):
+            pts, n = con.points, len(con.points)
+            for k, p in enumerate(pts):
+                if (p.smooth and p.type is not None and pts[k - 1].type is not None
+                        and pts[(k + 1) % n].type is None):
+                    hit = (g.name, ci, k)
+                    break
+            if hit:
+                break
+        if hit:
+            break
+    assert hit is not None
+    name, ci, k = hit
+    before = json.loads(_run(["check", "Z.ufo", "--format", "json"], tmp_path).stdout)
+    label = f"{name}#{ci}"
+    assert not [x for x in before["findings"]
+                if x["label"] == label and x.get("point_index") == k], before
+    pts = f[name].contours[ci].points
+    n = len(pts)
+    node = np.array([pts[k].x, pts[k].y])
+    h = np.array([pts[(k + 1) % n].x, pts[(k + 1) % n].y])
+    th = math.radians(1.0)
+    v = h - node
+    new = node + [v[0] * math.cos(th) - v[1] * math.sin(th),
+                  v[0] * math.sin(th) + v[1] * math.cos(th)]
+    pts[(k + 1) % n].x, pts[(k + 1) % n].y = float(new[0]), float(new[1])
+    assert pts[k].smooth
+    f.save(tmp_path / "K.ufo")
+    expect = _leg_angle(np.array([pts[k - 1].x, pts[k - 1].y]), node, new)
+    r = _run(["check", "K.ufo", "--format", "json"], tmp_path)
+    assert r.exit_code == 1
+    got = [x for x in json.loads(r.stdout)["findings"]
+           if x["label"] == label and x.get("point_index") == k]
+    assert [x["rule"] for x in got] == ["kink"], got
+    assert abs(got[0]["value"] - expect) < 1e-6 * expect
