@@ -226,8 +226,10 @@ def test_pre_commit_hook_definition():
 
 def test_g2_breaks_of_a_real_svg_match_svgpathtools(tmp_path: Path):
     """trimesh's MIL.svg (Inkscape, cubic chains that are G1 but not G2): every
-    tangent-continuous join whose curvature vector jumps by more than 5 % (computed here from
-    svgpathtools' own parse and derivatives) is a g2-break finding with the same value."""
+    tangent-continuous join of two curved segments whose curvature vector jumps by more than
+    5 % (computed here from svgpathtools' own parse and derivatives) is a g2-break finding
+    with the same value; joins with a straight side (a Line, or a Bezier whose control points
+    lie on its chord) are not G2-tested."""
     svgpathtools = pytest.importorskip("svgpathtools")
     from curvefair import read_curves
     from curvefair._check import check_records
@@ -239,7 +241,15 @@ def test_g2_breaks_of_a_real_svg_match_svgpathtools(tmp_path: Path):
         t = a / np.linalg.norm(a)
         return (b - (b @ t) * t) / (a @ a)
 
-    want = []
+    def straight(seg) -> bool:
+        q = [complex(z) for z in seg.bpoints()]
+        d = q[-1] - q[0]
+        if d == 0:
+            return False
+        tol = 1e-9 * max(abs(d), abs(q[0]))
+        return all(abs(((z - q[0]) * d.conjugate()).imag) / abs(d) <= tol for z in q)
+
+    want, skipped = [], 0
     paths, _ = svgpathtools.svg2paths(str(path))
     for p in paths:
         for sub in p.continuous_subpaths():
@@ -252,6 +262,9 @@ def test_g2_breaks_of_a_real_svg_match_svgpathtools(tmp_path: Path):
                 z = da.conjugate() * db
                 if math.degrees(abs(math.atan2(z.imag, z.real))) > 0.05:
                     continue  # a kink or a corner, not a G1 join
+                if straight(a) or straight(b):
+                    skipped += 1
+                    continue
                 kl, kr = kvec(da, a.derivative(1, 2)), kvec(db, b.derivative(0, 2))
                 rel = np.linalg.norm(kr - kl) / max(np.linalg.norm(kl), np.linalg.norm(kr),
                                                     1.0 / L)
@@ -260,7 +273,7 @@ def test_g2_breaks_of_a_real_svg_match_svgpathtools(tmp_path: Path):
     found = check_records(read_curves(path), str(path),
                           {"max_bad": None, "wiggle": None}, top=10**6)
     got = sorted(f.value for f in found if f.rule == "g2-break")
-    assert len(want) > 50
+    assert len(want) > 10 and skipped > 50
     np.testing.assert_allclose(got, sorted(want), rtol=1e-6)
 
 
@@ -325,3 +338,155 @@ def test_a_ufo_folder_given_by_name_is_one_input(tmp_path: Path):
     for arg in ("Z.ufo", "Z.ufo/", str(tmp_path / "Z.ufo")):
         rep = json.loads(_run(["check", arg, "--format", "json"], tmp_path).stdout)
         assert rep["n_files"] == 1 and rep["n_curves"] == 2, (arg, rep)
+
+
+def _bezier_chain(pieces: list[np.ndarray]) -> BSplineCurve:
+    """Cubic Bezier pieces end to end (each piece's first point the last one's end), as one
+    B-spline with interior knots of multiplicity 3."""
+    P = [pieces[0][0]]
+    for b in pieces:
+        assert np.array_equal(b[0], P[-1])
+        P += list(b[1:])
+    m = len(pieces)
+    knots = [0.0] * 4 + [float(k) for k in range(1, m) for _ in range(3)] + [float(m)] * 4
+    return BSplineCurve(np.array(P), knots, 3)
+
+
+def _signed_end_curvature(p0: np.ndarray, p1: np.ndarray, p2: np.ndarray) -> float:
+    """Signed curvature of a cubic Bezier at p0 travelling towards p1 (p2 the next control
+    point): 2/3 (p1-p0) x (p2-p1) / |p1-p0|^3."""
+    d1, d2 = p1 - p0, p2 - p1
+    return 2.0 / 3.0 * float(d1[0] * d2[1] - d1[1] * d2[0]) / float(np.linalg.norm(d1)) ** 3
+
+
+def test_line_to_curve_joins_are_not_g2_breaks_but_kinks_and_curve_joins_are(tmp_path: Path):
+    """One curve: a line drawn as a degenerate cubic (control points on its chord, unevenly
+    spaced), a tangent curve, and a second curve tangent to it with another end curvature.
+    The line-curve join (curvature 0 -> 2/3) is G1 by design and not reported; the
+    curve-curve join is a G2 break of the value computed from the control polygons. A second
+    curve whose line meets the curve 2 degrees off the line is a kink there."""
+    J1, J2 = np.array([3.0, 0.0]), np.array([6.0, 1.0])
+    line = np.array([[0.0, 0.0], [0.5, 0.0], [2.0, 0.0], J1])
+    curve1 = np.array([J1, [4.0, 0.0], [5.0, 1.0], J2])
+    curve2 = np.array([J2, [7.0, 1.0], [8.0, 3.0], [9.0, 3.0]])
+    smooth = _bezier_chain([line, curve1, curve2])
+    t = math.radians(2.0)
+    kinked = _bezier_chain([line, np.array([J1, J1 + [math.cos(t), math.sin(t)],
+                                            [5.0, 1.0], J2])])
+    write_curves(tmp_path / "lc.json", [smooth, kinked])
+    r = _run(["check", "lc.json", "--format", "json", "--max-bad", "off", "--wiggle", "off"],
+             tmp_path)
+    assert r.exit_code == 1, r.output
+    found = json.loads(r.output)["findings"]
+    # independently: the line side has no curvature, the curve's end curvature is not 0, so
+    # the relative jump at J1 would be 1 -- the join is skipped, not below the threshold
+    assert _end_curvature(J1, curve1[1], curve1[2]) > 0.5
+    g2 = [f for f in found if f["rule"] == "g2-break"]
+    assert len(g2) == 1 and g2[0]["curve"] == 0, found
+    np.testing.assert_allclose(g2[0]["point"], J2, atol=1e-12)
+    kl = -_signed_end_curvature(J2, curve1[2], curve1[1])  # the left side, run backwards
+    kr = _signed_end_curvature(J2, curve2[1], curve2[2])
+    assert abs(g2[0]["value"] - abs(kr - kl) / max(abs(kl), abs(kr))) < 1e-9
+    kinks = [f for f in found if f["rule"] == "kink"]
+    assert len(kinks) == 1 and kinks[0]["curve"] == 1, found
+    np.testing.assert_allclose(kinks[0]["point"], J1, atol=1e-12)
+    assert abs(kinks[0]["value"] - _leg_angle(line[2], J1, kinked.control_points[4])) < 1e-9
+    assert {f["rule"] for f in found} == {"g2-break", "kink"}
+
+
+def test_g2_breaks_of_a_real_font_skip_its_line_to_curve_nodes():
+    """Lobster (CFF subset): every g2-break finding is at a smooth node between two curved
+    segments, and the set of them is the one computed here from the contours' own control
+    points (signed Bezier end curvatures, joins within kink_angle, relative jump above
+    g2_rel). The font's smooth line-to-curve nodes, whose curved side bends (so the old
+    rule's jump would have been 1 > g2_rel), are not reported; kinks still are."""
+    from curvefair import analyze, read_curves
+    from curvefair._check import THRESHOLDS, check_records
+
+    path = ROOT / "tests" / "data" / "real" / "fonttools" / "Lobster.subset.otf"
+    recs = read_curves(path)
+    found = check_records(recs, str(path), {"max_bad": None, "wiggle": None}, top=10**6)
+    got = {(f.label, f.extra["point_index"]) for f in found if f.rule == "g2-break"}
+    want, line_curve, near = set(), 0, set()
+    for rec in recs:
+        c = rec.source["outline"]
+        P, on, n = np.asarray(c.points, dtype=float), c.on, len(c.on)
+        assert c.closed and not c.quadratic
+        L_lower = sum(float(np.linalg.norm(P[k] - P[k - 1])) for k in range(n) if on[k])
+        for k in range(n):
+            if not on[k]:
+                continue
+            prv, nxt = P[k - 1], P[(k + 1) % n]
+            if np.array_equal(prv, P[k]) or np.array_equal(nxt, P[k]):
+                continue  # zero-speed side: skipped by check
+            if _leg_angle(prv, P[k], nxt) > THRESHOLDS["kink_angle"]:
+                continue
+            line_left, line_right = on[k - 1], on[(k + 1) % n]
+            if line_left and line_right:
+                continue
+            if line_left or line_right:
+                p1, p2 = (P[(k + 1) % n], P[(k + 2) % n]) if line_left else (P[k - 1], P[k - 2])
+                if abs(_end_curvature(P[k], p1, p2)) > THRESHOLDS["g2_rel"] / L_lower:
+                    line_curve += 1  # the old rule: |k - 0| / max(|k|, 1/L) > g2_rel
+                continue
+            kl = -_signed_end_curvature(P[k], P[k - 1], P[k - 2])
+            kr = _signed_end_curvature(P[k], P[(k + 1) % n], P[(k + 2) % n])
+            L = float(analyze(rec.curve).arc_length)
+            rel = abs(kr - kl) / max(abs(kl), abs(kr), 1.0 / L)
+            if abs(rel - THRESHOLDS["g2_rel"]) < 1e-6:
+                near.add((rec.name, k))
+            elif rel > THRESHOLDS["g2_rel"]:
+                want.add((rec.name, k))
+    assert line_curve >= 3 and len(want) > 20
+    assert not near and got == want
+    assert any(f.rule == "kink" for f in found)
+
+
+def test_a_kinked_line_to_curve_node_marked_smooth_is_still_a_kink(tmp_path: Path):
+    """A smooth line-to-curve node of a real glyph (Lobster, made a UFO with font_to_ufo):
+    its handle turned 1 degree about the node off the line, the node still marked smooth.
+    Before the edit ``check`` reports nothing at that node (the G2 step from the line is by
+    design); after it, a kink of the angle computed here from the edited points."""
+    ufoLib2 = pytest.importorskip("ufoLib2")
+    from curvefair.fonts import font_to_ufo
+
+    lob = ROOT / "tests" / "data" / "real" / "fonttools" / "Lobster.subset.otf"
+    font_to_ufo(lob, tmp_path / "Z.ufo")
+    f = ufoLib2.Font.open(tmp_path / "Z.ufo")
+    hit = None
+    for g in f:
+        for ci, con in enumerate(g.contours):
+            pts, n = con.points, len(con.points)
+            for k, p in enumerate(pts):
+                if (p.smooth and p.type is not None and pts[k - 1].type is not None
+                        and pts[(k + 1) % n].type is None):
+                    hit = (g.name, ci, k)
+                    break
+            if hit:
+                break
+        if hit:
+            break
+    assert hit is not None
+    name, ci, k = hit
+    before = json.loads(_run(["check", "Z.ufo", "--format", "json"], tmp_path).stdout)
+    label = f"{name}#{ci}"
+    assert not [x for x in before["findings"]
+                if x["label"] == label and x.get("point_index") == k], before
+    pts = f[name].contours[ci].points
+    n = len(pts)
+    node = np.array([pts[k].x, pts[k].y])
+    h = np.array([pts[(k + 1) % n].x, pts[(k + 1) % n].y])
+    th = math.radians(1.0)
+    v = h - node
+    new = node + [v[0] * math.cos(th) - v[1] * math.sin(th),
+                  v[0] * math.sin(th) + v[1] * math.cos(th)]
+    pts[(k + 1) % n].x, pts[(k + 1) % n].y = float(new[0]), float(new[1])
+    assert pts[k].smooth
+    f.save(tmp_path / "K.ufo")
+    expect = _leg_angle(np.array([pts[k - 1].x, pts[k - 1].y]), node, new)
+    r = _run(["check", "K.ufo", "--format", "json"], tmp_path)
+    assert r.exit_code == 1
+    got = [x for x in json.loads(r.stdout)["findings"]
+           if x["label"] == label and x.get("point_index") == k]
+    assert [x["rule"] for x in got] == ["kink"], got
+    assert abs(got[0]["value"] - expect) < 1e-6 * expect

@@ -470,7 +470,8 @@ def _threshold(value: str | None, name: str) -> float | None:
               help="Joins turning by DEG or more are corners drawn on purpose [default: 10].")
 @click.option("--g2-rel", metavar="R|off",
               help="Relative curvature jump at a tangent-continuous join that is a G2 break "
-                   "[default: 0.05].")
+                   "(joins with a straight side, e.g. a line meeting a curve, are not "
+                   "G2-tested) [default: 0.05].")
 @click.option("--wiggle", metavar="F|off",
               help="Two inflections closer than F times the arc length are an S-wiggle "
                    "[default: 0.02].")

@@ -13,6 +13,13 @@ are reported, each against a threshold:
     A tangent-continuous join (angle at most ``kink_angle``) whose curvature vector jumps:
     ``|k+ - k-| / max(|k+|, |k-|, 1/L) > g2_rel`` with ``k = (r'' - (r''.T) T) / |r'|^2`` the
     curvature vector on either side and ``L`` the arc length.
+    A join where one side is a straight segment (a line, or a degenerate Bezier segment
+    whose control points lie on its chord: :func:`_straight_segments`) is not tested for a
+    G2 break: the curvature there steps from 0 to the curve's by design (the smooth
+    line-to-curve node of type design, where the handle is collinear with the line), the
+    join is G1 on purpose and ``rel`` would be 1 at every such join. It is still tested for
+    a kink, and a join of two curved segments is tested as above. The rule reads the
+    segments' shape, not the file format, so it serves every format with line segments.
 ``extra-inflection``
     Two consecutive inflections (sign changes of the curvature, :func:`curvefair.analyze`)
     closer than ``wiggle`` times the arc length: an S-wiggle a fair curve does not have. Also
@@ -60,7 +67,8 @@ THRESHOLDS: dict[str, float | None] = {"kink_angle": 0.05, "corner_angle": 10.0,
 
 RULES: dict[str, str] = {
     "kink": "a join meant to be smooth has a tangent break (kink)",
-    "g2-break": "the curvature jumps at a tangent-continuous join (G2 break)",
+    "g2-break": "the curvature jumps at a tangent-continuous join of two curved segments "
+                "(G2 break)",
     "extra-inflection": "extra inflections: an S-wiggle (two inflections close together) or "
                         "more inflections than allowed",
     "bad-point": "a bad point: a large jump of dk/ds at a breakpoint (Sapidis-Farin measure "
@@ -118,6 +126,28 @@ def _kvec(d1: np.ndarray, d2: np.ndarray) -> np.ndarray:
     return (d2 - (d2 @ t) * t) / s2
 
 
+def _straight_segments(pp: Any) -> np.ndarray:
+    """Which segments are straight: every power-basis term ``c[i, j] w_i^j`` (``j >= 1``) is
+    parallel to the chord ``d_i = r(breaks[i+1]) - r(breaks[i]) = sum_j c[i, j] w_i^j`` to
+    ``1e-9`` of ``max(|d_i|, |c[i, 0]|)`` (rounding of the basis change), so that every point
+    ``r(t) = c[i, 0] + sum_j c[i, j] (t - breaks[i])^j`` lies on the chord's line. For a
+    Bezier segment this is its control points being collinear with the chord (a line drawn as
+    a degenerate cubic or quadratic, as font outlines store lines). A zero chord is not
+    straight (a loop or a point)."""
+    c = np.asarray(pp.coeffs, dtype=float)
+    w = np.asarray(pp.widths, dtype=float)
+    p = c.shape[1] - 1
+    terms = np.stack([c[:, j, :] * w[:, None] ** j for j in range(1, p + 1)], axis=1)
+    d = terms.sum(axis=1)
+    dn = np.linalg.norm(d, axis=1)
+    tol = 1e-9 * np.maximum(dn, np.linalg.norm(c[:, 0, :], axis=1))
+    safe = np.where(dn > 0, dn, 1.0)
+    t = d / safe[:, None]
+    perp = terms - np.einsum("ijk,ik->ij", terms, t)[:, :, None] * t[:, None, :]
+    dev = np.linalg.norm(perp, axis=2).max(axis=1)
+    return np.asarray((dn > 0) & (dev <= tol), dtype=bool)
+
+
 def _regular(a: np.ndarray, b: np.ndarray, width: float, L: float) -> bool:
     """Both one-sided speeds at a join are above ``1e-6`` of the mean speed ``L / width``."""
     ref = 1e-6 * L / width if width > 0 else 0.0
@@ -161,6 +191,7 @@ def check_records(records: Sequence[Any], file: str = "",
         a = analyze(curve)
         L = float(a.arc_length)
         d1r, d2r, d1l, d2l = _side_derivatives(pp)
+        straight = _straight_segments(pp)
         joins = [(k, k - 1, k) for k in range(1, m)]
         outline = (getattr(rec, "source", None) or {}).get("outline")
         if curve.closed or (outline is not None and outline.closed and m > 1):
@@ -183,7 +214,8 @@ def check_records(records: Sequence[Any], file: str = "",
                                    f"kink of {ang:.4g} deg at a join (break {bk})", ang,
                                    th["kink_angle"], u, at(u)))
             elif th["g2_rel"] is not None and (th["kink_angle"] is None
-                                                or ang <= th["kink_angle"]):
+                                                or ang <= th["kink_angle"]) and not (
+                    straight[left] or straight[right]):  # line beside curve: G1 by design
                 kl, kr = _kvec(d1l[left], d2l[left]), _kvec(d1r[right], d2r[right])
                 scale = max(float(np.linalg.norm(kl)), float(np.linalg.norm(kr)),
                             1.0 / L if L > 0 else 0.0)
