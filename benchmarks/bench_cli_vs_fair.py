@@ -1,14 +1,16 @@
 """The ``curvefair fair`` command on a point CSV against the same work done in Python.
 
-Seeded data: ``n`` samples of ``(t, sin t)``, ``t`` in [0, 20], plus Gaussian noise of
-``--noise`` (default 1e-3) in y, written with ``np.savetxt`` (``%.8f``, header ``x,y``) to a
-CSV in a temporary folder. For each size the benchmark times, in the same run:
+Seeded data: ``n`` samples of ``(t, sin t)``, ``t`` in [0, 20], plus Gaussian noise in y of
+``--noise`` (default 0.1) times the spacing ``h = 20 / (n - 1)``, written with ``np.savetxt``
+(``%.8f``, header ``x,y``) to a CSV in a temporary folder. For each size the benchmark times,
+in the same run:
 
 * ``cli``: the whole command a user runs, ``python -m curvefair fair in.csv -o out.csv --tol T``
-  (default method, default options), in a subprocess, after one warm-up run (numba's cache
-  compiled); wall time, and the child's CPU time and peak RSS from
-  ``resource.getrusage(RUSAGE_CHILDREN)`` (CPU: difference before/after; peak RSS: the largest
-  child so far, so only a rise is meaningful). ``--cold`` also reports the first (warm-up) run.
+  with ``T`` = ``--tol`` (default 1) times ``h`` (default method, default options), in a
+  subprocess, after one warm-up run (numba's cache compiled); wall time, and the child's CPU
+  time and peak RSS from ``resource.getrusage(RUSAGE_CHILDREN)`` (CPU: difference
+  before/after; peak RSS: the largest child so far, so only a rise is meaningful). ``--cold``
+  also reports the first (warm-up) run.
 * ``py``: what a Python user does for the same result, in this process:
   ``read_curves(in.csv)``, ``fair(record.curve, tol=T, protect=record.corners)`` per record (the
   options the command passes by default: method None, clamp "g0", mode "spline"),
@@ -25,7 +27,7 @@ Ratios: cli / fair and cli / py.
 Usage::
 
     python benchmarks/bench_cli_vs_fair.py                  # sizes 1e5 1e6
-    python benchmarks/bench_cli_vs_fair.py --sizes 1e4 --tol 1e-3 --cold
+    python benchmarks/bench_cli_vs_fair.py --sizes 1e4 --tol 2 --cold
 """
 
 from __future__ import annotations
@@ -43,10 +45,16 @@ import numpy as np
 import curvefair as cf
 
 
+def spacing(n: int) -> float:
+    return 20.0 / (n - 1)
+
+
 def make_points(n: int, noise: float, seed: int = 0) -> np.ndarray:
+    """``noise`` in units of the spacing (noise much larger than the spacing makes the
+    reader's corner search scan many neighbours per point)."""
     rng = np.random.default_rng(seed)
     t = np.linspace(0.0, 20.0, n)
-    return np.c_[t, np.sin(t) + noise * rng.normal(size=n)]
+    return np.c_[t, np.sin(t) + noise * spacing(n) * rng.normal(size=n)]
 
 
 def run_child(cmd: list[str]) -> dict[str, float]:
@@ -86,6 +94,7 @@ def bench(n: int, tol: float, noise: float, d: str, cold: bool) -> dict[str, flo
     src = os.path.join(d, f"in{n}.csv")
     np.savetxt(src, make_points(n, noise), fmt="%.8f", delimiter=",", header="x,y",
                comments="")
+    tol = tol * spacing(n)
     out_cli = os.path.join(d, f"cli{n}.csv")
     out_py = os.path.join(d, f"py{n}.csv")
     cmd = [sys.executable, "-m", "curvefair", "fair", src, "-o", out_cli, "--tol", repr(tol)]
@@ -106,11 +115,12 @@ def bench(n: int, tol: float, noise: float, d: str, cold: bool) -> dict[str, flo
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--sizes", nargs="*", type=float, default=[1e5, 1e6])
-    ap.add_argument("--tol", type=float, default=1e-3)
-    ap.add_argument("--noise", type=float, default=1e-3)
+    ap.add_argument("--tol", type=float, default=1.0, help="in units of the spacing")
+    ap.add_argument("--noise", type=float, default=0.1, help="in units of the spacing")
     ap.add_argument("--cold", action="store_true", help="also show the first (warm-up) run")
     args = ap.parse_args()
-    print(f"tol {args.tol:g}, noise {args.noise:g}; seconds (wall) unless noted")
+    print(f"tol {args.tol:g} h, noise {args.noise:g} h (h: the point spacing); seconds "
+          "(wall) unless noted")
     print(f"{'n':>9} {'curves':>6} {'cli_s':>8} {'cli_cpu':>8} {'rss_MiB':>8} {'fair_s':>8} "
           f"{'py_s':>8} {'read_s':>7} {'write_s':>8} {'import_s':>8} {'cli/fair':>8} "
           f"{'cli/py':>7} {'same':>5}" + (f" {'cold_s':>8}" if args.cold else ""), flush=True)
@@ -118,7 +128,7 @@ def main() -> None:
         warm = os.path.join(d, "warm.csv")  # this process's compiled kernels, loaded once
         np.savetxt(warm, make_points(200, args.noise), fmt="%.8f", delimiter=",",
                    header="x,y", comments="")
-        python_user(warm, os.path.join(d, "warm_out.csv"), args.tol)
+        python_user(warm, os.path.join(d, "warm_out.csv"), args.tol * spacing(200))
         for size in args.sizes:
             n = int(size)
             r = bench(n, args.tol, args.noise, d, args.cold)
