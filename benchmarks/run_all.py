@@ -26,6 +26,7 @@ FULL = [
     ["bench_bspline_e2e.py"],
     ["bench_call_cost.py", "--cpu"],  # CPU time: the machines are shared
     ["bench_io.py"],
+    ["bench_cli_vs_fair.py"],
     ["bench_plot.py"],
     ["bench_dxf_entities.py", "1000", "10000", "--cpu"],  # entity counts: not given --sizes
 ]
@@ -33,7 +34,8 @@ FULL = [
 SIZE_ARG = {"bench_analyze.py": "pos", "bench_fair_step.py": "--sizes",
             "bench_bspline_eh_steps.py": "--sizes", "bench_cheng_yu.py": "--sizes",
             "bench_knot_removal.py": "--sizes", "bench_bspline_e2e.py": "--n",
-            "bench_call_cost.py": "pos", "bench_io.py": "--sizes", "bench_plot.py": "pos"}
+            "bench_call_cost.py": "pos", "bench_io.py": "--sizes", "bench_plot.py": "pos",
+            "bench_cli_vs_fair.py": "--sizes"}
 
 
 def with_sizes(cmd: list[str], sizes: list[int]) -> list[str]:
@@ -72,6 +74,7 @@ QUICK = [
     ["bench_bspline_e2e.py", "--n", "100000"],
     ["bench_call_cost.py", "1e3", "1e4", "--repeat", "1", "--cpu"],
     ["bench_io.py", "--sizes", "1000", "10000"],
+    ["bench_cli_vs_fair.py", "--sizes", "10000"],
     ["bench_plot.py", "1e3", "--repeat", "1"],
     ["bench_dxf_entities.py", "100", "--cpu"],
 ]
