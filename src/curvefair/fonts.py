@@ -38,9 +38,8 @@ import numpy as np
 
 from ._typing import FloatArray
 from .errors import CurvefairError, InputError, MissingDependencyError
-from .io._common import CurveRecord
-from .io._outline import Contour
-from .io.fonts import glyph_contours, record_points, ufo_contour
+from .io import CurveRecord
+from .io.fonts import Contour, glyph_contours, record_points, ufo_contour
 
 __all__ = ["fair_contours", "FairPointPen", "FairFilter", "font_to_ufo",  # noqa: F822
            "fair_designspace", "interpolation_problems", "check_outlines"]
@@ -241,7 +240,7 @@ def font_to_ufo(src: str | os.PathLike[str], dest: str | os.PathLike[str], *,
     from fontTools.pens.pointPen import SegmentToPointPen
     from fontTools.ttLib import TTFont
 
-    from .io.fonts import _exact_smooth_flags
+    from .io.fonts import exact_smooth_flags
 
     font = TTFont(os.fspath(src))
     gs = font.getGlyphSet()
@@ -263,7 +262,7 @@ def font_to_ufo(src: str | os.PathLike[str], dest: str | os.PathLike[str], *,
         for contour in glyph.contours:
             xy = np.array([(p.x, p.y) for p in contour.points], dtype=float)
             on = [p.type is not None for p in contour.points]
-            for p, s in zip(contour.points, _exact_smooth_flags(xy, on), strict=True):
+            for p, s in zip(contour.points, exact_smooth_flags(xy, on), strict=True):
                 p.smooth = s
     ufo.glyphOrder = names
     ufo.info.unitsPerEm = font["head"].unitsPerEm
@@ -290,7 +289,7 @@ def fair_designspace(path: str | os.PathLike[str], out_dir: str | os.PathLike[st
     property).
     """
     from .fairing.fair import fair
-    from .io._common import atomic_write
+    from .io import atomic_write
     from .io.fonts import designspace_records, designspace_sources, shared_points, write_ufo
 
     tol = _check_tol(tol)
@@ -429,7 +428,7 @@ def check_outlines(path: str | os.PathLike[str], *, glyphs: Sequence[str] | str 
     """
     from .analysis import analyze
     from .io import read_curves
-    from .io._outline import smooth_angle
+    from .io.fonts import smooth_angle
 
     out: list[dict[str, Any]] = []
     for r in read_curves(path, glyphs=glyphs, on_unsupported="skip"):

@@ -70,10 +70,11 @@ import numpy as np
 from .._typing import FloatArray
 from ..errors import CurvefairError, FileFormatError, InputError
 from ._common import CurveRecord, Unsupported, lazy_import
-from ._outline import Contour, constrained_points, contour_curve, fairness
+from ._outline import Contour, constrained_points, contour_curve, fairness, smooth_angle
 from ._outline import harmonize as _harmonize
 
-__all__ = ["read", "write", "glyph_contours", "font_contours"]
+__all__ = ["read", "write", "glyph_contours", "font_contours", "Contour", "smooth_angle",
+           "exact_smooth_flags"]
 
 
 def _ufolib2(what: str) -> Any:
@@ -101,7 +102,7 @@ def ufo_contour(points: Sequence[Any], path: object = None) -> Contour:
     return Contour(xy, on, smooth, closed, quad, grid=False)
 
 
-def _exact_smooth_flags(xy: FloatArray, on: Sequence[bool]) -> tuple[bool, ...]:
+def exact_smooth_flags(xy: FloatArray, on: Sequence[bool]) -> tuple[bool, ...]:
     n = len(on)
     out = []
     for k in range(n):
@@ -112,7 +113,7 @@ def _exact_smooth_flags(xy: FloatArray, on: Sequence[bool]) -> tuple[bool, ...]:
 
 
 def _binary_contour(xy: FloatArray, on: Sequence[bool], quadratic: bool) -> Contour:
-    return Contour(xy, tuple(bool(o) for o in on), _exact_smooth_flags(xy, on), True,
+    return Contour(xy, tuple(bool(o) for o in on), exact_smooth_flags(xy, on), True,
                    quadratic, grid=True)
 
 
