@@ -156,10 +156,10 @@ class PointStream:
             try:
                 for ln, line in enumerate(f, start=1):
                     s = line.split("#", 1)[0].strip()
-                    if n == 0 and not rows and not s:
+                    if n == 0 and not s:  # n: rows so far
                         self.preamble.append(line.rstrip("\r\n"))
                         continue
-                    if "#" in line and n + len(rows) > 0:
+                    if "#" in line and n > 0:
                         self.n_comments_dropped += 1
                     if not s:
                         continue

@@ -972,7 +972,7 @@ def run_jobs(jobs: Sequence[Job], options: Mapping[str, Any], *, jobs_n: int | N
                 on_event(job.display, "skipped", 1)
         else:
             todo.append(k)
-    n = default_jobs(jobs_n)
+    processes = executor(jobs_n, len(todo), client)["processes"]
     try:
         with _signals_raise():
             if client is not None:
@@ -992,7 +992,7 @@ def run_jobs(jobs: Sequence[Job], options: Mapping[str, Any], *, jobs_n: int | N
                                       "error": f"{type(exc).__name__}: {exc}"}
                     if on_event:
                         on_event(jobs[k].display, "file", 1)
-            elif n <= 1 or len(todo) <= 1:
+            elif processes == 0:
                 for k in todo:
                     def ev(event: str, value: Any, _d: str = jobs[k].display) -> None:
                         if on_event:
@@ -1003,7 +1003,7 @@ def run_jobs(jobs: Sequence[Job], options: Mapping[str, Any], *, jobs_n: int | N
                     if on_event:
                         on_event(jobs[k].display, "file", 1)
             else:
-                _run_pool(jobs, todo, options, min(n, len(todo)), dry_run, in_format,
+                _run_pool(jobs, todo, options, processes, dry_run, in_format,
                           reports, on_event)
     finally:
         if not dry_run:

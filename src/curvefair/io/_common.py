@@ -532,13 +532,13 @@ def _chord_turns_kernel(p, closed, Lmin, out):  # type: ignore[no-untyped-def]
     """Fill ``out`` (NaN on entry) for :func:`_chord_turns`: from every point ``i`` walk back
     and forth to the first point ``k`` with ``|p_k - p_i| >= Lmin`` (at most ``m // 2`` steps;
     an open list's ends stop the walk), then ``angle = arccos(a . b / (|a| |b|))`` of the
-    chords ``a = p_i - p_back``, ``b = p_fwd - p_i``, clipped to [-1, 1]. Sums of squares in
-    coordinate order, no fused multiply-add: the same figures on every CPU."""
+    chords ``a = p_i - p_back``, ``b = p_fwd - p_i``, clipped to [-1, 1]; sums in coordinate
+    order (no fastmath)."""
     m, dim = p.shape
     lo, hi = (0, m) if closed else (1, m - 1)
     lim = m // 2 + 1
     for i in range(lo, hi):
-        ends = np.empty(2, dtype=np.int64)
+        back = fwd = -1
         for e in range(2):
             step = -1 if e == 0 else 1
             k = i + step
@@ -557,15 +557,18 @@ def _chord_turns_kernel(p, closed, Lmin, out):  # type: ignore[no-untyped-def]
                     break
                 k += step
                 n_steps += 1
-            ends[e] = found
-        if ends[0] < 0 or ends[1] < 0:
+            if e == 0:
+                back = found
+            else:
+                fwd = found
+        if back < 0 or fwd < 0:
             continue
         ab = 0.0
         aa = 0.0
         bb = 0.0
         for c in range(dim):
-            a = p[i, c] - p[ends[0], c]
-            b = p[ends[1], c] - p[i, c]
+            a = p[i, c] - p[back, c]
+            b = p[fwd, c] - p[i, c]
             ab += a * b
             aa += a * a
             bb += b * b
