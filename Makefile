@@ -3,6 +3,8 @@ PYTHON ?= python3
 VENV   ?= .venv
 PY     := $(VENV)/bin/python
 PIP    := $(VENV)/bin/pip
+# test processes (pytest-xdist): one per core this process may use; `make test JOBS=1` runs in one
+JOBS   ?= $(shell nproc 2>/dev/null || echo 1)
 
 .PHONY: demo test docs lint bench bench-quality clean venv venv-test
 
@@ -28,9 +30,9 @@ venv-test: $(VENV)/.stamp-test
 demo: $(VENV)/.stamp-base
 	$(PY) examples/demo.py --out demo_out/report.json
 
-## test: the whole test suite
+## test: the whole test suite, spread over $(JOBS) processes
 test: $(VENV)/.stamp-test
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q -n $(JOBS) --dist worksteal
 
 ## docs: the HTML documentation in docs/_build/html (API reference, formats, benchmarks, the
 ## gallery of examples/plot_*.py run at build time); any Sphinx warning is an error
