@@ -24,6 +24,7 @@ __all__ = ["TextLayout", "Token", "parse_text", "format_number"]
 
 _NUM = r"[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|nan|inf(?:inity)?)"
 _NUM_RE = re.compile(_NUM, re.IGNORECASE)
+_NUM_FULL = _NUM_RE.fullmatch
 _SEP_RE = re.compile(r"(\s*[,;]\s*|\s+)")
 _TOKEN_RE = re.compile(r"([+-]?)([^eE]*)(?:([eE])([+-]?)(\d+))?$")
 
@@ -85,8 +86,9 @@ def format_number(v: float, tok: Token, column_decimals: int,
     """Text for ``v`` in the style of the token it replaces.
 
     1. ``decimals`` given: that many decimals, the token's style (fixed or exponent).
-    2. ``v`` is the token's own value: the token's text, character for character (also where
-       the file has more digits than a float64 holds, e.g. 18 decimals).
+    2. ``v`` is the token's own value (NaN for a NaN): the token's text, character for
+       character (also where the file has more digits than a float64 holds, e.g. 18
+       decimals).
        Else the token's own number of decimals if that writes ``v`` exactly.
     3. Otherwise the column's largest number of decimals in the file if that writes ``v``
        exactly, else the shortest representation that reads back as exactly ``v``. A faired
@@ -95,7 +97,8 @@ def format_number(v: float, tok: Token, column_decimals: int,
     """
     if decimals is not None:
         return _render(v, tok, int(decimals))
-    if float(tok.text) == v:
+    t = float(tok.text)
+    if t == v or (t != t and v != v):  # NaN for NaN: the file's spelling ("NaN", "nan")
         return tok.text
     s = _render(v, tok, tok.decimals)
     if float(s) == v:
@@ -107,34 +110,81 @@ def format_number(v: float, tok: Token, column_decimals: int,
     return _shortest(v)
 
 
+def _decimals(text: str) -> int:
+    """Digits after the point of a number's text (of the mantissa for exponent style): the
+    ``decimals`` of :meth:`Token.parse`, without building the token."""
+    e = text.find("e")
+    if e < 0:
+        e = text.find("E")
+    mant = text if e < 0 else text[:e]
+    point = mant.find(".")
+    return len(mant) - point - 1 if point >= 0 else 0
+
+
 @dataclass(frozen=True)
 class Row:
-    """One data line split into pieces: ``prefix tok0 sep0 tok1 ... suffix``."""
+    """One data line split into pieces: ``prefix text0 sep0 text1 ... suffix``.
+
+    Only the texts are kept; a :class:`Token` (the number's style) is built when a changed
+    value has to be written in that style (:meth:`render`), so reading a file of a million
+    rows makes no per-number objects."""
 
     prefix: str
-    tokens: tuple[Token, ...]
+    texts: tuple[str, ...]
     seps: tuple[str, ...]
     suffix: str
 
+    @property
+    def tokens(self) -> tuple[Token, ...]:
+        """The style of each number (built on demand)."""
+        return tuple(Token.parse(t) for t in self.texts)
+
     def render(self, values: Sequence[float], column_decimals: Sequence[int],
                decimals: int | None) -> str:
-        out = []
-        lead = self.prefix
-        for j, (tok, v) in enumerate(zip(self.tokens, values, strict=False)):
-            s = format_number(float(v), tok, column_decimals[j], decimals)
-            # keep right-aligned columns aligned: the blanks before the token absorb the
-            # change of length (at least one blank stays between whitespace-separated tokens)
-            delta = len(s) - len(tok.text)
+        """The row with ``values`` in place of its numbers (:func:`format_number` for each)."""
+        return _render_pieces(self.prefix, self.texts, self.seps, self.suffix, values,
+                              column_decimals, decimals)
+
+
+def _render_pieces(prefix: str, texts: Sequence[str], seps: Sequence[str], suffix: str,
+                   values: Sequence[float], column_decimals: Sequence[int],
+                   decimals: int | None) -> str:
+    out = []
+    lead = prefix
+    nsep = len(seps)
+    for j, text in enumerate(texts):
+        v = float(values[j])
+        t = float(text)
+        if decimals is None and (t == v or (t != t and v != v)):
+            s = text  # format_number's rule 2, without parsing the style
+        else:
+            s = format_number(v, Token.parse(text), column_decimals[j], decimals)
+        # keep right-aligned columns aligned: the blanks before the token absorb the change
+        # of length (at least one blank stays between whitespace-separated tokens)
+        delta = len(s) - len(text)
+        if delta:
             core = lead.rstrip(" \t")
             pad = lead[len(core):]
-            if delta and pad:
-                keep = 0 if j == 0 else 1
-                lead = core + pad[0] * max(len(pad) - delta, keep)
-            out.append(lead)
-            out.append(s)
-            lead = self.seps[j] if j < len(self.seps) else ""
-        out.append(self.suffix)
-        return "".join(out)
+            if pad:
+                lead = core + pad[0] * max(len(pad) - delta, 0 if j == 0 else 1)
+        out.append(lead)
+        out.append(s)
+        lead = seps[j] if j < nsep else ""
+    out.append(suffix)
+    return "".join(out)
+
+
+def _render_line(line: str, values: Sequence[float], column_decimals: Sequence[int],
+                 decimals: int | None) -> str:
+    """A data line as read (all numbers: not checked again) with ``values`` in place."""
+    hash_at = line.find("#")
+    body, comment = (line, "") if hash_at < 0 else (line[:hash_at], line[hash_at:])
+    stripped = body.strip()
+    lead = body.find(stripped[0])
+    parts = _SEP_RE.split(stripped)
+    return _render_pieces(body[:lead], parts[0::2], parts[1::2],
+                          body[lead + len(stripped):] + comment, values, column_decimals,
+                          decimals)
 
 
 @dataclass(frozen=True, eq=False)
@@ -152,7 +202,6 @@ class TextLayout:
         0-based line index of the header / name line.
     data_lines : tuple of int
         0-based line index of each data row, in file order.
-    rows : tuple of Row
     ncols : int
     column_decimals : tuple of int
         Largest number of decimals per column in the file.
@@ -172,7 +221,6 @@ class TextLayout:
     final_newline: bool
     header: int | None
     data_lines: tuple[int, ...]
-    rows: tuple[Row, ...]
     ncols: int
     column_decimals: tuple[int, ...]
     encoding: str
@@ -183,6 +231,12 @@ class TextLayout:
     @property
     def header_text(self) -> str | None:
         return None if self.header is None else self.lines[self.header]
+
+    @property
+    def rows(self) -> tuple[Row, ...]:
+        """Each data row split into its pieces (built on demand from :attr:`lines`)."""
+        rows = [_split_row(self.lines[i]) for i in self.data_lines]
+        return tuple(r for r in rows if r is not None)  # every data line splits
 
     def line_numbers(self) -> list[int]:
         """1-based line number of each data row."""
@@ -195,15 +249,24 @@ class TextLayout:
         Rows listed in ``keep_rows`` are written exactly as they were (e.g. a Lednicer count
         line).
         """
-        if values.shape != (len(self.rows), self.ncols):
-            raise ValueError(f"values must have shape {(len(self.rows), self.ncols)}, "
+        nrows = len(self.data_lines)
+        if values.shape != (nrows, self.ncols):
+            raise ValueError(f"values must have shape {(nrows, self.ncols)}, "
                              f"got {values.shape}")
         lines = list(self.lines)
         keep = set(int(k) for k in keep_rows)
-        for r, (li, row) in enumerate(zip(self.data_lines, self.rows, strict=False)):
-            if r in keep:
-                continue
-            lines[li] = row.render(values[r], self.column_decimals, decimals)
+        if decimals is None:
+            # a row whose every value is the one read is its line as read (format_number's
+            # rule 2 for each number, and nothing to re-align): only the others are rendered
+            same = (values == self.values) | (np.isnan(values) & np.isnan(self.values))
+            redo = np.flatnonzero(~np.all(same, axis=1)).tolist()
+        else:
+            redo = list(range(nrows))
+        data_lines, cols = self.data_lines, self.column_decimals
+        for r in redo:
+            if r not in keep:
+                li = data_lines[r]
+                lines[li] = _render_line(lines[li], values[r].tolist(), cols, decimals)
         text = self.newline.join(lines)
         if self.final_newline:
             text += self.newline
@@ -217,14 +280,24 @@ def _split_row(line: str) -> Row | None:
     stripped = body.strip()
     if not stripped:
         return None
-    prefix = body[: len(body) - len(body.lstrip())]
-    trail = body[len(body.rstrip()):]
     parts = _SEP_RE.split(stripped)
     toks = parts[0::2]
-    seps = parts[1::2]
-    if not toks or not all(_NUM_RE.fullmatch(t) for t in toks):
+    if not all(map(_NUM_FULL, toks)):
         return None
-    return Row(prefix, tuple(Token.parse(t) for t in toks), tuple(seps), trail + comment)
+    lead = body.find(stripped[0])
+    return Row(body[:lead], tuple(toks), tuple(parts[1::2]),
+               body[lead + len(stripped):] + comment)
+
+
+def _split_numbers(line: str) -> list[str] | None:
+    """The number texts of a data line (as :func:`_split_row`), or None when it is not all
+    numbers: what reading needs, without the pieces that only a rewrite of the row uses."""
+    hash_at = line.find("#")
+    stripped = (line if hash_at < 0 else line[:hash_at]).strip()
+    if not stripped:
+        return None
+    toks = _SEP_RE.split(stripped)[0::2]
+    return toks if all(map(_NUM_FULL, toks)) else None
 
 
 def read_lines(path: str | os.PathLike[str]) -> tuple[list[str], str, bool, str]:
@@ -279,20 +352,20 @@ def parse_text(path: str | os.PathLike[str], *, header: bool = True,
     leading: list[int] = []
     notes_from: int | None = None
     data_lines: list[int] = []
-    rows: list[Row] = []
+    texts: list[str] = []  # every number's text, row after row
     width: int | None = None
     for i, line in enumerate(lines):
         s = line.strip()
         if not s or s.startswith("#"):
             continue
-        row = _split_row(line)
+        row = _split_numbers(line)
         if notes and notes_from is not None:
-            if row is not None and len(row.tokens) == width:
+            if row is not None and len(row) == width:
                 raise FileFormatError(
                     f"a row of {width} numbers after the text at line {notes_from + 1} that "
                     "ends the coordinates (notes between coordinates are not read)", path, i + 1)
             continue
-        if notes and not data_lines and (row is None or len(row.tokens) not in ncols):
+        if notes and not data_lines and (row is None or len(row) not in ncols):
             if head is None and header:
                 head = i
             else:
@@ -310,7 +383,7 @@ def parse_text(path: str | os.PathLike[str], *, header: bool = True,
                 raise FileFormatError(f"not a row of numbers: {short!r}", path, i + 1)
             raise FileFormatError(f"not a row of numbers (and not a header): {short!r}",
                                   path, i + 1)
-        k = len(row.tokens)
+        k = len(row)
         if width is None:
             if k not in ncols:
                 raise FileFormatError(
@@ -322,15 +395,15 @@ def parse_text(path: str | os.PathLike[str], *, header: bool = True,
                 f"row has {k} columns but the first data row (line {data_lines[0] + 1}) has "
                 f"{width}", path, i + 1)
         data_lines.append(i)
-        rows.append(row)
-    if not rows:
+        texts.extend(row)
+    if not data_lines:
         if not any(line.strip() for line in lines):
             raise FileFormatError(f"empty {what}", path)
         raise FileFormatError(f"no data rows in the {what}", path)
     assert width is not None
-    values = np.array([[float(t.text) for t in r.tokens] for r in rows], dtype=np.float64)
-    col_dec = tuple(max(r.tokens[j].decimals for r in rows) for j in range(width))
-    return TextLayout(tuple(lines), newline, final, head, tuple(data_lines), tuple(rows), width,
+    values = np.array(list(map(float, texts)), dtype=np.float64).reshape(-1, width)
+    col_dec = tuple(max(map(_decimals, texts[j::width])) for j in range(width))
+    return TextLayout(tuple(lines), newline, final, head, tuple(data_lines), width,
                       col_dec, encoding, values, tuple(leading), notes_from)
 
 
