@@ -153,7 +153,7 @@ def _span_basis(knots, p, s, prev, have, ndu, left, right, a, d):  # type: ignor
         same = same and v == prev[k]
         prev[k] = v
     if not same:
-        _ders_one(knots, p, s, 0.0, ts, p, ndu, left, right, a, d, 0)
+        _ders_one(knots, p, s, 0.0, ts, p, ndu, left, right, a, d, np.intp(0))
     return True
 
 
@@ -171,7 +171,7 @@ def _power_form_kernel(knots, p, spans, ctrl, closed, out):  # type: ignore[no-u
     d = np.empty((1, p + 1, p + 1))
     fact = _factorials(p)
     prev = np.empty(2 * p)
-    have = False
+    have = np.bool_(False)
     for m in range(spans.shape[0]):
         s = spans[m]
         have = _span_basis(knots, p, s, prev, have, ndu, left, right, a, d)
@@ -201,7 +201,7 @@ def _power_form_pair_kernel(knots, p, spans, ctrl, base, closed, out, out_diff):
     d = np.empty((1, p + 1, p + 1))
     fact = _factorials(p)
     prev = np.empty(2 * p)
-    have = False
+    have = np.bool_(False)
     for m in range(spans.shape[0]):
         s = spans[m]
         have = _span_basis(knots, p, s, prev, have, ndu, left, right, a, d)

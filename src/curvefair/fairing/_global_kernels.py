@@ -22,6 +22,14 @@ Every kernel takes ``K`` as the pair ``(K, ks)``: the band rows of the UNSCALED 
 (the curve's cached Gram band, read only) and the scale ``ks = 2 / E0``; each entry is read as
 ``K[i, j] * ks``, the same rounded value as an entry of the scaled copy ``K * ks`` (so the
 results are bitwise those of a scaled copy, without its ``n (2p + 1)`` doubles).
+
+One compiled copy per kernel and array layout: numba compiles a function again for every new
+argument type, and a literal (``0``, ``False`` written in a call) has its own type
+(``Literal[int](0)`` is not ``int64``), as have read-only and writeable arrays. So calls between
+kernels pass ``np.intp(0)`` / ``np.bool_(False)``, and ``K`` always arrives read only
+(:func:`curvefair.fairing.global_fair._readonly`): each kernel is compiled once per layout of
+its blocks and frames (planar blocks are a strided view, see ``_ssn_work``), not once per
+caller.
 """
 
 from __future__ import annotations
@@ -268,7 +276,7 @@ def _assemble_range(K, ks, p, closed, B, Q, rot, fix, L, i0, i1):  # type: ignor
 @njit(cache=True, nogil=True)
 def assemble(K, ks, p, closed, B, Q, rot, fix, L):  # type: ignore[no-untyped-def]
     """Fill ``L`` (shape (n dim, kd + 1)) with the lower band of ``M`` (see module docstring)."""
-    _assemble_range(K, ks, p, closed, B, Q, rot, fix, L, 0, K.shape[0])
+    _assemble_range(K, ks, p, closed, B, Q, rot, fix, L, np.intp(0), K.shape[0])
 
 
 @njit(cache=True)
@@ -310,7 +318,7 @@ def _ldl7(K, ks, p, B, Q, rot, fix, L, j, jstop, nxt, nmax):  # type: ignore[no-
     while j < jstop:
         if j + 7 >= nxt * dim and nxt < nmax:
             stop = min(nmax, nxt + 256)
-            _assemble_range(K, ks, p, False, B, Q, rot, fix, L, nxt, stop)
+            _assemble_range(K, ks, p, np.bool_(False), B, Q, rot, fix, L, nxt, stop)
             nxt = stop
         d = p00
         if not d > 0.0:
@@ -416,14 +424,14 @@ def assemble_ldl(K, ks, p, B, Q, rot, fix, L):  # type: ignore[no-untyped-def]
     j = 0
     if kd == 7 and N > 16:
         nxt = min(n, 256)
-        _assemble_range(K, ks, p, False, B, Q, rot, fix, L, 0, nxt)
-        info, j, nxt = _ldl7(K, ks, p, B, Q, rot, fix, L, 0, N - 7, nxt, n)
+        _assemble_range(K, ks, p, np.bool_(False), B, Q, rot, fix, L, np.intp(0), nxt)
+        info, j, nxt = _ldl7(K, ks, p, B, Q, rot, fix, L, np.intp(0), N - 7, nxt, n)
         if info:
             return info
     while j < N:
         if nxt < n:
             stop = min(n, nxt + 256)
-            _assemble_range(K, ks, p, False, B, Q, rot, fix, L, nxt, stop)
+            _assemble_range(K, ks, p, np.bool_(False), B, Q, rot, fix, L, nxt, stop)
             nxt = stop
         # columns whose updates reach only assembled rows
         j1 = N if nxt == n else max(j, nxt * dim - kd)
@@ -443,8 +451,9 @@ def assemble_ldl_head(K, ks, p, B, Q, rot, fix, L, nmax):  # type: ignore[no-unt
     every column is assembled. The same operations as :func:`assemble_ldl` (bitwise)."""
     dim = B.shape[1]
     nxt = min(nmax, 256)
-    _assemble_range(K, ks, p, False, B, Q, rot, fix, L, 0, nxt)
-    info, j, nxt = _ldl7(K, ks, p, B, Q, rot, fix, L, 0, max(nmax * dim - 8, 0), nxt, nmax)
+    _assemble_range(K, ks, p, np.bool_(False), B, Q, rot, fix, L, np.intp(0), nxt)
+    info, j, nxt = _ldl7(K, ks, p, B, Q, rot, fix, L, np.intp(0), max(nmax * dim - 8, 0), nxt,
+                         nmax)
     return info, j
 
 
@@ -675,7 +684,7 @@ def band_cholesky(L, N):  # type: ignore[no-untyped-def]
     """In-place Cholesky of the first ``N`` rows of the lower band ``L`` (entries reaching
     beyond row ``N - 1`` are left alone). Returns 0, or ``j + 1`` if pivot ``j`` is not
     positive (not positive definite in floating point)."""
-    return _chol_cols(L, 0, N, N)
+    return _chol_cols(L, np.intp(0), N, N)
 
 
 @njit(cache=True)
@@ -878,7 +887,8 @@ def prep_rhs(K, ks, p, closed, B, Q, rot, fix, fix0, rhs, c, out, sgn=1.0):  # t
     for the normal of a ``rot`` point, 0 at fixed points)."""
     n, dim = rhs.shape
     if dim == 2:
-        prep_rhs2_range(K, ks, p, closed, B, Q, rot, fix, fix0, rhs, c, out, sgn, 0, rhs.shape[0])
+        prep_rhs2_range(K, ks, p, closed, B, Q, rot, fix, fix0, rhs, c, out, sgn, np.intp(0),
+                        rhs.shape[0])
         return
     anyrot = False
     for i in range(n):
@@ -1195,7 +1205,7 @@ def shift_cholesky(K, ks, p, rho, L):  # type: ignore[no-untyped-def]
         for o in range(p + 1):
             L[i, o] = (K[i, p + o] * ks) if i + o < n else 0.0
         L[i, 0] += rho
-    info = _chol_cols(L, 0, n, n)
+    info = _chol_cols(L, np.intp(0), n, n)
     for j in range(n):
         L[j, 0] = 1.0 / L[j, 0]
     return info
@@ -1686,7 +1696,8 @@ def ssn_update_k(K, ks, p, closed, v, dv, rd, lam, S, nrm, t2, retract,  # type:
     n, dim = v.shape
     if dim == 2 and p == 3 and n > 6:
         if not edges_only:
-            ssn_update23_range(K, ks, closed, v, dv, rd, lam, S, nrm, t2, retract, 3, n - 3)
+            ssn_update23_range(K, ks, closed, v, dv, rd, lam, S, nrm, t2, retract, np.intp(3),
+                               n - 3)
         lo = 3
         hi = n - 3
     else:

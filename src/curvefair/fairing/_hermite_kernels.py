@@ -858,7 +858,7 @@ def drive(P, D, h, orig, closed, degree, method, spline, hstep, eligible, tol, e
             a2 = a % nd
             b2 = b % nd
             tt_update_range(tv, ti, a2, nd - 1, values)
-            tt_update_range(tv, ti, 0, b2, values)
+            tt_update_range(tv, ti, np.intp(0), b2, values)
         elif b >= a:
             tt_update_range(tv, ti, a, b, values)
     return (steps, stop, h_idx[:steps].copy(), h_meas[:steps].copy(), h_disp[:steps].copy(),

@@ -580,7 +580,7 @@ def _run(Q, Q0, W, lw, mw, closed, planar, movable, e, eps, max_steps,  # type: 
         if not ok and pair:
             pair = False
             first = m
-            ok, dx = _try_step(Q, Q0, W, lw, mw, K, t, D, n, closed, planar, m, False, e,
+            ok, dx = _try_step(Q, Q0, W, lw, mw, K, t, D, n, closed, planar, m, np.bool_(False), e,
                                 eps)
         if not ok:
             frozen[m] = True
