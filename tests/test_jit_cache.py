@@ -122,6 +122,25 @@ def test_bounds_checking_gets_its_own_cache(tmp_path):
     assert checked["dir"] != plain["dir"] and checked["misses"] == 1
 
 
+def test_bounds_checked_and_plain_kernels_live_side_by_side_in_the_package(tmp_path):
+    # CI runs the suite, then the compiled tests with NUMBA_BOUNDSCHECK=1, whose native
+    # comparison run needs the plain kernels again: making the checked folder in the package's
+    # __pycache__ must not prune the plain one (the same sources), only other sources' folders
+    root = _copy_package(tmp_path)
+    cache = root / "curvefair" / "__pycache__"
+    plain, _ = _run(root, {})
+    checked, _ = _run(root, {"NUMBA_BOUNDSCHECK": "1"})
+    assert checked["dir"] != plain["dir"] and checked["misses"] == 1
+    again, _ = _run(root, {})
+    assert again == {**plain, "hits": 1, "misses": 0}  # not compiled again
+    assert sorted(p.name for p in cache.iterdir()) == sorted(
+        [Path(plain["dir"]).name, Path(checked["dir"]).name])
+    (root / "curvefair" / "_probe_callee.py").write_text(CALLEE.format(scale=1.0, factor=3.0))
+    edited, _ = _run(root, {})
+    assert edited["value"] == 30.0
+    assert [p.name for p in cache.iterdir()] == [Path(edited["dir"]).name]  # both pruned
+
+
 def test_imports_and_runs_with_no_writable_cache(tmp_path):
     # a system install: the package's __pycache__, the user cache and the temp folder all
     # unusable (a regular file stands where a folder would have to be made: even root cannot

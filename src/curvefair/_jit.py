@@ -20,8 +20,10 @@ Where the cache lives, first that is writable:
 5. nowhere: kernels are compiled in every process (a read-only system install whose user has
    no writable home still imports and runs).
 
-When a new directory is made, the older ``curvefair-jit-*`` ones beside it are removed: at once
-inside the package, after 14 days unused in a shared cache (which may serve several installs).
+When a new directory is made, the ``curvefair-jit-*`` ones beside it made from other sources are
+removed: at once inside the package, after 14 days unused in a shared cache (which may serve
+several installs). The directory name is ``curvefair-jit-<sources>-<options>``; the folders of
+the same sources under other compile options are kept.
 The first compilation into a new cache directory prints one line to stderr saying so
 (set ``CURVEFAIR_QUIET=1`` to silence it).
 
@@ -65,7 +67,7 @@ _OFF = {"", "0", "off", "none", "false", "no"}
 
 def _source_hash() -> str:
     """sha256 over every ``.py`` file of the package (relative path and bytes, sorted) and the
-    versions and options that change compiled code."""
+    numba, llvmlite and Python versions: which sources the kernels are compiled from."""
     h = hashlib.sha256()
     files: list[str] = []
     for root, dirs, names in os.walk(_PKG_DIR):
@@ -77,10 +79,16 @@ def _source_hash() -> str:
         with open(path, "rb") as f:
             h.update(f.read())
         h.update(b"\0")
-    h.update(repr((numba.__version__, llvmlite.__version__, sys.version, sys.platform,
-                   int(_nb_config.BOUNDSCHECK or 0), int(_nb_config.OPT),
-                   int(_nb_config.DEBUGINFO_DEFAULT or 0))).encode())
+    h.update(repr((numba.__version__, llvmlite.__version__, sys.version,
+                   sys.platform)).encode())
     return h.hexdigest()[:20]
+
+
+def _options_hash() -> str:
+    """The compile options that change the machine code but not numba's own cache key."""
+    opts = (int(_nb_config.BOUNDSCHECK or 0), int(_nb_config.OPT),
+            int(_nb_config.DEBUGINFO_DEFAULT or 0))
+    return hashlib.sha256(repr(opts).encode()).hexdigest()[:6]
 
 
 def _writable_dir(path: str) -> bool:
@@ -93,16 +101,19 @@ def _writable_dir(path: str) -> bool:
 
 
 def _prune_siblings(parent: str, keep: str, older_than: float) -> None:
-    """Remove the other ``curvefair-jit-*`` folders of ``parent`` not used for ``older_than``
-    seconds (0: all of them)."""
+    """Remove the ``curvefair-jit-*`` folders of ``parent`` made from other sources than
+    ``keep`` and not used for ``older_than`` seconds (0: all of them). The folders of the same
+    sources under other compile options (``NUMBA_BOUNDSCHECK=1`` beside the plain kernels) are
+    kept: switching an option back and forth compiles nothing again."""
     try:
         names = os.listdir(parent)
     except OSError:
         return
+    same_sources = keep.rsplit("-", 1)[0] + "-"
     now = time.time()
     for name in names:
         path = os.path.join(parent, name)
-        if not name.startswith(_PREFIX) or name == keep:
+        if not name.startswith(_PREFIX) or name.startswith(same_sources):
             continue
         try:
             if now - os.stat(path).st_mtime < older_than:
@@ -144,7 +155,7 @@ def _choose_cache_dir(key: str) -> str | None:
     return None
 
 
-_KEY = _source_hash()
+_KEY = f"{_source_hash()}-{_options_hash()}"
 _CACHE_DIR = _choose_cache_dir(_KEY)
 _noticed = False
 
