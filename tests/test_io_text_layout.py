@@ -30,7 +30,8 @@ def _style(rng: np.random.Generator, v: float) -> str:
     """``v`` written in one of the styles found in real files."""
     k = int(rng.integers(7))
     if k == 0:
-        s = f"{v:.{int(rng.integers(0, 9))}f}"
+        d = int(rng.integers(0, 9))
+        s = f"{v:.{d}f}" + ("." if d == 0 and rng.integers(2) else "")
     elif k == 1:
         s = f"{v:.{int(rng.integers(1, 8))}e}"
         if rng.integers(2):
@@ -158,3 +159,20 @@ def test_keep_rows_and_the_token_view(tmp_path):
     out = lay.render(np.array([[1.5, 30.0], [-0.125, 0.75]]), keep_rows=[1])
     assert out == "name\n   1.50   3.0e+01\n  -0.25  +.5 # c\n"
     assert math.isclose(float(out.split()[2]), 30.0)
+
+
+@pytest.mark.parametrize("column", [["3.", "-4.", "12."], ["3.", "-4.50", "0.125"],
+                                    ["-0.0", "0.00", "1.5"], ["7", "-8", "9"]])
+def test_point_only_and_zero_decimal_columns_against_the_reference(tmp_path, column):
+    """Columns whose numbers have no decimals after their point (``3.``), mixed decimals,
+    signed zeros and integers: changed values written as the slow reference writes them, and
+    read back exactly."""
+    path = tmp_path / "c.txt"
+    path.write_text("".join(f"{t} 1.0\n" for t in column))
+    lay = parse_text(path, header=False)
+    for new_x in ([3.25, -4.0, 12.0], [-0.0, 0.0, -1e-300], [1e22, -2.5e-7, 5.0]):
+        new = lay.values.copy()
+        new[:, 0] = new_x
+        out = lay.render(new)
+        assert out == _reference_render(lay, new, None)
+        np.testing.assert_array_equal(parse_text_of(tmp_path, out)[:, 0], new_x)

@@ -157,6 +157,8 @@ def _render_pieces(prefix: str, texts: Sequence[str], seps: Sequence[str], suffi
         t = float(text)
         if decimals is None and (t == v or (t != t and v != v)):
             s = text  # format_number's rule 2, without parsing the style
+        elif decimals is None and _is_plain(text):
+            s = _plain_number(v, text, column_decimals[j])
         else:
             s = format_number(v, Token.parse(text), column_decimals[j], decimals)
         # keep right-aligned columns aligned: the blanks before the token absorb the change
@@ -172,6 +174,34 @@ def _render_pieces(prefix: str, texts: Sequence[str], seps: Sequence[str], suffi
         lead = seps[j] if j < nsep else ""
     out.append(suffix)
     return "".join(out)
+
+
+def _is_plain(text: str) -> bool:
+    """A fixed-point number with digits before its point and no explicit ``+`` (``-12.50``,
+    ``3.``): the common style, rendered by :func:`_plain_number` without a :class:`Token`."""
+    point = text.find(".")
+    return (point > 0 and text[point - 1].isdigit() and text[0] != "+"
+            and "e" not in text and "E" not in text)
+
+
+def _plain_number(v: float, text: str, column_decimals: int) -> str:
+    """:func:`format_number` (no ``decimals``, ``v`` not the token's value) for a token of
+    :func:`_is_plain` style: its own decimals if they write ``v`` exactly, else the column's,
+    else the shortest exact form; a negative zero only where the token had a minus."""
+    d = len(text) - text.find(".") - 1
+    s = f"{v:.{d}f}" if d else f"{v:.0f}."
+    if s[0] == "-" and text[0] != "-" and float(s) == 0.0:
+        s = s[1:]
+    if float(s) == v:
+        return s
+    d2 = max(column_decimals, 1)
+    if column_decimals > 0 and d2 != d:
+        s = f"{v:.{d2}f}"
+        if s[0] == "-" and text[0] != "-" and float(s) == 0.0:
+            s = s[1:]
+        if float(s) == v:
+            return s
+    return _shortest(v)
 
 
 def _render_line(line: str, values: Sequence[float], column_decimals: Sequence[int],
