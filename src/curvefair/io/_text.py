@@ -25,6 +25,10 @@ __all__ = ["TextLayout", "Token", "parse_text", "format_number"]
 _NUM = r"[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|nan|inf(?:inity)?)"
 _NUM_RE = re.compile(_NUM, re.IGNORECASE)
 _NUM_FULL = _NUM_RE.fullmatch
+# whole rows in the two commonest layouts, matched at once: ``1.5,2.5`` and ``1.5  2.5`` (ASCII
+# blanks and tabs), whose numbers ``str.split`` then cuts out exactly as ``_SEP_RE`` would
+_COMMA_ROW = re.compile(rf"{_NUM}(?:,{_NUM})*", re.IGNORECASE).fullmatch
+_BLANK_ROW = re.compile(rf"{_NUM}(?:[ \t]+{_NUM})*", re.IGNORECASE).fullmatch
 _SEP_RE = re.compile(r"(\s*[,;]\s*|\s+)")
 _TOKEN_RE = re.compile(r"([+-]?)([^eE]*)(?:([eE])([+-]?)(\d+))?$")
 
@@ -211,10 +215,14 @@ def _render_line(line: str, values: Sequence[float], column_decimals: Sequence[i
     body, comment = (line, "") if hash_at < 0 else (line[:hash_at], line[hash_at:])
     stripped = body.strip()
     lead = body.find(stripped[0])
-    parts = _SEP_RE.split(stripped)
-    return _render_pieces(body[:lead], parts[0::2], parts[1::2],
-                          body[lead + len(stripped):] + comment, values, column_decimals,
-                          decimals)
+    if _COMMA_ROW(stripped):
+        texts = stripped.split(",")
+        seps: Sequence[str] = [","] * (len(texts) - 1)
+    else:
+        parts = _SEP_RE.split(stripped)
+        texts, seps = parts[0::2], parts[1::2]
+    return _render_pieces(body[:lead], texts, seps, body[lead + len(stripped):] + comment,
+                          values, column_decimals, decimals)
 
 
 @dataclass(frozen=True, eq=False)
@@ -326,6 +334,10 @@ def _split_numbers(line: str) -> list[str] | None:
     stripped = (line if hash_at < 0 else line[:hash_at]).strip()
     if not stripped:
         return None
+    if _COMMA_ROW(stripped):
+        return stripped.split(",")
+    if _BLANK_ROW(stripped):
+        return stripped.split()
     toks = _SEP_RE.split(stripped)[0::2]
     return toks if all(map(_NUM_FULL, toks)) else None
 
