@@ -5,7 +5,8 @@ Run: ``PYTHONPATH=src python benchmarks/calibrate_check.py [--out FILE.json]``.
 Every record of every file under tests/data/real (the CAD/SVG/airfoil corpus and the committed
 fonts) plus DejaVuSans (matplotlib's copy; a-z, A-Z, 0-9) is measured as ``curvefair check``
 measures it (``curvefair._check``): the tangent angle at every regular join (degrees), the
-relative curvature jump at every join whose angle is at most the kink threshold, the gap
+relative curvature jump at every join whose angle is at most the kink threshold and whose
+sides are both curved (``check`` does not G2-test a line beside a curve), the gap
 between consecutive inflections over the arc length, and the scale-free Sapidis-Farin
 bad-point measure at every breakpoint. It prints quantiles per source kind (fonts / other)
 and how many findings each threshold candidate would give; docs/benchmarks.md quotes the run.
@@ -23,7 +24,15 @@ from pathlib import Path
 import numpy as np
 
 from curvefair import analyze, read_curves
-from curvefair._check import THRESHOLDS, _angle, _arc, _kvec, _regular, _side_derivatives
+from curvefair._check import (
+    THRESHOLDS,
+    _angle,
+    _arc,
+    _kvec,
+    _regular,
+    _side_derivatives,
+    _straight_segments,
+)
 
 ROOT = Path(__file__).resolve().parents[1] / "tests" / "data" / "real"
 FONT_EXT = {".ttf", ".otf", ".ufo", ".glyphs", ".designspace"}
@@ -41,12 +50,15 @@ def measures(rec):
     closed = curve.closed or (outline is not None and outline.closed and m > 1)
     joins = [(k - 1, k) for k in range(1, m)] + ([(m - 1, 0)] if closed else [])
     width = float(br[-1] - br[0])
+    straight = _straight_segments(pp)
     ang, g2 = [], []
     for left, right in joins:
         if not _regular(d1l[left], d1r[right], width, L):
             continue
         t = _angle(d1l[left], d1r[right])
         ang.append(t)
+        if straight[left] or straight[right]:
+            continue  # a line beside a curve: G1 by design, not G2-tested by check
         kl, kr = _kvec(d1l[left], d2l[left]), _kvec(d1r[right], d2r[right])
         sc = max(float(np.linalg.norm(kl)), float(np.linalg.norm(kr)), 1.0 / L if L > 0 else 0)
         g2.append((t, float(np.linalg.norm(kr - kl)) / sc if sc > 0 else 0.0))
