@@ -226,3 +226,40 @@ def test_geometric_distance_finds_nearest_point_on_long_straight_piece():
     d = cf.deviation(a, b)
     assert d.kind == "geometric"
     assert d.max_distance == pytest.approx(_hausdorff_reference(a, b), rel=1e-6)
+
+
+@pytest.mark.parametrize("dim,closed", [(2, False), (3, False), (2, True)])
+def test_matched_hermite_bound_kernel_vs_numpy_and_dense_sampling(dim, closed):
+    """The compiled per-span bound of two Hermite curves through as many points equals the
+    numpy form to rounding, and bounds |b(t) - a(psi(t))| sampled densely with scipy's
+    CubicHermiteSpline on every span (psi maps b's parameters onto a's, point i to point i), up
+    to the rounding of evaluating the two curves separately."""
+    from curvefair.analysis import matched_hermite_bound
+    from curvefair.analysis._deviation import _matched_hermite_bound_reference
+
+    rng = np.random.default_rng(11 + dim + 7 * closed)
+    for n in (2, 3, 9, 120):
+        if closed and n < 4:
+            continue
+        th = np.linspace(0, 2 * np.pi, n, endpoint=not closed)
+        P = np.c_[np.cos(th), np.sin(th), 0.2 * th][:, :dim] * 10 + rng.normal(size=(n, dim))
+        Q = P + 10.0 ** rng.integers(-6, -1) * rng.normal(size=P.shape)
+        bc = "periodic" if closed else "natural"
+        a = cf.interpolate_cubic(np.r_[P, P[:1]] if closed else P, bc=bc)
+        b = cf.interpolate_cubic(np.r_[Q, Q[:1]] if closed else Q, bc=bc)
+        for pieces in (1, 4, 6):
+            got = matched_hermite_bound(a, b, pieces)
+            ref = _matched_hermite_bound_reference(a, b, pieces)
+            assert got.shape == ref.shape == (len(a.params) - 1,)
+            np.testing.assert_allclose(got, ref, rtol=1e-13, atol=1e-15 * float(ref.max()))
+        fa = CubicHermiteSpline(a.params, a.points, a.tangents)
+        fb = CubicHermiteSpline(b.params, b.points, b.tangents)
+        bound = matched_hermite_bound(a, b)
+        for i in range(len(bound)):
+            t = np.linspace(b.params[i], b.params[i + 1], 201)
+            s = (t - b.params[i]) / (b.params[i + 1] - b.params[i])
+            psi = a.params[i] + s * (a.params[i + 1] - a.params[i])
+            d = np.linalg.norm(fb(t) - fa(psi), axis=1).max()
+            # slack: the rounding of evaluating coordinates of size max|x| separately
+            slack = 16 * np.finfo(float).eps * float(np.abs(P).max() + 1)
+            assert d <= bound[i] + slack, (n, i, d, bound[i])

@@ -625,6 +625,56 @@ def matched_hermite_bound(a: Any, b: Any, pieces: int = 4) -> FloatArray:
         rounding of the coordinates (the result is enlarged by ``1e-12`` relative). O(n):
         what the read-back check of a written point file uses before any sampling.
     """
+    ua, ub = (np.ascontiguousarray(c.params, dtype=float) for c in (a, b))
+    pa, pb = (np.ascontiguousarray(c.points, dtype=float) for c in (a, b))
+    ta, tb = (np.ascontiguousarray(c.tangents, dtype=float) for c in (a, b))
+    out = np.empty(max(len(ua) - 1, 0))
+    _matched_bound_kernel(ua, ub, pa, pb, ta, tb, int(pieces), _TO_BERNSTEIN, out)
+    return out
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _matched_bound_kernel(ua, ub, pa, pb, ta, tb, pieces, tob, out):  # type: ignore[no-untyped-def]
+    """:func:`matched_hermite_bound` in one pass over the spans (no (n, 4, dim) temporaries):
+    per span and sub-piece, the difference cubic's values at ``s = (j + k / 3) / pieces``,
+    their Bernstein control points by ``tob``, the largest control-point norm.
+    :func:`_matched_hermite_bound_reference` is the same in numpy."""
+    dim = pa.shape[1]
+    vals = np.empty((4, dim))
+    for i in range(out.shape[0]):
+        ha = ua[i + 1] - ua[i]
+        hb = ub[i + 1] - ub[i]
+        r = ha / hb
+        best = 0.0
+        for j in range(pieces):
+            for kk in range(4):
+                s = (j + kk / 3.0) / pieces
+                s2 = s * s
+                s3 = s2 * s
+                h00 = 2 * s3 - 3 * s2 + 1
+                h10 = s3 - 2 * s2 + s
+                h01 = -2 * s3 + 3 * s2
+                h11 = s3 - s2
+                for c in range(dim):
+                    d0 = pa[i, c] - pb[i, c]
+                    d1 = pa[i + 1, c] - pb[i + 1, c]
+                    m0 = ta[i, c] * r * hb - tb[i, c] * hb
+                    m1 = ta[i + 1, c] * r * hb - tb[i + 1, c] * hb
+                    vals[kk, c] = d0 * h00 + m0 * h10 + d1 * h01 + m1 * h11
+            for q in range(4):
+                acc = 0.0
+                for c in range(dim):
+                    v = (tob[q, 0] * vals[0, c] + tob[q, 1] * vals[1, c]
+                         + tob[q, 2] * vals[2, c] + tob[q, 3] * vals[3, c])
+                    acc += v * v
+                if acc > best:
+                    best = acc
+        out[i] = math.sqrt(best) * (1.0 + 1e-12)
+
+
+def _matched_hermite_bound_reference(a: Any, b: Any, pieces: int = 4) -> FloatArray:
+    """:func:`matched_hermite_bound` with numpy arrays of all spans at once (the plain form the
+    compiled kernel is tested against)."""
     ua, ub = np.asarray(a.params), np.asarray(b.params)
     ha, hb = np.diff(ua), np.diff(ub)
     pa, pb = np.asarray(a.points), np.asarray(b.points)
