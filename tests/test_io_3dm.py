@@ -106,7 +106,7 @@ def test_read_matches_opennurbs_evaluation(tmp_path):
             np.testing.assert_allclose(ref[:, 2], r.source["z"])
     assert by[ids["periodic"]][0].curve.n_ctrl == 9
     pl = by[ids["polyline"]]
-    assert [x.source["indices"] for x in pl] == [(0, 1, 2, 3, 4), (4, 5, 6)]
+    assert [x.source["indices"].tolist() for x in pl] == [[0, 1, 2, 3, 4], [4, 5, 6]]
 
 
 def test_write_back_edits_only_the_faired_objects(tmp_path):

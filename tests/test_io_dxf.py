@@ -116,7 +116,7 @@ def test_read_geometry_matches_ezdxf_evaluation(tmp_path):
     np.testing.assert_allclose(r.curve(r.curve.params), r.points, atol=1e-12)
     # polylines: split at the 90 degree corner, closed loop periodic, 3-D kept 3-D
     lw = by[h["lw"]]
-    assert [x.source["indices"] for x in lw] == [(0, 1, 2, 3, 4), (4, 5, 6, 7)]
+    assert [x.source["indices"].tolist() for x in lw] == [[0, 1, 2, 3, 4], [4, 5, 6, 7]]
     assert lw[0].corners == (4,) and lw[1].corners == (0,) and lw[0].source["z"] == 1.5
     (lc,) = by[h["lwclosed"]]
     assert lc.curve.closed and lc.curve.points.shape == (13, 2)

@@ -153,7 +153,7 @@ def test_open_polyline_corner_split_and_threshold(tmp_path):
     p = tmp_path / "l.txt"
     np.savetxt(p, pts, fmt="%.6f")
     recs = read_curves(p)
-    assert [r.source["indices"] for r in recs] == [tuple(range(0, 5)), tuple(range(4, 9))]
+    assert [r.source["indices"].tolist() for r in recs] == [list(range(0, 5)), list(range(4, 9))]
     assert recs[0].corners == (4,) and recs[1].corners == (0,)
     assert len(read_curves(p, corner_angle=None)) == 1
     assert len(read_curves(p, corner_angle=15.0)) == 3

@@ -841,7 +841,8 @@ def point_records(points: FloatArray, *, closed: bool, corner_angle: float | Non
     end_corners : bool
         The first and last points are corners too (an airfoil's trailing edge).
     source : mapping
-        Common source keys; each record adds ``"indices"`` (into ``points``), ``"n_points"``
+        Common source keys; each record adds ``"indices"`` (into ``points``; a read-only
+        int64 array), ``"n_points"``
         (``m``), ``"closed"``, ``"piece"``, ``"n_pieces"``, ``"index"``.
     first_index : int
         ``source["index"]`` of the first record.
@@ -863,7 +864,9 @@ def point_records(points: FloatArray, *, closed: bool, corner_angle: float | Non
         curve = points_curve(pts, loop)
         corners = tuple(int(j) for j in np.flatnonzero(is_corner[idx]) if not loop)
         src = dict(source)
-        src.update(index=first_index + k, indices=tuple(int(i) for i in idx), n_points=m,
+        ind = np.array(idx, dtype=np.int64)  # an array, not a million Python ints
+        ind.flags.writeable = False
+        src.update(index=first_index + k, indices=ind, n_points=m,
                    closed=bool(closed), piece=k, n_pieces=len(pieces))
         pname = name if len(pieces) == 1 or name is None else f"{name} [{k}]"
         records.append(CurveRecord(curve, pname, kind, src, pts, corners))
