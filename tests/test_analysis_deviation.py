@@ -184,7 +184,7 @@ def test_geometric_distance_of_reparametrised_and_offset_curves():
         assert np.linalg.norm(d.point_a - d.point_b) == pytest.approx(d.max_distance, rel=1e-9)
         assert np.linalg.norm(d.point_a - x(d.param)) <= 1e-12
         # the cheap bound of one dense pass: above the distance, within a sample gap of it
-        from curvefair.analysis._deviation import geometric_upper_bound
+        from curvefair.analysis import geometric_upper_bound
 
         ub = geometric_upper_bound(x, y)
         length = max(float(np.sum(np.linalg.norm(np.diff(cv(np.linspace(*cv.domain, 20001)),

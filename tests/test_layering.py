@@ -98,8 +98,6 @@ KNOWN = {
     "fairing._tolerance -> curves.bspline._power_form_pair_kernel",
     "fairing.pipeline -> curves.bspline._as_degree",
     "fairing.pipeline -> curves.bspline._closed_data",
-    "io._verify -> analysis._deviation._point_displacement",
-    "io._verify -> analysis._deviation.geometric_upper_bound",
     "io._verify -> fairing._tolerance.point_report",
     "steps -> fairing._hermite_kernels",
 }

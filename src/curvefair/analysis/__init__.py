@@ -3,6 +3,8 @@
 Public: :func:`energy`, :func:`curvature`, :func:`curvature_derivative`, :func:`torsion`,
 :func:`analyze` (-> :class:`Analysis`), :func:`deviation` (-> :class:`Deviation`),
 :func:`matched_hermite_bound` (a cheap Hausdorff bound of two cubic Hermite curves),
+:func:`geometric_upper_bound` (the same for any two curves, from one dense pass),
+:func:`point_displacement` (the largest move of corresponding data points),
 :func:`rank_bad_points` (-> list of :class:`RankedBadPoint`: the one bad-point ranking that
 ``curvefair analyze`` and the plots show); the discrete
 curvature of Cheng & Yu lives in :mod:`curvefair.analysis.discrete`.
@@ -10,7 +12,13 @@ curvature of Cheng & Yu lives in :mod:`curvefair.analysis.discrete`.
 
 from ._analyze import Analysis, analyze, derivative_jumps
 from ._curvature import curvature, curvature_derivative, torsion
-from ._deviation import Deviation, deviation, matched_hermite_bound
+from ._deviation import (
+    Deviation,
+    deviation,
+    geometric_upper_bound,
+    matched_hermite_bound,
+    point_displacement,
+)
 from ._energy import energy, segment_energies
 from ._ranking import RankedBadPoint, c0_pieces, rank_bad_points
 from .discrete import (
@@ -31,6 +39,8 @@ __all__ = [
     "Deviation",
     "deviation",
     "matched_hermite_bound",
+    "geometric_upper_bound",
+    "point_displacement",
     "energy",
     "segment_energies",
     "discrete_curvature",

@@ -76,8 +76,24 @@ def _data_points(curve: PiecewiseCurve) -> tuple[str, FloatArray] | None:
     return None
 
 
-def _point_displacement(a: PiecewiseCurve, b: PiecewiseCurve
-                        ) -> tuple[float | None, int | None]:
+def point_displacement(a: PiecewiseCurve, b: PiecewiseCurve
+                       ) -> tuple[float | None, int | None]:
+    """The largest displacement between the data points of two curves of one kind.
+
+    Parameters
+    ----------
+    a, b : curve
+        Curves whose data points correspond one to one: control points of two B-splines,
+        points of two Hermite curves, with the same shape.
+
+    Returns
+    -------
+    (float, int) or (None, None)
+        ``max_i |b_i - a_i|`` (:func:`curvefair._distance.point_distances`, the figure
+        :func:`curvefair.fair` reports as ``max_point_displacement``) and its 0-based index;
+        ``(None, None)`` when the data points are of different kinds or counts (nothing to
+        compare point by point).
+    """
     da, db = _data_points(a), _data_points(b)
     if da is None or db is None or da[0] != db[0] or da[1].shape != db[1].shape:
         return None, None
@@ -435,7 +451,7 @@ def deviation(curve_a: object, curve_b: object,
     t = min(max(best_t, a0), a1)
     pa = np.asarray(a(t), dtype=float).reshape(-1)
     pb = np.asarray(b(min(max(t, b0), b1)), dtype=float).reshape(-1)
-    mpd, idx = _point_displacement(a, b)
+    mpd, idx = point_displacement(a, b)
     from ..curves.piecewise import readonly
 
     pa, pb = readonly(pa), readonly(pb)
@@ -710,6 +726,6 @@ def _geometric(a: PiecewiseCurve, b: PiecewiseCurve) -> Deviation:
     pb = np.asarray(pb, dtype=float).reshape(-1)
     pa.setflags(write=False)
     pb.setflags(write=False)
-    mpd, idx = _point_displacement(a, b)
+    mpd, idx = point_displacement(a, b)
     return Deviation(max_distance=float(best), upper_bound=None, param=float(t), point_a=pa,
                      point_b=pb, max_point_displacement=mpd, point_index=idx, kind="geometric")

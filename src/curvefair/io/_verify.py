@@ -62,7 +62,7 @@ class WriteCheck:
         ``"geometric upper bound"`` (a cheap bound, used when it already meets ``tol``: for
         point data read back with as many points, the per-span bound
         :func:`curvefair.analysis.matched_hermite_bound`, else the dense sampled bound of
-        :func:`curvefair.analysis._deviation.geometric_upper_bound`).
+        :func:`curvefair.analysis.geometric_upper_bound`).
     max_point_displacement : float or None
         Largest data/control point displacement read back, where the counts match.
     precision : str
@@ -255,8 +255,12 @@ def _measure(reference: Sequence[CurveRecord], curves: Sequence[Any], tol: float
     """Per curve: the parametric deviation (equal domains), else a cheap upper bound of the
     Hausdorff distance when it already meets ``tol`` (or there is no tol), else the refined
     geometric distance."""
-    from ..analysis import deviation, matched_hermite_bound
-    from ..analysis._deviation import _point_displacement, geometric_upper_bound
+    from ..analysis import (
+        deviation,
+        geometric_upper_bound,
+        matched_hermite_bound,
+        point_displacement,
+    )
     from ..curves.hermite import CubicHermite
 
     devs, kinds, mpd = [], [], None
@@ -274,7 +278,7 @@ def _measure(reference: Sequence[CurveRecord], curves: Sequence[Any], tol: float
                 ub = geometric_upper_bound(r.curve, c)
             if tol is None or ub <= tol:
                 d_max, kind = ub, "geometric upper bound"
-                m, _ = _point_displacement(r.curve, c)
+                m, _ = point_displacement(r.curve, c)
         if d_max is None:
             d = deviation(r.curve, c)
             d_max, kind, m = float(d.max_distance), d.kind, d.max_point_displacement
