@@ -96,8 +96,6 @@ KNOWN = {
     "cli -> io._verify.rescaled_report",
     "fairing._tolerance -> curves.bspline._power_form_kernel",
     "fairing._tolerance -> curves.bspline._power_form_pair_kernel",
-    "fairing.pipeline -> curves.bspline._as_degree",
-    "fairing.pipeline -> curves.bspline._closed_data",
     "io._verify -> fairing._tolerance.point_report",
     "steps -> fairing._hermite_kernels",
 }

@@ -277,6 +277,18 @@ def as_count(value: object, name: str, *, minimum: int = 0, maximum: int | None 
     return v
 
 
+#: Highest supported B-spline degree (as OCCT's ``Geom_BSplineCurve::MaxDegree()``): the power
+#: form and the basis derivatives take powers of the knot steps up to the degree, and Gram
+#: matrices up to ``2 degree - 1``.
+MAX_DEGREE = 25
+
+
+def as_degree(degree: object) -> int:
+    """A B-spline degree: an integer from 2 to :data:`MAX_DEGREE` (the check every builder and
+    fitter of B-splines applies to its ``degree`` argument)."""
+    return as_count(degree, "degree", minimum=2, maximum=MAX_DEGREE)
+
+
 def physical_memory() -> int | None:
     """Bytes of physical memory of this machine, or None where the OS does not say."""
     try:

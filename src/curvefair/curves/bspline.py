@@ -28,9 +28,17 @@ from scipy.sparse import csr_matrix
 
 from .._jit import njit
 from .._typing import ArrayLike, FloatArray
-from .._validate import as_count, as_float, as_params, as_points, check_steps, magnitude
+from .._validate import MAX_DEGREE as MAX_DEGREE  # the degree limit, also known here
+from .._validate import (
+    as_degree,
+    as_float,
+    as_params,
+    as_points,
+    check_steps,
+    magnitude,
+)
 from ..errors import InputError
-from .parameterize import parameterize
+from .parameterize import closed_point_data, parameterize
 from .piecewise import PiecewiseCurve, PiecewisePolynomial, readonly
 
 __all__ = ["BSplineCurve", "interpolate_bspline", "fit_bspline", "basis_derivatives"]
@@ -353,21 +361,12 @@ def _gauss(nq: int) -> tuple[FloatArray, FloatArray]:
 # ------------------------------------------------------------------------------------------
 # the curve
 # ------------------------------------------------------------------------------------------
-#: Highest supported degree (as OCCT's ``Geom_BSplineCurve::MaxDegree()``): the power form and
-#: the basis derivatives take powers of the knot steps up to the degree, and Gram matrices up
-#: to ``2 degree - 1``.
-MAX_DEGREE = 25
-
 #: Highest degree evaluated through the power form. Above it, values and derivatives come from
 #: the B-spline basis itself (Piegl & Tiller A2.3 on local offsets, the stable recurrence scipy's
 #: ``BSpline`` uses too): the power form's Horner sum cancels like ``2**p`` (relative errors
 #: against exact rational evaluation on one Bezier span: 3e-15 at degree 4, 8e-14 at 8, 8e-11
 #: at 15, 1.5e-6 at 25; the basis stays within 1e-15 throughout).
 POWER_FORM_MAX_DEGREE = 5
-
-
-def _as_degree(degree: object) -> int:
-    return as_count(degree, "degree", minimum=2, maximum=MAX_DEGREE)
 
 
 class BSplineCurve(PiecewiseCurve):
@@ -415,7 +414,7 @@ class BSplineCurve(PiecewiseCurve):
 
     def __init__(self, control_points: ArrayLike, knots: ArrayLike, degree: int,
                  closed: bool = False) -> None:
-        p = _as_degree(degree)
+        p = as_degree(degree)
         closed = bool(closed)
         pts = as_points(control_points, "control_points", min_points=p + 1,
                         allow_coincident=True)
@@ -717,7 +716,7 @@ class BSplineCurve(PiecewiseCurve):
             raise InputError(f"spl must be a scipy.interpolate.BSpline, got "
                              f"{type(spl).__name__}")
         t = as_float(spl.t, "spl.t")
-        k = _as_degree(spl.k)
+        k = as_degree(spl.k)
         c = as_float(spl.c, "spl.c")
         if c.ndim != 2:
             raise InputError(f"spl.c must have shape (n, dim) with dim 2 or 3, got {c.shape}")
@@ -756,24 +755,6 @@ class BSplineCurve(PiecewiseCurve):
 # ------------------------------------------------------------------------------------------
 # builders
 # ------------------------------------------------------------------------------------------
-def _closed_data(points: ArrayLike, param: Any) -> tuple[FloatArray, FloatArray]:
-    """Distinct points (first not repeated) and their parameters plus the closing one."""
-    pts = as_points(points, "points", min_points=3)
-    scale = magnitude(pts)
-    if np.allclose(pts[0], pts[-1], rtol=0.0, atol=1e-12 * scale):
-        pts = pts[:-1]
-    loop = np.vstack([pts, pts[:1]])
-    if isinstance(param, str):
-        t = parameterize(loop, param)
-    else:
-        t = np.asarray(param, dtype=float)
-        if t.shape != (loop.shape[0],):
-            raise InputError(f"param for a closed curve needs {loop.shape[0]} values (one per "
-                             f"distinct point plus the closing one), got shape {t.shape}")
-        t = parameterize(loop, t)
-    return pts, t
-
-
 def interpolate_bspline(points: ArrayLike, degree: int = 3, param: str | ArrayLike = "chord",
                         closed: bool = False) -> BSplineCurve:
     """B-spline curve of the given degree through ``points``.
@@ -807,9 +788,9 @@ def interpolate_bspline(points: ArrayLike, degree: int = 3, param: str | ArrayLi
     >>> bool(np.allclose(c(c.knots[3]), pts[0]))
     True
     """
-    p = _as_degree(degree)
+    p = as_degree(degree)
     if closed:
-        pts, t = _closed_data(points, param)
+        pts, t = closed_point_data(points, param)
         if pts.shape[0] < p + 1:
             raise InputError(f"a closed degree-{p} interpolant needs at least {p + 1} distinct "
                              f"points, got {pts.shape[0]}")
@@ -1009,12 +990,12 @@ def fit_bspline(points: ArrayLike, n_ctrl: int, degree: int = 3,
     >>> c.n_ctrl, c(1.5).round(12).tolist()
     (8, [1.5, 2.25])
     """
-    p = _as_degree(degree)
+    p = as_degree(degree)
     if isinstance(n_ctrl, bool) or not isinstance(n_ctrl, (int, np.integer)):
         raise InputError(f"n_ctrl must be an integer, got {n_ctrl!r}")
     n = int(n_ctrl)
     if closed:
-        pts, t = _closed_data(points, param)
+        pts, t = closed_point_data(points, param)
         m = pts.shape[0]
         if not p + 1 <= n <= m:
             raise InputError(f"n_ctrl must be in [degree + 1, number of distinct points] = "

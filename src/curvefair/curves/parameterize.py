@@ -5,9 +5,10 @@ from __future__ import annotations
 import numpy as np
 
 from .._typing import ArrayLike, FloatArray
-from .._validate import as_params, as_points, choice
+from .._validate import as_params, as_points, choice, magnitude
+from ..errors import InputError
 
-__all__ = ["parameterize", "PARAM_NAMES"]
+__all__ = ["parameterize", "closed_point_data", "PARAM_NAMES"]
 
 PARAM_NAMES = ("uniform", "chord", "centripetal")
 
@@ -47,3 +48,30 @@ def parameterize(points: ArrayLike, param: str | ArrayLike = "chord") -> FloatAr
     t[0] = 0.0
     np.cumsum(chords, out=t[1:])
     return t
+
+
+def closed_point_data(points: ArrayLike, param: str | ArrayLike
+                      ) -> tuple[FloatArray, FloatArray]:
+    """The data of a closed curve through ``points``: the distinct points (a repeated first
+    point, within 1e-12 of the coordinate size, dropped) and their parameters plus the closing
+    one (``param``: a name of :data:`PARAM_NAMES`, or ``len(distinct) + 1`` values).
+
+    Raises
+    ------
+    InputError
+        Fewer than 3 points, or given parameters of another length.
+    """
+    pts = as_points(points, "points", min_points=3)
+    scale = magnitude(pts)
+    if np.allclose(pts[0], pts[-1], rtol=0.0, atol=1e-12 * scale):
+        pts = pts[:-1]
+    loop = np.vstack([pts, pts[:1]])
+    if isinstance(param, str):
+        t = parameterize(loop, param)
+    else:
+        t = np.asarray(param, dtype=float)
+        if t.shape != (loop.shape[0],):
+            raise InputError(f"param for a closed curve needs {loop.shape[0]} values (one per "
+                             f"distinct point plus the closing one), got shape {t.shape}")
+        t = parameterize(loop, t)
+    return pts, t

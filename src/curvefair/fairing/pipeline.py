@@ -31,9 +31,9 @@ from scipy.interpolate import BSpline, make_interp_spline
 from scipy.sparse.linalg import splu
 
 from .._typing import ArrayLike, FloatArray
-from .._validate import as_points, as_positive
-from ..curves.bspline import BSplineCurve, _as_degree, _closed_data
-from ..curves.parameterize import parameterize
+from .._validate import as_degree, as_points, as_positive
+from ..curves.bspline import BSplineCurve
+from ..curves.parameterize import closed_point_data, parameterize
 from ..errors import InputError
 
 __all__ = ["fair_points", "PointFairingResult", "tube_energy_qp"]
@@ -346,7 +346,7 @@ def fair_points(points: ArrayLike, tol: float, *, degree: int = 5, l: Any = 3,  
     >>> bool(res.report["max_deviation"] <= 4e-3), res.report["stop_reason"]
     (True, 'converged')
     """
-    p = _as_degree(degree)
+    p = as_degree(degree)
     tolv = as_positive(tol, "tol", window=True)
     assert tolv is not None
     w = _energy_weights(l, p)
@@ -355,7 +355,7 @@ def fair_points(points: ArrayLike, tol: float, *, degree: int = 5, l: Any = 3,  
         raise InputError(f"max_steps must be an integer >= 1, got {max_steps!r}")
     closed = bool(closed)
     if closed:
-        pts, u_all = _closed_data(points, param)
+        pts, u_all = closed_point_data(points, param)
         if pts.shape[0] < p + 1:
             raise InputError(f"a closed degree-{p} curve needs at least {p + 1} distinct "
                              f"points, got {pts.shape[0]}")
