@@ -208,21 +208,28 @@ def _plain_number(v: float, text: str, column_decimals: int) -> str:
     return _shortest(v)
 
 
-def _render_line(line: str, values: Sequence[float], column_decimals: Sequence[int],
-                 decimals: int | None) -> str:
-    """A data line as read (all numbers: not checked again) with ``values`` in place."""
+def _pieces(line: str) -> tuple[str, list[str], list[str], str]:
+    """``(prefix, texts, seps, suffix)`` of a data line as read (all numbers: not checked
+    again): the blanks before the first number, the numbers and what separates them, and the
+    rest of the line (trailing blanks and a ``#`` comment)."""
     hash_at = line.find("#")
     body, comment = (line, "") if hash_at < 0 else (line[:hash_at], line[hash_at:])
     stripped = body.strip()
     lead = body.find(stripped[0])
     if _COMMA_ROW(stripped):
         texts = stripped.split(",")
-        seps: Sequence[str] = [","] * (len(texts) - 1)
+        seps = [","] * (len(texts) - 1)
     else:
         parts = _SEP_RE.split(stripped)
         texts, seps = parts[0::2], parts[1::2]
-    return _render_pieces(body[:lead], texts, seps, body[lead + len(stripped):] + comment,
-                          values, column_decimals, decimals)
+    return body[:lead], texts, seps, body[lead + len(stripped):] + comment
+
+
+def _render_line(line: str, values: Sequence[float], column_decimals: Sequence[int],
+                 decimals: int | None) -> str:
+    """A data line as read with ``values`` in place."""
+    prefix, texts, seps, suffix = _pieces(line)
+    return _render_pieces(prefix, texts, seps, suffix, values, column_decimals, decimals)
 
 
 @dataclass(frozen=True, eq=False)
@@ -313,18 +320,10 @@ class TextLayout:
 
 def _split_row(line: str) -> Row | None:
     """Parse a data line, or None when it is not all numbers."""
-    hash_at = line.find("#")
-    body, comment = (line, "") if hash_at < 0 else (line[:hash_at], line[hash_at:])
-    stripped = body.strip()
-    if not stripped:
+    if _split_numbers(line) is None:
         return None
-    parts = _SEP_RE.split(stripped)
-    toks = parts[0::2]
-    if not all(map(_NUM_FULL, toks)):
-        return None
-    lead = body.find(stripped[0])
-    return Row(body[:lead], tuple(toks), tuple(parts[1::2]),
-               body[lead + len(stripped):] + comment)
+    prefix, texts, seps, suffix = _pieces(line)
+    return Row(prefix, tuple(texts), tuple(seps), suffix)
 
 
 def _split_numbers(line: str) -> list[str] | None:
