@@ -685,3 +685,55 @@ def test_closed_curve_admm_start_kkt(monkeypatch, dim):
     monkeypatch.setattr(gf, "_ADMM_ITERS", 0)
     ref = gf.global_fair(c, tol=tol)
     assert abs(res.energy_after - ref.energy_after) <= 1e-10 * res.energy_after
+
+
+_SIGNATURES_SCRIPT = r"""
+import inspect, json
+import numpy as np
+from numba import types
+from numba.core.registry import CPUDispatcher
+from curvefair import interpolate_bspline
+from curvefair.fairing.global_fair import global_fair
+import curvefair.fairing._global_kernels as gk
+
+rng = np.random.default_rng(5)
+for dim in (2, 3):
+    for closed in (False, True):
+        th = np.linspace(0, 2 * np.pi, 40, endpoint=not closed)
+        P = np.c_[np.cos(th), np.sin(th), 0.3 * th][:, :dim] + 0.02 * rng.normal(size=(40, dim))
+        c = interpolate_bspline(P, closed=closed)
+        global_fair(c, tol=0.02)
+        global_fair(c, tol=0.02, l=(1.0, 0.1))  # a weighted sum of two bands
+bad, seen = [], 0
+for name, disp in vars(gk).items():
+    if not isinstance(disp, CPUDispatcher):
+        continue
+    params = list(inspect.signature(disp.py_func).parameters)
+    for sig in disp.signatures:
+        seen += 1
+        if any(isinstance(t, types.Literal) for t in sig):
+            bad.append(f"{name}: literal argument in {sig}")
+        if params and params[0] == "K" and sig[0].mutable:
+            bad.append(f"{name}: writeable band in {sig}")
+print(json.dumps({"seen": seen, "bad": bad}))
+"""
+
+
+def test_kernels_are_compiled_without_literal_or_writeable_band_variants():
+    """numba compiles a kernel again for every argument type: a literal ``0``/``False`` in a
+    call between kernels, or the energy band arriving writeable in one call and read only in
+    another, would each add a compiled copy (``_global_kernels`` module docstring). In a fresh
+    interpreter (the kernels' signatures are those its own calls compiled or loaded: other
+    tests here call kernels directly with arrays of their own), after global fairs of planar
+    and 3-D, open and closed curves, with the cached band and a weighted sum of bands, no
+    kernel of the module has a literal argument type and every ``K`` argument is read only."""
+    import json
+    import subprocess
+    import sys
+
+    proc = subprocess.run([sys.executable, "-c", _SIGNATURES_SCRIPT], capture_output=True,
+                          text=True, timeout=900)
+    assert proc.returncode == 0, proc.stderr
+    out = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert out["seen"] >= 10
+    assert not out["bad"], "\n".join(out["bad"])

@@ -657,26 +657,29 @@ def _matched_bound_kernel(ua, ub, pa, pb, ta, tb, pieces, tob, out):  # type: ig
     :func:`_matched_hermite_bound_reference` is the same in numpy."""
     dim = pa.shape[1]
     vals = np.empty((4, dim))
+    herm = np.empty((dim, 4))  # the span's Hermite data d0, m0, d1, m1 per coordinate
     for i in range(out.shape[0]):
         ha = ua[i + 1] - ua[i]
         hb = ub[i + 1] - ub[i]
         r = ha / hb
+        for c in range(dim):
+            herm[c, 0] = pa[i, c] - pb[i, c]
+            herm[c, 1] = ta[i, c] * r * hb - tb[i, c] * hb
+            herm[c, 2] = pa[i + 1, c] - pb[i + 1, c]
+            herm[c, 3] = ta[i + 1, c] * r * hb - tb[i + 1, c] * hb
         best = 0.0
         for j in range(pieces):
             for kk in range(4):
                 s = (j + kk / 3.0) / pieces
-                s2 = s * s
+                s2 = s * s  # products, not pow: the same roundings on every CPU
                 s3 = s2 * s
                 h00 = 2 * s3 - 3 * s2 + 1
                 h10 = s3 - 2 * s2 + s
                 h01 = -2 * s3 + 3 * s2
                 h11 = s3 - s2
                 for c in range(dim):
-                    d0 = pa[i, c] - pb[i, c]
-                    d1 = pa[i + 1, c] - pb[i + 1, c]
-                    m0 = ta[i, c] * r * hb - tb[i, c] * hb
-                    m1 = ta[i + 1, c] * r * hb - tb[i + 1, c] * hb
-                    vals[kk, c] = d0 * h00 + m0 * h10 + d1 * h01 + m1 * h11
+                    vals[kk, c] = (herm[c, 0] * h00 + herm[c, 1] * h10 + herm[c, 2] * h01
+                                   + herm[c, 3] * h11)
             for q in range(4):
                 acc = 0.0
                 for c in range(dim):

@@ -27,9 +27,9 @@ One compiled copy per kernel and array layout: numba compiles a function again f
 argument type, and a literal (``0``, ``False`` written in a call) has its own type
 (``Literal[int](0)`` is not ``int64``), as have read-only and writeable arrays. So calls between
 kernels pass ``np.intp(0)`` / ``np.bool_(False)``, and ``K`` always arrives read only
-(:func:`curvefair.fairing.global_fair._readonly`): each kernel is compiled once per layout of
-its blocks and frames (planar blocks are a strided view, see ``_ssn_work``), not once per
-caller.
+(:func:`curvefair.fairing.global_fair._readonly_view`): each kernel is compiled once per
+layout of its blocks and frames (planar blocks are a strided view, see ``_ssn_work``), not once
+per caller.
 """
 
 from __future__ import annotations

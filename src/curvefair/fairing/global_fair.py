@@ -286,10 +286,13 @@ def _band_storage(n: int, dim: int, p: int, closed: bool
     pre = _Prefault(L.reshape(-1)) if _THREADS >= 2 and n >= _PAR_MIN else None
     return L, pre
 
-def _readonly(a: FloatArray) -> FloatArray:
+
+def _readonly_view(a: FloatArray) -> FloatArray:
     """``a`` as a read-only array (a view if it is writeable, no copy): the kernels then see one
     array type whether a band is the curve's cached one (read only) or a weighted sum, and are
-    compiled once (see :mod:`._global_kernels`)."""
+    compiled once (see :mod:`._global_kernels`). Internal arguments only: unlike
+    :func:`curvefair.curves.piecewise.readonly` (one copy, for arrays a user receives) the
+    view's flag could be set back."""
     if not a.flags.writeable:
         return a
     v = a.view()
@@ -307,7 +310,7 @@ class _System:
                  fixed: np.ndarray, band: tuple[FloatArray, _Prefault | None] | None = None
                  ) -> None:
         n = K.shape[0]
-        K = _readonly(K)
+        K = _readonly_view(K)
         self.K, self.ks, self.p, self.dim, self.closed, self.n = K, ks, p, dim, closed, n
         self.N = N = n * dim
         self.kd = kd = (p + 1) * dim - 1
@@ -633,7 +636,7 @@ def _global_fair(problem: FairingProblem, l: Any, gap: float) -> GlobalResult:  
         if wgt != 1.0:
             Wk = Wk * wgt
         W = Wk if W is None else W + Wk
-    W = _readonly(np.ascontiguousarray(W))
+    W = _readonly_view(np.ascontiguousarray(W))
     d0 = np.ascontiguousarray(curve.control_points, dtype=float)  # read only: no copy
     n, dim = d0.shape
 
@@ -643,7 +646,7 @@ def _global_fair(problem: FairingProblem, l: Any, gap: float) -> GlobalResult:  
         return out
 
     def energy(x: FloatArray) -> float:
-        return float(band_energy(W, p, closed, _readonly(np.ascontiguousarray(x))))
+        return float(band_energy(W, p, closed, _readonly_view(np.ascontiguousarray(x))))
 
     E0 = energy(d0)
     lam = np.zeros(n)

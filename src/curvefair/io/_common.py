@@ -864,9 +864,8 @@ def point_records(points: FloatArray, *, closed: bool, corner_angle: float | Non
         curve = points_curve(pts, loop)
         corners = tuple(int(j) for j in np.flatnonzero(is_corner[idx]) if not loop)
         src = dict(source)
-        ind = np.array(idx, dtype=np.int64)  # an array, not a million Python ints
-        ind.flags.writeable = False
-        src.update(index=first_index + k, indices=ind, n_points=m,
+        src.update(index=first_index + k, n_points=m,
+                   indices=readonly(np.asarray(idx, dtype=np.int64)),  # not a million ints
                    closed=bool(closed), piece=k, n_pieces=len(pieces))
         pname = name if len(pieces) == 1 or name is None else f"{name} [{k}]"
         records.append(CurveRecord(curve, pname, kind, src, pts, corners))
