@@ -176,3 +176,123 @@ def test_point_only_and_zero_decimal_columns_against_the_reference(tmp_path, col
         out = lay.render(new)
         assert out == _reference_render(lay, new, None)
         np.testing.assert_array_equal(parse_text_of(tmp_path, out)[:, 0], new_x)
+
+
+def _plain_file(rng: np.random.Generator, sep: str, nrows: int, ncols: int) -> str:
+    """Rows of plain fixed-point numbers joined by one separator character (the layout the
+    block renderer serves), with a few rows of other styles among them."""
+    lines = ["x" + sep + "y" + (sep + "z" if ncols == 3 else "")]
+    for _ in range(nrows):
+        vals = rng.normal(scale=10.0 ** rng.integers(-2, 3), size=ncols)
+        toks = [f"{v:.{int(rng.integers(1, 9))}f}" for v in vals]
+        u = rng.random()
+        if u < 0.02:
+            toks[0] = str(int(rng.integers(-5, 5)))          # an integer
+        elif u < 0.03:
+            toks[-1] = "3."                                    # a point, no decimals
+        elif u < 0.04:
+            toks[0] = "0.000" if rng.integers(2) else "-0.00"  # signed zeros
+        lines.append(sep.join(toks))
+    return "\n".join(lines) + "\n"
+
+
+@pytest.mark.parametrize("sep", [",", ";", " ", "\t"])
+@pytest.mark.parametrize("seed", range(3))
+def test_block_renderer_writes_what_the_row_renderer_writes(tmp_path, sep, seed):
+    """Many changed rows of the common layout are rendered at once
+    (:func:`_render_plain_block`); the text must be the slow reference's, value for value:
+    unchanged values, values exact at their token's decimals or at the column's, signed and
+    tiny values that round to zero, huge values, shortest-form values."""
+    from curvefair.io import _text
+
+    rng = np.random.default_rng(100 + seed)
+    ncols = 2 + seed % 2
+    path = tmp_path / "p.csv"
+    path.write_text(_plain_file(rng, sep, 600, ncols))
+    lay = parse_text(path)
+    new = lay.values.copy()
+    kind = rng.integers(0, 8, size=new.shape)
+    d = rng.integers(1, 9, size=new.shape)
+    for (r, j), c in np.ndenumerate(kind):
+        v = new[r, j]
+        if c == 1:
+            new[r, j] = v + rng.normal() * 1e-4                   # shortest form
+        elif c == 2:
+            new[r, j] = float(f"{v + 0.01:.{d[r, j]}f}")          # exact at some decimals
+        elif c == 3:
+            new[r, j] = float(f"{v + 0.01:.{lay.column_decimals[j]}f}")  # the column's
+        elif c == 4:
+            new[r, j] = -0.0 if rng.integers(2) else -1e-12 * rng.random()
+        elif c == 5:
+            new[r, j] = float(rng.choice([1e17, -3.5e15, 2.0 ** 50 + 0.5, 123456789.125]))
+        elif c == 6:
+            new[r, j] = float(f"{v:.1f}")
+    out = lay.render(new)
+    assert out == _reference_render(lay, new, None)
+    np.testing.assert_array_equal(parse_text_of(tmp_path, out), new)
+    # the block renderer served every row of its layout and left exactly the others
+    lines = np.array(lay.lines, dtype=object)
+    redo = np.arange(len(lay.data_lines))
+    left = _text._render_plain_block(lines, np.array(lay.data_lines), redo, new, lay.values,
+                                     lay.column_decimals).tolist()
+    odd = [r for r in redo.tolist()
+           if not all(re.fullmatch(r"-?\d+\.\d+", t)
+                      for t in lay.lines[lay.data_lines[r]].split(sep))]
+    assert left == odd
+    assert len(left) < len(redo) // 10
+
+
+def _read_both(monkeypatch, path):
+    """parse_text with the block reader, then with the line-by-line reader only: both
+    results (or both errors' texts)."""
+    from curvefair.io import _text
+
+    out = []
+    for block_min in (_text._BLOCK_MIN_ROWS, 10 ** 12):
+        monkeypatch.setattr(_text, "_BLOCK_MIN_ROWS", block_min)
+        try:
+            out.append(parse_text(path))
+        except ValueError as exc:
+            out.append(str(exc))
+    return out
+
+
+@pytest.mark.parametrize("sep", [",", ";", " ", "\t"])
+def test_block_reader_reads_what_the_line_reader_reads(tmp_path, monkeypatch, sep):
+    """Files of the common layout are read with one check of the whole block: the same
+    values, decimals and row lines as the line-by-line reader, in plain, exponent and signed
+    styles."""
+    rng = np.random.default_rng(7)
+    text = _plain_file(rng, sep, 500, 2)
+    lines = text.splitlines()
+    lines[300] = sep.join(["1.5e-3", "+2.25E+01"])   # exponent and signed numbers
+    lines[301] = sep.join(["-.5", "7"])
+    path = tmp_path / "p.csv"
+    path.write_text("\n".join(lines) + "\n")
+    fast, slow = _read_both(monkeypatch, path)
+    np.testing.assert_array_equal(fast.values, slow.values)
+    assert fast.column_decimals == slow.column_decimals
+    assert fast.data_lines == slow.data_lines and fast.header == slow.header
+    assert fast.values.shape == (500, 2)
+    assert float(lines[300].split(sep)[1]) == fast.values[299, 1] == 22.5
+
+
+@pytest.mark.parametrize("bad", ["1.0,abc", "1.0,,2.0", "1.0", "1.0,2.0,3.0", "# a comment",
+                                 "", "1.0, 2.0", "1.0,2.0 # note", "1e,2.0", "-,2.0",
+                                 "1.0,2.0,", "nan,1.0", "1_0.0,2.0"])
+def test_block_reader_leaves_every_other_line_to_the_line_reader(tmp_path, monkeypatch, bad):
+    """A line the block check does not accept sends the file to the line-by-line reader: the
+    same result, or the same error naming the same line."""
+    rng = np.random.default_rng(8)
+    lines = _plain_file(rng, ",", 300, 2).splitlines()
+    lines[200] = bad
+    path = tmp_path / "p.csv"
+    path.write_text("\n".join(lines) + "\n")
+    fast, slow = _read_both(monkeypatch, path)
+    if isinstance(slow, str):
+        assert fast == slow
+        assert ":201: " in slow
+    else:
+        np.testing.assert_array_equal(fast.values, slow.values)
+        assert fast.data_lines == slow.data_lines
+        assert fast.column_decimals == slow.column_decimals

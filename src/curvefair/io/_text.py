@@ -13,6 +13,7 @@ import os
 import re
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
+from itertools import repeat
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -298,24 +299,130 @@ class TextLayout:
         if values.shape != (nrows, self.ncols):
             raise ValueError(f"values must have shape {(nrows, self.ncols)}, "
                              f"got {values.shape}")
-        lines = list(self.lines)
         keep = set(int(k) for k in keep_rows)
         if decimals is None:
             # a row whose every value is the one read is its line as read (format_number's
             # rule 2 for each number, and nothing to re-align): only the others are rendered
             same = (values == self.values) | (np.isnan(values) & np.isnan(self.values))
-            redo = np.flatnonzero(~np.all(same, axis=1)).tolist()
+            redo = np.flatnonzero(~np.all(same, axis=1))
         else:
-            redo = list(range(nrows))
+            redo = np.arange(nrows)
+        if keep:
+            redo = redo[~np.isin(redo, np.fromiter(keep, np.intp, count=len(keep)))]
         data_lines, cols = self.data_lines, self.column_decimals
-        for r in redo:
-            if r not in keep:
-                li = data_lines[r]
-                lines[li] = _render_line(lines[li], values[r].tolist(), cols, decimals)
+        lines: Any = list(self.lines)
+        if decimals is None and len(redo) >= _BLOCK_MIN_ROWS:
+            # the common layout (one separator character, plain fixed-point numbers) rendered
+            # for all rows at once; rows of any other style go through the row renderer
+            lines = np.array(lines, dtype=object)
+            redo = _render_plain_block(lines, np.asarray(data_lines, dtype=np.intp), redo,
+                                       values, self.values, cols)
+        for r in redo.tolist():
+            li = data_lines[r]
+            lines[li] = _render_line(lines[li], values[r].tolist(), cols, decimals)
+        if not isinstance(lines, list):
+            lines = lines.tolist()
         text = self.newline.join(lines)
         if self.final_newline:
             text += self.newline
         return text
+
+
+# below this many rows to rewrite the row renderer is as fast as the block set-up
+_BLOCK_MIN_ROWS = 64
+_PLAIN_SEPS = (",", ";", " ", "\t")
+
+
+def _render_plain_block(lines: np.ndarray, data_lines: np.ndarray, redo: np.ndarray,
+                        values: FloatArray, old: FloatArray,
+                        column_decimals: Sequence[int]) -> np.ndarray:
+    """Render the rows ``redo`` of the common layout at once, in place in ``lines`` (an
+    object array of the file's lines; ``data_lines`` the line of each row); return the rows
+    left for the row renderer.
+
+    The layout served: every line is its numbers joined by one separator character (``,``
+    ``;``, a blank or a tab; nothing before, after or between them), every number plain
+    fixed point (:func:`_is_plain`) with at least one decimal. For such a line
+    :func:`_render_line` reduces to the separator joining :func:`_plain_number` of each
+    changed value, a blank separator growing by what a shorter number gave up (a comma or
+    semicolon has no padding to give or take), which is what is computed here with
+    whole-array operations: an unchanged value keeps its text; a
+    changed one is written with its token's decimals, else the column's, where that reads
+    back as exactly the value (tried only where the value times ``10**d`` is within 0.01 of
+    an integer, a necessary condition), else in the shortest exact form. The same text as
+    the row renderer, character for character (tests/test_io_text_layout.py compares both).
+    """
+    m = len(redo)
+    k = values.shape[1]
+    at = data_lines[redo]
+    first = lines[at[0]]
+    sep = next((c for c in _PLAIN_SEPS if c in first), None)
+    if sep is None:
+        return redo
+    block = "\n".join(lines[at].tolist())
+    if re.search(rf"[^0-9.\n{re.escape(sep)}-]", block) is not None:
+        return redo
+    texts = block.replace("\n", sep).split(sep)
+    if len(texts) != m * k:
+        return redo
+    new = values[redo].ravel()
+    was = old[redo].ravel()
+    n = len(texts)
+    length = np.fromiter(map(len, texts), np.intp, count=n)
+    point = np.fromiter(map(str.find, texts, repeat(".")), np.intp, count=n)
+    minus = np.fromiter(map(str.startswith, texts, repeat("-")), bool, count=n)
+    dec = length - point - 1
+    plain = (point > 0) & ~((point == 1) & minus) & (dec > 0) & (length > 0)
+    finite = np.isfinite(new)
+    row_ok = np.all((plain & finite).reshape(m, k), axis=1)
+    if not row_ok.any():
+        return redo
+    ok = np.repeat(row_ok, k)
+    change = ok & (new != was)
+    out = np.array(texts, dtype=object)
+    todo = np.flatnonzero(change)
+    col = todo % k
+    v = new[todo]
+    done = np.zeros(len(todo), dtype=bool)
+    tries = [dec[todo]]
+    cd = np.asarray(column_decimals, dtype=np.intp)[col]
+    tries.append(np.where((cd > 0) & (np.maximum(cd, 1) != dec[todo]), np.maximum(cd, 1), -1))
+    for d_try in tries:
+        for d in np.unique(d_try[~done & (d_try >= 0)]).tolist():
+            sel = np.flatnonzero(~done & (d_try == d))
+            x = v[sel] * 10.0 ** d
+            cand = sel[(np.abs(x - np.rint(x)) <= 0.01) | (np.abs(x) >= 2.0 ** 45)]
+            if not len(cand):
+                continue
+            strs = (f"%.{d}f\x1f" * len(cand) % tuple(v[cand].tolist())).split("\x1f")[:-1]
+            back = np.fromiter(map(float, strs), np.float64, count=len(cand))
+            # a minus only where the token had one: "-0.00" for a tiny negative value
+            # becomes "0.00" (then exact only for -0.0)
+            for i in np.flatnonzero((back == 0.0) & np.signbit(v[cand])
+                                    & ~minus[todo[cand]]).tolist():
+                strs[i] = strs[i][1:]
+            exact = back == v[cand]
+            hit = cand[exact]
+            out[todo[hit]] = [s for s, e in zip(strs, exact.tolist(), strict=True) if e]
+            done[hit] = True
+    rest = np.flatnonzero(~done)
+    if len(rest):
+        # the shortest exact form of each (:func:`_shortest`): the list's repr, then its
+        # ".0" endings and "-0" signs dropped (twice: a match consumes the ", " of the next)
+        short = f", {repr(v[rest].tolist())[1:-1]}, ".replace(".0, ", ", ")
+        short = short.replace(", -0, ", ", 0, ").replace(", -0, ", ", 0, ")
+        out[todo[rest]] = short[2:-2].split(", ")
+    if sep in " \t" and len(todo):
+        # a blank separator is the padding of the number after it: a shorter number gets the
+        # blanks it gave up, so right-aligned columns stay aligned (the first number of a
+        # line has none before it)
+        shrink = length[todo] - np.fromiter(map(len, out[todo].tolist()), np.intp,
+                                            count=len(todo))
+        for i in np.flatnonzero((shrink > 0) & (col > 0)).tolist():
+            out[todo[i]] = sep * int(shrink[i]) + out[todo[i]]
+    rows_text = ((sep.join(["%s"] * k) + "\n") * m % tuple(out.tolist())).split("\n")
+    lines[at[row_ok]] = np.array(rows_text[:-1], dtype=object)[row_ok]
+    return redo[~row_ok]
 
 
 def _split_row(line: str) -> Row | None:
@@ -394,6 +501,7 @@ def parse_text(path: str | os.PathLike[str], *, header: bool = True,
     notes_from: int | None = None
     data_lines: list[int] = []
     texts: list[str] = []  # every number's text, row after row
+    bulk: tuple[list[str], FloatArray] | None = None  # the rows read at once, if any
     width: int | None = None
     for i, line in enumerate(lines):
         s = line.strip()
@@ -437,15 +545,64 @@ def parse_text(path: str | os.PathLike[str], *, header: bool = True,
                 f"{width}", path, i + 1)
         data_lines.append(i)
         texts.extend(row)
+        if len(data_lines) == 1 and not notes and len(lines) - i > _BLOCK_MIN_ROWS:
+            bulk = _plain_rows(lines, i + 1, k)
+            if bulk is not None:  # every line after the first row is a row like it
+                data_lines.extend(range(i + 1, len(lines)))
+                break
     if not data_lines:
         if not any(line.strip() for line in lines):
             raise FileFormatError(f"empty {what}", path)
         raise FileFormatError(f"no data rows in the {what}", path)
     assert width is not None
-    values = np.array(list(map(float, texts)), dtype=np.float64).reshape(-1, width)
-    col_dec = tuple(max(map(_decimals, texts[j::width])) for j in range(width))
+    values = np.array(list(map(float, texts)), dtype=np.float64)
+    if bulk is not None:
+        texts.extend(bulk[0])
+        values = np.concatenate([values, bulk[1]])
+    values = values.reshape(-1, width)
+    col_dec = _column_decimals(texts, width)
     return TextLayout(tuple(lines), newline, final, head, tuple(data_lines), width,
                       col_dec, encoding, values, tuple(leading), notes_from)
+
+
+def _plain_rows(lines: list[str], start: int, width: int
+                ) -> tuple[list[str], FloatArray] | None:
+    """The number texts and values of ``lines[start:]`` when every one of them is a row of ``width``
+    numbers joined by one separator character (``,``, ``;``, a blank or a tab) and nothing
+    else, or None (the line-by-line reader then goes on, with its own messages).
+
+    One check of the whole block instead of one per line: only digits, ``.``, ``e``/``E``,
+    signs and the separator occur, every line has ``width - 1`` separators, and every piece
+    between them is a number Python's ``float`` reads -- over those characters exactly the
+    numbers ``_NUM`` matches (no empty piece, no lone sign or point, no ``1e``)."""
+    rows = lines[start:]
+    sep = next((c for c in _PLAIN_SEPS if c in rows[0]), None)
+    if sep is None or width < 2:
+        return None
+    block = "\n".join(rows)
+    if re.search(rf"[^0-9.eE+\n{re.escape(sep)}-]", block) is not None:
+        return None
+    counts = np.fromiter(map(str.count, rows, repeat(sep)), np.intp, count=len(rows))
+    if np.any(counts != width - 1):
+        return None
+    texts = block.replace("\n", sep).split(sep)
+    try:
+        values = np.fromiter(map(float, texts), np.float64, count=len(texts))
+    except ValueError:
+        return None
+    return texts, values
+
+
+def _column_decimals(texts: list[str], width: int) -> tuple[int, ...]:
+    """Largest number of decimals per column (:func:`_decimals` of each text)."""
+    joined = "".join(texts)
+    if "e" in joined or "E" in joined:
+        return tuple(max(map(_decimals, texts[j::width])) for j in range(width))
+    n = len(texts)
+    length = np.fromiter(map(len, texts), np.intp, count=n)
+    point = np.fromiter(map(str.find, texts, repeat(".")), np.intp, count=n)
+    dec = np.where(point >= 0, length - point - 1, 0).reshape(-1, width)
+    return tuple(int(d) for d in dec.max(axis=0))
 
 
 def fresh_text(values: FloatArray, *, sep: str, header: str | None = None,
