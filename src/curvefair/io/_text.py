@@ -115,17 +115,6 @@ def format_number(v: float, tok: Token, column_decimals: int,
     return _shortest(v)
 
 
-def _decimals(text: str) -> int:
-    """Digits after the point of a number's text (of the mantissa for exponent style): the
-    ``decimals`` of :meth:`Token.parse`, without building the token."""
-    e = text.find("e")
-    if e < 0:
-        e = text.find("E")
-    mant = text if e < 0 else text[:e]
-    point = mant.find(".")
-    return len(mant) - point - 1 if point >= 0 else 0
-
-
 @dataclass(frozen=True)
 class Row:
     """One data line split into pieces: ``prefix text0 sep0 text1 ... suffix``.
@@ -594,14 +583,18 @@ def _plain_rows(lines: list[str], start: int, width: int
 
 
 def _column_decimals(texts: list[str], width: int) -> tuple[int, ...]:
-    """Largest number of decimals per column (:func:`_decimals` of each text)."""
-    joined = "".join(texts)
-    if "e" in joined or "E" in joined:
-        return tuple(max(map(_decimals, texts[j::width])) for j in range(width))
+    """Largest number of decimals per column (the ``decimals`` of :meth:`Token.parse` for each
+    text), by array operations: the digits between the point and the end of the mantissa,
+    which ends at an ``e``/``E`` or at the end of the text."""
     n = len(texts)
-    length = np.fromiter(map(len, texts), np.intp, count=n)
+    joined = "".join(texts)
+    end = np.fromiter(map(len, texts), np.intp, count=n)
     point = np.fromiter(map(str.find, texts, repeat(".")), np.intp, count=n)
-    dec = np.where(point >= 0, length - point - 1, 0).reshape(-1, width)
+    for e in "eE":
+        if e in joined:
+            at = np.fromiter(map(str.find, texts, repeat(e)), np.intp, count=n)
+            end = np.where(at >= 0, at, end)
+    dec = np.where(point >= 0, end - point - 1, 0).reshape(-1, width)
     return tuple(int(d) for d in dec.max(axis=0))
 
 
