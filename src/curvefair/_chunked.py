@@ -69,6 +69,7 @@ from typing import Any
 import numpy as np
 
 from .errors import FileFormatError, InputError
+from .io.points import number_decimals, render_row
 
 DEFAULT_CHUNK = 5000
 DEFAULT_OVERLAP = 64
@@ -91,13 +92,14 @@ class PointStream:
     data; separators blanks, commas or semicolons).
 
     Attributes after a full pass: ``n_rows``; ``header`` (text), ``preamble`` (the lines before
-    the first row: the header, comments and blank lines, written back as they are) and ``sep``
-    (the separator written back) are known after the first block; ``n_comments_dropped``
-    counts the comments after the first row (a text chunk is written row by row: they are not
-    copied).
+    the first row: the header, comments and blank lines) and ``sep`` (the separator of the
+    first row) are known after the first block; ``n_comments_dropped`` counts the comments
+    after the first row (lines an output without the input's layout does not copy).
+    ``column_decimals`` (text, ``decimals=True``): the largest number of decimals per column
+    over the file, the file's precision (:func:`curvefair.io.points.number_decimals`).
     """
 
-    def __init__(self, path: str | os.PathLike[str]) -> None:
+    def __init__(self, path: str | os.PathLike[str], *, decimals: bool = False) -> None:
         self.path = os.fspath(path)
         ext = Path(self.path).suffix.lower()
         if ext in NPY_EXTS:
@@ -115,6 +117,10 @@ class PointStream:
         self.sep = ","
         self.dim: int | None = None
         self.n_rows: int | None = None
+        self.track_decimals = bool(decimals)
+        self.column_decimals: list[int] = []
+        self.lead = ""  # text_rows: the raw text before the first row (with a BOM if any)
+        self.tail = ""  # text_rows, after a full pass: the raw text after the last row
         if self.kind == "npy":
             try:
                 mm = np.load(self.path, mmap_mode="r", allow_pickle=False)
@@ -146,22 +152,50 @@ class PointStream:
             for a in range(0, mm.shape[0], size):
                 yield np.array(mm[a:a + size], dtype=np.float64)
             return
-        yield from self._text_blocks(size)
+        for blk, _before, _lines in self._text_parse(size, keep=False):
+            yield blk
 
-    def _text_blocks(self, size: int) -> Iterator[np.ndarray]:
+    def text_rows(self, size: int) -> Iterator[tuple[np.ndarray, list[str], list[str]]]:
+        """Text files: :meth:`blocks` with the lines as read, ``(rows, before, lines)``:
+        ``lines[i]`` is row ``i``'s line with its own line ending, ``before[i]`` the raw text
+        of the comment and blank lines between the row before it and row ``i`` (``""`` for
+        none). :attr:`lead` (the lines before the first row, known after the first block) and
+        :attr:`tail` (the lines after the last row, after the last block) complete the file:
+        their concatenation in order is the file's text. Only one block of lines is held."""
+        if self.kind != "text":
+            raise InputError(f"{self.path!r}: text_rows reads text point files")
+        yield from self._text_parse(size, keep=True)
+
+    def _text_parse(self, size: int, keep: bool
+                    ) -> Iterator[tuple[np.ndarray, list[str], list[str]]]:
         rows: list[list[float]] = []
+        before: list[str] = []
+        lines: list[str] = []
+        between: list[str] = []  # keep: raw lines since the last row
         n = 0
         self.header, self.preamble, self.n_comments_dropped = None, [], 0
-        with open(self.path, encoding="utf-8-sig", errors="strict") as f:
+        self.lead, self.tail = "", ""
+        dec = self.column_decimals = []
+        track = self.track_decimals
+        if keep:
+            with open(self.path, "rb") as fb:
+                if fb.read(3) == b"\xef\xbb\xbf":
+                    between.append("\ufeff")
+        # newline="": the lines keep their own endings (split where the default mode would)
+        with open(self.path, encoding="utf-8-sig", errors="strict", newline="") as f:
             try:
                 for ln, line in enumerate(f, start=1):
                     s = line.split("#", 1)[0].strip()
                     if n == 0 and not s:  # n: rows so far
                         self.preamble.append(line.rstrip("\r\n"))
+                        if keep:
+                            between.append(line)
                         continue
                     if "#" in line and n > 0:
                         self.n_comments_dropped += 1
                     if not s:
+                        if keep:
+                            between.append(line)
                         continue
                     toks = _SPLIT.split(s)
                     try:
@@ -170,6 +204,8 @@ class PointStream:
                         if n == 0 and self.header is None and not rows:
                             self.header = line.rstrip("\r\n")
                             self.preamble.append(self.header)
+                            if keep:
+                                between.append(line)
                             continue
                         raise FileFormatError(f"line {ln}: not a row of numbers: {s[:60]!r}",
                                               self.path, ln) from None
@@ -184,15 +220,35 @@ class PointStream:
                                               f"before have {self.dim}", self.path, ln)
                     if not all(math.isfinite(v) for v in vals):
                         raise FileFormatError(f"line {ln}: not a finite number", self.path, ln)
+                    if track:
+                        if not dec:
+                            dec.extend([0] * len(toks))
+                        for j, t in enumerate(toks):
+                            d = number_decimals(t)
+                            if d > dec[j]:
+                                dec[j] = d
+                    if keep:
+                        if n == 0:
+                            self.lead = "".join(between)
+                            before.append("")
+                        else:
+                            before.append("".join(between))
+                        between = []
+                        lines.append(line)
                     rows.append(vals)
                     n += 1
                     if len(rows) == size:
-                        yield np.array(rows, dtype=np.float64)
-                        rows = []
+                        yield np.array(rows, dtype=np.float64), before, lines
+                        rows, before, lines = [], [], []
             except UnicodeDecodeError as exc:
                 raise FileFormatError(f"not a text file ({exc.reason})", self.path) from None
         if rows:
-            yield np.array(rows, dtype=np.float64)
+            yield np.array(rows, dtype=np.float64), before, lines
+        if keep:
+            if n == 0:
+                self.lead = "".join(between)
+            else:
+                self.tail = "".join(between)
         self.n_rows = n
 
 
@@ -490,7 +546,8 @@ class _Writer:
     def __init__(self, dest: str, kind: str, dim: int, sep: str,
                  preamble: list[str] | None) -> None:
         d = Path(dest)
-        fd, self.path = tempfile.mkstemp(prefix="." + d.name + ".", suffix=d.suffix,
+        fd, self.path = tempfile.mkstemp(prefix="." + d.name + ".",
+                                         suffix=".npy" if kind == "npy" else d.suffix,
                                          dir=str(d.parent) or ".")
         self.f = os.fdopen(fd, "wb")
         self.kind, self.dim, self.sep, self.n = kind, dim, sep, 0
@@ -519,6 +576,112 @@ class _Writer:
             self._npy_header(self.n)
             if self.f.tell() != self.hlen:  # pragma: no cover - fixed for 2-D float64
                 raise AssertionError("npy header length changed")
+        self.f.close()
+
+
+#: Extra decimals tried, one at a time, for a row whose rounding to the input's decimals
+#: would move it past tol (or onto a neighbour) before it is written exactly.
+_MAX_EXTRA = 8
+
+
+class _LayoutWriter:
+    """Rows written into the input's own lines (text input to text output).
+
+    The lines before the first row, between rows (comments, blank lines) and after the last
+    are copied as read, every line keeps its own ending, and a row whose values did not move
+    is its line as read, byte for byte. A moved row is rendered in its line's layout
+    (:func:`curvefair.io.points.render_row`: separators, padding, number style, a trailing
+    comment) with its moved numbers rounded to the input's precision (the column's largest
+    number of decimals over the file). Rounding is part of what the tolerance certifies, so
+    it is checked here per row, in float64: a row that would end farther than ``tol`` from its
+    input point, or on a neighbour's point (a zero chord does not read back), is rendered with
+    one more decimal at a time, then exactly (the shortest form that reads back as the value,
+    as the single-file writer writes it). The curve read back is measured afterwards by the
+    caller; a chunk written ``exact`` (its rounding undone) has every moved number exact.
+
+    A row is written once its next row is known (a rounded row must not land on it), so one
+    row is held back between blocks.
+    """
+
+    def __init__(self, dest: str, lead: str, column_decimals: list[int], sep: str,
+                 tol: float) -> None:
+        d = Path(dest)
+        fd, self.path = tempfile.mkstemp(prefix="." + d.name + ".", suffix=d.suffix,
+                                         dir=str(d.parent) or ".")
+        self.f = os.fdopen(fd, "w", encoding="utf-8", newline="")
+        self.f.write(lead)
+        self.cols, self.sep, self.tol = list(column_decimals), sep, tol
+        self.prev: list[float] | None = None  # the values of the last row written
+        self.pending: tuple[Any, ...] | None = None
+        #: per chunk: rows whose written values differ from the values given (rounded), rows
+        #: written with more decimals than the input's, rows not in a layout this writer
+        #: renders (written in the shortest exact form, the input's separator)
+        self.rounded: dict[int, int] = {}
+        self.more_decimals: dict[int, int] = {}
+        self.fresh: dict[int, int] = {}
+
+    def write(self, index: int, orig: np.ndarray, new: np.ndarray, before: list[str],
+              lines: list[str], exact: bool) -> None:
+        """Chunk ``index``'s rows: ``orig`` as read (with their ``lines`` and the text
+        ``before`` each), ``new`` the values to write."""
+        for k in (self.rounded, self.more_decimals, self.fresh):
+            k.setdefault(index, 0)
+        same = np.all(new == orig, axis=1)
+        f = self.f
+        for i in range(orig.shape[0]):
+            if same[i]:
+                o = orig[i].tolist()
+                if self.pending is not None:
+                    self._settle(o)
+                f.write(before[i])
+                f.write(lines[i])
+                self.prev = o
+            else:
+                if self.pending is not None:
+                    self._settle(None)
+                self.pending = (index, orig[i].tolist(), new[i].tolist(), before[i],
+                                lines[i], exact)
+
+    def _settle(self, nxt: list[float] | None) -> None:
+        """Write the held row: rounded, unless that puts it past tol or onto the row before
+        (``prev``) or after (``nxt``, None when that row moves too: it checks itself)."""
+        assert self.pending is not None
+        index, o, v, before, line, exact = self.pending
+        self.pending = None
+        body = line.rstrip("\r\n")
+        end = line[len(body):]
+        tol = self.tol
+        text, w = body, v
+        level: int | None = 0
+        r: tuple[str, list[float]] | None = None
+        for level in ([None] if exact else [*range(_MAX_EXTRA + 1), None]):
+            r = render_row(body, v, self.cols, level)
+            if r is None:  # not a row of this layout (e.g. "1,,2"): fresh, exact
+                self.fresh[index] += 1
+                text, w = self.sep.join(map(repr, v)), v
+                break
+            text, w = r
+            if level is None:
+                break
+            d2 = 0.0
+            for a, b in zip(w, o, strict=True):
+                d2 += (a - b) * (a - b)
+            if math.sqrt(d2) <= tol and w != self.prev and w != nxt:
+                break
+        if w != v:
+            self.rounded[index] += 1
+        if r is not None and (level is None and not exact or level is not None and level > 0):
+            self.more_decimals[index] += 1
+        f = self.f
+        f.write(before)
+        f.write(text)
+        f.write(end)
+        self.prev = w
+
+    def close(self, tail: str) -> None:
+        if self.pending is not None:
+            self._settle(None)
+        self.f.write(tail)
         self.f.close()
 
 
@@ -580,8 +743,10 @@ def fair_chunked(source: str | os.PathLike[str], out: str | os.PathLike[str], *,
     clamp_pair = parse_clamp(clamp)
     if "none" in clamp_pair:
         raise InputError("clamp 'none' is not available for point data: the ends stay")
-    stream = PointStream(src)
     out_kind = "npy" if Path(dest).suffix.lower() in NPY_EXTS else "text"
+    # text to text: the output is the input's lines with the moved rows rendered in place
+    layout = out_kind == "text" and Path(src).suffix.lower() in TEXT_EXTS
+    stream = PointStream(src, decimals=layout)
     if Path(dest).suffix.lower() not in TEXT_EXTS + NPY_EXTS:
         raise InputError(f"{dest!r}: the output of chunked fairing is a point file "
                          f"({', '.join(TEXT_EXTS + NPY_EXTS)})")
@@ -610,9 +775,10 @@ def fair_chunked(source: str | os.PathLike[str], out: str | os.PathLike[str], *,
         gen = windows(stream.blocks(blk), chunk, overlap, src, corner_angle)
         first = next(gen)
         dim = int(first[1].shape[1])
-        writer = _Writer(dest, out_kind, dim, stream.sep if stream.kind == "text" else ",",
-                         stream.preamble if out_kind == "text" and stream.kind == "text"
-                         else None)
+        # text to text: the faired rows first go to a float64 scratch file (the layout
+        # needs the file's precision, known after the whole input has been read)
+        writer = _Writer(dest, "npy" if layout else out_kind, dim,
+                         stream.sep if stream.kind == "text" else ",", None)
         temps.append(writer.path)
 
         def tasks() -> Iterator[tuple[Any, ...]]:
@@ -638,36 +804,57 @@ def fair_chunked(source: str | os.PathLike[str], out: str | os.PathLike[str], *,
         fair_file = writer.path
         # 2. read back, measure, scale where needed, until every core is within tol
         scales = [1.0] * len(chunks)
+        exact = [False] * len(chunks)  # layout: chunks whose rounding was undone
+        lw: _LayoutWriter | None = None
         current = fair_file
         notes: list[str] = []
         measured: list[dict[str, Any]] = []
-        for attempt in range(_MAX_SHRINK + 1):
+        last = _MAX_SHRINK + (1 if layout else 0)
+        for attempt in range(last + 1):
+            if layout:
+                lw = _write_layout(dest, src, fair_file, chunks, scales, exact,
+                                   stream.column_decimals, stream.sep, tol_v)
+                if current != fair_file:
+                    _remove(current)
+                current = lw.path
+                temps.append(current)
             measured = _measure_file(runner, src, current, chunks, chunk, overlap, tol_v,
                                      tick)
             over = [k for k, m in enumerate(measured) if not m["deviation"] <= tol_v]
             if not over:
                 break
-            if attempt == _MAX_SHRINK:
+            if attempt == last:
                 k = over[0]
                 raise InputError(f"{dest!r}: not written: rows {chunks[k].start}.."
                                  f"{chunks[k].stop - 1} read back "
                                  f"{measured[k]['deviation']:.6g} from the input, more than "
                                  f"tol {tol_v:g}")
-            for k in over:
+            undo = [k for k in over if lw is not None and lw.rounded[k] and not exact[k]]
+            shrink = [k for k in over if k not in undo]
+            for k in undo:
+                exact[k] = True
+            for k in shrink:
                 scales[k] *= min(0.998, 0.995 * tol_v / measured[k]["deviation"])
-            if attempt == 0:
-                notes.append(f"point data: {len(over)} chunk(s) read back farther than tol "
+            if undo and not any("rounding undone" in n for n in notes):
+                notes.append(f"{len(undo)} chunk(s) rounded to the input's decimals read back "
+                             f"farther than tol {tol_v:g}; their moved numbers were written "
+                             "exactly (rounding undone)")
+            if shrink and not any("scaled" in n for n in notes):
+                notes.append(f"point data: {len(shrink)} chunk(s) read back farther than tol "
                              f"{tol_v:g} (the curve re-interpolated through the written "
                              "points has new chord parameters); their moves were scaled "
                              "down until within tol")
-            w = _Writer(dest, out_kind, dim, writer.sep, stream.preamble
-                        if out_kind == "text" and stream.kind == "text" else None)
+            if layout:
+                continue
+            w = _Writer(dest, out_kind, dim, writer.sep, None)
             temps.append(w.path)
             for ch, orig, faired in _lockstep(src, fair_file, chunks):
                 s = scales[ch.index]
                 rows = faired if s == 1.0 else _scaled(orig, faired, s)
                 w.write(rows)
             w.close()
+            if current != fair_file:
+                _remove(current)
             current = w.path
         with atomic_path(dest) as tmp:
             os.replace(current, tmp)
@@ -688,11 +875,21 @@ def fair_chunked(source: str | os.PathLike[str], out: str | os.PathLike[str], *,
             row["curvature_rel_read_back"] = max(_krel(fa[1], back[1], fa[2]),
                                                  _krel(fb[1], back[1], fb[2]))
         joins.append(row)
-    for rep, m, s in zip(chunk_reports, measured, scales, strict=True):
+    for k, (rep, m, s) in enumerate(zip(chunk_reports, measured, scales, strict=True)):
         rep["on_disk_deviation"] = m["deviation"]
         rep["on_disk_deviation_kind"] = m["kind"]
         rep["move_scale"] = s
         rep["on_disk_max_point_displacement"] = m["max_point_displacement"]
+        if lw is not None:
+            rep["on_disk_numbers"] = "exact" if exact[k] else "input decimals"
+            rep["rows_rounded"] = lw.rounded[k]
+            rep["rows_more_decimals"] = lw.more_decimals[k]
+            rep["rows_not_in_layout"] = lw.fresh[k]
+    dropped = 0 if layout else stream.n_comments_dropped
+    if lw is not None and sum(lw.fresh.values()):
+        notes.append(f"{sum(lw.fresh.values())} moved row(s) the layout could not be kept for "
+                     "(odd separators) were written with the input's separator and exact "
+                     "numbers")
     g2 = max((max(r.get("tangent_angle", 0.0), r.get("curvature_rel", 0.0),
                   r.get("tangent_angle_read_back", 0.0), r.get("curvature_rel_read_back", 0.0))
               for r in joins), default=0.0)
@@ -702,10 +899,10 @@ def fair_chunked(source: str | os.PathLike[str], out: str | os.PathLike[str], *,
             "max_deviation": max(m["deviation"] for m in measured),
             "max_point_displacement": max(m["max_point_displacement"] for m in measured),
             "joins_g2_max": g2, "g2_tol": G2_TOL, "joins_within_g2_tol": g2 <= G2_TOL,
-            "n_comments_dropped": stream.n_comments_dropped,
-            "notes": notes + ([f"{stream.n_comments_dropped} comment(s) after the first row "
-                               "of the input were not copied (the lines before it were)"]
-                              if stream.n_comments_dropped else []),
+            "n_comments_dropped": dropped,
+            "layout_kept": layout,
+            "notes": notes + ([f"{dropped} comment(s) after the first row of the input were "
+                               "not copied"] if dropped else []),
             "chunks": chunk_reports, "joins": joins,
             "time_s": time.perf_counter() - t0}
 
@@ -715,6 +912,61 @@ def _scaled(orig: np.ndarray, faired: np.ndarray, s: float) -> np.ndarray:
     same = np.all(faired == orig, axis=1)
     out[same] = orig[same]
     return out
+
+
+def _write_layout(dest: str, src: str, fair_file: str, chunks: list[Chunk],
+                  scales: list[float], exact: list[bool], column_decimals: list[int],
+                  sep: str, tol: float) -> _LayoutWriter:
+    """The output file in the input's layout (:class:`_LayoutWriter`), from the input's lines
+    and the faired rows (``fair_file``), each chunk's moves scaled by ``scales``."""
+    src_rows = _text_rows(src)
+    faired = _rows(fair_file)
+    w = _LayoutWriter(dest, "", column_decimals, sep, tol)
+    try:
+        for ch in chunks:
+            n = ch.stop - ch.start
+            orig, before, lines = src_rows.take(n)
+            if ch.index == 0:
+                w.f.write(src_rows.stream.lead)
+            new = faired.take(n)
+            s = scales[ch.index]
+            w.write(ch.index, orig, new if s == 1.0 else _scaled(orig, new, s), before,
+                    lines, exact[ch.index])
+        src_rows.finish()
+        w.close(src_rows.stream.tail)
+    except BaseException:
+        w.f.close()
+        _remove(w.path)
+        raise
+    return w
+
+
+class _text_rows:
+    """Read a text point file forwards ``take(n)`` rows at a time, with their lines
+    (:meth:`PointStream.text_rows`)."""
+
+    def __init__(self, path: str) -> None:
+        self.stream = PointStream(path)
+        self.it = self.stream.text_rows(1 << 14)
+        self.buf: tuple[np.ndarray, list[str], list[str]] | None = None
+
+    def take(self, n: int) -> tuple[np.ndarray, list[str], list[str]]:
+        parts = [self.buf] if self.buf is not None else []
+        have = self.buf[0].shape[0] if self.buf is not None else 0
+        while have < n:
+            blk = next(self.it)
+            parts.append(blk)
+            have += blk[0].shape[0]
+        rows = np.vstack([p[0] for p in parts]) if len(parts) > 1 else parts[0][0]
+        before = [x for p in parts for x in p[1]]
+        lines = [x for p in parts for x in p[2]]
+        self.buf = (rows[n:], before[n:], lines[n:]) if have > n else None
+        return rows[:n], before[:n], lines[:n]
+
+    def finish(self) -> None:
+        """Read to the end (the lines after the last row: :attr:`PointStream.tail`)."""
+        for _ in self.it:
+            raise InputError(f"{self.stream.path!r}: more rows than the chunks cover")
 
 
 def _lockstep(src: str, written: str, chunks: list[Chunk]

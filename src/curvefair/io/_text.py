@@ -21,7 +21,7 @@ import numpy as np
 from .._typing import FloatArray
 from ..errors import FileFormatError
 
-__all__ = ["TextLayout", "Token", "parse_text", "format_number"]
+__all__ = ["TextLayout", "Token", "parse_text", "format_number", "rounded_number"]
 
 _NUM = r"[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|nan|inf(?:inity)?)"
 _NUM_RE = re.compile(_NUM, re.IGNORECASE)
@@ -142,7 +142,7 @@ class Row:
 
 def _render_pieces(prefix: str, texts: Sequence[str], seps: Sequence[str], suffix: str,
                    values: Sequence[float], column_decimals: Sequence[int],
-                   decimals: int | None) -> str:
+                   decimals: int | None, extra: int | None = None) -> str:
     out = []
     lead = prefix
     nsep = len(seps)
@@ -151,6 +151,8 @@ def _render_pieces(prefix: str, texts: Sequence[str], seps: Sequence[str], suffi
         t = float(text)
         if decimals is None and (t == v or (t != t and v != v)):
             s = text  # format_number's rule 2, without parsing the style
+        elif decimals is None and extra is not None:
+            s = rounded_number(v, text, column_decimals[j], extra)
         elif decimals is None and _is_plain(text):
             s = _plain_number(v, text, column_decimals[j])
         else:
@@ -168,6 +170,25 @@ def _render_pieces(prefix: str, texts: Sequence[str], seps: Sequence[str], suffi
         lead = seps[j] if j < nsep else ""
     out.append(suffix)
     return "".join(out)
+
+
+def rounded_number(v: float, text: str, column_decimals: int, extra: int = 0) -> str:
+    """Text for ``v``, replacing the number ``text``, rounded to the file's precision: the
+    token's own decimals if they write ``v`` exactly, else ``v`` rounded to the column's
+    largest number of decimals plus ``extra`` (at least one), in the token's style (fixed or
+    exponent, ``+``, bare point). An integer column (no decimals, no exponent) is not rounded:
+    the shortest exact form, as :func:`format_number` writes it.
+
+    Unlike :func:`format_number`, this rounds: a caller uses it only where the rounded file is
+    measured against the tolerance afterwards (and ``extra`` raised, or :func:`format_number`
+    used, where it is not met)."""
+    tok = Token.parse(text)
+    s = _render(v, tok, tok.decimals)
+    if float(s) == v:
+        return s
+    if column_decimals <= 0 and not tok.exponent:
+        return format_number(v, tok, column_decimals)
+    return _render(v, tok, max(column_decimals, 1) + int(extra))
 
 
 def _is_plain(text: str) -> bool:
@@ -216,10 +237,11 @@ def _pieces(line: str) -> tuple[str, list[str], list[str], str]:
 
 
 def _render_line(line: str, values: Sequence[float], column_decimals: Sequence[int],
-                 decimals: int | None) -> str:
-    """A data line as read with ``values`` in place."""
+                 decimals: int | None, extra: int | None = None) -> str:
+    """A data line as read with ``values`` in place (``extra``: changed values by
+    :func:`rounded_number`)."""
     prefix, texts, seps, suffix = _pieces(line)
-    return _render_pieces(prefix, texts, seps, suffix, values, column_decimals, decimals)
+    return _render_pieces(prefix, texts, seps, suffix, values, column_decimals, decimals, extra)
 
 
 @dataclass(frozen=True, eq=False)

@@ -43,9 +43,9 @@ from ._common import (
     piece_values,
     point_records,
 )
-from ._text import TextLayout, fresh_text, parse_text
+from ._text import TextLayout, _decimals, _render_line, _split_numbers, fresh_text, parse_text
 
-__all__ = ["read", "write"]
+__all__ = ["read", "write", "render_row", "number_decimals"]
 
 FORMAT = "points"
 
@@ -118,3 +118,33 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
     else:
         text = fresh_text(pts, sep=sep, header=header)
     atomic_write(path, text)
+
+
+def number_decimals(text: str) -> int:
+    """Digits after the point of a number as written in a points file (of the mantissa for
+    exponent style): what the file's precision per column is made of (its largest value)."""
+    return _decimals(text)
+
+
+def render_row(line: str, values: Sequence[float], column_decimals: Sequence[int],
+               extra: int | None = None) -> tuple[str, list[float]] | None:
+    """One data line of a points file with ``values`` in place, in the line's own layout
+    (the rule :meth:`TextLayout.render` follows for a row: separators, padding, the number
+    style and any trailing comment kept; a value equal to the one read keeps its text).
+
+    ``extra`` None: a changed value keeps its token's or the column's decimals only where that
+    writes it exactly, else the shortest exact form (what :func:`write` does). ``extra`` an
+    integer: a changed value is rounded to the column's decimals (``column_decimals``, the
+    file's largest per column) plus ``extra`` (:func:`curvefair.io._text.rounded_number`), for
+    a writer that measures the rounded result against its tolerance itself.
+
+    Returns the line (without line ending) and the values it reads back as, or None when
+    ``line`` is not a row of ``len(values)`` numbers by this reader's rules.
+    """
+    texts = _split_numbers(line)
+    if texts is None or len(texts) != len(values):
+        return None
+    out = _render_line(line, values, column_decimals, None, extra)
+    back = _split_numbers(out)
+    assert back is not None and len(back) == len(texts)  # the layout's own rendering
+    return out, [float(t) for t in back]
