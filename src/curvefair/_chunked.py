@@ -582,6 +582,22 @@ class _Writer:
 #: Extra decimals tried, one at a time, for a row whose rounding to the input's decimals
 #: would move it past tol (or onto a neighbour) before it is written exactly.
 _MAX_EXTRA = 8
+#: The most rounding may move a point from where the fair put it, as a share of ``tol``: the
+#: fair survives in the file (at decimals coarse against ``tol`` rounding would put the moved
+#: points back onto the input's grid, i.e. undo the fair, while staying within ``tol``).
+ROUND_SHARE = 0.1
+#: ... and as a share of the room the chunk's fair left below ``tol`` (``tol`` minus its
+#: certified deviation): the curve through rounded points moves by about the rounding (a
+#: natural cubic spline's interpolation has a small max-norm operator norm), so this leaves
+#: the read-back measure its margin and a rounded chunk is seldom written again.
+ROOM_SHARE = 0.25
+
+
+def rounding_budget(tol: float, fair_deviation: float | None) -> float:
+    """How far rounding may move a point of a chunk from where its fair put it."""
+    room = tol - fair_deviation if fair_deviation is not None and \
+        math.isfinite(fair_deviation) else tol
+    return min(ROUND_SHARE * tol, max(0.0, ROOM_SHARE * room))
 
 
 class _LayoutWriter:
@@ -594,10 +610,12 @@ class _LayoutWriter:
     comment) with its moved numbers rounded to the input's precision (the column's largest
     number of decimals over the file). Rounding is part of what the tolerance certifies, so
     it is checked here per row, in float64: a row that would end farther than ``tol`` from its
-    input point, or on a neighbour's point (a zero chord does not read back), is rendered with
-    one more decimal at a time, then exactly (the shortest form that reads back as the value,
-    as the single-file writer writes it). The curve read back is measured afterwards by the
-    caller; a chunk written ``exact`` (its rounding undone) has every moved number exact.
+    input point, farther than the chunk's budget (:func:`rounding_budget`) from its faired
+    point, or on a neighbour's point (a zero chord does not read back), is rendered with one
+    more decimal at a time, then exactly (the shortest form that reads back as the value, as
+    the single-file writer writes it). The curve read back is measured afterwards by the
+    caller; a chunk written with budget None (its rounding undone) has every moved number
+    exact.
 
     A row is written once its next row is known (a rounded row must not land on it), so one
     row is held back between blocks.
@@ -621,7 +639,7 @@ class _LayoutWriter:
         self.fresh: dict[int, int] = {}
 
     def write(self, index: int, orig: np.ndarray, new: np.ndarray, before: list[str],
-              lines: list[str], exact: bool) -> None:
+              lines: list[str], budget: float | None) -> None:
         """Chunk ``index``'s rows: ``orig`` as read (with their ``lines`` and the text
         ``before`` each), ``new`` the values to write."""
         for k in (self.rounded, self.more_decimals, self.fresh):
@@ -640,13 +658,14 @@ class _LayoutWriter:
                 if self.pending is not None:
                     self._settle(None)
                 self.pending = (index, orig[i].tolist(), new[i].tolist(), before[i],
-                                lines[i], exact)
+                                lines[i], budget)
 
     def _settle(self, nxt: list[float] | None) -> None:
         """Write the held row: rounded, unless that puts it past tol or onto the row before
         (``prev``) or after (``nxt``, None when that row moves too: it checks itself)."""
         assert self.pending is not None
-        index, o, v, before, line, exact = self.pending
+        index, o, v, before, line, budget = self.pending
+        exact = budget is None
         self.pending = None
         body = line.rstrip("\r\n")
         end = line[len(body):]
@@ -663,10 +682,12 @@ class _LayoutWriter:
             text, w = r
             if level is None:
                 break
-            d2 = 0.0
-            for a, b in zip(w, o, strict=True):
+            d2 = e2 = 0.0
+            for a, b, c in zip(w, o, v, strict=True):
                 d2 += (a - b) * (a - b)
-            if math.sqrt(d2) <= tol and w != self.prev and w != nxt:
+                e2 += (a - c) * (a - c)
+            if math.sqrt(d2) <= tol and math.sqrt(e2) <= budget and \
+                    w != self.prev and w != nxt:
                 break
         if w != v:
             self.rounded[index] += 1
@@ -812,7 +833,10 @@ def fair_chunked(source: str | os.PathLike[str], out: str | os.PathLike[str], *,
         last = _MAX_SHRINK + (1 if layout else 0)
         for attempt in range(last + 1):
             if layout:
-                lw = _write_layout(dest, src, fair_file, chunks, scales, exact,
+                lw = _write_layout(dest, src, fair_file, chunks, scales,
+                                   [None if exact[k] else
+                                    rounding_budget(tol_v, chunk_reports[k]["max_deviation"])
+                                    for k in range(len(chunks))],
                                    stream.column_decimals, stream.sep, tol_v)
                 if current != fair_file:
                     _remove(current)
@@ -881,7 +905,7 @@ def fair_chunked(source: str | os.PathLike[str], out: str | os.PathLike[str], *,
         rep["move_scale"] = s
         rep["on_disk_max_point_displacement"] = m["max_point_displacement"]
         if lw is not None:
-            rep["on_disk_numbers"] = "exact" if exact[k] else "input decimals"
+            rep["on_disk_numbers"] = "exact" if exact[k] else "rounded"
             rep["rows_rounded"] = lw.rounded[k]
             rep["rows_more_decimals"] = lw.more_decimals[k]
             rep["rows_not_in_layout"] = lw.fresh[k]
@@ -915,7 +939,8 @@ def _scaled(orig: np.ndarray, faired: np.ndarray, s: float) -> np.ndarray:
 
 
 def _write_layout(dest: str, src: str, fair_file: str, chunks: list[Chunk],
-                  scales: list[float], exact: list[bool], column_decimals: list[int],
+                  scales: list[float], budgets: list[float | None],
+                  column_decimals: list[int],
                   sep: str, tol: float) -> _LayoutWriter:
     """The output file in the input's layout (:class:`_LayoutWriter`), from the input's lines
     and the faired rows (``fair_file``), each chunk's moves scaled by ``scales``."""
@@ -931,7 +956,7 @@ def _write_layout(dest: str, src: str, fair_file: str, chunks: list[Chunk],
             new = faired.take(n)
             s = scales[ch.index]
             w.write(ch.index, orig, new if s == 1.0 else _scaled(orig, new, s), before,
-                    lines, exact[ch.index])
+                    lines, budgets[ch.index])
         src_rows.finish()
         w.close(src_rows.stream.tail)
     except BaseException:

@@ -176,8 +176,9 @@ def rounded_number(v: float, text: str, column_decimals: int, extra: int = 0) ->
     """Text for ``v``, replacing the number ``text``, rounded to the file's precision: the
     token's own decimals if they write ``v`` exactly, else ``v`` rounded to the column's
     largest number of decimals plus ``extra`` (at least one), in the token's style (fixed or
-    exponent, ``+``, bare point). An integer column (no decimals, no exponent) is not rounded:
-    the shortest exact form, as :func:`format_number` writes it.
+    exponent, ``+``, bare point); where that rounds onto the value read, the text read. An
+    integer column (no decimals, no exponent) is not rounded: the shortest exact form, as
+    :func:`format_number` writes it.
 
     Unlike :func:`format_number`, this rounds: a caller uses it only where the rounded file is
     measured against the tolerance afterwards (and ``extra`` raised, or :func:`format_number`
@@ -188,7 +189,8 @@ def rounded_number(v: float, text: str, column_decimals: int, extra: int = 0) ->
         return s
     if column_decimals <= 0 and not tok.exponent:
         return format_number(v, tok, column_decimals)
-    return _render(v, tok, max(column_decimals, 1) + int(extra))
+    s = _render(v, tok, max(column_decimals, 1) + int(extra))
+    return text if float(s) == float(text) else s  # rounded onto the value read: as read
 
 
 def _is_plain(text: str) -> bool:
