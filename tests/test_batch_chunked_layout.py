@@ -247,7 +247,7 @@ def test_crlf_line_endings_are_kept(tmp_path: Path):
     body = "".join(f"{x:.5f};{y:.5f}\r\n" for x, y in P0.tolist()[:250]) + "# half way\r\n" + \
         "".join(f"{x:.5f};{y:.5f}\r\n" for x, y in P0.tolist()[250:])
     src = tmp_path / "w.csv"
-    src.write_bytes(("x;y\r\n" + body).encode())
+    src.write_bytes(("x;y\r\n" + body + "\r\n# end\r\n").encode())
     out = tmp_path / "o.csv"
     fair_chunked(src, out, tol=0.01, chunk=120, overlap=16, hold=4, jobs=1)
     raw = out.read_bytes()
@@ -310,3 +310,19 @@ def test_point_stream_lines_and_decimals(tmp_path: Path):
     assert s.lead + "".join(x + y for b in got for x, y in zip(b[1], b[2], strict=True)) + \
         s.tail == raw
     assert s.column_decimals == [1, 3] and s.n_rows == 3
+
+
+def test_a_moved_row_outside_the_layout_rules_is_written_exactly(tmp_path: Path):
+    # "1.5;;2.5" is a row to the streaming reader but not one the layout renders: written
+    # with the file's separator and exact numbers (its comment kept), counted in the report
+    w = ck._LayoutWriter(str(tmp_path / "o.csv"), "x;y\n", [1, 1], ";", 0.5)
+    orig = np.array([[1.5, 2.5], [3.5, 4.5], [5.5, 6.5]])
+    new = np.array([[1.5, 2.5], [3.5 + 1e-3 / 3, 4.5], [5.5, 6.5 - 1e-3 / 7]])
+    w.write(0, orig, new, ["", "", "# c\n"],
+            ["1.5;2.5\n", "3.5;;4.5 # odd\n", "5.5 ; 6.5\n"], 0.05)
+    w.close("# end\n")
+    text = Path(w.path).read_text()  # the temporary file the driver measures, then moves
+    x, y = float(f"{new[2, 1]:.1f}"), float(new[1, 0])
+    assert x == 6.5  # rounded back onto the value read: its text
+    assert text == f"x;y\n1.5;2.5\n{y!r};4.5 # odd\n# c\n5.5 ; 6.5\n# end\n"
+    assert w.fresh == {0: 1} and w.rounded == {0: 1}

@@ -42,6 +42,19 @@ moves scaled down, ``p = p0 + s (p_faired - p0)`` aiming at ``0.995 tol``, and t
 written and measured again; only a file within ``tol`` everywhere is moved onto the
 destination (nothing is written otherwise).
 
+Text from text is written in the input's layout (:class:`_LayoutWriter`): the input's lines
+are streamed again, in step with the faired rows (kept exactly in a float64 scratch file,
+since the file's precision -- each column's largest number of decimals -- is known only after
+the whole input has been read); header, comment and blank lines and unmoved rows are copied
+byte for byte, each line with its own ending, and moved rows are rendered in their line's
+layout with their moved numbers rounded to the input's decimals. The rounding is part of the
+certificate: per row, the written point (as it reads back, in float64) is within ``tol`` of
+the input's point, within :func:`rounding_budget` of its faired point and not on a neighbour,
+else that row gets one more decimal at a time, then its exact value; the measure above is of
+the rounded file, and a core read back over ``tol`` whose rounding changed something has its
+rounding undone (its moved numbers written exactly, as the single-file writer writes them)
+before its moves are scaled.
+
 Parallel work
 -------------
 Fairing a chunk and measuring one depend only on the points of its window, so they run in
@@ -539,12 +552,11 @@ class _Runner:
 # writing in blocks
 # ------------------------------------------------------------------------------------------
 class _Writer:
-    """Rows appended in blocks to a temporary file (text: the input's separator and the lines
-    before its first row, numbers in the shortest form that reads back exactly; ``.npy``:
-    float64)."""
+    """Rows appended in blocks to a temporary file (text, from a ``.npy`` input: ``sep``
+    between numbers in the shortest form that reads back exactly; ``.npy``: float64, also the
+    scratch file of the faired rows for :class:`_LayoutWriter`)."""
 
-    def __init__(self, dest: str, kind: str, dim: int, sep: str,
-                 preamble: list[str] | None) -> None:
+    def __init__(self, dest: str, kind: str, dim: int, sep: str) -> None:
         d = Path(dest)
         fd, self.path = tempfile.mkstemp(prefix="." + d.name + ".",
                                          suffix=".npy" if kind == "npy" else d.suffix,
@@ -554,8 +566,6 @@ class _Writer:
         if kind == "npy":
             self._npy_header(10**12)
             self.hlen = self.f.tell()
-        elif preamble:
-            self.f.write("".join(line + "\n" for line in preamble).encode())
 
     def _npy_header(self, n: int) -> None:
         np.lib.format.write_array_header_1_0(
@@ -677,7 +687,10 @@ class _LayoutWriter:
             r = render_row(body, v, self.cols, level)
             if r is None:  # not a row of this layout (e.g. "1,,2"): fresh, exact
                 self.fresh[index] += 1
+                hash_at = body.find("#")
                 text, w = self.sep.join(map(repr, v)), v
+                if hash_at >= 0:
+                    text += " " + body[hash_at:]
                 break
             text, w = r
             if level is None:
@@ -799,7 +812,7 @@ def fair_chunked(source: str | os.PathLike[str], out: str | os.PathLike[str], *,
         # text to text: the faired rows first go to a float64 scratch file (the layout
         # needs the file's precision, known after the whole input has been read)
         writer = _Writer(dest, "npy" if layout else out_kind, dim,
-                         stream.sep if stream.kind == "text" else ",", None)
+                         stream.sep if stream.kind == "text" else ",")
         temps.append(writer.path)
 
         def tasks() -> Iterator[tuple[Any, ...]]:
@@ -870,7 +883,7 @@ def fair_chunked(source: str | os.PathLike[str], out: str | os.PathLike[str], *,
                              "down until within tol")
             if layout:
                 continue
-            w = _Writer(dest, out_kind, dim, writer.sep, None)
+            w = _Writer(dest, out_kind, dim, writer.sep)
             temps.append(w.path)
             for ch, orig, faired in _lockstep(src, fair_file, chunks):
                 s = scales[ch.index]
@@ -910,8 +923,9 @@ def fair_chunked(source: str | os.PathLike[str], out: str | os.PathLike[str], *,
             rep["rows_more_decimals"] = lw.more_decimals[k]
             rep["rows_not_in_layout"] = lw.fresh[k]
     dropped = 0 if layout else stream.n_comments_dropped
-    if lw is not None and sum(lw.fresh.values()):
-        notes.append(f"{sum(lw.fresh.values())} moved row(s) the layout could not be kept for "
+    n_fresh = 0 if lw is None else int(np.sum(list(lw.fresh.values())))
+    if n_fresh:
+        notes.append(f"{n_fresh} moved row(s) the layout could not be kept for "
                      "(odd separators) were written with the input's separator and exact "
                      "numbers")
     g2 = max((max(r.get("tangent_angle", 0.0), r.get("curvature_rel", 0.0),

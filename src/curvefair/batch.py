@@ -1140,10 +1140,17 @@ def fair_chunked(source: str | os.PathLike[str], out: str | os.PathLike[str], *,
     """Fair one open point list too large for memory in overlapping chunks; write ``out``.
 
     ``source`` is a point file (``.csv``, ``.txt``, ``.xyz``, ``.pts``, ``.dat`` columns, or a
-    ``.npy`` array of shape (n, 2) or (n, 3), memory-mapped); ``out`` a point file too (text:
-    the input's separator, its lines before the first row (header, comments) as they are, every
-    number in the shortest form that reads back exactly; comments after the first row are not
-    copied, ``n_comments_dropped`` counts them; ``.npy``: float64). Chunk ``k`` (rows ``k chunk
+    ``.npy`` array of shape (n, 2) or (n, 3), memory-mapped); ``out`` a point file too. Text
+    from text keeps the input's layout line for line, as the single-file writer does: header,
+    comment and blank lines, every line's ending, and each unmoved row byte for byte; a moved
+    row keeps its separators, padding and number style. Unlike the single-file writer (which
+    writes a moved number exactly where the file's decimals cannot), its moved numbers are
+    rounded to the column's decimals in the input, the rounding checked as part of the
+    tolerance, or given more decimals (one at a time, then exact) where rounding would move the
+    point past ``tol`` from the input, too far from its faired point or onto a neighbour; a
+    chunk whose curve read back then exceeds ``tol`` has its rounding undone (see
+    :mod:`curvefair._chunked`). Text from ``.npy``: numbers in the shortest form that reads back
+    exactly, ``,`` separated. ``.npy`` out: float64. Chunk ``k`` (rows ``k chunk
     ..``) is faired by :func:`curvefair.fair` on its rows extended by ``overlap`` rows each
     side, holding the ``hold`` rows either side of each join in both neighbouring fairs, and
     kept on its own rows; the file written is read back in chunks and measured like a
@@ -1181,7 +1188,9 @@ def fair_chunked(source: str | os.PathLike[str], out: str | os.PathLike[str], *,
     dict
         ``n_points``, ``n_chunks``, ``max_deviation`` (read back), ``max_point_displacement``,
         ``chunks`` (per chunk: rows, window, method, steps, its own certificate
-        ``max_deviation``, ``on_disk_deviation``, ``move_scale``), ``joins`` (per join: the
+        ``max_deviation``, ``on_disk_deviation``, ``move_scale``; text from text also
+        ``on_disk_numbers`` -- ``"rounded"`` or ``"exact"`` --, ``rows_rounded``,
+        ``rows_more_decimals``), ``layout_kept``, ``joins`` (per join: the
         tangent angle and relative curvature difference between the two fairs and against
         the curve read back), ``joins_g2_max`` and ``g2_tol``.
 
