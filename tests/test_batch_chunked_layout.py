@@ -193,14 +193,22 @@ def test_coarse_decimals_get_more_where_rounding_would_break_tol(tmp_path: Path)
     counts = _check_layout(src, out, P, Q, tol, needed_more=needed)
     assert counts["more"] > 100  # the extra-decimals path was taken
     assert sum(c["rows_more_decimals"] for c in rep["chunks"]) == counts["more"]
-    # one decimal at a time: no moved row has more decimals than it needs to meet the rules
-    for i in np.flatnonzero(moved):
-        k = max(_decimals(t) for t in rows[i + 1])
-        if k > 2 and not exact[i] and k <= 10:
-            r = np.array([float(f"{v:.{k - 1}f}") for v in V[i]])
-            assert (np.linalg.norm(r - P[i]) > tol or np.linalg.norm(r - V[i]) > budget[i]
+    # one decimal at a time (up to 2 + _MAX_EXTRA, then the exact value): no moved row has
+    # more decimals than it needs to meet the rules
+    top = 2 + ck._MAX_EXTRA
+
+    def breaks(i: int, k: int) -> bool:
+        r = np.array([float(f"{v:.{k}f}") for v in V[i]])
+        return bool(np.linalg.norm(r - P[i]) > tol or np.linalg.norm(r - V[i]) > budget[i]
                     or (i > 0 and np.array_equal(r, Q[i - 1]))
-                    or (i + 1 < len(Q) and np.array_equal(r, Q[i + 1]))), i
+                    or (i + 1 < len(Q) and np.array_equal(r, Q[i + 1])))
+
+    for i in np.flatnonzero(moved & ~exact):
+        k = max(_decimals(t) for t in rows[i + 1])
+        if 2 < k <= top:
+            assert breaks(i, k - 1), i
+        elif k > top:
+            assert np.array_equal(Q[i], V[i]) and breaks(i, top), i
 
 
 # ------------------------------------------------------------------------------------------
