@@ -20,8 +20,10 @@ Writing
 -------
 The faired data points (same number, same order) go back into the same lines: comments,
 header, separators, padding kept; each number keeps its token's decimals when that writes it
-exactly, else it is rounded to the column's largest number of decimals in the file (the
-file's precision) unless ``decimals=`` is given.
+exactly, else the column's largest number of decimals in the file when that writes it exactly,
+else the shortest exact form, unless ``decimals=`` is given (``curvefair.io._text.format_number``).
+:func:`render_row` renders one row by the same rule, or rounded to the file's precision for a
+writer that checks the rounding against its tolerance itself (chunked fairing).
 """
 
 from __future__ import annotations
