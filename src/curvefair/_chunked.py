@@ -82,7 +82,7 @@ from typing import Any
 import numpy as np
 
 from .errors import FileFormatError, InputError
-from .io.points import number_decimals, render_row
+from .io.points import column_decimals, render_row
 
 DEFAULT_CHUNK = 5000
 DEFAULT_OVERLAP = 64
@@ -109,7 +109,7 @@ class PointStream:
     first row) are known after the first block; ``n_comments_dropped`` counts the comments
     after the first row (lines an output without the input's layout does not copy).
     ``column_decimals`` (text, ``decimals=True``): the largest number of decimals per column
-    over the file, the file's precision (:func:`curvefair.io.points.number_decimals`).
+    over the file, the file's precision (:func:`curvefair.io.points.column_decimals`).
     """
 
     def __init__(self, path: str | os.PathLike[str], *, decimals: bool = False) -> None:
@@ -179,6 +179,13 @@ class PointStream:
             raise InputError(f"{self.path!r}: text_rows reads text point files")
         yield from self._text_parse(size, keep=True)
 
+    def _decimals_of(self, texts: list[str]) -> None:
+        """Fold a block's number texts into :attr:`column_decimals`."""
+        assert self.dim is not None
+        got = column_decimals(texts, self.dim)
+        self.column_decimals = [max(a, b) for a, b in
+                                zip(self.column_decimals or [0] * self.dim, got, strict=True)]
+
     def _text_parse(self, size: int, keep: bool
                     ) -> Iterator[tuple[np.ndarray, list[str], list[str]]]:
         rows: list[list[float]] = []
@@ -188,8 +195,9 @@ class PointStream:
         n = 0
         self.header, self.preamble, self.n_comments_dropped = None, [], 0
         self.lead, self.tail = "", ""
-        dec = self.column_decimals = []
+        self.column_decimals = []
         track = self.track_decimals
+        texts: list[str] = []  # track: the number texts of the block, row after row
         if keep:
             with open(self.path, "rb") as fb:
                 if fb.read(3) == b"\xef\xbb\xbf":
@@ -234,12 +242,7 @@ class PointStream:
                     if not all(math.isfinite(v) for v in vals):
                         raise FileFormatError(f"line {ln}: not a finite number", self.path, ln)
                     if track:
-                        if not dec:
-                            dec.extend([0] * len(toks))
-                        for j, t in enumerate(toks):
-                            d = number_decimals(t)
-                            if d > dec[j]:
-                                dec[j] = d
+                        texts.extend(toks)
                     if keep:
                         if n == 0:
                             self.lead = "".join(between)
@@ -251,11 +254,16 @@ class PointStream:
                     rows.append(vals)
                     n += 1
                     if len(rows) == size:
+                        if track:
+                            self._decimals_of(texts)
+                            texts = []
                         yield np.array(rows, dtype=np.float64), before, lines
                         rows, before, lines = [], [], []
             except UnicodeDecodeError as exc:
                 raise FileFormatError(f"not a text file ({exc.reason})", self.path) from None
         if rows:
+            if track:
+                self._decimals_of(texts)
             yield np.array(rows, dtype=np.float64), before, lines
         if keep:
             if n == 0:

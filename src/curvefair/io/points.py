@@ -45,9 +45,16 @@ from ._common import (
     piece_values,
     point_records,
 )
-from ._text import TextLayout, _decimals, _render_line, _split_numbers, fresh_text, parse_text
+from ._text import (
+    TextLayout,
+    _column_decimals,
+    _render_line,
+    _split_numbers,
+    fresh_text,
+    parse_text,
+)
 
-__all__ = ["read", "write", "render_row", "number_decimals"]
+__all__ = ["read", "write", "render_row", "column_decimals"]
 
 FORMAT = "points"
 
@@ -122,10 +129,11 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
     atomic_write(path, text)
 
 
-def number_decimals(text: str) -> int:
-    """Digits after the point of a number as written in a points file (of the mantissa for
-    exponent style): what the file's precision per column is made of (its largest value)."""
-    return _decimals(text)
+def column_decimals(texts: list[str], width: int) -> tuple[int, ...]:
+    """The largest number of decimals per column (of the mantissa for exponent style) of the
+    number texts of rows of ``width`` numbers, row after row: the file's precision, as the
+    reader records it (:attr:`TextLayout.column_decimals`)."""
+    return _column_decimals(texts, width)
 
 
 def render_row(line: str, values: Sequence[float], column_decimals: Sequence[int],
