@@ -263,3 +263,57 @@ def test_matched_hermite_bound_kernel_vs_numpy_and_dense_sampling(dim, closed):
             # slack: the rounding of evaluating coordinates of size max|x| separately
             slack = 16 * np.finfo(float).eps * float(np.abs(P).max() + 1)
             assert d <= bound[i] + slack, (n, i, d, bound[i])
+
+
+def test_geometric_distance_on_chosen_spans_against_scipy():
+    """``deviation(a, b, kind="geometric", spans=S)``: the Hausdorff distance restricted to
+    the pieces S of each curve, each point measured against the whole other curve (scipy:
+    dense k-d tree and bounded minimisation); all spans give the whole-curve figure, none 0."""
+    from scipy.optimize import minimize_scalar
+    from scipy.spatial import cKDTree
+
+    rng = np.random.default_rng(3)
+    t = np.linspace(0.0, 3.0, 40)
+    p = np.c_[t, np.sin(2 * t)] + rng.normal(scale=0.01, size=(40, 2))
+    q = p + rng.normal(scale=0.02, size=(40, 2))
+    a, b = cf.interpolate_cubic(p), cf.interpolate_cubic(q)  # each on its own chord lengths
+    spans = [5, 6, 20, 38]
+
+    def directed(x_curve, y_curve, pieces):
+        uy = np.linspace(*y_curve.domain, 400_001)
+        tree = cKDTree(y_curve(uy))
+        hy = uy[1] - uy[0]
+
+        def dist(s):
+            x = x_curve(s).reshape(-1)
+            d0, j = tree.query(x)
+            lo, hi = max(uy[j] - 2 * hy, uy[0]), min(uy[j] + 2 * hy, uy[-1])
+            r = minimize_scalar(lambda v: float(np.linalg.norm(y_curve(v) - x)),
+                                bounds=(lo, hi), method="bounded", options={"xatol": 1e-14})
+            return min(float(r.fun), float(d0))
+
+        br = x_curve.params
+        out = 0.0
+        for i in pieces:
+            ux = np.linspace(br[i], br[i + 1], 2001)
+            d = tree.query(x_curve(ux))[0]
+            k = int(np.argmax(d))
+            lo, hi = ux[max(k - 1, 0)], ux[min(k + 1, len(ux) - 1)]
+            r = minimize_scalar(lambda s: -dist(s), bounds=(lo, hi), method="bounded",
+                                options={"xatol": 1e-13})
+            out = max(out, -float(r.fun), dist(ux[k]))
+        return out
+
+    d = cf.deviation(a, b, kind="geometric", spans=spans)
+    ref = max(directed(a, b, spans), directed(b, a, spans))
+    assert d.kind == "geometric"
+    assert d.max_distance == pytest.approx(ref, rel=1e-6, abs=1e-9)
+    whole = cf.deviation(a, b, kind="geometric")
+    assert d.max_distance <= whole.max_distance
+    every = cf.deviation(a, b, kind="geometric", spans=np.arange(39))
+    assert every.max_distance == whole.max_distance
+    assert cf.deviation(a, b, kind="geometric", spans=[]).max_distance == 0.0
+    with pytest.raises(cf.InputError, match="spans"):
+        cf.deviation(a, b, kind="parametric", spans=[1])
+    with pytest.raises(cf.InputError, match="0 .. 38"):
+        cf.deviation(a, b, kind="geometric", spans=[39])

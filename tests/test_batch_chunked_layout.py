@@ -280,8 +280,8 @@ def test_a_rounded_chunk_read_back_over_tol_is_written_exactly(tmp_path: Path, m
     real = ck.measure_chunk
     calls = {"n": 0}
 
-    def inflated(ch, orig, new):
-        m = real(ch, orig, new)
+    def inflated(ch, orig, new, tol=None):
+        m = real(ch, orig, new, tol)
         if ch.index == 1 and calls["n"] == 0:
             calls["n"] += 1
             m = dict(m, deviation=0.02)

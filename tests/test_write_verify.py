@@ -340,3 +340,32 @@ def test_cli_report_after_figures_are_those_of_the_file_read_back(tmp_path, monk
     assert row["on_disk_deviation"] == pytest.approx(indep, rel=1e-3)
     # (and the fake fair's own moves, unscaled, would have read back beyond tol)
     assert row["max_point_displacement"] < 0.98 * tol
+
+
+def test_point_file_spans_over_the_bound_are_refined(tmp_path):
+    """A faired point list read back: where the O(n) per-span bound exceeds tol (here one
+    span of a poliakoff fair that uses the whole tolerance) only those spans get the refined
+    geometric distance; the figure is within tol, bounds the whole-curve refined distance, and
+    the file holds the faired points exactly."""
+    import curvefair as cf
+    from curvefair.analysis import matched_hermite_bound
+
+    rng = np.random.default_rng(0)
+    n = 3000
+    s = np.linspace(0.0, 24.0 * np.pi, n)
+    P = np.c_[s, 3.0 * np.sin(s)] + 0.003 * rng.standard_normal((n, 2))
+    src = tmp_path / "p.csv"
+    np.savetxt(src, P, delimiter=",", header="x,y", comments="")
+    recs = read_curves(src, corner_angle=None)
+    tol = 0.01
+    r = cf.fair(recs[0].curve, "poliakoff", tol=tol)
+    mb = matched_hermite_bound(recs[0].curve, r.curve)
+    assert np.count_nonzero(mb > tol) >= 1  # the case this test is about
+    chk = write_curves(tmp_path / "o.csv", [recs[0].with_curve(r.curve)], template=src,
+                       reference=recs, tol=tol, corner_angle=None)
+    assert chk.kinds == ("geometric",)
+    back = read_curves(tmp_path / "o.csv", corner_angle=None)[0].curve
+    whole = cf.deviation(recs[0].curve, back, kind="geometric").max_distance
+    assert whole * (1 - 1e-9) <= chk.deviations[0] <= tol
+    np.testing.assert_array_equal(np.loadtxt(tmp_path / "o.csv", delimiter=",", skiprows=1),
+                                  r.curve.points)

@@ -35,12 +35,13 @@ On disk
 The output is written in blocks to a temporary file next to the destination, then read back
 in blocks and measured as a single-file run of point data is (:mod:`curvefair.io._verify`):
 per core, the geometric (Hausdorff) distance between the curve rebuilt from the written
-points and the input's curve, both on their windows (``overlap`` points either side;
-by the bound above the window's curve on the core is the whole curve's to ``2^-overlap``
-relative, far below rounding for the default). A core read back farther than ``tol`` gets its
-moves scaled down, ``p = p0 + s (p_faired - p0)`` aiming at ``0.995 tol``, and the file is
-written and measured again; only a file within ``tol`` everywhere is moved onto the
-destination (nothing is written otherwise).
+points and the input's curve -- its O(n) per-span upper bound where that meets ``tol``, else
+the refined distance on the spans it does not clear (:func:`measure_chunk`) -- both on their
+windows (``overlap`` points either side; by the bound above the window's curve on the core is
+the whole curve's to ``2^-overlap`` relative, far below rounding for the default). A core
+read back farther than ``tol`` gets its moves scaled down, ``p = p0 + s (p_faired - p0)``
+aiming at ``0.995 tol``, and the file is written and measured again; only a file within
+``tol`` everywhere is moved onto the destination (nothing is written otherwise).
 
 Text from text is written in the input's layout (:class:`_LayoutWriter`): the input's lines
 are streamed again, in step with the faired rows (kept exactly in a float64 scratch file,
@@ -454,20 +455,27 @@ def fair_chunk(ch: Chunk, pts: np.ndarray, tol: float, method: str | None, hold:
                        "extrema_after": r["extrema_after"]}}
 
 
-def measure_chunk(ch: Chunk, orig: np.ndarray, new: np.ndarray) -> dict[str, Any]:
+def measure_chunk(ch: Chunk, orig: np.ndarray, new: np.ndarray,
+                  tol: float | None = None) -> dict[str, Any]:
     """The core of ``ch`` read back: Hausdorff distance between the curves through ``new``
     and ``orig`` on the window, restricted to the core (segments ``start .. stop``), the
     largest point move, and the read-back curve's tangent / curvature at the joins.
-    The refined geometric distance (:func:`curvefair.deviation`, ``kind="geometric"``, as
-    :mod:`curvefair.io._verify` measures point data whose cheap bound exceeds ``tol``; that
-    bound is about half a sample gap above it, more than the room a fair to ``tol`` leaves)."""
+
+    As :mod:`curvefair.io._verify` measures a point file read back: the per-span upper bound
+    of the Hausdorff distance (:func:`curvefair.analysis.matched_hermite_bound`, one O(n)
+    compiled pass) where it meets ``tol`` (``kind`` ``"matched bound"``), else, on the spans
+    whose bound exceeds ``tol``, the refined geometric distance (:func:`curvefair.deviation`,
+    ``kind="geometric"``, ``spans=``: Newton projections of their points onto the whole other
+    core), which then decides; ``tol`` None: the refined distance of the whole core."""
 
     with _one_blas_thread():
-        return _measure(ch, orig, new)
+        return _measure(ch, orig, new, tol)
 
 
-def _measure(ch: Chunk, orig: np.ndarray, new: np.ndarray) -> dict[str, Any]:
+def _measure(ch: Chunk, orig: np.ndarray, new: np.ndarray,
+             tol: float | None = None) -> dict[str, Any]:
     from . import CubicHermite, deviation, interpolate_cubic
+    from .analysis import matched_hermite_bound
 
     a = interpolate_cubic(orig, "chord", "natural")
     b = interpolate_cubic(new, "chord", "natural")
@@ -476,8 +484,18 @@ def _measure(ch: Chunk, orig: np.ndarray, new: np.ndarray) -> dict[str, Any]:
     for c in (a, b):
         P, T, U = c.points, c.tangents, c.params
         cores.append(CubicHermite(P[lo:hi + 1], T[lo:hi + 1], U[lo:hi + 1]))
-    dist = float(deviation(cores[0], cores[1], kind="geometric").max_distance)
-    kind = "geometric"
+    bound = matched_hermite_bound(cores[0], cores[1])
+    dist = float(bound.max()) if bound.size else 0.0
+    kind = "matched bound"
+    if tol is None:
+        dist = float(deviation(cores[0], cores[1], kind="geometric").max_distance)
+        kind = "geometric"
+    elif not dist <= tol:
+        # the spans the bound does not clear, measured against the whole other core
+        over = ~(bound <= tol)
+        refined = deviation(cores[0], cores[1], kind="geometric", spans=np.flatnonzero(over))
+        dist = max(float(refined.max_distance), float(bound[~over].max(initial=0.0)))
+        kind = "geometric"
     moved = np.linalg.norm(new[lo:ch.stop - ch.w0] - orig[lo:ch.stop - ch.w0], axis=1)
     frames = {}
     Pb, Tb, Ub = np.asarray(b.points), np.asarray(b.tangents), np.asarray(b.params)
@@ -1056,7 +1074,7 @@ def _measure_file(runner: _Runner, src: str, written: str, chunks: list[Chunk], 
         for (ca, pa), (cb, pb) in zip(ga, gb, strict=True):
             if (ca.start, ca.stop, ca.w0, ca.w1) != (cb.start, cb.stop, cb.w0, cb.w1):
                 raise InputError(f"{written!r}: reads back with other rows than written")
-            yield (ca, pa, pb)
+            yield (ca, pa, pb, tol)
 
     out = []
     for _args, m in runner.map(measure_chunk, tasks()):

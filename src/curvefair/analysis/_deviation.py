@@ -10,7 +10,7 @@ import numpy as np
 
 from .._distance import point_distances
 from .._jit import njit
-from .._typing import FloatArray
+from .._typing import ArrayLike, FloatArray
 from ..curves.piecewise import PiecewiseCurve
 from ..errors import InputError
 from ._core import bernstein_matrix, check_curve, fields_to_dict, taylor_shift, to_bernstein
@@ -290,7 +290,8 @@ def _branch_and_bound(cb, lo, hi, best, best_t, ub, rtol, atol, levels, cap):  #
 
 
 def deviation(curve_a: object, curve_b: object,
-              kind: Literal["auto", "parametric", "geometric"] = "auto") -> Deviation:
+              kind: Literal["auto", "parametric", "geometric"] = "auto", *,
+              spans: ArrayLike | None = None) -> Deviation:
     """Maximum distance between two curves: ``max_t |a(t) - b(t)|``, or geometric.
 
     Parameters
@@ -304,6 +305,12 @@ def deviation(curve_a: object, curve_b: object,
         ``max(h(a, b), h(b, a))``, ``h(a, b) = max_t min_s |a(t) - b(s)|``, which needs no
         common parametrisation (two files read back, a curve re-interpolated through moved
         points). ``"auto"`` (default): parametric when the domains agree, else geometric.
+    spans : array_like of int, optional
+        Geometric distance only: measure only the points of these polynomial pieces
+        (0-based, each curve's own pieces; for two curves through the same number of points,
+        the spans between the same data points), each against the whole other curve: the
+        Hausdorff distance restricted to them. What a per-span bound such as
+        :func:`matched_hermite_bound` leaves to refine, at the cost of those pieces only.
 
     Returns
     -------
@@ -359,6 +366,18 @@ def deviation(curve_a: object, curve_b: object,
     b = check_curve(curve_b, "curve_b")
     if kind not in ("auto", "parametric", "geometric"):
         raise InputError(f"kind must be 'auto', 'parametric' or 'geometric', got {kind!r}")
+    if spans is not None:
+        if kind != "geometric":
+            raise InputError("spans is for kind='geometric' (the parametric search already "
+                             "visits only the pieces that can hold the maximum)")
+        sel = np.unique(np.asarray(spans, dtype=np.int64).reshape(-1))
+        n_min = min(a.piecewise.n_segments, b.piecewise.n_segments)
+        if sel.size and (sel[0] < 0 or sel[-1] >= n_min):
+            raise InputError(f"spans must be piece indices 0 .. {n_min - 1} of both curves, "
+                             f"got {int(sel[0] if sel[0] < 0 else sel[-1])}")
+        if a.dim != b.dim:
+            raise InputError(f"curve_a is {a.dim}-D but curve_b is {b.dim}-D")
+        return _geometric(a, b, sel)
     if a.dim != b.dim:
         raise InputError(f"curve_a is {a.dim}-D but curve_b is {b.dim}-D")
     (a0, a1), (b0, b1) = a.domain, b.domain
@@ -546,17 +565,46 @@ class _Nearest:
         return best_d, best_s
 
 
-def _directed(a: PiecewiseCurve, near_b: _Nearest) -> tuple[float, float, float]:
-    """``h(a, b) = max_t min_s |a(t) - b(s)|``: value, ``t`` on ``a``, ``s`` on ``b``."""
+def _directed(a: PiecewiseCurve, near_b: _Nearest, spans: np.ndarray | None = None
+              ) -> tuple[float, float, float]:
+    """``h(a, b) = max_t min_s |a(t) - b(s)|``: value, ``t`` on ``a``, ``s`` on ``b``; with
+    ``spans`` (sorted piece indices of ``a``), ``t`` only on those pieces (the same samples as
+    for the whole curve, with the pieces' ends). ``-1`` when no sample is left."""
     ua = _dense_params(a)
+    lo_run = hi_run = None
+    if spans is not None:
+        # the samples on the chosen pieces, each piece with both ends; runs of consecutive
+        # chosen pieces bound the refinement (it never looks at a piece not chosen)
+        br = np.asarray(a.piecewise.breaks, dtype=float)
+        chosen = np.zeros(br.shape[0] - 1, dtype=bool)
+        chosen[spans] = True
+        edges = np.diff(np.r_[0, chosen.astype(np.int8), 0])
+        lo_run, hi_run = br[np.flatnonzero(edges == 1)], br[np.flatnonzero(edges == -1)]
+        run = np.searchsorted(hi_run, ua, side="left")
+        inside = run < hi_run.shape[0]
+        inside[inside] = ua[inside] >= lo_run[run[inside]]
+        full, idx = ua, np.flatnonzero(inside)
+        ua = full[idx]
+        if ua.shape[0] == 0:
+            return -1.0, float(br[0]), float(near_b.u[0])
     da, sb = near_b(np.asarray(a(ua), dtype=float), _GEO_DENSE_NEIGHBOURS)
     best, bt, bs = -1.0, float(ua[0]), float(sb[0])
     # refine the largest local maxima of the sampled distance
-    interior = np.r_[True, da[1:] >= da[:-1]] & np.r_[da[:-1] >= da[1:], True]
+    if lo_run is None:
+        interior = np.r_[True, da[1:] >= da[:-1]] & np.r_[da[:-1] >= da[1:], True]
+    else:  # a run's first and last samples have no neighbour in the other runs
+        step = np.diff(idx) == 1
+        interior = (np.r_[True, (da[1:] >= da[:-1]) | ~step]
+                    & np.r_[(da[:-1] >= da[1:]) | ~step, True])
     cand = np.flatnonzero(interior)
     cand = cand[np.argsort(-da[cand], kind="stable")][:_GEO_REFINE]
-    lo = ua[np.maximum(cand - 1, 0)]
-    hi = ua[np.minimum(cand + 1, ua.shape[0] - 1)]
+    if lo_run is None or hi_run is None:
+        lo = ua[np.maximum(cand - 1, 0)]
+        hi = ua[np.minimum(cand + 1, ua.shape[0] - 1)]
+    else:  # the neighbouring samples of the whole curve, within the candidate's run
+        r = np.searchsorted(hi_run, ua[cand], side="left")
+        lo = np.maximum(full[np.maximum(idx[cand] - 1, 0)], lo_run[r])
+        hi = np.minimum(full[np.minimum(idx[cand] + 1, full.shape[0] - 1)], hi_run[r])
     g = (math.sqrt(5.0) - 1.0) / 2.0
 
     def dist(t: FloatArray) -> tuple[FloatArray, FloatArray]:
@@ -718,9 +766,10 @@ def _matched_hermite_bound_reference(a: Any, b: Any, pieces: int = 4) -> FloatAr
     return best * (1.0 + 1e-12)
 
 
-def _geometric(a: PiecewiseCurve, b: PiecewiseCurve) -> Deviation:
-    hab, ta, sb = _directed(a, _Nearest(b))
-    hba, tb, sa = _directed(b, _Nearest(a))
+def _geometric(a: PiecewiseCurve, b: PiecewiseCurve, spans: np.ndarray | None = None
+               ) -> Deviation:
+    hab, ta, sb = _directed(a, _Nearest(b), spans)
+    hba, tb, sa = _directed(b, _Nearest(a), spans)
     if hab >= hba:
         best, t, pa, pb = hab, ta, a(ta), b(sb)
     else:
@@ -730,5 +779,7 @@ def _geometric(a: PiecewiseCurve, b: PiecewiseCurve) -> Deviation:
     pa.setflags(write=False)
     pb.setflags(write=False)
     mpd, idx = point_displacement(a, b)
-    return Deviation(max_distance=float(best), upper_bound=None, param=float(t), point_a=pa,
+    # (max with 0: no sample at all, ``spans`` empty)
+    return Deviation(max_distance=max(float(best), 0.0), upper_bound=None, param=float(t),
+                     point_a=pa,
                      point_b=pb, max_point_displacement=mpd, point_index=idx, kind="geometric")

@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
+from .._typing import FloatArray
 from ..errors import CurvefairError, InputError
 from ._common import CurveRecord, atomic_path, points_curve
 
@@ -266,6 +267,7 @@ def _measure(reference: Sequence[CurveRecord], curves: Sequence[Any], tol: float
     devs, kinds, mpd = [], [], None
     for r, c in zip(reference, curves, strict=True):
         d_max: float | None = None
+        mb: FloatArray | None = None
         if not _same_domain(r.curve, c):
             if (type(r.curve) is CubicHermite and type(c) is CubicHermite
                     and np.shape(r.curve.points) == np.shape(c.points)):
@@ -279,6 +281,12 @@ def _measure(reference: Sequence[CurveRecord], curves: Sequence[Any], tol: float
             if tol is None or ub <= tol:
                 d_max, kind = ub, "geometric upper bound"
                 m, _ = point_displacement(r.curve, c)
+        if d_max is None and mb is not None and tol is not None:
+            # the spans the bound does not clear, measured against the whole other curve
+            over = ~(mb <= tol)
+            d = deviation(r.curve, c, kind="geometric", spans=np.flatnonzero(over))
+            d_max = max(float(d.max_distance), float(mb[~over].max(initial=0.0)))
+            kind, m = d.kind, d.max_point_displacement
         if d_max is None:
             d = deviation(r.curve, c)
             d_max, kind, m = float(d.max_distance), d.kind, d.max_point_displacement
