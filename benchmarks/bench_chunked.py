@@ -8,6 +8,7 @@ run pays for compiling. Input: a sine of ``n`` points with 0.003 noise, written 
 both runs read through corners (``--no-corners`` / ``corner_angle=None``: noise makes a few).
 
     python benchmarks/bench_chunked.py --sizes 20000,100000 --unchunked-max 100000
+    python benchmarks/bench_chunked.py --sizes 10000000 --unchunked-max 0 --method poliakoff
 
 Figures go to docs/benchmarks.md (measured on a shared, loaded machine: CPU times, not wall).
 """
@@ -29,8 +30,8 @@ TOL = 0.01
 CHUNKED = """
 import sys
 from curvefair.batch import fair_chunked
-r = fair_chunked(sys.argv[1], sys.argv[2], tol={tol}, chunk={chunk}, jobs=1,
-                 corner_angle=None)
+r = fair_chunked(sys.argv[1], sys.argv[2], tol={tol}, chunk={chunk}, jobs={jobs},
+                 corner_angle=None, method={method!r})
 print("max_deviation", r["max_deviation"], "chunks", r["n_chunks"], "g2", r["joins_g2_max"])
 """
 UNCHUNKED = """
@@ -68,6 +69,11 @@ def main() -> None:
     ap.add_argument("--sizes", default="20000,100000")
     ap.add_argument("--unchunked-max", type=int, default=100000)
     ap.add_argument("--chunk", type=int, default=5000)
+    ap.add_argument("--method", default=None,
+                    help="fairing method per chunk (default: fair()'s default for point data)")
+    ap.add_argument("--jobs", type=int, default=1,
+                    help="chunked: worker processes (1: the RSS is the whole run's; more: "
+                         "the parent's only, CPU of all)")
     a = ap.parse_args()
     warm = "import numpy as np; from curvefair import fair, interpolate_cubic; " \
            "fair(interpolate_cubic(np.c_[np.arange(50.), np.sin(np.arange(50.))]), tol=.1)"
@@ -84,7 +90,8 @@ def main() -> None:
         for n in (int(float(x)) for x in a.sizes.split(",")):
             src = Path(tmp) / f"in{n}.csv"
             _data(n, src)
-            cases = [("chunked", CHUNKED.format(tol=TOL, chunk=a.chunk))]
+            cases = [("chunked", CHUNKED.format(tol=TOL, chunk=a.chunk, jobs=a.jobs,
+                                                method=a.method))]
             if n <= a.unchunked_max:
                 cases.append(("unchunked", UNCHUNKED.format(tol=TOL)))
             for name, code in cases:
