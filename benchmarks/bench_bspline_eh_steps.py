@@ -10,7 +10,7 @@ Last column: the same step in the sweep schedule (``schedule="sweep"``: Gauss-Se
 queue, no priority structure; threshold 0, the same step cap) on the same state.
 
 Peer, measured in the same run: the same loop written with the generic per-point tournament tree
-of ``curvefair.fairing.ranking`` (``tt_build`` / ``tt_update`` per changed entry, one leaf per
+of ``curvefair._kernels.ranking`` (``tt_build`` / ``tt_update`` per changed entry, one leaf per
 control point, separate arrays for points, residuals and originals).
 
 Usage::
@@ -27,8 +27,8 @@ import numpy as np
 from numba import njit
 
 from curvefair import BSplineCurve
+from curvefair._kernels.ranking import tt_build, tt_update
 from curvefair.fairing import eck_hadenfeld as eh
-from curvefair.fairing.ranking import tt_build, tt_update
 
 
 def make_curve(n: int, seed: int = 0) -> BSplineCurve:

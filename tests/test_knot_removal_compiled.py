@@ -28,6 +28,7 @@ import numpy as np
 import pytest
 
 from curvefair import BSplineCurve, interpolate_bspline
+from curvefair._kernels.ranking import tt_build, tt_top, tt_update
 from curvefair._validate import as_nonnegative, as_step_count
 from curvefair.curves.bspline import basis_derivatives
 from curvefair.errors import InputError
@@ -42,7 +43,6 @@ from curvefair.fairing.knot_removal import (
     knot_removal_fair,
     sapidis_measure,
 )
-from curvefair.fairing.ranking import tt_build, tt_top, tt_update
 
 
 # ------------------------------------------------------------------------------------------

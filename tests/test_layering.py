@@ -1,11 +1,12 @@
 """No private import across packages (issue 15).
 
 A module may import an underscore name, or a name from an underscore module, only from its own
-package (curves, analysis, fairing, io, and the top level each count as one). The exception is
-the top level's shared internals - ``curvefair._typing``, ``_validate``, ``_jit``,
-``_distance`` and the other underscore modules directly under ``curvefair/``: they exist to be
-shared by every subpackage (array types, argument checks, the numba cache), so importing a
-public name from them is allowed; importing an underscore name from them is not."""
+package (curves, analysis, fairing, io, ``_kernels``, and the top level each count as one).
+The exception is the shared internals - ``curvefair._typing``, ``_validate``, ``_jit``,
+``_distance`` and the other underscore modules directly under ``curvefair/``, and the compiled
+kernels' package ``curvefair._kernels`` with its (non-underscore) modules: they exist to be
+shared by every subpackage (array types, argument checks, the numba cache, the kernels), so
+importing a public name from them is allowed; importing an underscore name from them is not."""
 
 from __future__ import annotations
 
@@ -63,8 +64,10 @@ def _private_imports(mod: tuple[str, ...], path: Path) -> list[str]:
             there = _package(target + (("__init__",) if SRC.joinpath(*target).is_dir() else ()))
             if there == here:
                 continue
-            shared = len(target) == 1 and target[0].startswith("_") and SRC.joinpath(
+            shared = (len(target) == 1 and target[0].startswith("_") and SRC.joinpath(
                 target[0] + ".py").is_file()   # a top-level shared internal module
+                or target[:1] == ("_kernels",)    # the kernels' package and its modules
+                and not any(p.startswith("_") for p in target[1:]))
             private = (any(p.startswith("_") for p in target) and not shared) \
                 or ((name or "").startswith("_") and not (name or "").startswith("__"))
             if private:
@@ -79,12 +82,18 @@ def test_the_checker_sees_a_private_import_across_packages(tmp_path):
     assert _private_imports(("fairing", "x"), p) is not None
     src = ("from ..curves.interpolate import _secret\nfrom ._own import ok\n"
            "from .._typing import A\nfrom .._validate import _hidden\n"
-           "from ..analysis._sampling import sample_curve\nimport curvefair.io._verify\n")
+           "from ..analysis._sampling import sample_curve\nimport curvefair.io._verify\n"
+           # the kernels' package is shared: its public names and modules may be imported,
+           # its underscore names (and underscore modules) may not
+           "from .._kernels import hermite\nfrom .._kernels.global_fair import band_cholesky\n"
+           "import curvefair._kernels.points\nfrom .._kernels.hermite import _kseg\n"
+           "from .._kernels._hidden import x\n")
     f = tmp_path / "x.py"
     f.write_text(src)
     got = _private_imports(("fairing", "x"), f)
     assert got == ["fairing.x -> curves.interpolate._secret", "fairing.x -> _validate._hidden",
-                   "fairing.x -> analysis._sampling.sample_curve", "fairing.x -> io._verify"]
+                   "fairing.x -> analysis._sampling.sample_curve", "fairing.x -> io._verify",
+                   "fairing.x -> _kernels.hermite._kseg", "fairing.x -> _kernels._hidden.x"]
 
 
 # The imports across packages that still reach private pieces (issue 15 lists them; each needs
@@ -97,7 +106,6 @@ KNOWN = {
     "fairing._tolerance -> curves.bspline._power_form_kernel",
     "fairing._tolerance -> curves.bspline._power_form_pair_kernel",
     "io._verify -> fairing._tolerance.point_report",
-    "steps -> fairing._hermite_kernels",
 }
 
 

@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .._jit import njit
+from .._kernels.ranking import tt_build, tt_top, tt_update
 from .._typing import FloatArray
 from .._validate import as_nonnegative, as_step_count
 from ..analysis.discrete import (
@@ -28,7 +29,6 @@ from ..analysis.discrete import (
     second_discrete_curvature,
 )
 from ..errors import InputError
-from .ranking import tt_build, tt_top, tt_update
 from .stop import StopReason
 
 if TYPE_CHECKING:

@@ -19,12 +19,12 @@ from typing import TYPE_CHECKING, Any, Literal, cast
 import numpy as np
 
 from .._jit import njit
+from .._kernels.ranking import tt_build, tt_update, tt_update_range
 from .._typing import FloatArray
 from .._validate import as_step_count
 from ..curves.bspline import BSplineCurve, basis_derivatives
 from ..errors import InputError
 from .eck_hadenfeld import check_bspline
-from .ranking import tt_build, tt_update, tt_update_range
 from .stop import StopReason
 
 if TYPE_CHECKING:
@@ -404,7 +404,7 @@ def knot_removal_fair(curve: BSplineCurve, *, variant: Variant = "one-point",
     coefficients, one-sided basis derivative rows, Boehm's ratios) is set up vectorised, then
     each step costs the removal moves (one point, or a ``p x (p-1)`` least-squares solve), the
     measure at the ``<= 2p + 1`` touched knots and ``O(log N)`` updates of an indexed tournament
-    tree (:mod:`~curvefair.fairing.ranking`).
+    tree (:mod:`curvefair._kernels.ranking`).
 
     Examples
     --------

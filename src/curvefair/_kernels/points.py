@@ -11,7 +11,7 @@ non-zero basis functions there). The Newton matrix is
 ``K`` the (scaled) interleaved energy matrix, banded with ``dim x dim`` blocks of block
 half-bandwidth 4 (given by its lower band ``Kb``), and one symmetric ``dim x dim`` block
 ``B_i`` per constraint row. Lower band storage ``L[r, k] = M[r + k, r]`` with
-``kd = 5 dim - 1``, as :func:`curvefair.fairing._global_kernels.band_cholesky` takes it.
+``kd = 5 dim - 1``, as :func:`curvefair._kernels.global_fair.band_cholesky` takes it.
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._jit import njit
-from ._global_kernels import band_cholesky, band_solve
+from .global_fair import band_cholesky, band_solve
 
 
 @njit(cache=True)

@@ -1,0 +1,17 @@
+"""curvefair's compiled kernels (private): the numba-jitted loops of the fairing methods.
+
+One module per family, each kernel written once; the Python drivers that prepare arrays, call
+the kernels and read their results live in the public packages (:mod:`curvefair.fairing`,
+:mod:`curvefair.curves`, :mod:`curvefair.steps`):
+
+* :mod:`.hermite` -- the local Hermite steps (Kjellander, Poliakoff, Wang-Cao, Wang quintic)
+  and their automatic loop;
+* :mod:`.global_fair` -- the block-banded Newton systems of the global fairing;
+* :mod:`.points` -- the interior point of the point-fairing tube QP.
+
+Every kernel is decorated with :func:`curvefair._jit.njit`. The package is private, but its
+public names (no leading underscore) may be imported by every other curvefair package
+(``tests/test_layering.py`` treats it as a shared internal, like ``curvefair._typing``). The
+package itself imports nothing, so that importing one kernel module loads only what that module
+needs.
+"""
