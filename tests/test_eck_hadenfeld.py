@@ -345,7 +345,7 @@ def test_loop_matches_slow_reference_mixed_knots(closed, tol):
 def test_fused_setup_is_bitwise_band_residual_and_energy(closed, p, dim):
     # the loop's one-pass set-up must give exactly the values of the separate band kernels
     # (the stopping threshold is relative to this energy), and the energy must match quadrature
-    from curvefair.curves.bspline import band_energy, band_residual
+    from curvefair._kernels.bspline import band_energy, band_residual
     from curvefair.fairing.eck_hadenfeld import _aligned_empty, _setup_state
 
     rng = np.random.default_rng(100 * p + dim + closed)

@@ -103,8 +103,6 @@ KNOWN = {
     "batch -> io._verify.write_checked",
     "cli -> io._verify.write_checked",
     "cli -> io._verify.rescaled_report",
-    "fairing._tolerance -> curves.bspline._power_form_kernel",
-    "fairing._tolerance -> curves.bspline._power_form_pair_kernel",
     "io._verify -> fairing._tolerance.point_report",
 }
 

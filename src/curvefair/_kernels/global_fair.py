@@ -37,7 +37,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._jit import njit
-from ..curves.bspline import residual_row
+from .bspline import residual_row
 
 # ------------------------------------------------------------------------------------------
 # assembly
@@ -586,7 +586,7 @@ def _krow(K, ks, p, closed, x, i, a, interior):  # type: ignore[no-untyped-def]
 @njit(cache=True)
 def band_residual_scaled(W, ks, p, closed, x, out):  # type: ignore[no-untyped-def]
     """``out = (W ks) x`` per coordinate in the difference form of
-    :func:`curvefair.curves.bspline.band_residual` (``sum_{o != 0} (W[i, p + o] ks) (x_{i+o} -
+    :func:`curvefair._kernels.bspline.band_residual` (``sum_{o != 0} (W[i, p + o] ks) (x_{i+o} -
     x_i)``, the same operations on the entries of the scaled band: :func:`residual_row`)."""
     n, dim = x.shape
     for i in range(n):

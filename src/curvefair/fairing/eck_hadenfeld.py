@@ -23,9 +23,10 @@ from typing import TYPE_CHECKING, Any, cast
 import numpy as np
 
 from .._jit import njit, prefetch
+from .._kernels.bspline import band_energy, band_residual, energy_row, residual_row
 from .._typing import FloatArray
 from .._validate import as_step_count, check_finite, choice, parse_clamp
-from ..curves.bspline import BSplineCurve, band_energy, band_residual, energy_row, residual_row
+from ..curves.bspline import BSplineCurve
 from ..errors import InputError
 from .stop import StopReason
 
@@ -164,7 +165,7 @@ def eh_weights(curve: BSplineCurve, r: int,
 
 def _residual(curve: BSplineCurve, W: FloatArray) -> FloatArray:
     """``g = G d`` (per coordinate) from the band, compiled, in difference form (accurate for
-    large coordinates, see :func:`curvefair.curves.bspline.band_residual`): shape (n, dim)."""
+    large coordinates, see :func:`curvefair._kernels.bspline.band_residual`): shape (n, dim)."""
     d = np.ascontiguousarray(curve.control_points)
     g = np.empty_like(d)
     band_residual(np.ascontiguousarray(W), curve.degree, curve.closed, d, g)
@@ -172,7 +173,7 @@ def _residual(curve: BSplineCurve, W: FloatArray) -> FloatArray:
 
 
 def _energy(curve: BSplineCurve, W: FloatArray) -> float:
-    """``E_l = d^T G d`` in difference form (:func:`curvefair.curves.bspline.band_energy`)."""
+    """``E_l = d^T G d`` in difference form (:func:`curvefair._kernels.bspline.band_energy`)."""
     return float(band_energy(np.ascontiguousarray(W), curve.degree, curve.closed,
                              np.ascontiguousarray(curve.control_points)))
 
@@ -784,7 +785,7 @@ def band_patterns(W: FloatArray) -> tuple[FloatArray, np.ndarray, int, int, int]
 @njit(cache=True)
 def _largest_free_z(W, p, closed, d, mask):  # type: ignore[no-untyped-def]
     """Largest unconstrained ranking number ``|(G d)_i|^2 / G_ii`` over the movable points (0
-    if none): the residual of :func:`curvefair.curves.bspline.band_residual` row by row, same
+    if none): the residual of :func:`curvefair._kernels.bspline.band_residual` row by row, same
     operations, without the ``(n, dim)`` temporaries."""
     n, dim = d.shape
     best = 0.0
@@ -807,7 +808,7 @@ def _largest_free_z(W, p, closed, d, mask):  # type: ignore[no-untyped-def]
 @njit(cache=True)
 def _setup_state(W, p, closed, d, mask, X, z):  # type: ignore[no-untyped-def]
     """One pass over the control points ``d``: the loop state ``X = [d | G d | d]`` (the
-    residual of :func:`curvefair.curves.bspline.band_residual`), the ranking-number slots
+    residual of :func:`curvefair._kernels.bspline.band_residual`), the ranking-number slots
     ``z`` (0 movable, -1 fixed, from ``mask``) and the energy ``d^T G d``, returned. Each value
     is computed with the same operations in the same order as ``band_residual`` /
     ``band_energy`` (so bitwise equal to them); fused, the 1e6-point set-up reads ``d`` once."""

@@ -37,9 +37,10 @@ import numpy as np
 import scipy.sparse as sp
 
 from .._kernels import global_fair as _k
+from .._kernels.bspline import band_energy
 from .._typing import FloatArray
 from .._validate import as_step_count
-from ..curves.bspline import BSplineCurve, band_energy
+from ..curves.bspline import BSplineCurve
 from ..errors import InputError
 from .eck_hadenfeld import check_bspline
 from .stop import StopReason
