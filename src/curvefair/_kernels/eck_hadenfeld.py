@@ -164,7 +164,7 @@ _PREFETCH_LEVELS = 4  # tree nodes prefetched on the runner-up's path (from its 
 
 @njit(cache=True, error_model="numpy")
 def eh_loop(X, z, Wu, pat, upat, ulo, uhi, D, p, closed, tol, eps_abs, max_steps,
-             hist, T):  # type: ignore[no-untyped-def]
+            hist, T):  # type: ignore[no-untyped-def]
     """Ranking-list loop, compiled; updates ``X`` and ``z`` in place.
 
     ``X[i] = (d_i, g_i, orig_i)``, ``D`` columns each (``X`` has ``3 D`` columns),
@@ -415,7 +415,7 @@ def eh_loop(X, z, Wu, pat, upat, ulo, uhi, D, p, closed, tol, eps_abs, max_steps
 
 @njit(cache=True, error_model="numpy")
 def eh_sweep(X, z, Wu, pat, upat, ulo, uhi, D, p, closed, tol, eps_abs, max_steps,
-              hist, Q, flags):  # type: ignore[no-untyped-def]
+             hist, Q, flags):  # type: ignore[no-untyped-def]
     """Sweep schedule (``schedule="sweep"``), compiled; updates ``X`` in place.
 
     The same step, state and stopping test as :func:`eh_loop` (``X = [d | G d | orig]``,
