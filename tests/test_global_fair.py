@@ -497,7 +497,7 @@ def test_split_factorisation_is_the_fused_one(n):
     assert k.assemble_ldl(K, 1.0, p, B, Q, rot, fix, L0) == 0
     for m in sorted({1, 4, n // 3, n // 2, n - 1}):
         L = np.full((2 * n, 8), np.nan)
-        k._assemble_range(K, 1.0, p, False, B, Q, rot, fix, L, m, n)
+        k.assemble_range(K, 1.0, p, False, B, Q, rot, fix, L, m, n)
         info, j = k.assemble_ldl_head(K, 1.0, p, B, Q, rot, fix, L, m)
         assert info == 0
         assert k.assemble_ldl_tail(K, 1.0, p, B, Q, rot, fix, L, j) == 0

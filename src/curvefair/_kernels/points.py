@@ -111,7 +111,7 @@ def band_quad(Kb, x):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def _rows(start, W, x, out):  # type: ignore[no-untyped-def]
+def apply_rows(start, W, x, out):  # type: ignore[no-untyped-def]
     """``out = C x`` (``x`` shape (N, dim), ``out`` shape (m, dim))."""
     m = start.shape[0]
     dim = x.shape[1]
@@ -160,7 +160,7 @@ def _residuals(Kb, start, W, Y, t2, x, lam, tinv, v, fi, rd, rc):  # type: ignor
     ``rc = -lam f - tinv``; returns the residual norm squared without ``rd``'s scaling."""
     m, dim = Y.shape
     N = x.shape[0]
-    _rows(start, W, x, v)
+    apply_rows(start, W, x, v)
     for i in range(m):
         s = 0.0
         for a in range(dim):
@@ -345,7 +345,7 @@ def tube_ipm(Kb, start, W, Y, rad, x, lam, max_steps, gap, stall):  # type: igno
         if not finite:
             code = 2
             break
-        _rows(start, W, dx, Cdx)
+        apply_rows(start, W, dx, Cdx)
         smax = 1.0
         tmax = np.inf
         for i in range(m):

@@ -401,7 +401,7 @@ class _System:
             # operations (bitwise)
             args = (self.K, self.ks, self.p, B, self.Q, self.rot, self.fix, self.L)
             m = int(self.n * _ASM_SPLIT)
-            fin = _ranges_start(lambda a, b: _k._assemble_range(
+            fin = _ranges_start(lambda a, b: _k.assemble_range(
                 self.K, self.ks, self.p, False, B, self.Q, self.rot, self.fix, self.L, a, b),
                 m, self.n)
             self.then = then() if then is not None else None

@@ -330,7 +330,7 @@ def _tube_qp(K: sp.csr_matrix | FloatArray, A: sp.csr_matrix | None, x0: FloatAr
         reason = "max_steps"
     else:
         Cx = np.empty((m, dim))
-        _pk._rows(start, W, x, Cx)
+        _pk.apply_rows(start, W, x, Cx)
         eta = float(-(lam @ (0.5 * (np.sum((Cx - pts) ** 2, axis=1) / rad ** 2 - 1.0))))
         reason = "converged" if eta < 1e-6 else "numerical"
     return x, lam, int(steps), reason
