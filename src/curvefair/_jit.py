@@ -28,8 +28,8 @@ The first compilation into a new cache directory prints one line to stderr sayin
 (set ``CURVEFAIR_QUIET=1`` to silence it).
 
 This is the one module of curvefair that imports numba (and llvmlite): kernels elsewhere use
-:func:`njit` and :func:`prefetch` from here (``tests/test_layering.py`` checks it), so a change
-of numba's API is met in one file.
+:func:`njit` and :func:`prefetch` from here (``tests/test_numba_layering.py`` checks it), so a
+change of numba's API is met in one file.
 
 The locator plugs into numba's documented-by-example cache machinery
 (``numba.core.caching.CacheImpl._locator_classes``), placed first so that it answers for

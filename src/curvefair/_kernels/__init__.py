@@ -8,6 +8,8 @@ the kernels and read their results live in the public packages (:mod:`curvefair.
   residual in difference form that the B-spline methods share;
 * :mod:`.hermite` -- the local Hermite steps (Kjellander, Poliakoff, Wang-Cao, Wang quintic)
   and their automatic loop;
+* :mod:`.eck_hadenfeld`, :mod:`.knot_removal`, :mod:`.cheng_yu` -- the steps and automatic
+  loops of the B-spline methods of those names;
 * :mod:`.global_fair` -- the block-banded Newton systems of the global fairing;
 * :mod:`.points` -- the interior point of the point-fairing tube QP;
 * :mod:`.ranking` -- the indexed max tournament tree of the ranking-list drivers.
