@@ -11,6 +11,7 @@ the kernels and read their results live in the public packages (:mod:`curvefair.
 * :mod:`.eck_hadenfeld`, :mod:`.knot_removal`, :mod:`.cheng_yu` -- the steps and automatic
   loops of the B-spline methods of those names;
 * :mod:`.global_fair` -- the block-banded Newton systems of the global fairing;
+* :mod:`.joins` -- the straight-span test of the join planning;
 * :mod:`.points` -- the interior point of the point-fairing tube QP;
 * :mod:`.ranking` -- the indexed max tournament tree of the ranking-list drivers.
 
