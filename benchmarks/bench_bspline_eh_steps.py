@@ -10,7 +10,7 @@ Last column: the same step in the sweep schedule (``schedule="sweep"``: Gauss-Se
 queue, no priority structure; threshold 0, the same step cap) on the same state.
 
 Peer, measured in the same run: the same loop written with the generic per-point tournament tree
-of ``curvefair.fairing.ranking`` (``tt_build`` / ``tt_update`` per changed entry, one leaf per
+of ``curvefair._kernels.ranking`` (``tt_build`` / ``tt_update`` per changed entry, one leaf per
 control point, separate arrays for points, residuals and originals).
 
 Usage::
@@ -27,8 +27,9 @@ import numpy as np
 from numba import njit
 
 from curvefair import BSplineCurve
+from curvefair._kernels import eck_hadenfeld as ek
+from curvefair._kernels.ranking import tt_build, tt_update
 from curvefair.fairing import eck_hadenfeld as eh
-from curvefair.fairing.ranking import tt_build, tt_update
 
 
 def make_curve(n: int, seed: int = 0) -> BSplineCurve:
@@ -59,17 +60,17 @@ def aligned_copy(a: np.ndarray) -> np.ndarray:
 
 def run_loop(X, z, bp, tol: float, steps: int) -> int:
     Wu, pat, upat, ulo, uhi = bp
-    return int(eh._eh_loop(X, z, Wu, pat, upat, ulo, uhi, 2, 3, False, tol, 0.0, steps,
-                           np.zeros((0, 3)), eh._tree_buffer(X.shape[0]))[0])
+    return int(ek.eh_loop(X, z, Wu, pat, upat, ulo, uhi, 2, 3, False, tol, 0.0, steps,
+                          np.zeros((0, 3)), eh._tree_buffer(X.shape[0]))[0])
 
 
 def run_sweep(X, z, bp, tol: float, steps: int) -> int:
     """The same steps in the sweep schedule (``schedule="sweep"``), threshold 0."""
     Wu, pat, upat, ulo, uhi = bp
     n = X.shape[0]
-    return int(eh._eh_sweep(X, z, Wu, pat, upat, ulo, uhi, 2, 3, False, tol, 0.0, steps,
-                            np.zeros((0, 3)), np.empty(n, dtype=np.int64),
-                            np.empty(n, dtype=np.uint8))[0])
+    return int(ek.eh_sweep(X, z, Wu, pat, upat, ulo, uhi, 2, 3, False, tol, 0.0, steps,
+                           np.zeros((0, 3)), np.empty(n, dtype=np.int64),
+                           np.empty(n, dtype=np.uint8))[0])
 
 
 @njit(cache=True)

@@ -21,8 +21,9 @@ import time
 import numpy as np
 
 from curvefair import interpolate_bspline, second_discrete_curvature
+from curvefair._kernels.cheng_yu import cy_loop
 from curvefair.analysis.discrete import corner_cut_ratios
-from curvefair.fairing.cheng_yu import _run, cheng_yu_driver
+from curvefair.fairing.cheng_yu import cheng_yu_driver
 
 
 def data(n: int, seed: int = 0) -> np.ndarray:
@@ -49,7 +50,7 @@ def run(prep: tuple, steps: int) -> tuple[float, int]:
     hist = np.zeros(steps + 1)
     moves = np.zeros((steps, 4))
     t0 = time.perf_counter()
-    done, _ = _run(Qw, Q, W, lw, mw, False, True, mask, tol, 0.0, steps, True, hist, moves)
+    done, _ = cy_loop(Qw, Q, W, lw, mw, False, True, mask, tol, 0.0, steps, True, hist, moves)
     return time.perf_counter() - t0, int(done)
 
 

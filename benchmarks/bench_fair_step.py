@@ -24,7 +24,7 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from curvefair import interpolate_cubic, interpolate_quintic
-from curvefair.fairing import _hermite_kernels as _k
+from curvefair._kernels import hermite as _k
 from curvefair.fairing.local_hermite import prepare
 
 _MUTABLE = (0, 1, 22, 23, 24, 25, 26, 27)  # P, D and the loop state in the kernel arguments

@@ -8,7 +8,8 @@ runs until the sum of jumps stops decreasing (about ``n / 5`` steps at ``--rel 0
 Measured in the same run, best of ``--repeat``:
 
 * ``new``: :func:`knot_removal_fair` end to end (the vectorised per-knot set-up, the compiled loop,
-  the final measure) and the compiled loop alone (``_kr_loop`` on fresh copies of its state);
+  the final measure) and the compiled loop alone (``curvefair._kernels.knot_removal.kr_loop`` on
+  fresh copies of its state);
 * ``old``: the Python ``while`` loop that ``knot_removal_fair`` was up to session 2 (the reference
   kept in ``tests/test_knot_removal_compiled.py``), only for ``n <= --old-max``; its per-step cost
   is ``(t(full) - t(max_steps=0)) / steps`` (the same set-up and final measure subtracted).
@@ -32,6 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from curvefair import interpolate_bspline
+from curvefair._kernels import knot_removal as kk
 from curvefair.fairing import knot_removal as kr
 from curvefair.fairing.eck_hadenfeld import movable_mask
 
@@ -63,7 +65,7 @@ def best(f, repeat: int) -> float:
 
 
 def loop_only(curve, variant: str, repeat: int) -> tuple[float, int]:
-    """Time ``_kr_loop`` alone on fresh copies of the state set up as knot_removal_fair does."""
+    """Time ``kr_loop`` alone on fresh copies of the state set up as knot_removal_fair does."""
     kd = kr._KnotData(curve)
     d0 = np.array(curve.control_points)
     z0 = kd.jumps(d0)
@@ -78,7 +80,7 @@ def loop_only(curve, variant: str, repeat: int) -> tuple[float, int]:
         for i in mutable:
             args[i] = args0[i].copy()
         t0 = time.perf_counter()
-        steps = int(kr._kr_loop(*args)[0])
+        steps = int(kk.kr_loop(*args)[0])
         ts.append(time.perf_counter() - t0)
     return min(ts), steps
 

@@ -345,8 +345,9 @@ def test_loop_matches_slow_reference_mixed_knots(closed, tol):
 def test_fused_setup_is_bitwise_band_residual_and_energy(closed, p, dim):
     # the loop's one-pass set-up must give exactly the values of the separate band kernels
     # (the stopping threshold is relative to this energy), and the energy must match quadrature
-    from curvefair.curves.bspline import band_energy, band_residual
-    from curvefair.fairing.eck_hadenfeld import _aligned_empty, _setup_state
+    from curvefair._kernels.bspline import band_energy, band_residual
+    from curvefair._kernels.eck_hadenfeld import setup_state
+    from curvefair.fairing.eck_hadenfeld import _aligned_empty
 
     rng = np.random.default_rng(100 * p + dim + closed)
     for n in (p + 2, 2 * p + 1, 40):
@@ -356,7 +357,7 @@ def test_fused_setup_is_bitwise_band_residual_and_energy(closed, p, dim):
         mask = rng.random(n) < 0.7
         X = _aligned_empty((n, 3 * dim))
         z = _aligned_empty((n,))
-        e = _setup_state(W, p, closed, d, mask, X, z)
+        e = setup_state(W, p, closed, d, mask, X, z)
         g = np.empty_like(d)
         band_residual(W, p, closed, d, g)
         assert e == band_energy(W, p, closed, d)

@@ -236,7 +236,7 @@ def test_band_system_matches_dense_solve(closed, dim, p, n):
 
 @pytest.mark.parametrize("closed", [False, True])
 def test_band_residual_and_energy_match_gram_matrix(closed):
-    from curvefair.curves.bspline import band_energy, band_residual
+    from curvefair._kernels.bspline import band_energy, band_residual
 
     rng = np.random.default_rng(3 + closed)
     c = noisy(n=40, closed=closed, seed=11, dim=3)
@@ -270,7 +270,7 @@ def test_large_coordinates_keep_precision():
 def test_admm_sweep_matches_dense_solve_and_projection(dim, p):
     """One fused ADMM iteration (banded solve + relaxation + ball projection + dual update)
     against numpy.linalg.solve on the dense matrix and the projection written out."""
-    from curvefair.fairing import _global_kernels as _k
+    from curvefair._kernels import global_fair as _k
 
     rng = np.random.default_rng(10 * dim + p)
     n = 40
@@ -469,7 +469,7 @@ def test_split_factorisation_is_the_fused_one(n):
     separately + assemble_ldl_tail give bitwise the factor of assemble_ldl (planar cubic,
     random blocks, frames and fixed unknowns), and it solves the assembled system (dense
     reference)."""
-    from curvefair.fairing import _global_kernels as k
+    from curvefair._kernels import global_fair as k
 
     rng = np.random.default_rng(n)
     p = 3  # planar cubic: kd = 7
@@ -497,7 +497,7 @@ def test_split_factorisation_is_the_fused_one(n):
     assert k.assemble_ldl(K, 1.0, p, B, Q, rot, fix, L0) == 0
     for m in sorted({1, 4, n // 3, n // 2, n - 1}):
         L = np.full((2 * n, 8), np.nan)
-        k._assemble_range(K, 1.0, p, False, B, Q, rot, fix, L, m, n)
+        k.assemble_range(K, 1.0, p, False, B, Q, rot, fix, L, m, n)
         info, j = k.assemble_ldl_head(K, 1.0, p, B, Q, rot, fix, L, m)
         assert info == 0
         assert k.assemble_ldl_tail(K, 1.0, p, B, Q, rot, fix, L, j) == 0
@@ -632,7 +632,7 @@ def test_scaled_band_is_the_scaled_copy():
     """The kernels read ``K[i, j] * ks``: factorising and solving with ``(K, ks)`` gives bitwise
     the result of the explicitly scaled copy ``(K * ks, 1)`` (planar and 3-D, open and closed,
     with frames and fixed points)."""
-    import curvefair.fairing._global_kernels as k
+    import curvefair._kernels.global_fair as k
     from curvefair.fairing.global_fair import _System
 
     rng = np.random.default_rng(5)
@@ -694,7 +694,7 @@ from numba import types
 from numba.core.registry import CPUDispatcher
 from curvefair import interpolate_bspline
 from curvefair.fairing.global_fair import global_fair
-import curvefair.fairing._global_kernels as gk
+import curvefair._kernels.global_fair as gk
 
 rng = np.random.default_rng(5)
 for dim in (2, 3):
@@ -722,11 +722,12 @@ print(json.dumps({"seen": seen, "bad": bad}))
 def test_kernels_are_compiled_without_literal_or_writeable_band_variants():
     """numba compiles a kernel again for every argument type: a literal ``0``/``False`` in a
     call between kernels, or the energy band arriving writeable in one call and read only in
-    another, would each add a compiled copy (``_global_kernels`` module docstring). In a fresh
-    interpreter (the kernels' signatures are those its own calls compiled or loaded: other
-    tests here call kernels directly with arrays of their own), after global fairs of planar
-    and 3-D, open and closed curves, with the cached band and a weighted sum of bands, no
-    kernel of the module has a literal argument type and every ``K`` argument is read only."""
+    another, would each add a compiled copy (``curvefair._kernels.global_fair`` module
+    docstring). In a fresh interpreter (the kernels' signatures are those its own calls
+    compiled or loaded: other tests here call kernels directly with arrays of their own),
+    after global fairs of planar and 3-D, open and closed curves, with the cached band and a
+    weighted sum of bands, no kernel of the module has a literal argument type and every ``K``
+    argument is read only."""
     import json
     import subprocess
     import sys

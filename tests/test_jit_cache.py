@@ -152,7 +152,7 @@ def test_imports_and_runs_with_no_writable_cache(tmp_path):
     # with no cache at all, a kernel of the package itself (compiled in the process) as well
     full = RUN.replace("v = kernel(1.0)", "v = kernel(1.0)\nimport numpy as np\n"
                        "import curvefair\n"
-                       "from curvefair.fairing.ranking import tt_build, tt_top\n"
+                       "from curvefair._kernels.ranking import tt_build, tt_top\n"
                        "assert tt_top(*tt_build(np.array([3.0, 7.0, 1.0]))) == (1, 7.0)")
     for env, code in (({"XDG_CACHE_HOME": str(blocker), "HOME": str(blocker / "home"),
                         "TMPDIR": str(tmp_path)}, RUN),  # only the temp folder is left

@@ -28,6 +28,7 @@ import numpy as np
 import pytest
 
 from curvefair import BSplineCurve, interpolate_bspline
+from curvefair._kernels.ranking import tt_build, tt_top, tt_update
 from curvefair._validate import as_nonnegative, as_step_count
 from curvefair.curves.bspline import basis_derivatives
 from curvefair.errors import InputError
@@ -42,7 +43,6 @@ from curvefair.fairing.knot_removal import (
     knot_removal_fair,
     sapidis_measure,
 )
-from curvefair.fairing.ranking import tt_build, tt_top, tt_update
 
 
 # ------------------------------------------------------------------------------------------
@@ -357,7 +357,7 @@ def test_no_knots_and_zero_steps():
 def test_local_measure_equals_vectorised_one():
     # the loop's scalar measure at every knot, and _KnotData.jumps (bitwise), against the
     # session-2 numpy measure (einsum + sapidis_measure), all degrees/dims
-    from curvefair.fairing.knot_removal import _knot_measure
+    from curvefair._kernels.knot_removal import knot_measure
 
     rng = np.random.default_rng(9)
     for p in (2, 3, 4, 5):
@@ -376,7 +376,7 @@ def test_local_measure_equals_vectorised_one():
                 sub = np.array([0, 3, 2, 2, kd.js.size - 1])
                 np.testing.assert_allclose(kd.jumps(d, sub), old.jumps(d, sub), rtol=1e-14,
                                            atol=0)
-                got = np.array([_knot_measure(d, k, p, kd.ctrl, kd.c, kd.right, kd.left2)
+                got = np.array([knot_measure(d, k, p, kd.ctrl, kd.c, kd.right, kd.left2)
                                 for k in range(kd.js.size)])
                 np.testing.assert_allclose(got, ref, rtol=4e-16 * 8, atol=0)
                 np.testing.assert_array_equal(kd.js, knot_jumps(c)[0])
@@ -391,7 +391,7 @@ def test_local_measure_equals_vectorised_one():
         assert np.any(np.abs(r2).max(axis=1) < 1e-12)  # the straight piece is there
         ref = _RefKnotData(c).jumps(d)
         np.testing.assert_array_equal(kd.jumps(d), ref)
-        got = np.array([_knot_measure(d, k, p, kd.ctrl, kd.c, kd.right, kd.left2)
+        got = np.array([knot_measure(d, k, p, kd.ctrl, kd.c, kd.right, kd.left2)
                         for k in range(kd.js.size)])
         np.testing.assert_allclose(got, ref, rtol=4e-16 * 8, atol=0)
 
@@ -426,7 +426,7 @@ def test_small_closed_and_multiple_knots_match_reference(p):
 
 def test_pairwise_sum_is_numpys():
     # the tracked sum adds the touched knots' z as numpy's sum does (pairwise), bitwise
-    from curvefair.fairing.knot_removal import _pw_sum_long
+    from curvefair._kernels.knot_removal import _pw_sum_long
 
     rng = np.random.default_rng(2)
     for m in [*range(0, 140), 255, 256, 1000, 4097]:

@@ -98,7 +98,7 @@ def test_tube_qp_matches_scipy_minimize_and_kkt() -> None:
 def test_energy_band_matches_the_sparse_energy_matrix(dim: int, tau: float, beta: float) -> None:
     """The band assembled directly from the operator rows (what the solver uses) against the
     sparse products of _energy_matrix, and x^T K x from the band against the sparse product."""
-    from curvefair.fairing import _points_kernels as pk
+    from curvefair._kernels import points as pk
     from curvefair.fairing.points_l1 import _band_lower, _energy_band, _rows4
 
     rng = np.random.default_rng(dim)

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from curvefair.fairing.ranking import tt_build, tt_top, tt_update, tt_value
+from curvefair._kernels.ranking import tt_build, tt_top, tt_update, tt_value
 
 
 def _brute_top(values):
@@ -42,7 +42,7 @@ def test_all_ineligible():
 
 @pytest.mark.parametrize("n", [1, 5, 16, 17, 33, 1000])
 def test_range_updates_match_argmax(n):
-    from curvefair.fairing.ranking import tt_update_range
+    from curvefair._kernels.ranking import tt_update_range
 
     rng = np.random.default_rng(1000 + n)
     values = rng.integers(0, 10, n).astype(float)  # many ties
@@ -71,7 +71,7 @@ def test_empty_tree():
 @pytest.mark.parametrize("n", [70_000, 70_001 + 16 * 5])
 def test_blocked_tree_matches_argmax(n):
     # above 65536 entries the tree holds blocks of 16: single and range updates vs brute force
-    from curvefair.fairing.ranking import tt_update_range
+    from curvefair._kernels.ranking import tt_update_range
 
     rng = np.random.default_rng(n)
     values = rng.integers(0, 50, n).astype(float)

@@ -1,7 +1,7 @@
 """Where curvefair's compiled kernels are decorated: ``njit`` with a cache that cannot go stale.
 
 numba's own on-disk cache keys a kernel on the source file that defines it. A kernel that
-inlines or calls a function from another file (``residual_row`` from ``curves/bspline.py``
+inlines or calls a function from another file (``residual_row`` from ``_kernels/bspline.py``
 inside the Eck-Hadenfeld loop, say) is not invalidated when that callee changes, and a module
 constant frozen into the machine code is not either: the old machine code keeps running. Here
 every curvefair kernel is cached under a directory named by a hash of *all* of the package's
@@ -28,8 +28,8 @@ The first compilation into a new cache directory prints one line to stderr sayin
 (set ``CURVEFAIR_QUIET=1`` to silence it).
 
 This is the one module of curvefair that imports numba (and llvmlite): kernels elsewhere use
-:func:`njit` and :func:`prefetch` from here (``tests/test_layering.py`` checks it), so a change
-of numba's API is met in one file.
+:func:`njit` and :func:`prefetch` from here (``tests/test_numba_layering.py`` checks it), so a
+change of numba's API is met in one file.
 
 The locator plugs into numba's documented-by-example cache machinery
 (``numba.core.caching.CacheImpl._locator_classes``), placed first so that it answers for

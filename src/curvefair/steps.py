@@ -24,9 +24,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._kernels import hermite as _k
 from .curves.hermite import CubicHermite, HermiteSpline, QuinticHermite
 from .errors import InputError
-from .fairing import _hermite_kernels as _k
 from .fairing.cheng_yu import cheng_yu  # (Cheng & Yu, cubic B-splines)
 from .fairing.eck_hadenfeld import eck_hadenfeld  # (Eck & Hadenfeld, B-splines)
 from .fairing.hermite_data import distinct_data, rebuild, uniform_spacing

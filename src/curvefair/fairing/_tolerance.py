@@ -34,13 +34,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._distance import exceeds, point_distances
+from .._kernels.bspline import power_form_kernel, power_form_pair_kernel
 from .._typing import FloatArray
-from ..curves.bspline import (
-    POWER_FORM_MAX_DEGREE,
-    BSplineCurve,
-    _power_form_kernel,
-    _power_form_pair_kernel,
-)
+from ..curves.bspline import POWER_FORM_MAX_DEGREE, BSplineCurve
 from ..curves.hermite import (
     CubicHermite,
     QuinticHermite,
@@ -127,7 +123,7 @@ def _difference_form(a: PiecewiseCurve, delta: dict[str, FloatArray]) -> Piecewi
         s = np.ascontiguousarray(a.spans, dtype=np.int64)
         d = np.ascontiguousarray(delta["control_points"], dtype=np.float64)
         coeffs = np.empty((s.size, p + 1, d.shape[1]))
-        _power_form_kernel(t, p, s, d, bool(a.closed), coeffs)
+        power_form_kernel(t, p, s, d, bool(a.closed), coeffs)
         return PiecewisePolynomial(np.append(t[s], t[s[-1] + 1]), coeffs)
     params = np.asarray(a.params)  # type: ignore[attr-defined]
     if isinstance(a, QuinticHermite):
@@ -142,7 +138,7 @@ def prime_power_forms(original: PiecewiseCurve, new: PiecewiseCurve
     """For two comparable B-splines (same knots, degree, closedness, shapes): ``new``'s power
     form (cached on it, as its :attr:`~curvefair.PiecewiseCurve.piecewise` would be) and
     the power form of the difference curve ``new - original`` in one pass
-    (:func:`~curvefair.curves.bspline._power_form_pair_kernel`: the basis derivatives once
+    (:func:`curvefair._kernels.bspline.power_form_pair_kernel`: the basis derivatives once
     for both, bitwise the two separate results). Returns ``(new, difference form)`` for
     :func:`enforce_tolerance`'s ``primed``, or None (other curves, high degree, ``new``'s form
     already built, a non-finite form: the usual paths then)."""
@@ -156,7 +152,7 @@ def prime_power_forms(original: PiecewiseCurve, new: PiecewiseCurve
     base = np.ascontiguousarray(original.control_points, dtype=np.float64)  # type: ignore[attr-defined]
     coeffs = np.empty((s.size, p + 1, ctrl.shape[1]))
     diff = np.empty_like(coeffs)
-    _power_form_pair_kernel(t, p, s, ctrl, base, bool(new.closed), coeffs, diff)
+    power_form_pair_kernel(t, p, s, ctrl, base, bool(new.closed), coeffs, diff)
     if not (np.isfinite(coeffs).all() and np.isfinite(diff).all()):
         return None  # new.piecewise raises its own message when asked
     breaks = np.append(t[s], t[s[-1] + 1])

@@ -17,9 +17,9 @@ are known (a damped, Levenberg-Marquardt step while its steps are too long, see
 predictor-corrector interior point with strictly feasible iterates, finished by the same Newton
 iteration. Each Newton iteration factorises one symmetric block-banded matrix (bandwidth
 ``(degree + 1) dim - 1``, coordinates interleaved) by a compiled band Cholesky (closed curves:
-the cyclic band bordered by a small Schur complement), see :mod:`._global_kernels`: ``O(n)``
-time and memory per iteration; typically 4-8 Newton iterations after the warm start (10-20
-with the interior point).
+the cyclic band bordered by a small Schur complement), see
+:mod:`curvefair._kernels.global_fair`: ``O(n)`` time and memory per iteration; typically 4-8
+Newton iterations after the warm start (10-20 with the interior point).
 """
 
 from __future__ import annotations
@@ -36,11 +36,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import scipy.sparse as sp
 
+from .._kernels import global_fair as _k
+from .._kernels.bspline import band_energy
 from .._typing import FloatArray
 from .._validate import as_step_count
-from ..curves.bspline import BSplineCurve, band_energy
+from ..curves.bspline import BSplineCurve
 from ..errors import InputError
-from . import _global_kernels as _k
 from .eck_hadenfeld import check_bspline
 from .stop import StopReason
 
@@ -290,7 +291,7 @@ def _band_storage(n: int, dim: int, p: int, closed: bool
 def _readonly_view(a: FloatArray) -> FloatArray:
     """``a`` as a read-only array (a view if it is writeable, no copy): the kernels then see one
     array type whether a band is the curve's cached one (read only) or a weighted sum, and are
-    compiled once (see :mod:`._global_kernels`). Internal arguments only: unlike
+    compiled once (see :mod:`curvefair._kernels.global_fair`). Internal arguments only: unlike
     :func:`curvefair.curves.piecewise.readonly` (one copy, for arrays a user receives) the
     view's flag could be set back."""
     if not a.flags.writeable:
@@ -302,9 +303,10 @@ def _readonly_view(a: FloatArray) -> FloatArray:
 
 class _System:
     """Newton systems ``Q^T (kron(K, I) + blockdiag(B)) Q`` with fixed unknowns (see
-    :mod:`._global_kernels`): band Cholesky (open curves), bordered cyclic band (closed), dense
-    for tiny closed curves. ``K`` is given by its band rows ``K[i, p + o] = K_{i, i+o}``;
-    ``fixed`` points never move. Work arrays are allocated once and reused."""
+    :mod:`curvefair._kernels.global_fair`): band Cholesky (open curves), bordered cyclic band
+    (closed), dense for tiny closed curves. ``K`` is given by its band rows
+    ``K[i, p + o] = K_{i, i+o}``; ``fixed`` points never move. Work arrays are allocated once
+    and reused."""
 
     def __init__(self, K: FloatArray, ks: float, p: int, dim: int, closed: bool,
                  fixed: np.ndarray, band: tuple[FloatArray, _Prefault | None] | None = None
@@ -353,8 +355,8 @@ class _System:
         """Factorise for blocks ``B`` (n, dim, dim); points ``rot`` get the frame whose first
         axis is ``nrm`` and that axis fixed (a prescribed normal displacement). ``nrot``: the
         caller has already written ``self.rot``, ``self.Q`` and ``self.fix`` for ``nrot``
-        such points (:func:`._global_kernels.ssn_eval_prep`). False if the matrix is not
-        positive definite in floating point."""
+        such points (:func:`curvefair._kernels.global_fair.ssn_eval_prep`). False if the
+        matrix is not positive definite in floating point."""
         self.B = B
         self.then = None
         if nrot is not None:
@@ -399,7 +401,7 @@ class _System:
             # operations (bitwise)
             args = (self.K, self.ks, self.p, B, self.Q, self.rot, self.fix, self.L)
             m = int(self.n * _ASM_SPLIT)
-            fin = _ranges_start(lambda a, b: _k._assemble_range(
+            fin = _ranges_start(lambda a, b: _k.assemble_range(
                 self.K, self.ks, self.p, False, B, self.Q, self.rot, self.fix, self.L, a, b),
                 m, self.n)
             self.then = then() if then is not None else None
@@ -837,8 +839,8 @@ def _admm_start(K: FloatArray, ks: float, p: int, g0: FloatArray, free: np.ndarr
     onto the balls. ``rho`` starts at ``_ADMM_RHO0`` times the mean diagonal of ``K`` and is
     reset every ``_ADMM_ADAPT`` iterations to the median curvature ``lambda_i / tol^2`` of the
     projected points (the scale at which the splitting converges fastest). Cubics keep the
-    vectors coordinate-major (:func:`._global_kernels.admm_sweep_t`). The work arrays are
-    carved from ``scratch`` (the
+    vectors coordinate-major (:func:`curvefair._kernels.global_fair.admm_sweep_t`). The work
+    arrays are carved from ``scratch`` (the
     Newton system's band storage, unused until then: its pages are then already mapped when
     the Newton iteration factorises) if it is large enough; the returned ``v`` may be a view
     of it. None if the factorisation fails."""

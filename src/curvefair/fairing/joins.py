@@ -53,7 +53,7 @@ from typing import Any, cast
 
 import numpy as np
 
-from .._jit import njit
+from .._kernels import joins as _k
 from .._typing import FloatArray
 from ..curves.bspline import BSplineCurve, basis_derivatives
 from ..curves.piecewise import PiecewiseCurve
@@ -182,70 +182,15 @@ def _size(pts: FloatArray) -> float:
     return max(ext, float(np.abs(pts).max()) if pts.size else 0.0, 1e-300)
 
 
-@njit(cache=True)
-def _straight_kernel(P, spans, p, closed, rel, eps, mark):  # type: ignore[no-untyped-def]
-    """Mark (``mark[i] = True``) the control points of every straight span; return how many
-    spans are straight. Span ``s`` uses control points ``s - p .. s`` (mod ``n`` if closed);
-    it is straight when its line ``d = W_p - W_0`` has ``L = |d| > eps`` and every
-    ``r_a = W_a - W_0`` is within ``rel L + eps`` of that line: ``|r_a - (r_a . u) u| <=
-    rel L + eps``, ``u = d / max(L, 1e-300)``. One pass, no temporaries; the operations and
-    their order are those of the numpy formula this replaced (sums over the coordinates in
-    order), so the decisions are bitwise the same."""
-    n = P.shape[0]
-    dim = P.shape[1]
-    u = np.empty(dim)
-    r = np.empty(dim)
-    count = 0
-    for m in range(spans.shape[0]):
-        s = spans[m]
-        i0 = s - p
-        i1 = s
-        if closed:
-            i0 = i0 % n
-            i1 = i1 % n
-        L2 = 0.0
-        for e in range(dim):
-            de = P[i1, e] - P[i0, e]
-            L2 += de * de
-        L = np.sqrt(L2)
-        den = max(L, 1e-300)
-        for e in range(dim):
-            u[e] = (P[i1, e] - P[i0, e]) / den
-        lim = rel * L + eps
-        ok = L > eps
-        a = 0
-        while ok and a <= p:
-            i = s - p + a
-            if closed:
-                i = i % n
-            dot = 0.0
-            for e in range(dim):
-                r[e] = P[i, e] - P[i0, e]
-                dot += r[e] * u[e]
-            o2 = 0.0
-            for e in range(dim):
-                o = r[e] - dot * u[e]
-                o2 += o * o
-            ok = np.sqrt(o2) <= lim
-            a += 1
-        if ok:
-            count += 1
-            for a in range(p + 1):
-                i = s - p + a
-                if closed:
-                    i = i % n
-                mark[i] = True
-    return count
-
-
 def _straight_spans(curve: BSplineCurve, P: FloatArray, eps: float) -> tuple[set[int], int]:
     """Control points of every knot span whose ``degree + 1`` control points are within
     ``_STRAIGHT_REL`` times the span's chord plus ``eps`` of the line through the first and
-    last of them, and the number of such spans (:func:`_straight_kernel`)."""
+    last of them, and the number of such spans
+    (:func:`curvefair._kernels.joins.straight_kernel`)."""
     mark = np.zeros(P.shape[0], dtype=np.bool_)
-    k = _straight_kernel(np.ascontiguousarray(P, dtype=np.float64),
-                         np.ascontiguousarray(curve.spans, dtype=np.int64), int(curve.degree),
-                         bool(curve.closed), _STRAIGHT_REL, float(eps), mark)
+    k = _k.straight_kernel(np.ascontiguousarray(P, dtype=np.float64),
+                           np.ascontiguousarray(curve.spans, dtype=np.int64), int(curve.degree),
+                           bool(curve.closed), _STRAIGHT_REL, float(eps), mark)
     return set(np.flatnonzero(mark).tolist()), int(k)
 
 

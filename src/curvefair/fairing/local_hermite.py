@@ -113,11 +113,11 @@ from typing import Any, cast
 import numpy as np
 from scipy.interpolate import CubicSpline
 
+from .._kernels import hermite as _k
 from .._typing import FloatArray
 from ..curves.hermite import CubicHermite, HermiteSpline, QuinticHermite
 from ..curves.interpolate import quintic_hermite_data
 from ..errors import InputError
-from . import _hermite_kernels as _k
 from .fair import MethodSpec, register_method
 from .hermite_data import distinct_data, rebuild, uniform_spacing
 from .problem import FairingHistory, FairingProblem, Outcome, eps_threshold
@@ -296,7 +296,7 @@ def prepare(curve: HermiteSpline, *, method: str, tol: float | None, eps: float 
             mode: str = "spline", measure: str | None = None) -> dict[str, Any]:
     """Validate and set up everything the compiled loop needs (``O(n)``); see
     :func:`hermite_driver`. Returns a dict with the kernel arguments under ``"args"`` (in the
-    order of :func:`_hermite_kernels.drive`) and bookkeeping entries."""
+    order of :func:`curvefair._kernels.hermite.drive`) and bookkeeping entries."""
     degree = curve.degree
     code = _METHOD_CODE[method]
     mname, mcode = measure_code(measure, degree, method)

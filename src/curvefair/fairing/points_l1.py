@@ -42,9 +42,9 @@ Solver. Primal-dual interior point with strictly feasible iterates (Boyd & Vande
 *Convex Optimization*, sec. 11.7) on the second-order-cone constraints
 ``f_i = (|A_i x - p_i|^2 / r_i^2 - 1) / 2 <= 0``; its Newton matrix
 ``2 K / Phi_0 (x) I + A^T blockdiag(B_i) A`` is block banded (bandwidth ``5 dim - 1``) and is
-factorised by the band Cholesky kernel of :mod:`curvefair.fairing._global_kernels`: ``O(n)``
+factorised by the band Cholesky kernel of :mod:`curvefair._kernels.global_fair`: ``O(n)``
 time and memory per Newton step. The whole loop (residuals, assembly, factorisation, step
-length, line search) runs compiled, :func:`curvefair.fairing._points_kernels.tube_ipm`.
+length, line search) runs compiled, :func:`curvefair._kernels.points.tube_ipm`.
 
 Jump costs and the choice among them. The L1 norm weighs every jump alike, so on data whose
 spacing varies 1:100 (an airfoil's leading edge) the dense end's jumps -- ``(h_max /
@@ -276,7 +276,7 @@ def _energy_band(ops: NaturalOperators, jrows: tuple[np.ndarray, FloatArray],
     """The lower band (``kd = 5 dim - 1``) of :func:`_energy_matrix`, assembled directly from
     the rows of ``Jm`` (``jrows``, :func:`_rows4` with width 5) and ``G`` (``grows``): no
     sparse products, ``O(n)`` time and memory."""
-    from . import _points_kernels as _pk
+    from .._kernels import points as _pk
 
     dim = P.shape[1]
     N = ops.A.shape[0]
@@ -297,7 +297,7 @@ def _tube_qp(K: sp.csr_matrix | FloatArray, A: sp.csr_matrix | None, x0: FloatAr
     """``min sum_a x_a^T K x_a`` s.t. ``|A_i x - p_i| <= rad_i`` from a strictly feasible ``x0``.
 
     ``A`` any constraint matrix whose rows are curve values (four consecutive non-zeros at
-    most); the interior point runs compiled (:func:`curvefair.fairing._points_kernels.tube_ipm`).
+    most); the interior point runs compiled (:func:`curvefair._kernels.points.tube_ipm`).
     Returns ``(x, lam, steps, reason)``; ``lam`` the multipliers of ``f_i`` (scaled problem:
     energy ``x^T K x / E0``, ``E0`` the energy of ``x0``). ``lam0`` warm-starts them. The
     surrogate gap has a rounding floor that grows with the number of constraints: below
@@ -305,7 +305,7 @@ def _tube_qp(K: sp.csr_matrix | FloatArray, A: sp.csr_matrix | None, x0: FloatAr
     ``rows``: :func:`_rows4` of ``A`` when the caller has it (then ``A`` may be None); ``K``
     may be given as its lower band (:func:`_energy_band`).
     """
-    from . import _points_kernels as _pk
+    from .._kernels import points as _pk
 
     N, dim = x0.shape
     m = pts.shape[0]
@@ -330,7 +330,7 @@ def _tube_qp(K: sp.csr_matrix | FloatArray, A: sp.csr_matrix | None, x0: FloatAr
         reason = "max_steps"
     else:
         Cx = np.empty((m, dim))
-        _pk._rows(start, W, x, Cx)
+        _pk.apply_rows(start, W, x, Cx)
         eta = float(-(lam @ (0.5 * (np.sum((Cx - pts) ** 2, axis=1) / rad ** 2 - 1.0))))
         reason = "converged" if eta < 1e-6 else "numerical"
     return x, lam, int(steps), reason
@@ -354,7 +354,7 @@ def _tube_qp_cyclic(K: sp.csr_matrix, C: sp.csr_matrix, x0: FloatArray, pts: Flo
                     ) -> tuple[FloatArray, FloatArray, int, str]:
     """:func:`_tube_qp` for closed curves: the same primal-dual interior point (Boyd &
     Vandenberghe sec. 11.7, the steps of
-    :func:`curvefair.fairing._points_kernels.tube_ipm`), in numpy, for a ``K`` and constraint
+    :func:`curvefair._kernels.points.tube_ipm`), in numpy, for a ``K`` and constraint
     rows ``C`` that wrap around (cyclic band). Each Newton matrix is put in the order of
     :func:`_zigzag`, where it is an ordinary band, and factorised by LAPACK's band Cholesky:
     ``O(n)`` per step."""

@@ -11,7 +11,7 @@ non-zero basis functions there). The Newton matrix is
 ``K`` the (scaled) interleaved energy matrix, banded with ``dim x dim`` blocks of block
 half-bandwidth 4 (given by its lower band ``Kb``), and one symmetric ``dim x dim`` block
 ``B_i`` per constraint row. Lower band storage ``L[r, k] = M[r + k, r]`` with
-``kd = 5 dim - 1``, as :func:`curvefair.fairing._global_kernels.band_cholesky` takes it.
+``kd = 5 dim - 1``, as :func:`curvefair._kernels.global_fair.band_cholesky` takes it.
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._jit import njit
-from ._global_kernels import band_cholesky, band_solve
+from .global_fair import band_cholesky, band_solve
 
 
 @njit(cache=True)
@@ -111,7 +111,7 @@ def band_quad(Kb, x):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def _rows(start, W, x, out):  # type: ignore[no-untyped-def]
+def apply_rows(start, W, x, out):  # type: ignore[no-untyped-def]
     """``out = C x`` (``x`` shape (N, dim), ``out`` shape (m, dim))."""
     m = start.shape[0]
     dim = x.shape[1]
@@ -160,7 +160,7 @@ def _residuals(Kb, start, W, Y, t2, x, lam, tinv, v, fi, rd, rc):  # type: ignor
     ``rc = -lam f - tinv``; returns the residual norm squared without ``rd``'s scaling."""
     m, dim = Y.shape
     N = x.shape[0]
-    _rows(start, W, x, v)
+    apply_rows(start, W, x, v)
     for i in range(m):
         s = 0.0
         for a in range(dim):
@@ -345,7 +345,7 @@ def tube_ipm(Kb, start, W, Y, rad, x, lam, max_steps, gap, stall):  # type: igno
         if not finite:
             code = 2
             break
-        _rows(start, W, dx, Cdx)
+        apply_rows(start, W, dx, Cdx)
         smax = 1.0
         tmax = np.inf
         for i in range(m):

@@ -37,7 +37,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._jit import njit
-from ..curves.bspline import residual_row
+from .bspline import residual_row
 
 # ------------------------------------------------------------------------------------------
 # assembly
@@ -46,7 +46,7 @@ from ..curves.bspline import residual_row
 
 @njit(cache=True)
 def _assemble_range2(K, ks, p, closed, B, Q, rot, fix, L, i0, i1):  # type: ignore[no-untyped-def]
-    """:func:`_assemble_range` for planar curves, branch-light: the frame of point ``i`` is the
+    """:func:`assemble_range` for planar curves, branch-light: the frame of point ``i`` is the
     rotation with first column ``q_i`` (``(1, 0)`` without frame), so the block
     ``M[(j, .), (i, .)] = K_ij Q_j^T Q_i = K_ij [[C, -S], [S, C]]`` with ``C = q_j . q_i``,
     ``S = q_j x q_i``; fixed unknowns enter as 0/1 weights."""
@@ -104,7 +104,7 @@ def _assemble_range2(K, ks, p, closed, B, Q, rot, fix, L, i0, i1):  # type: igno
 
 
 @njit(cache=True, nogil=True)
-def _assemble_range(K, ks, p, closed, B, Q, rot, fix, L, i0, i1):  # type: ignore[no-untyped-def]
+def assemble_range(K, ks, p, closed, B, Q, rot, fix, L, i0, i1):  # type: ignore[no-untyped-def]
     """Write the lower-band entries of the columns of points ``i0 .. i1 - 1`` into ``L``."""
     if B.shape[1] == 2:
         _assemble_range2(K, ks, p, closed, B, Q, rot, fix, L, i0, i1)
@@ -276,7 +276,7 @@ def _assemble_range(K, ks, p, closed, B, Q, rot, fix, L, i0, i1):  # type: ignor
 @njit(cache=True, nogil=True)
 def assemble(K, ks, p, closed, B, Q, rot, fix, L):  # type: ignore[no-untyped-def]
     """Fill ``L`` (shape (n dim, kd + 1)) with the lower band of ``M`` (see module docstring)."""
-    _assemble_range(K, ks, p, closed, B, Q, rot, fix, L, np.intp(0), K.shape[0])
+    assemble_range(K, ks, p, closed, B, Q, rot, fix, L, np.intp(0), K.shape[0])
 
 
 @njit(cache=True)
@@ -318,7 +318,7 @@ def _ldl7(K, ks, p, B, Q, rot, fix, L, j, jstop, nxt, nmax):  # type: ignore[no-
     while j < jstop:
         if j + 7 >= nxt * dim and nxt < nmax:
             stop = min(nmax, nxt + 256)
-            _assemble_range(K, ks, p, np.bool_(False), B, Q, rot, fix, L, nxt, stop)
+            assemble_range(K, ks, p, np.bool_(False), B, Q, rot, fix, L, nxt, stop)
             nxt = stop
         d = p00
         if not d > 0.0:
@@ -424,14 +424,14 @@ def assemble_ldl(K, ks, p, B, Q, rot, fix, L):  # type: ignore[no-untyped-def]
     j = 0
     if kd == 7 and N > 16:
         nxt = min(n, 256)
-        _assemble_range(K, ks, p, np.bool_(False), B, Q, rot, fix, L, np.intp(0), nxt)
+        assemble_range(K, ks, p, np.bool_(False), B, Q, rot, fix, L, np.intp(0), nxt)
         info, j, nxt = _ldl7(K, ks, p, B, Q, rot, fix, L, np.intp(0), N - 7, nxt, n)
         if info:
             return info
     while j < N:
         if nxt < n:
             stop = min(n, nxt + 256)
-            _assemble_range(K, ks, p, np.bool_(False), B, Q, rot, fix, L, nxt, stop)
+            assemble_range(K, ks, p, np.bool_(False), B, Q, rot, fix, L, nxt, stop)
             nxt = stop
         # columns whose updates reach only assembled rows
         j1 = N if nxt == n else max(j, nxt * dim - kd)
@@ -445,13 +445,13 @@ def assemble_ldl(K, ks, p, B, Q, rot, fix, L):  # type: ignore[no-untyped-def]
 @njit(cache=True, nogil=True)
 def assemble_ldl_head(K, ks, p, B, Q, rot, fix, L, nmax):  # type: ignore[no-untyped-def]
     """First part of :func:`assemble_ldl` (``kd = 7``, ``N > 16``) while the columns of the
-    points ``nmax .. n - 1`` are assembled elsewhere (:func:`_assemble_range`, e.g. on another
+    points ``nmax .. n - 1`` are assembled elsewhere (:func:`assemble_range`, e.g. on another
     thread): assembles points ``0 .. nmax - 1`` and eliminates the columns that read only
     those. Returns ``(info, j)``: continue with :func:`assemble_ldl_tail` from ``j`` once
     every column is assembled. The same operations as :func:`assemble_ldl` (bitwise)."""
     dim = B.shape[1]
     nxt = min(nmax, 256)
-    _assemble_range(K, ks, p, np.bool_(False), B, Q, rot, fix, L, np.intp(0), nxt)
+    assemble_range(K, ks, p, np.bool_(False), B, Q, rot, fix, L, np.intp(0), nxt)
     info, j, nxt = _ldl7(K, ks, p, B, Q, rot, fix, L, np.intp(0), max(nmax * dim - 8, 0), nxt,
                          nmax)
     return info, j
@@ -586,7 +586,7 @@ def _krow(K, ks, p, closed, x, i, a, interior):  # type: ignore[no-untyped-def]
 @njit(cache=True)
 def band_residual_scaled(W, ks, p, closed, x, out):  # type: ignore[no-untyped-def]
     """``out = (W ks) x`` per coordinate in the difference form of
-    :func:`curvefair.curves.bspline.band_residual` (``sum_{o != 0} (W[i, p + o] ks) (x_{i+o} -
+    :func:`curvefair._kernels.bspline.band_residual` (``sum_{o != 0} (W[i, p + o] ks) (x_{i+o} -
     x_i)``, the same operations on the entries of the scaled band: :func:`residual_row`)."""
     n, dim = x.shape
     for i in range(n):

@@ -1,0 +1,447 @@
+"""Compiled kernels of Cheng & Yu's method (:mod:`curvefair.fairing.cheng_yu`): cubic B-splines
+faired with the second discrete curvature.
+
+:func:`plan` computes the move of one control point (or of two consecutive ones) and its
+modifying factor, shared by the single step :func:`curvefair.fairing.cheng_yu.cheng_yu` and the
+automatic method; :func:`cy_loop` is the automatic method's ranking loop with local updates
+(:func:`curvefair.fairing.cheng_yu.cheng_yu_driver`), its stop codes :data:`NONE_LEFT`,
+:data:`EPS`, :data:`MAX_STEPS`, :data:`CONVERGED`.
+
+Indices are 0-based (the paper's ``Q_0 .. Q_n`` are ``control_points[0 .. n]``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._jit import njit
+from .ranking import tt_build, tt_top, tt_update
+
+_P = 3  # cubic
+_BISECT = 64
+_SAMPLES = 32
+
+
+# --------------------------------------------------------------------------------------------
+# compiled kernels shared by the single step and the driver
+# --------------------------------------------------------------------------------------------
+@njit(cache=True)
+def _gram(W, n, closed, m, j):  # type: ignore[no-untyped-def]
+    """``G[m, j]`` from the band ``W`` (aliased offsets of a short closed curve add up)."""
+    s = 0.0
+    for o in range(-_P, _P + 1):
+        k = m + o
+        if closed:
+            k = k % n
+        elif k < 0 or k >= n:
+            continue
+        if k == j:
+            s += W[m, _P + o]
+    return s
+
+
+@njit(cache=True)
+def _residual(W, Q, n, closed, m, out):  # type: ignore[no-untyped-def]
+    """``out = sum_{i != m} d_i Q_i - Q_m = -(G Q)_m / G_mm`` (eq. (8) target minus current)."""
+    dim = Q.shape[1]
+    for c in range(dim):
+        out[c] = 0.0
+    for o in range(-_P, _P + 1):
+        k = m + o
+        if closed:
+            k = k % n
+        elif k < 0 or k >= n:
+            continue
+        w = W[m, _P + o]
+        for c in range(dim):
+            out[c] += w * Q[k, c]
+    g = W[m, _P]
+    for c in range(dim):
+        out[c] = -out[c] / g
+
+
+@njit(cache=True)
+def _moves(s, r0, r1, a, b, pair, out0, out1):  # type: ignore[no-untyped-def]
+    """Displacements at ``s = 1 - d``: single ``s r0``; pair ``s A(s)^-1 [r0, r1]`` (eq. (9))."""
+    dim = r0.shape[0]
+    if not pair:
+        for c in range(dim):
+            out0[c] = s * r0[c]
+        return
+    den = 1.0 - s * s * a * b
+    for c in range(dim):
+        out0[c] = s * (r0[c] + s * a * r1[c]) / den
+        out1[c] = s * (r1[c] + s * b * r0[c]) / den
+
+
+@njit(cache=True)
+def _excess(Q, Q0, m0, m1, s, r0, r1, a, b, pair, e, tmp0, tmp1):  # type: ignore[no-untyped-def]
+    """``max_j |Q_j + move_j(s) - Q0_j| - e`` over the moved points."""
+    _moves(s, r0, r1, a, b, pair, tmp0, tmp1)
+    dim = Q.shape[1]
+    d2 = 0.0
+    for c in range(dim):
+        v = Q[m0, c] + tmp0[c] - Q0[m0, c]
+        d2 += v * v
+    worst = np.sqrt(d2)
+    if pair:
+        d2 = 0.0
+        for c in range(dim):
+            v = Q[m1, c] + tmp1[c] - Q0[m1, c]
+            d2 += v * v
+        worst = max(worst, np.sqrt(d2))
+    return worst - e
+
+
+@njit(cache=True)
+def _step_factor(Q, Q0, m0, m1, r0, r1, a, b, pair, e, tmp0, tmp1):  # type: ignore[no-untyped-def]
+    """Largest ``s = 1 - d`` in ``[0, 1]`` with the error bound kept on all of ``[0, s]``
+    (one point: closed form; two points: sampled, then bisected). The returned ``s`` satisfies
+    the bound as computed."""
+    if e == np.inf:  # no bound
+        return 1.0
+    e = e * (1.0 - 1e-12)  # margin: the bound then survives any re-rounding of the distance
+    if not pair:
+        # the segment Q + s r meets the ball |x - Q0| <= e in an interval containing s = 0:
+        # its upper end in closed form, |p + s r|^2 = e^2 with p = Q - Q0
+        rr = 0.0
+        pr = 0.0
+        pp = 0.0
+        for c in range(Q.shape[1]):
+            p = Q[m0, c] - Q0[m0, c]
+            rr += r0[c] * r0[c]
+            pr += p * r0[c]
+            pp += p * p
+        if rr == 0.0:
+            return 1.0
+        es = e * (1.0 - 1e-12)  # aim a hair inside, so the check below passes at once
+        disc = pr * pr - rr * (pp - es * es)
+        if disc < 0.0:
+            disc = 0.0
+        if pr <= 0.0:
+            s = (np.sqrt(disc) - pr) / rr
+        else:
+            s = (es * es - pp) / (pr + np.sqrt(disc))
+        s = min(max(s, 0.0), 1.0)
+        for _ in range(60):  # guard against rounding: shrink until the computed point is inside
+            if _excess(Q, Q0, m0, m1, s, r0, r1, a, b, pair, e, tmp0, tmp1) <= 0.0:
+                return s
+            s *= 1.0 - 1e-12
+        return 0.0
+    if _excess(Q, Q0, m0, m1, 1.0, r0, r1, a, b, pair, e, tmp0, tmp1) <= 0.0:
+        # still check the path for a rational curve leaving and re-entering the ball
+        ok = True
+        for k in range(1, _SAMPLES):
+            if _excess(Q, Q0, m0, m1, k / _SAMPLES, r0, r1, a, b, pair, e, tmp0, tmp1) > 0.0:
+                ok = False
+                break
+        if ok:
+            return 1.0
+    lo = 0.0
+    hi = 1.0
+    for k in range(1, _SAMPLES + 1):
+        sk = k / _SAMPLES
+        if _excess(Q, Q0, m0, m1, sk, r0, r1, a, b, pair, e, tmp0, tmp1) > 0.0:
+            hi = sk
+            break
+        lo = sk
+    for _ in range(_BISECT):
+        mid = 0.5 * (lo + hi)
+        if mid <= lo or mid >= hi:
+            break
+        if _excess(Q, Q0, m0, m1, mid, r0, r1, a, b, pair, e, tmp0, tmp1) > 0.0:
+            hi = mid
+        else:
+            lo = mid
+    return lo
+
+
+@njit(cache=True)
+def plan(Q, Q0, W, n, closed, m0, pair, e, dfix, new0, new1):  # type: ignore[no-untyped-def]
+    """New positions of ``Q[m0]`` (and ``Q[m0+1]`` if ``pair``); returns the factor ``d`` used.
+
+    ``e = inf`` means no bound; ``dfix >= 0`` forces the factor.
+    """
+    dim = Q.shape[1]
+    m1 = (m0 + 1) % n if closed else m0 + 1
+    r0 = np.zeros(dim)
+    r1 = np.zeros(dim)
+    tmp0 = np.zeros(dim)
+    tmp1 = np.zeros(dim)
+    _residual(W, Q, n, closed, m0, r0)
+    a = 0.0
+    b = 0.0
+    if pair:
+        _residual(W, Q, n, closed, m1, r1)
+        a = -_gram(W, n, closed, m0, m1) / W[m0, _P]
+        b = -_gram(W, n, closed, m1, m0) / W[m1, _P]
+    if dfix >= 0.0:
+        s = 1.0 - dfix
+    else:
+        s = _step_factor(Q, Q0, m0, m1, r0, r1, a, b, pair, e, tmp0, tmp1)
+    _moves(s, r0, r1, a, b, pair, tmp0, tmp1)
+    for c in range(dim):
+        new0[c] = Q[m0, c] + tmp0[c]
+        if pair:
+            new1[c] = Q[m1, c] + tmp1[c]
+    return 1.0 - s
+
+
+# --------------------------------------------------------------------------------------------
+# the automatic method: compiled ranking loop with local updates
+# --------------------------------------------------------------------------------------------
+NONE_LEFT = 0  # movable bad points remain, none can lower x
+EPS = 1  # largest z of a movable bad point below the threshold
+MAX_STEPS = 2
+CONVERGED = 3  # no movable bad point at all
+
+
+@njit(cache=True)
+def _k_at(Q, lw, mw, i, n, closed, planar):  # type: ignore[no-untyped-def]
+    """``K_i`` (eq. (3)); the same arithmetic as ``second_curvature_values``."""
+    if not closed and (i == 0 or i == n - 1):
+        return 0.0
+    ip = (i - 1) % n
+    inx = (i + 1) % n
+    dim = Q.shape[1]
+    e0 = np.empty(dim)
+    e1 = np.empty(dim)
+    for c in range(dim):
+        e0[c] = Q[i, c] - Q[ip, c]
+        e1[c] = Q[inx, c] - Q[i, c]
+    if planar:
+        area = 0.5 * (e0[0] * e1[1] - e0[1] * e1[0])
+    else:
+        cx = e0[1] * e1[2] - e0[2] * e1[1]
+        cy = e0[2] * e1[0] - e0[0] * e1[2]
+        cz = e0[0] * e1[1] - e0[1] * e1[0]
+        area = 0.5 * np.sqrt(cx * cx + cy * cy + cz * cz)
+    if area == 0.0:
+        return 0.0
+    s = 0.0
+    for c in range(dim):
+        w = lw[i] * e0[c] + mw[i] * e1[c]
+        s += w * w
+    wn = np.sqrt(s)
+    if wn == 0.0:
+        return 0.0
+    return area / wn**3
+
+
+@njit(cache=True)
+def _t_at(Q, i, n, closed):  # type: ignore[no-untyped-def]
+    if not closed and (i == 0 or i == n - 1):
+        return 0.5
+    ip = (i - 1) % n
+    inx = (i + 1) % n
+    a = 0.0
+    b = 0.0
+    for c in range(Q.shape[1]):
+        u = Q[i, c] - Q[ip, c]
+        v = Q[inx, c] - Q[i, c]
+        a += u * u
+        b += v * v
+    a = np.sqrt(a)
+    b = np.sqrt(b)
+    s = a + b
+    if s > 0.0:
+        return b / s
+    return 0.5
+
+
+@njit(cache=True)
+def _valid(i, n, closed):  # type: ignore[no-untyped-def]
+    return closed or (2 <= i <= n - 3)
+
+
+@njit(cache=True)
+def _d_at(K, t, i, n, closed):  # type: ignore[no-untyped-def]
+    if not closed and (i == 0 or i == n - 1):
+        return 0.0
+    return t[i] * K[(i - 1) % n] + (1.0 - t[i]) * K[(i + 1) % n] - K[i]
+
+
+@njit(cache=True)
+def _flags_at(K, t, i, n, closed):  # type: ignore[no-untyped-def]
+    """Bit mask of the bad-point kinds at ``i`` (1, 2, 4 for kinds 1, 2, 3), as in
+    ``bad_point_kinds``."""
+    if not _valid(i, n, closed):
+        return 0
+    kp = K[(i - 1) % n]
+    k = K[i]
+    kn = K[(i + 1) % n]
+    f = 0
+    if k * kn <= 0.0 and kp * k > 0.0:
+        f |= 1
+    if (k - kp) * (kn - k) < 0.0:
+        f |= 2
+    same = (kp > 0 and k > 0 and kn > 0) or (kp < 0 and k < 0 and kn < 0)
+    if same and not (abs(k) > 0.5 * ((1.0 - t[i]) * abs(kp) + t[i] * abs(kn))):
+        f |= 4
+    return f
+
+
+@njit(cache=True)
+def _index_range(lo, hi, n, closed):  # type: ignore[no-untyped-def]
+    """Distinct indices ``lo .. hi`` (cyclic or clipped)."""
+    if closed:
+        if hi - lo + 1 >= n:
+            return np.arange(n)
+        out = np.empty(hi - lo + 1, dtype=np.int64)
+        for k in range(lo, hi + 1):
+            out[k - lo] = k % n
+        return out
+    a = max(lo, 0)
+    b = min(hi, n - 1)
+    if b < a:
+        return np.empty(0, dtype=np.int64)
+    return np.arange(a, b + 1)
+
+
+@njit(cache=True)
+def _priority(D, flags, movable, frozen, i):  # type: ignore[no-untyped-def]
+    if flags[i] != 0 and movable[i] and not frozen[i]:
+        return D[i] * D[i]
+    return -np.inf
+
+
+@njit(cache=True)
+def _try_step(Q, Q0, W, lw, mw, K, t, D, n, closed, planar, m0, pair, e, min_drop):  # type: ignore[no-untyped-def]
+    """Move ``m0`` (and ``m0 + 1``); keep it iff ``sum D_i**2`` over the touched valid indices
+    drops by more than ``min_drop``. Returns ``(accepted, local change of x)``."""
+    dim = Q.shape[1]
+    m1 = (m0 + 1) % n if closed else m0 + 1
+    new0 = np.zeros(dim)
+    new1 = np.zeros(dim)
+    plan(Q, Q0, W, n, closed, m0, pair, e, -1.0, new0, new1)
+    changed = False
+    for c in range(dim):
+        if new0[c] != Q[m0, c] or (pair and new1[c] != Q[m1, c]):
+            changed = True
+    if not changed:
+        return False, 0.0
+    last = m0 + 1 if pair else m0
+    kr = _index_range(m0 - 1, last + 1, n, closed)
+    dr = _index_range(m0 - 2, last + 2, n, closed)
+    old_q0 = Q[m0].copy()
+    old_q1 = Q[m1].copy() if pair else Q[m0].copy()
+    old_k = K[kr].copy()
+    old_t = t[kr].copy()
+    old_d = D[dr].copy()
+    before = 0.0
+    for j in dr:
+        if _valid(j, n, closed):
+            before += D[j] * D[j]
+    Q[m0] = new0
+    if pair:
+        Q[m1] = new1
+    for j in kr:
+        K[j] = _k_at(Q, lw, mw, j, n, closed, planar)
+        t[j] = _t_at(Q, j, n, closed)
+    after = 0.0
+    for j in dr:
+        D[j] = _d_at(K, t, j, n, closed)
+        if _valid(j, n, closed):
+            after += D[j] * D[j]
+    if before - after > min_drop:
+        return True, after - before
+    Q[m0] = old_q0
+    if pair:
+        Q[m1] = old_q1
+    K[kr] = old_k
+    t[kr] = old_t
+    D[dr] = old_d
+    return False, 0.0
+
+
+@njit(cache=True)
+def cy_loop(Q, Q0, W, lw, mw, closed, planar, movable, e, eps, max_steps,  # type: ignore[no-untyped-def]
+            allow_pair, hist, moves):
+    """The ranking loop. ``hist[k]`` = x after ``k`` accepted steps; ``moves[k]`` = (first moved
+    index, 1 or 2 points, ``z`` of the top bad point, largest displacement). Returns
+    ``(steps, reason)``."""
+    n = Q.shape[0]
+    K = np.zeros(n)
+    t = np.full(n, 0.5)
+    D = np.zeros(n)
+    for i in range(n):
+        K[i] = _k_at(Q, lw, mw, i, n, closed, planar)
+        t[i] = _t_at(Q, i, n, closed)
+    x = 0.0
+    for i in range(n):
+        D[i] = _d_at(K, t, i, n, closed)
+        if _valid(i, n, closed):
+            x += D[i] * D[i]
+    flags = np.zeros(n, dtype=np.int64)
+    frozen = np.zeros(n, dtype=np.bool_)
+    pr = np.empty(n)
+    for i in range(n):
+        flags[i] = _flags_at(K, t, i, n, closed)
+        pr[i] = _priority(D, flags, movable, frozen, i)
+    tv, ti = tt_build(pr)
+    hist[0] = x
+    steps = 0
+    reason = CONVERGED
+    while True:
+        m, zm = tt_top(tv, ti)
+        if zm == -np.inf:
+            reason = CONVERGED
+            for i in range(n):
+                if frozen[i] and flags[i] != 0 and movable[i]:
+                    reason = NONE_LEFT
+                    break
+            break
+        if zm < eps:
+            reason = EPS
+            break
+        if steps >= max_steps:
+            reason = MAX_STEPS
+            break
+        first = m
+        pair = False
+        if allow_pair:
+            tt_update(tv, ti, m, -np.inf)
+            m2, z2 = tt_top(tv, ti)
+            tt_update(tv, ti, m, zm)
+            if z2 != -np.inf and z2 >= eps:
+                if (closed and (m2 - m) % n == 1) or (not closed and m2 == m + 1):
+                    pair = True
+                elif (closed and (m - m2) % n == 1) or (not closed and m2 == m - 1):
+                    pair = True
+                    first = m2
+        q_first = Q[first].copy()
+        q_second = Q[(first + 1) % n].copy()
+        ok, dx = _try_step(Q, Q0, W, lw, mw, K, t, D, n, closed, planar, first, pair, e,
+                            eps)
+        if not ok and pair:
+            pair = False
+            first = m
+            ok, dx = _try_step(Q, Q0, W, lw, mw, K, t, D, n, closed, planar, m, np.bool_(False), e,
+                                eps)
+        if not ok:
+            frozen[m] = True
+            tt_update(tv, ti, m, -np.inf)
+            continue
+        steps += 1
+        x += dx
+        hist[steps] = x
+        moves[steps - 1, 0] = first
+        moves[steps - 1, 1] = 2 if pair else 1
+        moves[steps - 1, 2] = zm
+        disp = 0.0
+        for c in range(Q.shape[1]):
+            disp += (Q[first, c] - q_first[c]) ** 2
+        disp = np.sqrt(disp)
+        if pair:
+            d2 = 0.0
+            for c in range(Q.shape[1]):
+                d2 += (Q[(first + 1) % n, c] - q_second[c]) ** 2
+            disp = max(disp, np.sqrt(d2))
+        moves[steps - 1, 3] = disp
+        last = first + 1 if pair else first
+        for j in _index_range(first - 4, last + 4, n, closed):
+            frozen[j] = False
+        for j in _index_range(first - 4, last + 4, n, closed):
+            flags[j] = _flags_at(K, t, j, n, closed)
+            tt_update(tv, ti, j, _priority(D, flags, movable, frozen, j))
+    return steps, reason
