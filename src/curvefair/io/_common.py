@@ -474,11 +474,18 @@ _NOISE_CHORDS = 6.0
 _NOISE_SCALES = (1.0, 2.0, 4.0)
 
 
+_RAYLEIGH_MEDIAN = float(np.sqrt(2.0 * np.log(2.0)))  # median of a Rayleigh distribution
+
+
 def noise_scale(points: FloatArray, closed: bool) -> float:
     """Estimated noise amplitude of a point list, or 0 when it does not look noisy.
 
     ``r_i`` is the distance of ``p_i`` from the chord ``p_{i-1} p_{i+1}``; the estimate is
-    ``median(r) / 0.6745`` (the median absolute deviation of a normal distribution). The list
+    ``median(r) / 0.6745`` in the plane (the median absolute deviation of a normal
+    distribution) and ``median(r) / 1.1774`` in space, where ``r`` is the length of a normal
+    vector across the chord, two components (the median of a Rayleigh distribution,
+    ``sqrt(2 ln 2)``): the same figure for the same noise per coordinate, about ``1.22 sigma``
+    (the residual's own spread, ``sqrt(1.5) sigma`` for evenly spaced neighbours). The list
     is taken as noisy only if it has at least 10 points, the sign of the turning flips between
     at least 30 % of consecutive points (a smooth sampling flips only at its inflections, a
     convex polygon never) and the estimate is at most 1 % of the list's extent (a zigzag
@@ -509,7 +516,7 @@ def noise_scale(points: FloatArray, closed: bool) -> float:
     else:
         bn = np.cross(e1, e2)
         alt = float(np.mean(np.einsum("ij,ij->i", bn[1:], bn[:-1]) < 0))
-    sigma = float(np.median(cr[ok] / L[ok])) / 0.6745
+    sigma = float(np.median(cr[ok] / L[ok])) / (0.6745 if p.shape[1] == 2 else _RAYLEIGH_MEDIAN)
     size = float(np.ptp(p, axis=0).max())
     if alt < _NOISE_ALTERNATION or not sigma <= _NOISE_MAX_REL * size:
         return 0.0
