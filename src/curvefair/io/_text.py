@@ -403,8 +403,10 @@ def _render_plain_block(lines: np.ndarray, data_lines: np.ndarray, redo: np.ndar
     for d_try in tries:
         for d in np.unique(d_try[~done & (d_try >= 0)]).tolist():
             sel = np.flatnonzero(~done & (d_try == d))
+            # exact needs v * 10**d within |k| 2^-52 of an integer k: below 0.01 for
+            # |k| < 2^45 (10**d itself exact up to d = 22); beyond that every value is tried
             x = v[sel] * 10.0 ** d
-            cand = sel[(np.abs(x - np.rint(x)) <= 0.01) | (np.abs(x) >= 2.0 ** 45)]
+            cand = sel[(np.abs(x - np.rint(x)) <= 0.01) | (np.abs(x) >= 2.0 ** 45) | (d > 22)]
             if not len(cand):
                 continue
             strs = (f"%.{d}f\x1f" * len(cand) % tuple(v[cand].tolist())).split("\x1f")[:-1]
@@ -580,8 +582,8 @@ def parse_text(path: str | os.PathLike[str], *, header: bool = True,
 
 def _plain_rows(lines: list[str], start: int, width: int
                 ) -> tuple[list[str], FloatArray] | None:
-    """The number texts and values of ``lines[start:]`` when every one of them is a row of ``width``
-    numbers joined by one separator character (``,``, ``;``, a blank or a tab) and nothing
+    """The number texts and values of ``lines[start:]`` when every one of them is a row of
+    ``width`` numbers joined by one separator character (``,``, ``;``, a blank or a tab) and nothing
     else, or None (the line-by-line reader then goes on, with its own messages).
 
     One check of the whole block instead of one per line: only digits, ``.``, ``e``/``E``,
