@@ -16,9 +16,9 @@ def straight_kernel(P, spans, p, closed, rel, eps, mark):  # type: ignore[no-unt
     spans are straight. Span ``s`` uses control points ``s - p .. s`` (mod ``n`` if closed);
     it is straight when its line ``d = W_p - W_0`` has ``L = |d| > eps`` and every
     ``r_a = W_a - W_0`` is within ``rel L + eps`` of that line: ``|r_a - (r_a . u) u| <=
-    rel L + eps``, ``u = d / max(L, 1e-300)``. One pass, no temporaries; the operations and
-    their order are those of the numpy formula this replaced (sums over the coordinates in
-    order), so the decisions are bitwise the same."""
+    rel L + eps``, ``u = d / max(L, 1e-300)``. One pass, no temporaries; sums over the
+    coordinates in order (no fastmath), so the decisions do not depend on the CPU's vector
+    width."""
     n = P.shape[0]
     dim = P.shape[1]
     u = np.empty(dim)
