@@ -23,6 +23,7 @@ from _helpers import record_points
 
 from curvefair import read_curves, write_curves
 from curvefair.errors import FileFormatError
+from curvefair.io.airfoil import LEADING_EDGE_CORNER_ANGLE
 
 HERE = Path(__file__).parent
 REAL = HERE / "data" / "real"
@@ -181,6 +182,7 @@ def test_every_uiuc_file_of_the_aerosandbox_wheel(aerosandbox_wheel, tmp_path):
         assert len(names) == 2174
         read_ok, refused, notes = 0, {}, 0
         not_identical: list[str] = []
+        round_le, cut_wrong = 0, []
         for n in names:
             base = n[len(DB):]
             raw = z.read(n)
@@ -194,6 +196,18 @@ def test_every_uiuc_file_of_the_aerosandbox_wheel(aerosandbox_wheel, tmp_path):
                 refused[base] = str(exc)
                 continue
             read_ok += 1
+            # the leading edge (farthest from the trailing edge's middle) is cut only where
+            # it turns by LEADING_EDGE_CORNER_ANGLE or more; the other corners by the default
+            pts = _contour(recs)
+            le = int(np.argmax(np.linalg.norm(pts - 0.5 * (pts[0] + pts[-1]), axis=1)))
+            if 0 < le < len(pts) - 1:
+                a, b = pts[le] - pts[le - 1], pts[le + 1] - pts[le]
+                turn = np.degrees(np.arccos(np.clip(
+                    a @ b / (np.linalg.norm(a) * np.linalg.norm(b)), -1.0, 1.0)))
+                cut = le in {int(r.source["indices"][0]) for r in recs[1:]}
+                round_le += bool(60.0 <= turn < LEADING_EDGE_CORNER_ANGLE)
+                if cut != (turn >= LEADING_EDGE_CORNER_ANGLE):
+                    cut_wrong.append((base, float(turn), cut))
             src = recs[0].source
             notes += bool(src["notes"])
             if src["airfoil_layout"] == "selig":
@@ -214,3 +228,7 @@ def test_every_uiuc_file_of_the_aerosandbox_wheel(aerosandbox_wheel, tmp_path):
     assert read_ok == 2174 - len(refused_doc)
     assert notes >= 300        # 341 files carry notes after the coordinates
     assert not_identical == [], f"{len(not_identical)} unchanged files not written back as read"
+    # coarse tables turn by 60-120 degrees at a round leading edge (the default corner angle
+    # alone cut 527 files there); none is cut, every sharper one is
+    assert round_le >= 400
+    assert cut_wrong == []

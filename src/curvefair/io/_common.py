@@ -647,7 +647,9 @@ def corner_turning(points: FloatArray, closed: bool) -> FloatArray:
 
 
 def split_at_corners(points: FloatArray, closed: bool, corner_angle: float | None,
-                     extra_corners: Sequence[int] = ()) -> tuple[list[np.ndarray], FloatArray]:
+                     extra_corners: Sequence[int] = (),
+                     min_angles: Mapping[int, float] | None = None
+                     ) -> tuple[list[np.ndarray], FloatArray]:
     """Cut a point list at its corners.
 
     Parameters
@@ -660,6 +662,9 @@ def split_at_corners(points: FloatArray, closed: bool, corner_angle: float | Non
         is ``>= corner_angle`` degrees is a corner; None: no detection.
     extra_corners : sequence of int
         Points that are corners whatever their angle.
+    min_angles : mapping of int to float, optional
+        Points that are corners only from this angle on (or ``corner_angle`` if larger), e.g.
+        an airfoil's leading edge.
 
     Returns
     -------
@@ -673,7 +678,10 @@ def split_at_corners(points: FloatArray, closed: bool, corner_angle: float | Non
     angles = corner_turning(points, closed)
     is_c = np.zeros(m, dtype=bool)
     if corner_angle is not None:
-        is_c |= angles >= float(corner_angle)
+        limit = np.full(m, float(corner_angle))
+        for i, a in (min_angles or {}).items():
+            limit[int(i) % m] = max(float(corner_angle), float(a))
+        is_c |= angles >= limit
     if len(extra_corners):
         is_c[np.asarray(extra_corners, dtype=int) % m] = True
     if not closed:
@@ -836,7 +844,8 @@ def same_path(a: object, b: object) -> bool:
 
 def point_records(points: FloatArray, *, closed: bool, corner_angle: float | None,
                   kind: str, name: str | None, source: Mapping[str, Any],
-                  end_corners: bool = False, first_index: int = 0) -> list[CurveRecord]:
+                  end_corners: bool = False, first_index: int = 0,
+                  min_angles: Mapping[int, float] | None = None) -> list[CurveRecord]:
     """Records of one point list: split at corners, each piece a curve through its points.
 
     Parameters
@@ -847,6 +856,8 @@ def point_records(points: FloatArray, *, closed: bool, corner_angle: float | Non
         The list is a closed loop.
     end_corners : bool
         The first and last points are corners too (an airfoil's trailing edge).
+    min_angles : mapping of int to float, optional
+        Points split only from this corner angle on (:func:`split_at_corners`).
     source : mapping
         Common source keys; each record adds ``"indices"`` (into ``points``; a read-only
         int64 array), ``"n_points"``
@@ -855,7 +866,7 @@ def point_records(points: FloatArray, *, closed: bool, corner_angle: float | Non
         ``source["index"]`` of the first record.
     """
     m = points.shape[0]
-    pieces, _ = split_at_corners(points, closed, corner_angle)
+    pieces, _ = split_at_corners(points, closed, corner_angle, min_angles=min_angles)
     loop = closed and len(pieces) == 1
     is_corner = np.zeros(m, dtype=bool)
     if len(pieces) > 1:

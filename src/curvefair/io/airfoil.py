@@ -20,7 +20,13 @@ Records
 The contour in Selig order (Lednicer: upper reversed, then lower, the shared leading-edge
 point once) as ``kind="airfoil"`` records; the first and last points (the trailing edge) are
 corners, and so is any interior point turning by ``corner_angle`` or more (the contour is then
-split there). ``name`` is the name line. ``source`` keys: ``layout`` (TextLayout),
+split there) -- but the leading edge (the contour point farthest from the middle of the
+trailing edge) only from :data:`LEADING_EDGE_CORNER_ANGLE` (120 degrees) on: a round leading
+edge sampled more coarsely than its radius (0, 1.25 %, 2.5 % ... of the chord, as many
+tables are) turns by up to about 118 degrees at that one point, while a sharp one (biconvex,
+double wedge) turns by 135 degrees or more. Split at a round leading edge, each surface
+would be faired on its own with the leading edge as a free end, and the two faired pieces
+would meet there at an angle. ``name`` is the name line. ``source`` keys: ``layout`` (TextLayout),
 ``airfoil_layout``
 (``"selig"`` or ``"lednicer"``), ``counts`` (Lednicer ``(NU, NL)``), ``row_map`` (file data row ->
 contour point; the count line is row 0 of a Lednicer file and maps to -1), ``indices``,
@@ -57,6 +63,18 @@ from ._text import TextLayout, fresh_text, parse_text
 __all__ = ["read", "write"]
 
 FORMAT = "airfoil"
+
+
+#: The corner angle at an airfoil's leading edge (degrees; ``corner_angle`` if larger): see
+#: the module docstring.
+LEADING_EDGE_CORNER_ANGLE = 120.0
+
+
+def leading_edge(contour: np.ndarray) -> int:
+    """Index of the leading edge of a contour from trailing edge to trailing edge: the point
+    farthest from the middle of its first and last points."""
+    mid = 0.5 * (contour[0] + contour[-1])
+    return int(np.argmax(np.linalg.norm(contour - mid, axis=1)))
 
 
 def _is_count_row(v: np.ndarray) -> bool:
@@ -111,7 +129,8 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
            "leading_lines": tuple(lay.lines[i] for i in lay.leading),
            "notes": tuple(notes)}
     return point_records(contour, closed=False, corner_angle=corner_angle, kind="airfoil",
-                         name=name, source=src, end_corners=True)
+                         name=name, source=src, end_corners=True,
+                         min_angles={leading_edge(contour): LEADING_EDGE_CORNER_ANGLE})
 
 
 def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
