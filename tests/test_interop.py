@@ -120,6 +120,40 @@ def test_pchip_akima_ppoly_bpoly():
     _close(cb, lambda u, nu: bp(u, nu), x[0], x[-1], derivs=(0, 1))
 
 
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_piecewise_polynomials_with_the_values_first(dim):
+    # scipy objects built with axis=1 evaluate to (dim, len(u)) (csaps' spline form is such a
+    # PPoly): converted like their axis-0 twins, checked against scipy's evaluation moved back
+    x, y = _data(dim=dim)
+    cases = [si.CubicSpline(x, y.T, axis=1),  # C2 cubic: CubicHermite
+             si.PPoly.from_spline(si.make_interp_spline(x, y[:, 0], k=3))]  # scalar graph
+    spl5 = si.make_interp_spline(x, y, k=5)
+    pp5 = _ppoly(spl5)
+    # the values' axis first in the coefficients, as scipy takes them with axis=1
+    cases.append(si.PPoly(np.moveaxis(pp5.c, 2, 0), pp5.x, axis=1))  # C4 quintic
+    d = np.gradient(y, x, axis=0)
+    bp = si.BPoly.from_derivatives(x, np.stack([y, d], axis=1))  # C1 cubic, Bernstein basis
+    cases.append(si.BPoly(np.moveaxis(bp.c, 2, 0), bp.x, axis=1))
+    kinds = (CubicHermite, CubicHermite, QuinticHermite, CubicHermite)
+    for obj, kind in zip(cases, kinds, strict=True):
+        c = as_curve(obj)
+        assert isinstance(c, kind), type(obj).__name__
+        if obj.c.ndim == 2:
+            continue  # the graph case is tested in test_scalar_splines_are_graphs
+        _close(c, lambda u, nu, o=obj: np.moveaxis(np.asarray(o(u, nu)), 1, 0), x[0], x[-1],
+               derivs=(0, 1))
+
+
+def test_csaps_spline_form_is_accepted():
+    csaps = pytest.importorskip("csaps")
+    x, y = _data()
+    spl = csaps.CubicSmoothingSpline(x, y.T, smooth=0.99).spline  # a PPoly with axis=1
+    c = as_curve(spl)
+    assert isinstance(c, CubicHermite)
+    _close(c, lambda u, nu: np.moveaxis(np.asarray(spl(u, nu)), 1, 0), x[0], x[-1])
+
+
 def test_scalar_splines_are_graphs():
     x = np.linspace(0, 3, 9)
     f = np.sin(x)

@@ -201,6 +201,11 @@ def _from_ppoly(pp: Any, name: str, closed: bool | None) -> PiecewiseCurve:
 
     x = np.asarray(pp.x, dtype=float)
     c = np.asarray(pp.c, dtype=float)
+    if int(getattr(pp, "axis", 0)) != 0:
+        # scipy stores ``c`` as (k + 1, m, values) whatever the axis; only the evaluation puts
+        # the values first (``axis=1``: shape (dim, len(u)), e.g. csaps' spline form): the same
+        # polynomial pieces with the parameter axis first
+        pp = PPoly(c, x, extrapolate=pp.extrapolate)
     if x.shape[0] >= 2 and np.all(np.diff(x) >= 0) and np.any(np.diff(x) == 0):
         # empty intervals (PPoly.from_spline keeps the repeated end knots): no part of the curve
         keep = np.diff(x) > 0
