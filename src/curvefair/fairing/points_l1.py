@@ -456,14 +456,6 @@ def _tube_qp_cyclic(K: sp.csr_matrix, C: sp.csr_matrix, x0: FloatArray, pts: Flo
 # ------------------------------------------------------------------------------------------
 # the method
 # ------------------------------------------------------------------------------------------
-#: rounding floor of the final round's surrogate gap, per constraint: the gap ``eta = -f.lam``
-#: sums one term per constraint, each known to about ``1e-13`` of the scaled energy (measured:
-#: with 400,000 constraints the final round stays at ``eta ~ 1e-7`` however many steps it
-#: takes). Below ``FINAL_STALL * m`` an iteration whose gap no longer halves in three steps is
-#: converged; under 1,000 constraints this is below the final gap ``1e-9`` and changes nothing
-FINAL_STALL = 1e-12
-
-
 def _jump_norms(ops: NaturalOperators, x: FloatArray, P: FloatArray | None = None
                 ) -> FloatArray:
     """``|J_k|``, or ``|P_k J_k|`` with the per-jump projections ``P`` (shape (k, dim, dim))."""
@@ -718,7 +710,7 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
             else:
                 x, lam, st, reason = _tube_qp(
                     K, None, x0, Y, rad, max_steps=max_steps, gap=1e-9 if last else round_gap,
-                    stall=FINAL_STALL * Y.shape[0] if last else 100.0 * round_gap, rows=rows,
+                    stall=0.0 if last else 100.0 * round_gap, rows=rows,
                     lam0=None if (lam is None or not warm_lam) else np.maximum(lam, 1e-3))
             newton += st
             rounds_done += 1
