@@ -428,11 +428,11 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
         (with a B-spline method registered).
     method : str, optional
         A name from :func:`available_methods`; default: the curve type's default
-        (``"points-l1"`` for open chord-length natural cubics - point data - up to 20,000
-        points, ``"poliakoff"`` for other cubic, ``"wang-quintic"`` for quintic Hermite splines,
-        ``"global"`` with ``l=3`` for B-splines: the fairest method of the quality benchmark
-        that keeps the B-spline's degree, knots and number of control points), with that
-        method's ``default_options`` under the caller's own options.
+        (``"points-l1"`` for point data up to 20,000 points, i.e. chord-length natural cubics,
+        open or closed (periodic), ``"poliakoff"`` for other cubic, ``"wang-quintic"`` for
+        quintic Hermite splines, ``"global"`` with ``l=3`` for B-splines: the fairest method of
+        the quality benchmark that keeps the B-spline's degree, knots and number of control
+        points), with that method's ``default_options`` under the caller's own options.
     tol : float > 0, optional
         Neither the output curve nor any data point ends farther than ``tol`` from the input.
         Each step is clamped onto the ball of radius ``tol`` around the ORIGINAL point (ERRATA,
