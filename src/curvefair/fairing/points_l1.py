@@ -77,7 +77,13 @@ excess and the problem solved again (scaling the moves instead would bring the n
 The curve a reader rebuilds from the written points uses the chord lengths of ``q``; at
 fixed parameters the points of a fair curve sit along it, so the rebuilt curve is the same
 curve up to a smooth change of parameter and close to it (its Hausdorff distance from the
-input's chord interpolant is checked too, ``curve_tol``). Keeping the chord parameters of
+input's chord interpolant is checked too, ``curve_tol``). Where it strays farther, it does so
+on a few spans: short spans where the noisy input's interpolant kinks and a smooth curve
+cannot follow it. Lists of up to ``LOCAL_SHRINK_MIN_POINTS`` points shrink every radius by
+the excess (a local halving on a coarse list leaves a visible jump); longer lists whose excess
+would need a harsh global factor shrink the radii near those spans only
+(:func:`_local_factors`), so that a handful of spans among thousands do not narrow the whole
+tube. Keeping the chord parameters of
 ``q`` instead (affinely onto the input's domain) is not an option: the chord lengths of noisy
 samples drift from those of the smoothed points like a random walk (45 tol at 10,000 noisy
 points of ``benchmarks/bench_points_l1.py``), far beyond any equal-parameter tolerance.
@@ -575,8 +581,9 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
         through ``q``) within ``tol`` of the input's chord-length natural cubic as a curve
         (Hausdorff distance, :func:`_rebuilt_distance`), as the read-back check
         of a written point file measures it: when it strays farther, the radii are scaled by
-        ``0.98 tol / bound`` and the problem solved again (``max_attempts`` times at most;
-        the equal-parameter bound shrinks them the same way).
+        ``0.98 tol / bound`` (long lists with a large excess: near the offending spans only,
+        ``LOCAL_SHRINK_*``) and the problem solved again (``max_attempts`` times at most; the
+        equal-parameter bound shrinks them all by ``0.97 tol / bound``).
     samples : int
         Curve samples per span (equally spaced inside it) constrained like the data points:
         ``|S_q(s) - S_p(s)| <= tol``; the certified bound then rarely needs the final scaling.
@@ -690,6 +697,7 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
     lam = None
     floor = None
     shrink = 1.0
+    went_local = False
     while True:
         attempts += 1
         rad = np.r_[rad_p, rad_s]
@@ -732,8 +740,13 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
         # exceeds tol (the interpolant of alternating moves overshoots between its samples),
         # the radii are shrunk by the excess and the problem solved again (a re-solve keeps
         # the sparsity, scaling the moves would not)
+        # the global factor (equal-parameter bound, mild rebuilt-curve excess) and, for long
+        # lists with a harsh rebuilt-curve excess, per-span local factors (LOCAL_SHRINK_*)
+        shrink = 1.0
+        local: tuple[FloatArray, FloatArray] | None = None
         _, ub, _ = difference_deviation(ref_in, curve)
-        shrink = 0.97 * tol_out / ub if ub > tol_out else 1.0
+        if ub > tol_out:
+            shrink = 0.97 * tol_out / ub
         if ref is not None:
             # the curve rebuilt from the written points (chord-length parameters of q): the
             # read-back check of a point file measures its (Hausdorff) distance from the
@@ -743,11 +756,28 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
             rebuilt: Any = spline(np.array(q_out), "chord")
             curve_dev = _rebuilt_distance(ref, rebuilt, tol_out)
             if curve_dev > tol_out:
-                shrink = min(shrink, 0.98 * tol_out / curve_dev)
-        if shrink >= 1.0 or attempts > max_attempts:
+                g = 0.98 * tol_out / curve_dev
+                per = matched_hermite_bound(ref, rebuilt) if (
+                    N > LOCAL_SHRINK_MIN_POINTS and (went_local or g < LOCAL_SHRINK_BELOW)) \
+                    else None
+                if per is not None and np.any(per > tol_out):
+                    went_local = True
+                    local = _local_factors(per, tol_out, closed)
+                else:
+                    shrink = min(shrink, g)
+        if local is None and shrink >= 1.0 or attempts > max_attempts:
             break
-        rad_p = np.where(held, rad_p, rad_p * shrink)
-        rad_s = rad_s * shrink
+        if local is None:
+            rad_p = np.where(held, rad_p, rad_p * shrink)
+            rad_s = rad_s * shrink
+        else:
+            pf, sf = local
+            rad_p = np.where(held, rad_p, rad_p * np.minimum(pf, shrink))
+            rad_s = (rad_s.reshape(sf.shape[0], -1) * np.minimum(sf, shrink)[:, None]
+                     ).reshape(-1)
+            # the warm start of the next attempt is pulled toward the input by the smallest
+            # factor (strictly inside every shrunk ball)
+            shrink = min(shrink, float(pf.min()))
     # equal parameter: certified on the difference curve, every move scaled if needed
     curve_e, cert = enforce_tolerance(ref_in, curve, tol_out, curve_bound=True)
     curve = cast(CubicHermite, curve_e)
@@ -763,6 +793,48 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
               "scale": float(cert.scale)}
     q_out.setflags(write=False)
     return PointsL1Result(q_out, curve, report)
+
+
+
+#: above this many points (and only when a global factor would be harsh, see
+#: ``LOCAL_SHRINK_BELOW``) the radii are shrunk near the spans whose rebuilt curve strays
+#: beyond ``tol`` instead of everywhere: with tens of thousands of points the offending spans
+#: are a small fraction (short spans where the noisy input's interpolant kinks), and one global
+#: factor spends the whole tube on them (100,000 noisy spiral points: four global shrinks to
+#: 0.21 tol for the last 3 offending spans). On coarse files a local halving leaves a visible
+#: jump instead (33-point airfoils of the quality benchmark: up to 7 more curvature extrema),
+#: so small lists keep the global factor
+LOCAL_SHRINK_MIN_POINTS = 5_000
+
+#: the global factor ``0.98 tol / distance`` below which the shrink goes local (and stays so
+#: for the later attempts of the same call)
+LOCAL_SHRINK_BELOW = 0.9
+
+#: a span whose per-span bound ``b_s`` exceeds ``tol`` has its radii, and those of the points
+#: and spans within ``LOCAL_SHRINK_REACH`` spans of it, multiplied by
+#: ``LOCAL_SHRINK_FACTOR * 0.98 tol / b_s``: decisively, since the interpolant's overshoot on a
+#: span depends on the moves of the points around it (a factor of just ``0.98 tol / b_s``
+#: moved the excess to the neighbouring spans attempt after attempt)
+LOCAL_SHRINK_FACTOR = 0.5
+LOCAL_SHRINK_REACH = 5
+
+
+def _local_factors(per: FloatArray, tol: float, closed: bool
+                   ) -> tuple[FloatArray, FloatArray]:
+    """``(point factors, span factors)`` of a local shrink from the per-span bounds ``per``
+    (one per span; closed: the spans wrap around, as many as points): each span and point
+    gets the smallest factor ``LOCAL_SHRINK_FACTOR * 0.98 tol / per_s`` of the spans ``s``
+    within ``LOCAL_SHRINK_REACH`` spans of it whose bound exceeds ``tol``, 1 where there is
+    none (point ``i`` ends spans ``i - 1`` and ``i``)."""
+    f = np.where(per > tol, LOCAL_SHRINK_FACTOR * 0.98 * tol / np.maximum(per, 1e-300), 1.0)
+    ns, r = f.shape[0], LOCAL_SHRINK_REACH
+    pad = np.r_[f[-r:], f, f[:r]] if closed and ns >= r else np.r_[np.ones(r), f, np.ones(r)]
+    sf = np.min(np.stack([pad[k:k + ns] for k in range(2 * r + 1)]), axis=0)
+    if closed:
+        pf = np.minimum(sf, np.roll(sf, 1))
+    else:
+        pf = np.minimum(np.r_[sf, 1.0], np.r_[1.0, sf])
+    return cast(FloatArray, pf), cast(FloatArray, sf)
 
 
 def _polyline_distance(x: FloatArray, poly: FloatArray,
