@@ -348,6 +348,22 @@ def test_dry_run_writes_nothing_and_says_what_a_run_changes(tmp_path: Path):
         assert f"moved {moved}/{n} points (largest move {d.max():.6g})" in out, out
 
 
+
+def test_dry_run_needs_no_output(tmp_path: Path):
+    # a dry run writes nothing, so it needs no -o: one file, and a folder of files
+    write_curves(tmp_path / "b.json", [interpolate_bspline(_wavy())])
+    (tmp_path / "in").mkdir()
+    write_curves(tmp_path / "in/c.json", [interpolate_bspline(_wavy(seed=3))])
+    before = _snapshot(tmp_path)
+    for args in (["b.json"], ["in"], ["b.json", "in"]):
+        r = _run(["fair", *args, "--tol", str(TOL), "--dry-run"], tmp_path)
+        assert r.exit_code == 0, r.output
+        assert "would write" in r.output and "nothing written" in r.output
+        assert _snapshot(tmp_path) == before  # no output, no report folder, inputs as they were
+    # without --dry-run the output is still required
+    r = _run(["fair", "b.json", "--tol", str(TOL)], tmp_path)
+    assert r.exit_code == 2 and "missing option '-o'" in r.output
+
 @pytest.mark.slow
 def test_jobs_give_the_bytes_of_one_process(tmp_path: Path):
     _tree(tmp_path)

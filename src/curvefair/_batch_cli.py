@@ -135,7 +135,7 @@ def fair_many(paths: Sequence[str], out: str | None, in_place: bool, options: di
     t0 = time.perf_counter()
     if plot_path is not None:
         raise click.UsageError("--plot takes one input file and one output file")
-    if out is None and not in_place:
+    if out is None and not in_place and not dry_run:
         raise click.UsageError("missing option '-o' / '--output' (a folder for many inputs, "
                                "or pass --in-place to replace each input)")
     if out == "-" and (len(paths) != 1 or (paths[0] != "-" and not os.path.isfile(paths[0]))):
@@ -165,7 +165,9 @@ def fair_many(paths: Sequence[str], out: str | None, in_place: bool, options: di
                     if not parent.is_dir():
                         raise click.BadParameter(f"the folder of {out!r} does not exist",
                                                  param_hint="-o/--output")
-                jobs_list = _batch.plan_inputs(paths, out, in_place=in_place, stdin_format=fmt)
+                # a dry run without -o: the jobs are planned in place (it writes nothing)
+                jobs_list = _batch.plan_inputs(paths, out, stdin_format=fmt,
+                                               in_place=in_place or (dry_run and out is None))
                 for j in jobs_list:
                     if j.input == "-":
                         assert tmp is not None
