@@ -14,7 +14,7 @@ from .._typing import FloatArray
 
 
 @njit(cache=True)
-def chord_turns_kernel(p, closed, Lmin, out):  # type: ignore[no-untyped-def]
+def chord_turns_kernel(p, closed, Lmin, out):
     """Fill ``out`` (NaN on entry) for :func:`curvefair.io._common._chord_turns`: from every
     point ``i`` walk back and forth to the first point ``k`` with ``|p_k - p_i| >= Lmin`` (at
     most ``m // 2`` steps; an open list's ends stop the walk), then

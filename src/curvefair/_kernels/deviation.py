@@ -24,7 +24,7 @@ TO_BERNSTEIN = np.linalg.inv(np.array([[(1 - x) ** 3, 3 * x * (1 - x) ** 2, 3 * 
 
 
 @njit(cache=True, error_model="numpy")
-def first_pass(d, w, M, U):  # type: ignore[no-untyped-def]
+def first_pass(d, w, M, U):
     """Per piece: ``U[i]`` = max norm of the Bernstein control points of ``d`` on piece ``i``
     (``M`` maps scaled power coefficients to Bernstein ones); returns the largest sampled
     ``|d|`` (ends and quarter points), its piece and fraction."""
@@ -67,7 +67,7 @@ def first_pass(d, w, M, U):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, error_model="numpy")
-def _norm_row(v):  # type: ignore[no-untyped-def]
+def _norm_row(v):
     """``sqrt(sum(v * v))`` summed in index order (as the numpy ``_norms`` of
     :mod:`curvefair.analysis._deviation` rounds it)."""
     acc = v[0] * v[0]
@@ -77,7 +77,7 @@ def _norm_row(v):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, error_model="numpy")
-def branch_and_bound(cb, lo, hi, best, best_t, ub, rtol, atol, levels, cap):  # type: ignore[no-untyped-def]
+def branch_and_bound(cb, lo, hi, best, best_t, ub, rtol, atol, levels, cap):
     """The levels of :func:`curvefair.deviation`'s branch-and-bound in one compiled pass.
 
     Per level, for the pieces left (Bernstein control points ``cb`` (k, q, dim) on
@@ -177,7 +177,7 @@ def branch_and_bound(cb, lo, hi, best, best_t, ub, rtol, atol, levels, cap):  # 
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def matched_bound_kernel(ua, ub, pa, pb, ta, tb, pieces, tob, out):  # type: ignore[no-untyped-def]
+def matched_bound_kernel(ua, ub, pa, pb, ta, tb, pieces, tob, out):
     """:func:`curvefair.analysis.matched_hermite_bound` in one pass over the spans (no
     ``(n, 4, dim)`` temporaries): per span and sub-piece, the difference cubic's values at
     ``s = (j + k / 3) / pieces``, their Bernstein control points by ``tob``, the largest

@@ -25,7 +25,7 @@ _F32_MAX = 1e38
 
 
 @njit(cache=True, error_model="numpy")
-def _variations_1d(b, n):  # type: ignore[no-untyped-def]
+def _variations_1d(b, n):
     """Sign changes (zeros skipped) of ``b[:n]``."""
     v = 0
     zero = False
@@ -45,7 +45,7 @@ def _variations_1d(b, n):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, fastmath=_FM, inline="always", error_model="numpy")
-def _setup(cw, i, hi, fall, e):  # type: ignore[no-untyped-def]
+def _setup(cw, i, hi, fall, e):
     """Scaled coefficients ``e_j = c_j h^j`` of segment ``i`` and the sizes of its first and
     second derivative polynomials (for the zero-speed and zero-curvature tests)."""
     p1, dim = e.shape
@@ -69,7 +69,7 @@ def _setup(cw, i, hi, fall, e):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, fastmath=_FM, inline="always", error_model="numpy")
-def _frenet_node(r1, r2, r3, sc1, sc2, speed_rtol, cross_rtol):  # type: ignore[no-untyped-def]
+def _frenet_node(r1, r2, r3, sc1, sc2, speed_rtol, cross_rtol):
     """``(kappa, dkds, speed, N, E, singular)`` at one node (see ``_core.frenet``)."""
     dim = r1.shape[0]
     s2 = 0.0
@@ -114,7 +114,7 @@ def _frenet_node(r1, r2, r3, sc1, sc2, speed_rtol, cross_rtol):  # type: ignore[
 @njit(cache=True, fastmath=_FM, error_model="numpy")
 def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cross_rtol,
                 closed, kap, dks, knots, energies, quad, box, ell, pos,
-                gaps, unit):  # type: ignore[no-untyped-def]
+                gaps, unit):
     """One fused pass over the segments (see
     :func:`curvefair.analysis._sampling.sample_curve`).
 
@@ -405,7 +405,7 @@ def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cr
 
 
 @njit(cache=True, error_model="numpy")
-def allowances(quad, h, rtol, allow, worst, hist):  # type: ignore[no-untyped-def]
+def allowances(quad, h, rtol, allow, worst, hist):
     """Error allowance of each segment for the arc length and the dkds energy:
     ``rtol (|Q_i| + |total| h_i / sum h)``; ``worst`` = largest estimate / allowance ratio;
     ``hist[k]`` counts the segments with ``2^k < worst <= 2^(k+1)`` (k capped at 63).
@@ -439,7 +439,7 @@ def allowances(quad, h, rtol, allow, worst, hist):  # type: ignore[no-untyped-de
 
 @njit(cache=True, fastmath=_FM, error_model="numpy")
 def refine_kernel(cw, h, quad, allow, worst, thresh, P, xk, w7, fall, speed_rtol,
-                  cross_rtol, max_levels, budget):  # type: ignore[no-untyped-def]
+                  cross_rtol, max_levels, budget):
     """Adaptive re-integration, in place, of the segments with ``worst > thresh``.
 
     Level ``L`` integrates segment ``i`` with the 7-point rule on ``P 2^L`` equal pieces; it
@@ -511,7 +511,7 @@ def refine_kernel(cw, h, quad, allow, worst, thresh, P, xk, w7, fall, speed_rtol
 
 @njit(cache=True, error_model="numpy")
 def scan_kernel(vals, x, breaks, ex_seg, ex_u, ex_val, tol, ell, pos, floor, power,
-                out):  # type: ignore[no-untyped-def]
+                out):
     """The sign changes of :func:`curvefair.analysis._sampling.scan_sign_changes` in one pass:
     the sampled values ``vals`` (m, K) at fractions ``x`` merged per segment with the extra
     samples (``ex_seg``, ``ex_u``, ``ex_val``, sorted), a value counting as zero within
