@@ -35,7 +35,8 @@ import numpy as np
 
 import curvefair as cf
 from curvefair.fairing import joins as _joins
-from curvefair.fairing._tolerance import enforce_tolerance, point_report, prime_power_forms
+from curvefair.fairing import point_report
+from curvefair.fairing._tolerance import enforce_tolerance, prime_power_forms
 
 
 def data(n: int, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:

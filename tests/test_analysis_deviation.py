@@ -234,8 +234,8 @@ def test_matched_hermite_bound_kernel_vs_numpy_and_dense_sampling(dim, closed):
     numpy form to rounding, and bounds |b(t) - a(psi(t))| sampled densely with scipy's
     CubicHermiteSpline on every span (psi maps b's parameters onto a's, point i to point i), up
     to the rounding of evaluating the two curves separately."""
+    from curvefair._kernels.deviation import matched_hermite_bound_reference
     from curvefair.analysis import matched_hermite_bound
-    from curvefair.analysis._deviation import _matched_hermite_bound_reference
 
     rng = np.random.default_rng(11 + dim + 7 * closed)
     for n in (2, 3, 9, 120):
@@ -249,7 +249,7 @@ def test_matched_hermite_bound_kernel_vs_numpy_and_dense_sampling(dim, closed):
         b = cf.interpolate_cubic(np.r_[Q, Q[:1]] if closed else Q, bc=bc)
         for pieces in (1, 4, 6):
             got = matched_hermite_bound(a, b, pieces)
-            ref = _matched_hermite_bound_reference(a, b, pieces)
+            ref = matched_hermite_bound_reference(a, b, pieces)
             assert got.shape == ref.shape == (len(a.params) - 1,)
             np.testing.assert_allclose(got, ref, rtol=1e-13, atol=1e-15 * float(ref.max()))
         fa = CubicHermiteSpline(a.params, a.points, a.tangents)

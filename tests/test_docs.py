@@ -57,6 +57,10 @@ def test_api_reference_covers_public_names(html: Path) -> None:
         assert f'id="curvefair.fairing.{name}"' in fairing, name
     io_page = (html / "api" / "io.html").read_text(encoding="utf-8")
     assert 'id="curvefair.io.detect_format"' in io_page
+    # the public homes of what the CLI and batch use across packages (issue 15)
+    assert 'id="curvefair.io.write_checked"' in io_page
+    assert 'id="curvefair.io.rescaled_report"' in io_page
+    assert 'id="curvefair.fairing.point_report"' in fairing
 
 
 def test_markdown_pages(html: Path) -> None:

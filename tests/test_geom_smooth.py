@@ -444,11 +444,13 @@ def test_guard_on_a_hermite_curve_reports_and_keeps_the_counts():
 @pytest.mark.parametrize("closed", [False, True])
 @pytest.mark.parametrize("dim", [2, 3])
 def test_compiled_chord_turns_match_the_plain_walk(closed, dim):
-    """The compiled corner search (``_chord_turns``) against its slow reference (numpy norms
-    and dot products point by point): the same points reach each chord length (same NaN
-    pattern) and the angles agree to 1e-9 degrees, on noisy open and closed lists of 3 to 400
-    points, for chord lengths from 0 (every neighbour) to beyond the list's size."""
-    from curvefair.io._common import _chord_turns, _chord_turns_reference
+    """The compiled corner search (``_chord_turns``, ``_kernels.corners.chord_turns_kernel``)
+    against its slow reference beside the kernel (numpy norms and dot products point by
+    point): the same points reach each chord length (same NaN pattern) and the angles agree to
+    1e-9 degrees, on noisy open and closed lists of 3 to 400 points, for chord lengths from 0
+    (every neighbour) to beyond the list's size."""
+    from curvefair._kernels.corners import chord_turns_reference
+    from curvefair.io._common import _chord_turns
 
     rng = np.random.default_rng(7 + dim + 10 * closed)
     for n in (3, 4, 7, 50, 400):
@@ -456,7 +458,7 @@ def test_compiled_chord_turns_match_the_plain_walk(closed, dim):
         p = np.c_[np.cos(t), np.sin(t)] if dim == 2 else np.c_[np.cos(t), np.sin(t), 0.3 * t]
         p = p + 0.01 * rng.standard_normal(p.shape)
         for length in (0.0, 0.02, 0.1, 0.5, 5.0):
-            a, b = _chord_turns(p, closed, length), _chord_turns_reference(p, closed, length)
+            a, b = _chord_turns(p, closed, length), chord_turns_reference(p, closed, length)
             assert np.array_equal(np.isnan(a), np.isnan(b)), (n, length)
             assert np.nanmax(np.abs(a - b), initial=0.0) <= 1e-9, (n, length)
             if length == 0.02 and n >= 50:

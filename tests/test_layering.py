@@ -114,15 +114,10 @@ def test_the_checker_sees_a_private_import_across_packages(tmp_path):
                    "fairing.x -> _kernels.hermite._kseg", "fairing.x -> curves.bspline._gauss"]
 
 
-# The imports across packages that still reach private pieces (issue 15 lists them; each needs
-# a public home in the owning package). The list may only shrink: a new private import fails
-# the test, and so does an entry that no longer occurs (remove it from the list).
-KNOWN = {
-    "batch -> io._verify.write_checked",
-    "cli -> io._verify.write_checked",
-    "cli -> io._verify.rescaled_report",
-    "io._verify -> fairing._tolerance.point_report",
-}
+# The imports across packages that still reach private pieces. Issue 15 gave every one of them a
+# public home in the owning package, so the list is empty; it may only shrink: a new private
+# import fails the test, and so does an entry that no longer occurs (remove it from the list).
+KNOWN: set[str] = set()
 
 
 def test_no_new_private_import_across_packages():

@@ -36,3 +36,33 @@ def test_only_jit_imports_numba():
     importers = {p.relative_to(SRC).as_posix() for p in sorted(SRC.rglob("*.py"))
                  if _backend_imports(p)}
     assert importers == {"_jit.py"}
+
+
+def _jit_users(path: Path) -> bool:
+    """Whether a file takes ``njit`` (or ``prefetch``) from ``curvefair._jit``, relative or
+    absolute import alike."""
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.ImportFrom) and (node.module or "").split(".")[-1] == "_jit" \
+                and (node.level or (node.module or "").startswith("curvefair.")) \
+                and any(a.name in ("njit", "prefetch") for a in node.names):
+            return True
+    return False
+
+
+def test_the_checker_sees_jit_users(tmp_path):
+    f = tmp_path / "x.py"
+    f.write_text("from .._typing import FloatArray\n")
+    assert not _jit_users(f)
+    for src in ("from .._jit import njit\n", "from curvefair._jit import prefetch\n",
+                "def g():\n    from ..._jit import njit as nj\n"):
+        f.write_text(src)
+        assert _jit_users(f), src
+
+
+def test_kernels_live_in_the_kernels_package():
+    # issue 15: every compiled kernel is in curvefair._kernels, beside the others (and beside
+    # its slow reference); the public packages keep the Python drivers only
+    users = {p.relative_to(SRC).as_posix() for p in sorted(SRC.rglob("*.py")) if _jit_users(p)}
+    outside = sorted(u for u in users if not u.startswith("_kernels/"))
+    assert not outside, "compiled kernels outside curvefair._kernels: " + ", ".join(outside)
+    assert "_kernels/sampling.py" in users  # the checker finds the kernels it should

@@ -215,7 +215,7 @@ def test_report_after_figures_describe_the_written_file(tmp_path):
     from scipy.interpolate import CubicSpline
 
     from curvefair import analyze, fair
-    from curvefair.io._verify import rescaled_report
+    from curvefair.io import rescaled_report
 
     recs = read_curves(DATA / "clarky.dat")
     tol = 1e-4

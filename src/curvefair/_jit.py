@@ -237,7 +237,7 @@ def njit(*args: Any, **kwargs: Any) -> Any:
 
 
 @_intrinsic
-def prefetch(typingctx, arr, idx):  # type: ignore[no-untyped-def]
+def prefetch(typingctx, arr, idx):
     """Hint the CPU to load the cache line holding ``arr.flat[idx]`` (a C-contiguous array;
     ``idx`` need not be in range: a prefetch never faults). ``llvm.prefetch``; no effect on
     results.
@@ -249,7 +249,7 @@ def prefetch(typingctx, arr, idx):  # type: ignore[no-untyped-def]
         return None
     sig = _types.void(arr, _types.intp)
 
-    def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
+    def codegen(context, builder, signature, args):
         aryty = signature.args[0]
         ary = context.make_array(aryty)(context, builder, args[0])
         ptr = builder.gep(ary.data, [args[1]])

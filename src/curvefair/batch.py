@@ -2,7 +2,7 @@
 
 The unit of work is one file, :func:`fair_file`: read it with :func:`curvefair.read_curves`,
 fair the selected curves with :func:`curvefair.fair`, write the result through
-:func:`curvefair.io._verify.write_checked` (temporary file, read back, measured against the
+:func:`curvefair.io.write_checked` (temporary file, read back, measured against the
 input, moved onto the output only when every curve is within ``tol``) and write a per-file
 JSON report. The same function runs in this process, in a pool of processes
 (:func:`fair_files` with ``jobs``) or on Dask distributed workers (``client``); its result
@@ -799,7 +799,7 @@ def _err(exc: BaseException) -> str:
 
 def _write(outfile: str, faired: list[Any], records: list[Any], infile: str, fmt_in: str,
            fmt_out: str, opts: Mapping[str, Any], in_place: bool) -> Any:
-    from .io._verify import write_checked
+    from .io import write_checked
 
     folder = os.path.dirname(os.path.abspath(outfile))
     os.makedirs(folder, exist_ok=True)

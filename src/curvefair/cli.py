@@ -1041,7 +1041,7 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
             return
     _check_protect_range(records, user_protect)
     from . import fair
-    from .io._verify import write_checked
+    from .io import write_checked
 
     rows: list[dict[str, Any]] = []
     faired = []
@@ -1108,7 +1108,7 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
                                   format=out_fmt, overwrite=in_place, decimals=decimals)
             if prog is not None:
                 prog[0].advance(prog[1])
-            from .io._verify import rescaled_report
+            from .io import rescaled_report
 
             kept_notes: list[str] = []
             for i, (row, d, kind) in enumerate(zip(rows, check.deviations, check.kinds,

@@ -167,7 +167,7 @@ def _filter_class() -> type:
     except ImportError:  # pragma: no cover - the fonts extra installs it
         raise MissingDependencyError("ufo2ft", "fonts", "FairFilter") from None
 
-    class FairFilter(BaseFilter):  # type: ignore[misc,valid-type]
+    class FairFilter(BaseFilter):
         """ufo2ft filter: fair every glyph's contours within ``tol`` font units.
 
         Options (keyword arguments, also in ``--filter "curvefair.fonts::FairFilter(...)"``):
@@ -355,7 +355,7 @@ def _grid_if_integer(r: CurveRecord) -> CurveRecord:
     return dataclasses.replace(r, source=dict(r.source, outline=dataclasses.replace(c, grid=True)))
 
 
-class _Glyphset(dict):  # type: ignore[type-arg]
+class _Glyphset(dict):
     """A glyph set that gives None for a glyph it does not have (interpolatable's sparse
     masters)."""
 

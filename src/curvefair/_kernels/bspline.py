@@ -31,7 +31,7 @@ from .._jit import njit
 
 
 @njit(cache=True)
-def _ders_one(knots, p, s, u, base, nder, ndu, left, right, a, out, q):  # type: ignore[no-untyped-def]
+def _ders_one(knots, p, s, u, base, nder, ndu, left, right, a, out, q):
     """Basis derivatives at one parameter into ``out[q]`` (Piegl & Tiller A2.3); work arrays
     ``ndu`` (p+1, p+1), ``left``/``right`` (p+1,), ``a`` (2, p+1)."""
     ndu[0, 0] = 1.0
@@ -76,7 +76,7 @@ def _ders_one(knots, p, s, u, base, nder, ndu, left, right, a, out, q):  # type:
 
 
 @njit(cache=True)
-def ders_kernel(knots, p, span, x, nder, local, out):  # type: ignore[no-untyped-def]
+def ders_kernel(knots, p, span, x, nder, local, out):
     ndu = np.empty((p + 1, p + 1))
     left = np.empty(p + 1)
     right = np.empty(p + 1)
@@ -88,7 +88,7 @@ def ders_kernel(knots, p, span, x, nder, local, out):  # type: ignore[no-untyped
 
 
 @njit(cache=True)
-def _factorials(p):  # type: ignore[no-untyped-def]
+def _factorials(p):
     fact = np.empty(p + 1)
     fact[0] = 1.0
     for k in range(1, p + 1):
@@ -97,7 +97,7 @@ def _factorials(p):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def _span_basis(knots, p, s, prev, have, ndu, left, right, a, d):  # type: ignore[no-untyped-def]
+def _span_basis(knots, p, s, prev, have, ndu, left, right, a, d):
     """Basis derivatives of span ``s`` into ``d[0]`` (local offsets), unless its local knot
     pattern equals the previous span's (kept in ``prev``): then ``d`` already holds bitwise the
     same values. Returns whether ``d`` is valid (``have`` for the next span)."""
@@ -113,7 +113,7 @@ def _span_basis(knots, p, s, prev, have, ndu, left, right, a, d):  # type: ignor
 
 
 @njit(cache=True)
-def power_form_kernel(knots, p, spans, ctrl, closed, out):  # type: ignore[no-untyped-def]
+def power_form_kernel(knots, p, spans, ctrl, closed, out):
     """``out[m, k, :] = sum_a N_{s-p+a}^(k)(t_s) d_{s-p+a} / k!`` for ``s = spans[m]`` (control
     indices mod ``n`` for a closed curve): the piecewise power form of the B-spline. A span
     whose local knot pattern equals the previous span's reuses its basis derivatives."""
@@ -142,7 +142,7 @@ def power_form_kernel(knots, p, spans, ctrl, closed, out):  # type: ignore[no-un
 
 
 @njit(cache=True)
-def power_form_pair_kernel(knots, p, spans, ctrl, base, closed, out, out_diff):  # type: ignore[no-untyped-def]
+def power_form_pair_kernel(knots, p, spans, ctrl, base, closed, out, out_diff):
     """:func:`power_form_kernel` of ``ctrl`` into ``out`` and of ``ctrl - base`` into
     ``out_diff`` in one pass: the basis derivatives of each span (most of the work) are
     computed once for both. The same operations in the same order as two calls of
@@ -175,7 +175,7 @@ def power_form_pair_kernel(knots, p, spans, ctrl, base, closed, out, out_diff): 
 
 
 @njit(cache=True)
-def gram_kernel(knots, p, spans, l, xq, wq, n, closed, W):  # type: ignore[no-untyped-def]  # noqa: E741
+def gram_kernel(knots, p, spans, l, xq, wq, n, closed, W):  # noqa: E741
     """Banded Gram matrix ``W`` (n, 2p+1) of ``int N_i^(l) N_j^(l)`` (see
     :meth:`curvefair.BSplineCurve.gram_band`), accumulated into ``W`` (zeros on entry,
     allocated by numpy: huge pages, see :func:`natural_cubic_kernel`).
@@ -229,7 +229,7 @@ def gram_kernel(knots, p, spans, l, xq, wq, n, closed, W):  # type: ignore[no-un
 
 
 @njit(cache=True, inline="always")
-def residual_row(W, ks, p, closed, x, i, a, interior):  # type: ignore[no-untyped-def]
+def residual_row(W, ks, p, closed, x, i, a, interior):
     """``((W ks) x)_{i, a}`` in the difference form of :func:`band_residual`,
     ``sum_{o != 0} (W[i, p + o] ks) (x_{i+o} - x_i)``; ``ks = 1.0`` gives ``(G x)_{i, a}``
     exactly (a product by 1 is exact), another ``ks`` the residual of the scaled band of the
@@ -252,7 +252,7 @@ def residual_row(W, ks, p, closed, x, i, a, interior):  # type: ignore[no-untype
 
 
 @njit(cache=True)
-def band_residual(W, p, closed, x, out):  # type: ignore[no-untyped-def]
+def band_residual(W, p, closed, x, out):
     """``out = G x`` (per coordinate) for the Gram band ``W`` of
     :meth:`curvefair.BSplineCurve.gram_band`, in difference form
     ``(G x)_i = sum_{o != 0} W[i, p + o] (x_{i+o} - x_i)``.
@@ -269,7 +269,7 @@ def band_residual(W, p, closed, x, out):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, inline="always")
-def energy_row(W, p, closed, x, i, e):  # type: ignore[no-untyped-def]
+def energy_row(W, p, closed, x, i, e):
     """``e`` less row ``i``'s terms of :func:`band_energy`, ``sum_{o=1..p} W[i, p + o]
     |x_{i+o} - x_i|^2``, subtracted one by one (the caller's sum keeps its order of
     operations). Inlined at numba IR level; the one place this sum is written."""
@@ -291,7 +291,7 @@ def energy_row(W, p, closed, x, i, e):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def band_energy(W, p, closed, x):  # type: ignore[no-untyped-def]
+def band_energy(W, p, closed, x):
     """``x^T G x`` summed over the coordinates, in difference form
     ``-sum_i sum_{o=1..p} W[i, p + o] |x_{i+o} - x_i|^2`` (see :func:`band_residual`): exact
     for ``l >= 1`` and free of the cancellation of large coordinates."""
@@ -305,7 +305,7 @@ def band_energy(W, p, closed, x):  # type: ignore[no-untyped-def]
 # the natural cubic interpolant
 # ------------------------------------------------------------------------------------------
 @njit(cache=True)
-def natural_cubic_kernel(u, pts, T, d, cp):  # type: ignore[no-untyped-def]
+def natural_cubic_kernel(u, pts, T, d, cp):
     """Fill the clamped knot vector ``T`` (m + 6) and the control points ``d`` (m + 2, dim) of
     the natural cubic interpolant (see :func:`curvefair.curves.bspline._natural_cubic`): the
     tridiagonal system solved for every coordinate at once by elimination without pivoting
@@ -363,7 +363,7 @@ def natural_cubic_kernel(u, pts, T, d, cp):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def first_coincident(pts):  # type: ignore[no-untyped-def]
+def first_coincident(pts):
     """Index ``i`` of the first pair of consecutive points closer than ``as_points`` accepts
     (every coordinate difference ``<= 4 eps max|pts|``), or -1; one pass, no temporaries."""
     n, dim = pts.shape

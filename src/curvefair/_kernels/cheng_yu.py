@@ -26,7 +26,7 @@ _SAMPLES = 32
 # compiled kernels shared by the single step and the driver
 # --------------------------------------------------------------------------------------------
 @njit(cache=True)
-def _gram(W, n, closed, m, j):  # type: ignore[no-untyped-def]
+def _gram(W, n, closed, m, j):
     """``G[m, j]`` from the band ``W`` (aliased offsets of a short closed curve add up)."""
     s = 0.0
     for o in range(-_P, _P + 1):
@@ -41,7 +41,7 @@ def _gram(W, n, closed, m, j):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def _residual(W, Q, n, closed, m, out):  # type: ignore[no-untyped-def]
+def _residual(W, Q, n, closed, m, out):
     """``out = sum_{i != m} d_i Q_i - Q_m = -(G Q)_m / G_mm`` (eq. (8) target minus current)."""
     dim = Q.shape[1]
     for c in range(dim):
@@ -61,7 +61,7 @@ def _residual(W, Q, n, closed, m, out):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def _moves(s, r0, r1, a, b, pair, out0, out1):  # type: ignore[no-untyped-def]
+def _moves(s, r0, r1, a, b, pair, out0, out1):
     """Displacements at ``s = 1 - d``: single ``s r0``; pair ``s A(s)^-1 [r0, r1]`` (eq. (9))."""
     dim = r0.shape[0]
     if not pair:
@@ -75,7 +75,7 @@ def _moves(s, r0, r1, a, b, pair, out0, out1):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def _excess(Q, Q0, m0, m1, s, r0, r1, a, b, pair, e, tmp0, tmp1):  # type: ignore[no-untyped-def]
+def _excess(Q, Q0, m0, m1, s, r0, r1, a, b, pair, e, tmp0, tmp1):
     """``max_j |Q_j + move_j(s) - Q0_j| - e`` over the moved points."""
     _moves(s, r0, r1, a, b, pair, tmp0, tmp1)
     dim = Q.shape[1]
@@ -94,7 +94,7 @@ def _excess(Q, Q0, m0, m1, s, r0, r1, a, b, pair, e, tmp0, tmp1):  # type: ignor
 
 
 @njit(cache=True)
-def _step_factor(Q, Q0, m0, m1, r0, r1, a, b, pair, e, tmp0, tmp1):  # type: ignore[no-untyped-def]
+def _step_factor(Q, Q0, m0, m1, r0, r1, a, b, pair, e, tmp0, tmp1):
     """Largest ``s = 1 - d`` in ``[0, 1]`` with the error bound kept on all of ``[0, s]``
     (one point: closed form; two points: sampled, then bisected). The returned ``s`` satisfies
     the bound as computed."""
@@ -157,7 +157,7 @@ def _step_factor(Q, Q0, m0, m1, r0, r1, a, b, pair, e, tmp0, tmp1):  # type: ign
 
 
 @njit(cache=True)
-def plan(Q, Q0, W, n, closed, m0, pair, e, dfix, new0, new1):  # type: ignore[no-untyped-def]
+def plan(Q, Q0, W, n, closed, m0, pair, e, dfix, new0, new1):
     """New positions of ``Q[m0]`` (and ``Q[m0+1]`` if ``pair``); returns the factor ``d`` used.
 
     ``e = inf`` means no bound; ``dfix >= 0`` forces the factor.
@@ -197,7 +197,7 @@ CONVERGED = 3  # no movable bad point at all
 
 
 @njit(cache=True)
-def _k_at(Q, lw, mw, i, n, closed, planar):  # type: ignore[no-untyped-def]
+def _k_at(Q, lw, mw, i, n, closed, planar):
     """``K_i`` (eq. (3)); the same arithmetic as ``second_curvature_values``."""
     if not closed and (i == 0 or i == n - 1):
         return 0.0
@@ -229,7 +229,7 @@ def _k_at(Q, lw, mw, i, n, closed, planar):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def _t_at(Q, i, n, closed):  # type: ignore[no-untyped-def]
+def _t_at(Q, i, n, closed):
     if not closed and (i == 0 or i == n - 1):
         return 0.5
     ip = (i - 1) % n
@@ -250,19 +250,19 @@ def _t_at(Q, i, n, closed):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def _valid(i, n, closed):  # type: ignore[no-untyped-def]
+def _valid(i, n, closed):
     return closed or (2 <= i <= n - 3)
 
 
 @njit(cache=True)
-def _d_at(K, t, i, n, closed):  # type: ignore[no-untyped-def]
+def _d_at(K, t, i, n, closed):
     if not closed and (i == 0 or i == n - 1):
         return 0.0
     return t[i] * K[(i - 1) % n] + (1.0 - t[i]) * K[(i + 1) % n] - K[i]
 
 
 @njit(cache=True)
-def _flags_at(K, t, i, n, closed):  # type: ignore[no-untyped-def]
+def _flags_at(K, t, i, n, closed):
     """Bit mask of the bad-point kinds at ``i`` (1, 2, 4 for kinds 1, 2, 3), as in
     ``bad_point_kinds``."""
     if not _valid(i, n, closed):
@@ -282,7 +282,7 @@ def _flags_at(K, t, i, n, closed):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def _index_range(lo, hi, n, closed):  # type: ignore[no-untyped-def]
+def _index_range(lo, hi, n, closed):
     """Distinct indices ``lo .. hi`` (cyclic or clipped)."""
     if closed:
         if hi - lo + 1 >= n:
@@ -299,14 +299,14 @@ def _index_range(lo, hi, n, closed):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def _priority(D, flags, movable, frozen, i):  # type: ignore[no-untyped-def]
+def _priority(D, flags, movable, frozen, i):
     if flags[i] != 0 and movable[i] and not frozen[i]:
         return D[i] * D[i]
     return -np.inf
 
 
 @njit(cache=True)
-def _try_step(Q, Q0, W, lw, mw, K, t, D, n, closed, planar, m0, pair, e, min_drop):  # type: ignore[no-untyped-def]
+def _try_step(Q, Q0, W, lw, mw, K, t, D, n, closed, planar, m0, pair, e, min_drop):
     """Move ``m0`` (and ``m0 + 1``); keep it iff ``sum D_i**2`` over the touched valid indices
     drops by more than ``min_drop``. Returns ``(accepted, local change of x)``."""
     dim = Q.shape[1]
@@ -355,7 +355,7 @@ def _try_step(Q, Q0, W, lw, mw, K, t, D, n, closed, planar, m0, pair, e, min_dro
 
 
 @njit(cache=True)
-def cy_loop(Q, Q0, W, lw, mw, closed, planar, movable, e, eps, max_steps,  # type: ignore[no-untyped-def]
+def cy_loop(Q, Q0, W, lw, mw, closed, planar, movable, e, eps, max_steps,
             allow_pair, hist, moves):
     """The ranking loop. ``hist[k]`` = x after ``k`` accepted steps; ``moves[k]`` = (first moved
     index, 1 or 2 points, ``z`` of the top bad point, largest displacement). Returns

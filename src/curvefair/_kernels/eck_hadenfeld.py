@@ -22,7 +22,7 @@ from .bspline import energy_row, residual_row
 # the compiled ranking-list loop
 # ------------------------------------------------------------------------------------------
 @njit(cache=True, error_model="numpy")
-def _candidate(g0, g1, g2, d0, d1, d2, o0, o1, o2, gii, igii, tol):  # type: ignore[no-untyped-def]
+def _candidate(g0, g1, g2, d0, d1, d2, o0, o1, o2, gii, igii, tol):
     """Constrained minimiser of the energy over one control point: ``(z, e0, e1, e2)``.
 
     The energy as a function of ``d_i`` alone is ``G_ii |x - x*|^2 + const`` (isotropic), with
@@ -72,7 +72,7 @@ def _candidate(g0, g1, g2, d0, d1, d2, o0, o1, o2, gii, igii, tol):  # type: ign
 
 
 @njit(cache=True, inline="always")
-def _candidate2(g0, g1, d0, d1, o0, o1, gii, igii, tol):  # type: ignore[no-untyped-def]
+def _candidate2(g0, g1, d0, d1, o0, o1, gii, igii, tol):
     """:func:`_candidate` for a planar point, branch-free: the free and the clamped move are
     both computed and one is selected (a mispredicted branch on whether the ball is reached
     costs more than the extra arithmetic); the same operations in the same order, so the same
@@ -109,7 +109,7 @@ def _candidate2(g0, g1, d0, d1, o0, o1, gii, igii, tol):  # type: ignore[no-unty
 
 
 @njit(cache=True, inline="always")
-def _point_candidate(X, i, Wu, pi, p, D, tol):  # type: ignore[no-untyped-def]
+def _point_candidate(X, i, Wu, pi, p, D, tol):
     """``(z, e0, e1, e2)`` of control point ``i`` from the loop state ``X = [d | G d | orig]``
     (``D`` columns each) and its band row ``Wu[pi]``: :func:`_candidate` in 3-D, the
     branch-free :func:`_candidate2` in the plane (same values). Inlined; the one place the
@@ -123,7 +123,7 @@ def _point_candidate(X, i, Wu, pi, p, D, tol):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, inline="always")
-def _record(hist, nh, r, z, e0, e1, e2):  # type: ignore[no-untyped-def]
+def _record(hist, nh, r, z, e0, e1, e2):
     """Write step ``(index, z, displacement)`` into row ``nh`` of ``hist`` while it has room;
     returns the new row count. Inlined into both loops."""
     if nh < hist.shape[0]:
@@ -135,7 +135,7 @@ def _record(hist, nh, r, z, e0, e1, e2):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, inline="always")
-def _move_residuals(X, Wu, pr, r, e0, e1, e2, D, p, closed):  # type: ignore[no-untyped-def]
+def _move_residuals(X, Wu, pr, r, e0, e1, e2, D, p, closed):
     """After ``d_r`` moved by ``e``: ``(G d)_i += G_ir e`` over the band of ``r`` (cyclic for
     closed curves), ``G``'s row ``r`` being ``Wu[pr]``. Inlined at numba IR level into both
     loops (no call with array arguments in them); the one place this update is written."""
@@ -164,7 +164,7 @@ _PREFETCH_LEVELS = 4  # tree nodes prefetched on the runner-up's path (from its 
 
 @njit(cache=True, error_model="numpy")
 def eh_loop(X, z, Wu, pat, upat, ulo, uhi, D, p, closed, tol, eps_abs, max_steps,
-            hist, T):  # type: ignore[no-untyped-def]
+            hist, T):
     """Ranking-list loop, compiled; updates ``X`` and ``z`` in place.
 
     ``X[i] = (d_i, g_i, orig_i)``, ``D`` columns each (``X`` has ``3 D`` columns),
@@ -415,7 +415,7 @@ def eh_loop(X, z, Wu, pat, upat, ulo, uhi, D, p, closed, tol, eps_abs, max_steps
 
 @njit(cache=True, error_model="numpy")
 def eh_sweep(X, z, Wu, pat, upat, ulo, uhi, D, p, closed, tol, eps_abs, max_steps,
-             hist, Q, flags):  # type: ignore[no-untyped-def]
+             hist, Q, flags):
     """Sweep schedule (``schedule="sweep"``), compiled; updates ``X`` in place.
 
     The same step, state and stopping test as :func:`eh_loop` (``X = [d | G d | orig]``,
@@ -521,7 +521,7 @@ def eh_sweep(X, z, Wu, pat, upat, ulo, uhi, D, p, closed, tol, eps_abs, max_step
 
 
 @njit(cache=True)
-def patterns(W, Wu, pat):  # type: ignore[no-untyped-def]
+def patterns(W, Wu, pat):
     """Fill ``pat`` and the distinct rows ``Wu`` (see
     :func:`curvefair.fairing.eck_hadenfeld.band_patterns`); returns ``(number of patterns,
     pattern of the longest run, its start, its end)``."""
@@ -553,7 +553,7 @@ def patterns(W, Wu, pat):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def largest_free_z(W, p, closed, d, mask):  # type: ignore[no-untyped-def]
+def largest_free_z(W, p, closed, d, mask):
     """Largest unconstrained ranking number ``|(G d)_i|^2 / G_ii`` over the movable points (0
     if none): the residual of :func:`curvefair._kernels.bspline.band_residual` row by row, same
     operations, without the ``(n, dim)`` temporaries."""
@@ -576,7 +576,7 @@ def largest_free_z(W, p, closed, d, mask):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def setup_state(W, p, closed, d, mask, X, z):  # type: ignore[no-untyped-def]
+def setup_state(W, p, closed, d, mask, X, z):
     """One pass over the control points ``d``: the loop state ``X = [d | G d | d]`` (the
     residual of :func:`curvefair._kernels.bspline.band_residual`), the ranking-number slots
     ``z`` (0 movable, -1 fixed, from ``mask``) and the energy ``d^T G d``, returned. Each value

@@ -45,7 +45,7 @@ from .bspline import residual_row
 
 
 @njit(cache=True)
-def _assemble_range2(K, ks, p, closed, B, Q, rot, fix, L, i0, i1):  # type: ignore[no-untyped-def]
+def _assemble_range2(K, ks, p, closed, B, Q, rot, fix, L, i0, i1):
     """:func:`assemble_range` for planar curves, branch-light: the frame of point ``i`` is the
     rotation with first column ``q_i`` (``(1, 0)`` without frame), so the block
     ``M[(j, .), (i, .)] = K_ij Q_j^T Q_i = K_ij [[C, -S], [S, C]]`` with ``C = q_j . q_i``,
@@ -104,7 +104,7 @@ def _assemble_range2(K, ks, p, closed, B, Q, rot, fix, L, i0, i1):  # type: igno
 
 
 @njit(cache=True, nogil=True)
-def assemble_range(K, ks, p, closed, B, Q, rot, fix, L, i0, i1):  # type: ignore[no-untyped-def]
+def assemble_range(K, ks, p, closed, B, Q, rot, fix, L, i0, i1):
     """Write the lower-band entries of the columns of points ``i0 .. i1 - 1`` into ``L``."""
     if B.shape[1] == 2:
         _assemble_range2(K, ks, p, closed, B, Q, rot, fix, L, i0, i1)
@@ -274,13 +274,13 @@ def assemble_range(K, ks, p, closed, B, Q, rot, fix, L, i0, i1):  # type: ignore
 
 
 @njit(cache=True, nogil=True)
-def assemble(K, ks, p, closed, B, Q, rot, fix, L):  # type: ignore[no-untyped-def]
+def assemble(K, ks, p, closed, B, Q, rot, fix, L):
     """Fill ``L`` (shape (n dim, kd + 1)) with the lower band of ``M`` (see module docstring)."""
     assemble_range(K, ks, p, closed, B, Q, rot, fix, L, np.intp(0), K.shape[0])
 
 
 @njit(cache=True)
-def _ldl7(K, ks, p, B, Q, rot, fix, L, j, jstop, nxt, nmax):  # type: ignore[no-untyped-def]
+def _ldl7(K, ks, p, B, Q, rot, fix, L, j, jstop, nxt, nmax):
     """Elimination steps ``j .. jstop - 1`` (``jstop <= N - 7``) of :func:`assemble_ldl` for
     ``kd = 7``, with the 7 x 7 window loaded from (and written back to) the right-looking
     storage at ``L[j:j + 7]``, the columns of points ``nxt .. nmax - 1`` assembled in batches
@@ -408,7 +408,7 @@ def _ldl7(K, ks, p, B, Q, rot, fix, L, j, jstop, nxt, nmax):  # type: ignore[no-
 
 
 @njit(cache=True, nogil=True)
-def assemble_ldl(K, ks, p, B, Q, rot, fix, L):  # type: ignore[no-untyped-def]
+def assemble_ldl(K, ks, p, B, Q, rot, fix, L):
     """Assemble (open curves) and factorise ``M = U D U^T`` (``U`` unit lower band) in one pass:
     the columns of a batch of points are written just before the first elimination step that
     needs them. On exit ``L[j, 0] = 1 / D_j`` and ``L[j, k] = U[j + k, j]`` (see
@@ -443,7 +443,7 @@ def assemble_ldl(K, ks, p, B, Q, rot, fix, L):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, nogil=True)
-def assemble_ldl_head(K, ks, p, B, Q, rot, fix, L, nmax):  # type: ignore[no-untyped-def]
+def assemble_ldl_head(K, ks, p, B, Q, rot, fix, L, nmax):
     """First part of :func:`assemble_ldl` (``kd = 7``, ``N > 16``) while the columns of the
     points ``nmax .. n - 1`` are assembled elsewhere (:func:`assemble_range`, e.g. on another
     thread): assembles points ``0 .. nmax - 1`` and eliminates the columns that read only
@@ -458,7 +458,7 @@ def assemble_ldl_head(K, ks, p, B, Q, rot, fix, L, nmax):  # type: ignore[no-unt
 
 
 @njit(cache=True, nogil=True)
-def assemble_ldl_tail(K, ks, p, B, Q, rot, fix, L, j):  # type: ignore[no-untyped-def]
+def assemble_ldl_tail(K, ks, p, B, Q, rot, fix, L, j):
     """The rest of :func:`assemble_ldl` after :func:`assemble_ldl_head` (every column
     assembled)."""
     n = K.shape[0]
@@ -470,7 +470,7 @@ def assemble_ldl_tail(K, ks, p, B, Q, rot, fix, L, j):  # type: ignore[no-untype
 
 
 @njit(cache=True)
-def _ldl_cols(L, j0, j1, N):  # type: ignore[no-untyped-def]
+def _ldl_cols(L, j0, j1, N):
     """Elimination steps ``j0 .. j1 - 1`` of the band ``U D U^T`` factorisation of the first
     ``N`` rows, right looking in place (see :func:`assemble_ldl`)."""
     kd = L.shape[1] - 1
@@ -493,7 +493,7 @@ def _ldl_cols(L, j0, j1, N):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def ldl_solve(L, N, x):  # type: ignore[no-untyped-def]
+def ldl_solve(L, N, x):
     """Solve ``U D U^T y = x`` in place (factor of :func:`assemble_ldl`), left looking: each
     substitution step is one multiply-add on the recurrence (``kd = 7`` written out with the
     last seven unknowns in registers)."""
@@ -563,7 +563,7 @@ def ldl_solve(L, N, x):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, inline="always")
-def _krow(K, ks, p, closed, x, i, a, interior):  # type: ignore[no-untyped-def]
+def _krow(K, ks, p, closed, x, i, a, interior):
     """``(K x)_{i, a}`` for points ``x`` (n, dim), ``K`` by its band rows ``K[i, p + o] * ks``
     (closed: indices mod n); ``interior`` (``p <= i < n - p``) skips the wrap tests. Inlined at
     numba IR level: the same additions in the same order as a written-out loop."""
@@ -584,7 +584,7 @@ def _krow(K, ks, p, closed, x, i, a, interior):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def band_residual_scaled(W, ks, p, closed, x, out):  # type: ignore[no-untyped-def]
+def band_residual_scaled(W, ks, p, closed, x, out):
     """``out = (W ks) x`` per coordinate in the difference form of
     :func:`curvefair._kernels.bspline.band_residual` (``sum_{o != 0} (W[i, p + o] ks) (x_{i+o} -
     x_i)``, the same operations on the entries of the scaled band: :func:`residual_row`)."""
@@ -596,7 +596,7 @@ def band_residual_scaled(W, ks, p, closed, x, out):  # type: ignore[no-untyped-d
 
 
 @njit(cache=True)
-def band_matvec(K, ks, p, closed, x, out):  # type: ignore[no-untyped-def]
+def band_matvec(K, ks, p, closed, x, out):
     """``out = kron(K ks, I) x`` for points ``x`` (n, dim); ``K ks`` given by its band rows
     ``K[i, p + o] * ks = (K ks)_{i, i+o}`` (symmetric; closed: indices mod n)."""
     n, dim = x.shape
@@ -612,7 +612,7 @@ def band_matvec(K, ks, p, closed, x, out):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def _chol_cols(L, j0, j1, N):  # type: ignore[no-untyped-def]
+def _chol_cols(L, j0, j1, N):
     """Elimination steps ``j0 .. j1 - 1`` of the band Cholesky of the first ``N`` rows (right
     looking; the planar cubic band ``kd = 7`` written out). Returns 0 or ``j + 1`` for a
     non-positive pivot ``j``."""
@@ -680,7 +680,7 @@ def _chol_cols(L, j0, j1, N):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def band_cholesky(L, N):  # type: ignore[no-untyped-def]
+def band_cholesky(L, N):
     """In-place Cholesky of the first ``N`` rows of the lower band ``L`` (entries reaching
     beyond row ``N - 1`` are left alone). Returns 0, or ``j + 1`` if pivot ``j`` is not
     positive (not positive definite in floating point)."""
@@ -688,7 +688,7 @@ def band_cholesky(L, N):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def band_solve(L, N, x):  # type: ignore[no-untyped-def]
+def band_solve(L, N, x):
     """Solve ``L L^T y = x`` in place for the first ``N`` entries of ``x`` (1-D)."""
     kd = L.shape[1] - 1
     if kd == 7 and N > 7:
@@ -710,7 +710,7 @@ def band_solve(L, N, x):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def _band_solve7(L, N, x):  # type: ignore[no-untyped-def]
+def _band_solve7(L, N, x):
     """:func:`band_solve` for ``kd = 7`` (planar cubics), ``N > 7``: left-looking substitutions
     with the last seven unknowns in registers, the newest subtracted last (one multiply-add and
     one multiply by the reciprocal pivot on the recurrence)."""
@@ -772,7 +772,7 @@ def _band_solve7(L, N, x):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, nogil=True)
-def cyclic_cholesky(L, Y, S):  # type: ignore[no-untyped-def]
+def cyclic_cholesky(L, Y, S):
     """Factorise the cyclic band ``L`` (N > 3 kd): band Cholesky of the leading
     ``N - kd`` unknowns, ``Y = M_II^{-1} M_IB`` (shape (N - kd, kd)) and the Cholesky factor of
     the Schur complement ``S = M_BB - M_IB^T Y`` (lower, (kd, kd)). Returns 0 or a failure
@@ -842,7 +842,7 @@ def cyclic_cholesky(L, Y, S):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def cyclic_solve_full(L, Y, S, x):  # type: ignore[no-untyped-def]
+def cyclic_solve_full(L, Y, S, x):
     """Solve ``M y = x`` in place with the factorisation of :func:`cyclic_cholesky`."""
     N = L.shape[0]
     kd = L.shape[1] - 1
@@ -881,7 +881,7 @@ def cyclic_solve_full(L, Y, S, x):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def prep_rhs(K, ks, p, closed, B, Q, rot, fix, fix0, rhs, c, out, sgn=1.0):  # type: ignore[no-untyped-def]
+def prep_rhs(K, ks, p, closed, B, Q, rot, fix, fix0, rhs, c, out, sgn=1.0):
     """``out = Q^T (sgn rhs - (kron(K ks, I) + B) z)`` with ``z_i = c_i Q_i[:, 0]`` at the ``rot``
     points (their prescribed normal displacement), fixed unknowns set to their values (``c_i``
     for the normal of a ``rot`` point, 0 at fixed points)."""
@@ -933,7 +933,7 @@ def prep_rhs(K, ks, p, closed, B, Q, rot, fix, fix0, rhs, c, out, sgn=1.0):  # t
 
 
 @njit(cache=True, nogil=True)
-def prep_rhs2_range(K, ks, p, closed, B, Q, rot, fix, fix0, rhs, c, out, sgn, i0, i1):  # type: ignore[no-untyped-def]
+def prep_rhs2_range(K, ks, p, closed, B, Q, rot, fix, fix0, rhs, c, out, sgn, i0, i1):
     """:func:`prep_rhs` for planar curves in one pass (selects instead of branches on the
     frame flags of the neighbours), on the points ``i0 .. i1 - 1`` (each point is independent:
     ranges may run concurrently)."""
@@ -977,14 +977,14 @@ def prep_rhs2_range(K, ks, p, closed, B, Q, rot, fix, fix0, rhs, c, out, sgn, i0
 
 
 @njit(cache=True)
-def post_solve(y, Q, rot, fix0):  # type: ignore[no-untyped-def]
+def post_solve(y, Q, rot, fix0):
     """Back to the original frame: ``y_i <- Q_i y_i`` at the ``rot`` points, 0 at fixed
     points."""
     post_solve_range(y, Q, rot, fix0, 0, y.shape[0])
 
 
 @njit(cache=True, nogil=True)
-def post_solve_range(y, Q, rot, fix0, i0, i1):  # type: ignore[no-untyped-def]
+def post_solve_range(y, Q, rot, fix0, i0, i1):
     """:func:`post_solve` on the points ``i0 .. i1 - 1``; returns ``max |y_i|^2`` over the
     ``rot`` points and over the others (the norm before the rotation, which keeps it)."""
     dim = y.shape[1]
@@ -1021,7 +1021,7 @@ def post_solve_range(y, Q, rot, fix0, i0, i1):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def max_point_norm2(y):  # type: ignore[no-untyped-def]
+def max_point_norm2(y):
     """``max_i |y_i|^2`` (NaN propagates)."""
     m2 = 0.0
     for i in range(y.shape[0]):
@@ -1039,7 +1039,7 @@ def max_point_norm2(y):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def ip_eval(g0, K, ks, p, closed, v, lam, free, t2, rd, s):  # type: ignore[no-untyped-def]
+def ip_eval(g0, K, ks, p, closed, v, lam, free, t2, rd, s):
     """Dual residual ``rd = g0 + K v + lam v / t2`` and slacks ``s = -f`` (at least ``1e-16``:
     a point that rounding puts on its sphere) at the free points (0 and 1 elsewhere); returns
     ``(max |rd|, min s, sum lam s)``. (Helpers inlined by hand: numba's inlined helpers made
@@ -1077,7 +1077,7 @@ def ip_eval(g0, K, ks, p, closed, v, lam, free, t2, rd, s):  # type: ignore[no-u
 
 
 @njit(cache=True)
-def ip_blocks(v, lam, s, free, t2, B):  # type: ignore[no-untyped-def]
+def ip_blocks(v, lam, s, free, t2, B):
     """``B_i = lam_i I / t2 + (lam_i / s_i) a_i a_i^T``, ``a_i = v_i / t2`` (identity at fixed
     points, whose rows are replaced anyway)."""
     n, dim = v.shape
@@ -1096,7 +1096,7 @@ def ip_blocks(v, lam, s, free, t2, B):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def ip_rhs(rd, v, rc, rp, lam, s, free, t2, out):  # type: ignore[no-untyped-def]
+def ip_rhs(rd, v, rc, rp, lam, s, free, t2, out):
     """``out = -rd - a q``, ``q = (-rc + lam rp) / s`` (reduced Newton right-hand side,
     ``a = v / t2``; ``rp`` a primal residual to remove, e.g. the second-order term)."""
     n, dim = v.shape
@@ -1111,7 +1111,7 @@ def ip_rhs(rd, v, rc, rp, lam, s, free, t2, out):  # type: ignore[no-untyped-def
 
 
 @njit(cache=True)
-def ip_recover(dv, v, rc, rp, lam, s, free, t2, ds, dl):  # type: ignore[no-untyped-def]
+def ip_recover(dv, v, rc, rp, lam, s, free, t2, ds, dl):
     """``ds = -rp - a.dv`` (linearised slack step), ``dl = (-rc + lam rp + lam a.dv) / s``;
     returns the
     largest steps keeping every point inside its ball (exact, the constraint is quadratic) and
@@ -1153,7 +1153,7 @@ def ip_recover(dv, v, rc, rp, lam, s, free, t2, ds, dl):  # type: ignore[no-unty
 
 
 @njit(cache=True)
-def ip_corrector(lam, s, dl, ds, ap, ad, free, rc):  # type: ignore[no-untyped-def]
+def ip_corrector(lam, s, dl, ds, ap, ad, free, rc):
     """Affine-scaling complementarity ``sum (lam + ad dl)(s + ap ds)`` and
     ``rc = lam s + dl ds`` (the sigma mu term is subtracted by the caller)."""
     n = lam.shape[0]
@@ -1168,7 +1168,7 @@ def ip_corrector(lam, s, dl, ds, ap, ad, free, rc):  # type: ignore[no-untyped-d
 
 
 @njit(cache=True)
-def ip_update(v, dv, lam, dl, st):  # type: ignore[no-untyped-def]
+def ip_update(v, dv, lam, dl, st):
     n, dim = v.shape
     for i in range(n):
         for a in range(dim):
@@ -1177,7 +1177,7 @@ def ip_update(v, dv, lam, dl, st):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def second_order(dv, free, t2, out):  # type: ignore[no-untyped-def]
+def second_order(dv, free, t2, out):
     """``out_i = |dv_i|^2 / (2 t2)``: the slack a full step loses to the curvature of the
     sphere (the constraint is quadratic: ``f(v + dv) = f + a.dv + |dv|^2 / (2 t2)``)."""
     n, dim = dv.shape
@@ -1196,7 +1196,7 @@ def second_order(dv, free, t2, out):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def shift_cholesky(K, ks, p, rho, L):  # type: ignore[no-untyped-def]
+def shift_cholesky(K, ks, p, rho, L):
     """Band Cholesky of ``K + rho I`` (open curve, ``L`` shape (n, p + 1), ``L[r, k] =
     M[r + k, r]``), with the RECIPROCAL pivots stored in ``L[:, 0]`` (for
     :func:`admm_sweep`). Returns 0 or ``j + 1`` for a non-positive pivot ``j``."""
@@ -1212,7 +1212,7 @@ def shift_cholesky(K, ks, p, rho, L):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, nogil=True)
-def admm_factor(K, ks, p, rho, L):  # type: ignore[no-untyped-def]
+def admm_factor(K, ks, p, rho, L):
     """Factor of ``K + rho I`` (open curve) for the ADMM sweeps. ``p = 3`` (for
     :func:`admm_sweep_t`): ``K + rho I = U D U^T`` (``U`` unit lower) computed with the active
     window in registers (one division, one multiply and one multiply-add on the pivot
@@ -1263,7 +1263,7 @@ def admm_factor(K, ks, p, rho, L):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, nogil=True)
-def admm_sweep(L, y, z, u, g0, rho, r2, alpha):  # type: ignore[no-untyped-def]
+def admm_sweep(L, y, z, u, g0, rho, r2, alpha):
     """One over-relaxed ADMM iteration for ``min g0.x + x.K x / 2`` s.t. ``|z_i|^2 <= r2_i``,
     ``x = z`` (Boyd et al. 2011, sec. 3.4.3 / 5.1, scaled dual ``u``): on entry ``y`` holds
     ``-g0 + rho (z - u)``; ``x = (K + rho I)^{-1} y`` (factor ``L`` of :func:`shift_cholesky`),
@@ -1322,7 +1322,7 @@ def admm_sweep(L, y, z, u, g0, rho, r2, alpha):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, nogil=True)
-def admm_sweep_t(L, y, z, u, g0, rho, t2, free, alpha):  # type: ignore[no-untyped-def]
+def admm_sweep_t(L, y, z, u, g0, rho, t2, free, alpha):
     """:func:`admm_sweep` for cubics (``p = 3``, the ``U D U^T`` factor of :func:`admm_factor`)
     on COORDINATE-MAJOR arrays ``y, z, u, g0`` of shape ``(dim, n)``, balls of radius^2 ``t2``
     at the ``free`` points (0 elsewhere): unit substitutions with the last three unknowns in
@@ -1445,7 +1445,7 @@ def admm_sweep_t(L, y, z, u, g0, rho, t2, free, alpha):  # type: ignore[no-untyp
 
 
 @njit(cache=True)
-def finish_points(d0, v, free, rmax, ract, x, act):  # type: ignore[no-untyped-def]
+def finish_points(d0, v, free, rmax, ract, x, act):
     """``x = d0 + v`` with every free point pulled inside radius ``rmax`` so that the ROUNDED
     ``fl(x_i - d0_i)`` is within ``rmax`` too (fixed points: ``x = d0``); ``act[i]``: the final
     displacement is longer than ``ract``."""
@@ -1453,7 +1453,7 @@ def finish_points(d0, v, free, rmax, ract, x, act):  # type: ignore[no-untyped-d
 
 
 @njit(cache=True, nogil=True)
-def finish_points_range(d0, v, free, rmax, ract, x, act, i0, i1):  # type: ignore[no-untyped-def]
+def finish_points_range(d0, v, free, rmax, ract, x, act, i0, i1):
     """:func:`finish_points` on the points ``i0 .. i1 - 1`` (independent: ranges may run
     concurrently)."""
     dim = d0.shape[1]
@@ -1486,7 +1486,7 @@ def finish_points_range(d0, v, free, rmax, ract, x, act, i0, i1):  # type: ignor
 
 
 @njit(cache=True, inline="always")
-def _frame3(Q, i, x, y, z):  # type: ignore[no-untyped-def]
+def _frame3(Q, i, x, y, z):
     """``Q_i``: the orthonormal 3-D frame whose first column is the unit vector ``(x, y, z)``
     (Duff et al. 2017, "Building an orthonormal basis, revisited"); inlined at numba IR level
     (no call with an array argument in the loops)."""
@@ -1505,7 +1505,7 @@ def _frame3(Q, i, x, y, z):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def set_frames(nrm, rot, Q, fix, fix0):  # type: ignore[no-untyped-def]
+def set_frames(nrm, rot, Q, fix, fix0):
     """``fix = fix0`` plus the first axis of the ``rot`` points; ``Q_i`` the orthonormal frame
     whose first column is the unit ``nrm_i`` at the ``rot`` points (2-D: the tangent is ``nrm``
     turned by 90 degrees; 3-D: Duff et al. 2017, "Building an orthonormal basis, revisited"),
@@ -1527,7 +1527,7 @@ def set_frames(nrm, rot, Q, fix, fix0):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def admm_active_norms(u, free, out):  # type: ignore[no-untyped-def]
+def admm_active_norms(u, free, out):
     """``|u_i|`` of the free points with ``u_i != 0`` (the projected ones) packed into ``out``;
     returns their number."""
     n, dim = u.shape
@@ -1544,7 +1544,7 @@ def admm_active_norms(u, free, out):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def admm_rescale(z, u, g0, f, rho, y):  # type: ignore[no-untyped-def]
+def admm_rescale(z, u, g0, f, rho, y):
     """``u *= f`` (new ``rho`` = old / ``f``) and ``y = rho (z - u) - g0``."""
     n, dim = z.shape
     for i in range(n):
@@ -1554,7 +1554,7 @@ def admm_rescale(z, u, g0, f, rho, y):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def admm_multipliers(z, u, free, rho, t2, lam):  # type: ignore[no-untyped-def]
+def admm_multipliers(z, u, free, rho, t2, lam):
     """``lam_i = max(rho t2 (u_i . z_i) / |z_i|^2, 0)`` at the free points with ``z_i != 0``
     (from ``g0 + K z + rho u = 0`` and ``g0 + K z + lam z / t2 = 0``), 0 elsewhere; returns the
     sums over the free points of ``lam`` and of the slack ``(1 - |z|^2 / t2) / 2``, and their
@@ -1586,7 +1586,7 @@ def admm_multipliers(z, u, free, rho, t2, lam):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def ssn_eval_prep(g0, K, ks, p, closed, v, lam, free, t2, kappa, delta, S, rd,  # type: ignore[no-untyped-def]
+def ssn_eval_prep(g0, K, ks, p, closed, v, lam, free, t2, kappa, delta, S, rd,
                   B, nrm, c, Q, fix, fix0):
     """Semismooth Newton per-point work, one pass: active set ``S = free & (lam + kappa f > 0) &
     (v != 0)`` (``f = (|v|^2 / t2 - 1) / 2``); ``lam`` clipped to ``max(lam, 0)`` on ``S`` and 0
@@ -1601,7 +1601,7 @@ def ssn_eval_prep(g0, K, ks, p, closed, v, lam, free, t2, kappa, delta, S, rd,  
 
 
 @njit(cache=True, nogil=True)
-def ssn_eval_range(g0, K, ks, p, closed, v, lam, free, t2, kappa, delta, S, rd,  # type: ignore[no-untyped-def]
+def ssn_eval_range(g0, K, ks, p, closed, v, lam, free, t2, kappa, delta, S, rd,
                    B, nrm, c, Q, fix, fix0, i0, i1):
     """:func:`ssn_eval_prep` on the points ``i0 .. i1 - 1`` (reads ``v`` of their neighbours,
     writes their own data only: ranges may run concurrently; the maxima and the count of
@@ -1686,7 +1686,7 @@ def ssn_eval_range(g0, K, ks, p, closed, v, lam, free, t2, kappa, delta, S, rd, 
 
 
 @njit(cache=True)
-def ssn_update_k(K, ks, p, closed, v, dv, rd, lam, S, nrm, t2, retract,  # type: ignore[no-untyped-def]
+def ssn_update_k(K, ks, p, closed, v, dv, rd, lam, S, nrm, t2, retract,
                  edges_only=False):
     """Semismooth Newton update: the multipliers of the active points from the normal component
     of the stationarity equation (``K dv`` computed on the fly), then ``v += dv``; with
@@ -1734,7 +1734,7 @@ def ssn_update_k(K, ks, p, closed, v, dv, rd, lam, S, nrm, t2, retract,  # type:
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
-def ssn_update23_range(K, ks, closed, v, dv, rd, lam, S, nrm, t2, retract, i0, i1):  # type: ignore[no-untyped-def]
+def ssn_update23_range(K, ks, closed, v, dv, rd, lam, S, nrm, t2, retract, i0, i1):
     """:func:`ssn_update_k` for planar cubics on the interior points ``i0 .. i1 - 1``: one
     pass, selects instead of branches (numpy error model: the unselected quotients of inactive
     points may be inf). Reads ``dv`` of the neighbours, writes the points' own ``v`` and

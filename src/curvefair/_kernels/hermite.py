@@ -80,7 +80,7 @@ def hermite_gram(degree: int, q: int) -> tuple[np.ndarray, np.ndarray]:
 # segment coefficients
 # ----------------------------------------------------------------------------------------------
 @njit(cache=True, inline="always")
-def _cubic_a23(P, D, h, j, c):  # type: ignore[no-untyped-def]
+def _cubic_a23(P, D, h, j, c):
     """``(a_{j,2}, a_{j,3})`` of cubic segment ``j``, coordinate ``c`` (Wang & Cao, eq. (6))."""
     nd = P.shape[0]
     i0 = j
@@ -93,7 +93,7 @@ def _cubic_a23(P, D, h, j, c):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, inline="always")
-def _quintic_a2345(P, D, h, j, c):  # type: ignore[no-untyped-def]
+def _quintic_a2345(P, D, h, j, c):
     """``a_{j,2..5}`` of quintic segment ``j``, coordinate ``c`` (Wang 2005, eq. (2))."""
     nd = P.shape[0]
     i0 = j
@@ -116,7 +116,7 @@ def _quintic_a2345(P, D, h, j, c):  # type: ignore[no-untyped-def]
 # the local steps
 # ----------------------------------------------------------------------------------------------
 @njit(cache=True)
-def cubic_step(P, D, h, k, method, hstep, delta, eta):  # type: ignore[no-untyped-def]
+def cubic_step(P, D, h, k, method, hstep, delta, eta):
     """Unconstrained step of a cubic method at point ``k``; fills ``delta`` (and ``eta``).
 
     * Kjellander (Wang & Cao 2006, eq. (4), spacing ``hstep``):
@@ -150,7 +150,7 @@ def cubic_step(P, D, h, k, method, hstep, delta, eta):  # type: ignore[no-untype
 
 
 @njit(cache=True)
-def wang_cao_eta_given_delta(P, D, h, k, delta, eta):  # type: ignore[no-untyped-def]
+def wang_cao_eta_given_delta(P, D, h, k, delta, eta):
     """Energy-optimal ``eta`` for a GIVEN position change ``delta`` (Wang & Cao, Lemma 1, eq. (14)).
 
     ``dF/deta = 0``: ``eta = (G - (3/D1^2 - 3/D0^2) delta) / (2 (1/D1 + 1/D0))`` with
@@ -168,7 +168,7 @@ def wang_cao_eta_given_delta(P, D, h, k, delta, eta):  # type: ignore[no-untyped
 
 
 @njit(cache=True, inline="always")
-def _quintic_C(P, D, h, k, c):  # type: ignore[no-untyped-def]
+def _quintic_C(P, D, h, k, c):
     """Wang 2005, Lemma: ``(C1, C2, C3)`` of coordinate ``c`` at point ``k``."""
     nd = P.shape[0]
     km = (k - 1) % nd
@@ -186,7 +186,7 @@ def _quintic_C(P, D, h, k, c):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, inline="always")
-def _quintic_H(D0, D1):  # type: ignore[no-untyped-def]
+def _quintic_H(D0, D1):
     """Wang 2005, Theorem: Hessian entries ``(H00, H01, H02, H11, H22)``; ``H12 = 0``."""
     H00 = 240.0 / 7.0 * (1.0 / D1**3 + 1.0 / D0**3)
     H01 = 120.0 / 7.0 * (1.0 / D1**2 - 1.0 / D0**2)
@@ -197,7 +197,7 @@ def _quintic_H(D0, D1):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def quintic_system(P, D, h, k, C):  # type: ignore[no-untyped-def]
+def quintic_system(P, D, h, k, C):
     """Wang 2005, Lemma: gradient ``C[c] = (C1, C2, C3)`` per coordinate and the Hessian entries
     ``(H00, H01, H02, H11, H22)`` (``H12 = 0``), with ``W* - W = C.x + x^T H x / 2``."""
     nd = P.shape[0]
@@ -207,7 +207,7 @@ def quintic_system(P, D, h, k, C):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def quintic_step(P, D, h, k, delta, eta, xi, clamped_delta):  # type: ignore[no-untyped-def]
+def quintic_step(P, D, h, k, delta, eta, xi, clamped_delta):
     """Wang 2005 step: solve ``H [delta, eta, xi] = -[C1, C2, C3]`` per coordinate.
 
     Because ``H12 = 0`` the system is solved by eliminating ``eta`` and ``xi``:
@@ -236,7 +236,7 @@ def quintic_step(P, D, h, k, delta, eta, xi, clamped_delta):  # type: ignore[no-
 
 
 @njit(cache=True)
-def quintic_measure(P, D, h, k, spline):  # type: ignore[no-untyped-def]
+def quintic_measure(P, D, h, k, spline):
     """Energy drop of the Wang step at ``k`` (whole step, or only its position part)."""
     nd = P.shape[0]
     H00, H01, H02, H11, H22 = _quintic_H(h[(k - 1) % nd], h[k])
@@ -252,7 +252,7 @@ def quintic_measure(P, D, h, k, spline):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def cubic_jump(P, D, h, k):  # type: ignore[no-untyped-def]
+def cubic_jump(P, D, h, k):
     """``|r'''(t_k+) - r'''(t_k-)| = 6 |a_{k,3} - a_{k-1,3}|`` (Wang & Cao 2006, eq. (7))."""
     nd = P.shape[0]
     km = (k - 1) % nd
@@ -272,7 +272,7 @@ M_MOVE = 3     # length of the (unclamped) move the method's step wants
 
 
 @njit(cache=True, inline="always")
-def _cubic_step_coord(P, D, h, k, method, hstep, c):  # type: ignore[no-untyped-def]
+def _cubic_step_coord(P, D, h, k, method, hstep, c):
     """``(delta_c, eta_c, delta_poliakoff_c)`` of :func:`cubic_step`, one coordinate, no
     allocation (the same formulas)."""
     nd = P.shape[0]
@@ -298,7 +298,7 @@ def _cubic_step_coord(P, D, h, k, method, hstep, c):  # type: ignore[no-untyped-
 
 
 @njit(cache=True)
-def cubic_energy_drop(P, D, h, k, method, hstep):  # type: ignore[no-untyped-def]
+def cubic_energy_drop(P, D, h, k, method, hstep):
     """Exact drop of ``int |r''|^2 dt`` over the two segments at ``k`` when the method's
     unclamped step (derivatives as the step leaves them) is applied.
 
@@ -326,7 +326,7 @@ def cubic_energy_drop(P, D, h, k, method, hstep):  # type: ignore[no-untyped-def
 
 
 @njit(cache=True)
-def cubic_move(P, D, h, k, method, hstep):  # type: ignore[no-untyped-def]
+def cubic_move(P, D, h, k, method, hstep):
     """Length of the position change the method's unclamped step wants at ``k``."""
     s = 0.0
     for c in range(P.shape[1]):
@@ -336,7 +336,7 @@ def cubic_move(P, D, h, k, method, hstep):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, inline="always")
-def _dkds(r1, r2, r3, dim):  # type: ignore[no-untyped-def]
+def _dkds(r1, r2, r3, dim):
     """``dkappa/ds`` from the first three derivatives (plane: signed curvature; space: the
     derivative of ``|r1 x r2| / |r1|^3``, and ``|r1 x r3| / |r1|^4`` where ``r1 x r2 = 0``)."""
     v2 = 0.0
@@ -365,7 +365,7 @@ def _dkds(r1, r2, r3, dim):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def cubic_sapidis(P, D, h, k):  # type: ignore[no-untyped-def]
+def cubic_sapidis(P, D, h, k):
     """``|kappa_s(t_k+) - kappa_s(t_k-)|``, the jump of ``dkappa/ds`` at point ``k``
     (Sapidis & Farin 1990; seed 004), each side from its own segment (first three
     coordinates of a curve in more than three dimensions)."""
@@ -393,7 +393,7 @@ def cubic_sapidis(P, D, h, k):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def quintic_move(P, D, h, k):  # type: ignore[no-untyped-def]
+def quintic_move(P, D, h, k):
     """Length of the position change of the unclamped Wang step at ``k``."""
     nd = P.shape[0]
     H00, H01, H02, H11, H22 = _quintic_H(h[(k - 1) % nd], h[k])
@@ -407,7 +407,7 @@ def quintic_move(P, D, h, k):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def measure_at(P, D, h, k, degree, spline, method=POLIAKOFF, hstep=0.0, mcode=M_DEFAULT):  # type: ignore[no-untyped-def]
+def measure_at(P, D, h, k, degree, spline, method=POLIAKOFF, hstep=0.0, mcode=M_DEFAULT):
     """Ranking measure of point ``k``. ``mcode`` ``M_DEFAULT`` (the papers'): cubic ->
     third-derivative jump; quintic -> energy drop of the Wang step (hermite mode: whole step;
     spline mode: the part due to the position). ``M_ENERGY``: the energy drop of the method's
@@ -430,7 +430,7 @@ def measure_at(P, D, h, k, degree, spline, method=POLIAKOFF, hstep=0.0, mcode=M_
 # window solve of the spline system (block tridiagonal, SPD, block size nb = 1 or 2)
 # ----------------------------------------------------------------------------------------------
 @njit(cache=True, inline="always")
-def _powers(hj, q, pw):  # type: ignore[no-untyped-def]
+def _powers(hj, q, pw):
     """``pw[e] = hj ** (1 - 2 q + e)`` for ``e = 0 .. 2 q - 2`` (exponents up to -1)."""
     ih = 1.0 / hj
     x = ih
@@ -440,13 +440,13 @@ def _powers(hj, q, pw):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, inline="always")
-def _kseg(K0, pe, pw, a, b):  # type: ignore[no-untyped-def]
+def _kseg(K0, pe, pw, a, b):
     """Entry (a, b) of the Gram matrix of a segment whose powers ``pw`` are set."""
     return K0[a, b] * pw[pe[a] + pe[b]]
 
 
 @njit(cache=True)
-def _inv_small(M, nb, out):  # type: ignore[no-untyped-def]
+def _inv_small(M, nb, out):
     if nb == 1:
         out[0, 0] = 1.0 / M[0, 0]
     else:
@@ -458,7 +458,7 @@ def _inv_small(M, nb, out):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def _assemble_window(nd, closed, h, K0, pe, q, nb, fixed, idx, L, Bd, Cu, pw):  # type: ignore[no-untyped-def]
+def _assemble_window(nd, closed, h, K0, pe, q, nb, fixed, idx, L, Bd, Cu, pw):
     """Diagonal blocks ``Bd[v]`` and super-diagonal blocks ``Cu[v]`` (v -> v+1) of the window
     whose actual point indices are ``idx[0..L-1]``; fixed unknowns become identity rows/cols."""
     r1 = nb + 1  # offset of the end point's data in the local vector
@@ -494,7 +494,7 @@ def _assemble_window(nd, closed, h, K0, pe, q, nb, fixed, idx, L, Bd, Cu, pw):  
 
 
 @njit(cache=True)
-def _block_thomas(L, nb, dim, Bd, Cu, R, X, Bp, Y, inv, W):  # type: ignore[no-untyped-def]
+def _block_thomas(L, nb, dim, Bd, Cu, R, X, Bp, Y, inv, W):
     """Solve the symmetric block tridiagonal system (sub-diagonal = Cu^T) for X (L, nb, dim);
     ``inv`` and ``W`` are 2x2 scratch arrays."""
     for v in range(L):
@@ -540,7 +540,7 @@ def _block_thomas(L, nb, dim, Bd, Cu, R, X, Bp, Y, inv, W):  # type: ignore[no-u
 
 
 @njit(cache=True)
-def _rhs_for_move(nd, closed, h, K0, pe, q, nb, k, dr, idx, L, fixed, R, pw):  # type: ignore[no-untyped-def]
+def _rhs_for_move(nd, closed, h, K0, pe, q, nb, k, dr, idx, L, fixed, R, pw):
     """Right-hand side (minus the gradient change) caused by moving point ``k`` by ``dr``.
 
     Only the points ``k - 1, k, k + 1`` share a segment with ``k``; for point ``i`` the entry is
@@ -576,7 +576,7 @@ def _rhs_for_move(nd, closed, h, K0, pe, q, nb, k, dr, idx, L, fixed, R, pw):  #
 # the automatic loop
 # ----------------------------------------------------------------------------------------------
 @njit(cache=True)
-def _clamped_move(P, D, h, orig, k, method, degree, spline, hstep, tol, delta, eta, xi):  # type: ignore[no-untyped-def]
+def _clamped_move(P, D, h, orig, k, method, degree, spline, hstep, tol, delta, eta, xi):
     """Step at ``k`` clamped onto the ball of radius ``tol`` around ``orig[k]``.
 
     Fills ``delta`` with the (clamped) position change and ``eta``/``xi`` with the derivative
@@ -632,13 +632,13 @@ RECHECK = 1e-9
 
 
 @njit(cache=True, inline="always")
-def _is_blocked(mv, clamped, want, move_floor):  # type: ignore[no-untyped-def]
+def _is_blocked(mv, clamped, want, move_floor):
     return mv <= move_floor or (clamped and mv <= BLOCK_FRACTION * want)
 
 
 @njit(cache=True)
 def drive_setup(P, D, h, closed, degree, spline, eligible, method=POLIAKOFF, hstep=0.0,
-                mcode=M_DEFAULT):  # type: ignore[no-untyped-def]
+                mcode=M_DEFAULT):
     """Initial state of the loop (``O(n)``): ``(measure, values, tv, ti, blocked,
     block_measure)`` -- measures, tree leaves, the tree, block flags and measures at blocking."""
     nd = P.shape[0]
@@ -654,7 +654,7 @@ def drive_setup(P, D, h, closed, degree, spline, eligible, method=POLIAKOFF, hst
 @njit(cache=True)
 def drive(P, D, h, orig, closed, degree, method, spline, hstep, eligible, tol, eps,
           max_steps, move_floor, K0, pe, q, fixed, Hinv, w0, wmax, thr,
-          measure, values, tv, ti, blocked, block_measure, mcode=M_DEFAULT):  # type: ignore[no-untyped-def]
+          measure, values, tv, ti, blocked, block_measure, mcode=M_DEFAULT):
     """Seed 001's steps 2-6 on the distinct data (``P``, ``D`` and the state from
     :func:`drive_setup` are modified in place; no ``O(n)`` work or allocation here).
 
@@ -867,7 +867,7 @@ def drive(P, D, h, orig, closed, degree, method, spline, hstep, eligible, tol, e
 
 @njit(cache=True)
 def all_measures(P, D, h, closed, degree, spline, method=POLIAKOFF, hstep=0.0,
-                 mcode=M_DEFAULT):  # type: ignore[no-untyped-def]
+                 mcode=M_DEFAULT):
     """Ranking measure of every point (0 at the ends of an open curve)."""
     nd = P.shape[0]
     out = np.zeros(nd)

@@ -11,7 +11,7 @@ from .._jit import njit
 
 
 @njit(cache=True)
-def straight_kernel(P, spans, p, closed, rel, eps, mark):  # type: ignore[no-untyped-def]
+def straight_kernel(P, spans, p, closed, rel, eps, mark):
     """Mark (``mark[i] = True``) the control points of every straight span; return how many
     spans are straight. Span ``s`` uses control points ``s - p .. s`` (mod ``n`` if closed);
     it is straight when its line ``d = W_p - W_0`` has ``L = |d| > eps`` and every

@@ -19,7 +19,7 @@ from .ranking import tt_update, tt_update_range
 # the compiled loop
 # ------------------------------------------------------------------------------------------
 @njit(cache=True)
-def _pw_sum_long(v, m):  # type: ignore[no-untyped-def]
+def _pw_sum_long(v, m):
     """numpy's pairwise summation above 128 values (recursive halves, multiples of 8)."""
     if m <= 128:
         return _pw_sum(v, m)
@@ -29,7 +29,7 @@ def _pw_sum_long(v, m):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, inline="always")
-def _pw_sum(v, m):  # type: ignore[no-untyped-def]
+def _pw_sum(v, m):
     """``v[:m].sum()`` in numpy's order (pairwise summation: sequential below 8 values, eight
     accumulators up to 128), so that the tracked sum is bitwise the vectorised one."""
     if m < 8:
@@ -60,7 +60,7 @@ def _pw_sum(v, m):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, inline="always")
-def ipow(x, k):  # type: ignore[no-untyped-def]
+def ipow(x, k):
     """``x ** k`` for a whole ``k >= 1`` as ``k - 1`` multiplications in turn (no ``pow``: the
     same bits on every CPU; :func:`curvefair.fairing.knot_removal._speed_power` is its numpy
     twin)."""
@@ -71,7 +71,7 @@ def ipow(x, k):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, inline="always")
-def knot_measure(d, k, p, ctrl, C, right, left2):  # type: ignore[no-untyped-def]
+def knot_measure(d, k, p, ctrl, C, right, left2):
     """:meth:`curvefair.fairing.knot_removal._KnotData.jumps` /
     :func:`curvefair.fairing.knot_removal.sapidis_measure` at one knot, same operation order."""
     num, speed = _measure_parts(d, k, p, ctrl, C, right, left2)
@@ -79,7 +79,7 @@ def knot_measure(d, k, p, ctrl, C, right, left2):  # type: ignore[no-untyped-def
 
 
 @njit(cache=True, inline="always")
-def _measure_parts(d, k, p, ctrl, C, right, left2):  # type: ignore[no-untyped-def]
+def _measure_parts(d, k, p, ctrl, C, right, left2):
     """Numerator and ``|r'|`` (``inf`` if zero) of the measure at knot ``k``: the measure is
     ``num / speed ** (p + 1)`` (``p = 2``: ``** 3``); numpy's operation order."""
     dim = d.shape[1]
@@ -150,13 +150,13 @@ def _measure_parts(d, k, p, ctrl, C, right, left2):  # type: ignore[no-untyped-d
 
 
 @njit(cache=True)
-def measure_all(d, ks, p, ctrl, C, right, left2, out):  # type: ignore[no-untyped-def]
+def measure_all(d, ks, p, ctrl, C, right, left2, out):
     for u in range(ks.shape[0]):
         out[u] = knot_measure(d, ks[u], p, ctrl, C, right, left2)
 
 
 @njit(cache=True, inline="always")
-def _ls_moves(d, k, p, ctrl, alphas, new, Q, A, f):  # type: ignore[no-untyped-def]
+def _ls_moves(d, k, p, ctrl, alphas, new, Q, A, f):
     """Least-squares removal (seed 004 eqs. (8.24)-(8.30)) at knot ``k``: the ``p`` new control
     points of basis functions ``j-p .. j-1`` into ``new``; ``Q`` (p+2, dim), ``A`` (p, p-1),
     ``f`` (p, dim) are work arrays. Householder QR of the ``p x (p-1)`` removal system."""
@@ -228,7 +228,7 @@ def _ls_moves(d, k, p, ctrl, alphas, new, Q, A, f):  # type: ignore[no-untyped-d
 @njit(cache=True)
 def kr_loop(d, orig, mask, tol, p, n, closed, js, pos, C, right, left2, ctrl, a1, denom,
             alphas, lsq, eps_abs, max_steps, stop_on_tol, z, rank, tv, ti, total,
-            cap, floor):  # type: ignore[no-untyped-def]
+            cap, floor):
     """The Sapidis-Farin loop (see :func:`curvefair.fairing.knot_removal.knot_removal_fair`);
     returns ``(steps, reason code, tracked sum, history, blocked knots, number blocked)``. ``d``,
     ``z``, ``rank`` and the tree are updated in place. Per step: the removal moves (one point, or a

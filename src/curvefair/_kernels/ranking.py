@@ -58,7 +58,7 @@ def _better(v1: float, i1: int, v2: float, i2: int) -> bool:
 
 
 @njit(cache=True)
-def _scan_block(tv, P, n, b, shift):  # type: ignore[no-untyped-def]
+def _scan_block(tv, P, n, b, shift):
     """Largest value of block ``b`` and its first index (``(-inf, -1)`` if empty)."""
     k0 = b << shift
     k1 = min(k0 + (1 << shift), n)
@@ -76,7 +76,7 @@ def _scan_block(tv, P, n, b, shift):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def tt_build(values):  # type: ignore[no-untyped-def]
+def tt_build(values):
     """Build the tree over ``values`` (float64, shape (N,)); returns ``(tv, ti)``."""
     n = values.shape[0]
     shift = _SHIFT if n > _BLOCKED else 0
@@ -107,7 +107,7 @@ def tt_build(values):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def tt_update(tv, ti, i, value):  # type: ignore[no-untyped-def]
+def tt_update(tv, ti, i, value):
     """Set entry ``i`` to ``value`` and repair the path to the root (``O(16 + log N)``)."""
     n = int(tv[0])
     P = (tv.shape[0] - n) // 2
@@ -162,7 +162,7 @@ def tt_update(tv, ti, i, value):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def tt_update_range(tv, ti, lo, hi, values):  # type: ignore[no-untyped-def]
+def tt_update_range(tv, ti, lo, hi, values):
     """Set entries ``lo..hi`` (inclusive) to ``values[lo..hi]`` and repair their ancestors
     (``O(hi - lo + 16 + log N)``)."""
     if hi < lo:
@@ -231,13 +231,13 @@ def tt_update_range(tv, ti, lo, hi, values):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def tt_top(tv, ti):  # type: ignore[no-untyped-def]
+def tt_top(tv, ti):
     """``(index, value)`` of the largest entry (index -1 if the tree is empty)."""
     return ti[1], tv[1]
 
 
 @njit(cache=True)
-def tt_value(tv, i):  # type: ignore[no-untyped-def]
+def tt_value(tv, i):
     """Current value of entry ``i``."""
     n = int(tv[0])
     return tv[tv.shape[0] - n + i]

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import importlib
 
+from ._tolerance import point_report
 from .fair import (
     METHODS,
     DriverOutput,
@@ -37,6 +38,7 @@ __all__ = [
     "method_options",
     "StopReason",
     "STOP_REASONS",
+    "point_report",
 ]
 
 METHOD_MODULES = [

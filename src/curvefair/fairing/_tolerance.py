@@ -292,8 +292,36 @@ def enforce_tolerance(original: PiecewiseCurve, new: PiecewiseCurve, tol: float 
 
 def point_report(original: PiecewiseCurve, new: PiecewiseCurve
                  ) -> tuple[np.ndarray, FloatArray, float, int | None]:
-    """``(moved indices, their displacement, max displacement, its index)`` of the data points
-    (with :func:`curvefair._distance.point_distances`); zero moves when the shapes differ."""
+    """The data points a fair moved and how far: the ``moved``, ``n_moved``,
+    ``max_point_displacement`` and ``max_point_index`` figures of a :func:`curvefair.fair`
+    report.
+
+    Parameters
+    ----------
+    original, new : curve
+        A curve and its faired version, whose data points correspond one to one: the control
+        points of B-splines, else the points (a closed Hermite curve's repeated last point
+        left out).
+
+    Returns
+    -------
+    moved : ndarray of int
+        The 0-based indices, ascending, of the data points that differ in any coordinate.
+    displacement : ndarray of float
+        Their distances ``|new_i - original_i|``, in the order of ``moved``: the float64
+        Euclidean norm every curvefair report uses for a point's move.
+    max_displacement : float
+        The largest of them; 0.0 when no point moved.
+    max_index : int or None
+        The index of that point (the first of equal ones); None when no point moved.
+
+    Notes
+    -----
+    When the two curves' data points differ in number or dimension (nothing to compare point
+    by point), every index of ``new`` is returned as moved, with no displacements, 0.0 and
+    None. :func:`curvefair.analysis.point_displacement` gives the largest displacement alone
+    (every point counted, a closed Hermite curve's repeated point included).
+    """
     from .fair import data_points
 
     p0 = data_points(original)

@@ -155,7 +155,7 @@ def _solver_as_driver(solver: Callable[..., Outcome], curve: PiecewiseCurve, *,
     return solver(prob, **options)
 
 
-class FairingReport(dict):  # type: ignore[type-arg]
+class FairingReport(dict):
     """The report of :func:`fair`: a ``dict`` whose per-point entries stay numpy arrays.
 
     Every entry is a plain Python value (``float``, ``int``, ``str``, ``bool``, ``None``,
@@ -168,7 +168,7 @@ class FairingReport(dict):  # type: ignore[type-arg]
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON-ready copy: arrays become lists, non-finite floats ``None``."""
-        return jsonable(self)  # type: ignore[no-any-return]
+        return jsonable(self)
 
 
 @dataclass(frozen=True, eq=False)
@@ -236,7 +236,7 @@ def _driver_options(spec: MethodSpec) -> tuple[dict[str, Any], bool]:
     """
     fn = spec.solver if spec.solver is not None else spec.driver
     try:
-        sig = inspect.signature(fn)  # type: ignore[arg-type]
+        sig = inspect.signature(fn)
     except (TypeError, ValueError):
         return {}, True
     bound = set(fn.keywords) if isinstance(fn, functools.partial) else set()
@@ -344,7 +344,7 @@ def data_points(curve: PiecewiseCurve) -> FloatArray:
     A closed Hermite curve's repeated last point is dropped (distinct points only).
     """
     if hasattr(curve, "control_points"):
-        return np.asarray(curve.control_points)  # type: ignore[attr-defined]
+        return np.asarray(curve.control_points)
     pts = np.asarray(curve.points)  # type: ignore[attr-defined]
     if curve.closed and not hasattr(curve, "control_points"):
         return pts[:-1]

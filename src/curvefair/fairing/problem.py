@@ -175,7 +175,7 @@ class Outcome:
 
 def normalize_protect(protect: object, curve: PiecewiseCurve) -> frozenset[int]:
     """Validate protected data-point indices; a closed Hermite curve maps ``n-1`` to the seam 0."""
-    n_stored = (int(curve.control_points.shape[0]) if hasattr(curve, "control_points")  # type: ignore[attr-defined]
+    n_stored = (int(curve.control_points.shape[0]) if hasattr(curve, "control_points")
                 else int(np.asarray(curve.points).shape[0]))  # type: ignore[attr-defined]
     seam_alias = curve.closed and not hasattr(curve, "control_points")
     if protect is None:
@@ -212,7 +212,7 @@ def fixed_mask(curve: PiecewiseCurve, clamp: tuple[str, str],
     """
     closed = bool(curve.closed)
     if hasattr(curve, "control_points"):
-        n = int(curve.control_points.shape[0])  # type: ignore[attr-defined]
+        n = int(curve.control_points.shape[0])
         mask = np.zeros(n, dtype=bool)
         if not closed:
             left, right = (CLAMP_POINTS[c] for c in clamp)

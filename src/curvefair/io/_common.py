@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from .._jit import njit
+from .._kernels import corners as _k
 from .._typing import ArrayLike, FloatArray
 from .._validate import MAX_MAGNITUDE, MIN_EXTENT
 from ..curves.bspline import BSplineCurve
@@ -526,88 +526,13 @@ def noise_scale(points: FloatArray, closed: bool) -> float:
 def _chord_turns(p: FloatArray, closed: bool, Lmin: float) -> FloatArray:
     """Turning angle (degrees) at every point between the chords to the nearest points before
     and after it at least ``Lmin`` away; NaN where a chord cannot reach that length before an
-    end of an open list (or half-way round a closed one). Compiled (:func:`_chord_turns_kernel`);
-    :func:`_chord_turns_reference` is the same search written plainly."""
+    end of an open list (or half-way round a closed one). Compiled
+    (:func:`curvefair._kernels.corners.chord_turns_kernel`);
+    :func:`curvefair._kernels.corners.chord_turns_reference` is the same search written
+    plainly."""
     q = np.ascontiguousarray(p, dtype=np.float64)
     out = np.full(q.shape[0], np.nan)
-    _chord_turns_kernel(q, bool(closed), float(Lmin), out)
-    return out
-
-
-@njit(cache=True)
-def _chord_turns_kernel(p, closed, Lmin, out):  # type: ignore[no-untyped-def]
-    """Fill ``out`` (NaN on entry) for :func:`_chord_turns`: from every point ``i`` walk back
-    and forth to the first point ``k`` with ``|p_k - p_i| >= Lmin`` (at most ``m // 2`` steps;
-    an open list's ends stop the walk), then ``angle = arccos(a . b / (|a| |b|))`` of the
-    chords ``a = p_i - p_back``, ``b = p_fwd - p_i``, clipped to [-1, 1]; sums in coordinate
-    order (no fastmath)."""
-    m, dim = p.shape
-    lo, hi = (0, m) if closed else (1, m - 1)
-    lim = m // 2 + 1
-    for i in range(lo, hi):
-        back = fwd = -1
-        for e in range(2):
-            step = -1 if e == 0 else 1
-            k = i + step
-            n_steps = 1
-            found = -1
-            while n_steps < lim:
-                if not closed and (k < 0 or k >= m):
-                    break
-                kk = k % m
-                d2 = 0.0
-                for c in range(dim):
-                    t = p[kk, c] - p[i, c]
-                    d2 += t * t
-                if np.sqrt(d2) >= Lmin:
-                    found = kk
-                    break
-                k += step
-                n_steps += 1
-            if e == 0:
-                back = found
-            else:
-                fwd = found
-        if back < 0 or fwd < 0:
-            continue
-        ab = 0.0
-        aa = 0.0
-        bb = 0.0
-        for c in range(dim):
-            a = p[i, c] - p[back, c]
-            b = p[fwd, c] - p[i, c]
-            ab += a * b
-            aa += a * a
-            bb += b * b
-        cosv = ab / (np.sqrt(aa) * np.sqrt(bb))
-        cosv = min(1.0, max(-1.0, cosv))
-        out[i] = np.degrees(np.arccos(cosv))
-
-
-def _chord_turns_reference(p: FloatArray, closed: bool, Lmin: float) -> FloatArray:
-    """:func:`_chord_turns` by a plain Python walk (numpy norms and dot products per point):
-    the slow reference the compiled kernel is tested against."""
-    m = p.shape[0]
-    out = np.full(m, np.nan)
-    idx = range(m) if closed else range(1, m - 1)
-    for i in idx:
-        ends = []
-        for step in (-1, 1):
-            k, n_steps, found = i + step, 1, False
-            while n_steps < m // 2 + 1:
-                if not closed and not 0 <= k < m:
-                    break
-                if np.linalg.norm(p[k % m] - p[i]) >= Lmin:
-                    found = True
-                    break
-                k += step
-                n_steps += 1
-            ends.append(k % m if found else -1)
-        if ends[0] < 0 or ends[1] < 0:
-            continue
-        a, b = p[i] - p[ends[0]], p[ends[1]] - p[i]
-        na, nb = float(np.linalg.norm(a)), float(np.linalg.norm(b))
-        out[i] = np.degrees(np.arccos(np.clip(float(a @ b) / (na * nb), -1.0, 1.0)))
+    _k.chord_turns_kernel(q, bool(closed), float(Lmin), out)
     return out
 
 

@@ -319,12 +319,25 @@ def write_checked(path: str | os.PathLike[str], records: Sequence[CurveRecord],
                   reader: Callable[[str], list[CurveRecord]], template: object = None,
                   format: str | None = None, overwrite: bool = False,
                   decimals: int | None = None, precision: str = "file") -> WriteCheck:
-    """Write ``records`` to ``path`` only if the file read back is within ``tol`` of
-    ``reference``; see the module docstring.
+    """Write ``records`` to ``path`` only if the file read back holds every curve within
+    ``tol`` of ``reference``.
+
+    The records are written to a temporary file beside ``path``, which is read back with
+    ``reader``; every curve read back is measured against its reference curve (what the user
+    had before): the parametric deviation when both have the same parameter domain (spline
+    entities: same knots), else the geometric (Hausdorff) distance of
+    :func:`curvefair.deviation`, or an upper bound of it where that already meets ``tol``. A
+    curve read back farther than ``tol`` is handled in this order: SVG elements rounded to
+    their own decimals are written again with exact numbers; point data (re-interpolated on
+    reading) get their moves from the reference scaled down, ``p = p0 + s (p_faired - p0)``
+    with ``s < 1``, until within ``tol``; otherwise nothing is written. Only a file that
+    passes replaces ``path``. :func:`curvefair.write_curves` and ``curvefair fair`` write
+    through this function.
 
     Parameters
     ----------
     path : path-like
+        The destination; untouched unless the check passes.
     records : sequence of CurveRecord
         The faired records, one per reference record, in the same order.
     reference : sequence of CurveRecord
@@ -338,6 +351,12 @@ def write_checked(path: str | os.PathLike[str], records: Sequence[CurveRecord],
         As for :func:`curvefair.write_curves` (which calls this function; ``overwrite`` is
         checked there); ``decimals`` given: the rounding asked for is kept, and a file it puts
         out of tolerance is not written; ``precision="exact"``: exact numbers from the start.
+
+    Returns
+    -------
+    WriteCheck
+        What was measured on the written file (deviations per record, how each was measured,
+        the move scales applied, the curves read back).
 
     Raises
     ------
@@ -437,9 +456,28 @@ def rescaled_report(report: dict[str, Any], original: Any, written: Any,
                     scale: float) -> dict[str, Any]:
     """A :func:`curvefair.fair` report whose after-figures describe ``written``, the curve read
     back from the file, instead of the faired curve whose moves were scaled by ``scale`` to
-    hold the tolerance on disk (point data re-interpolated on reading; see the module
-    docstring, step 2).
+    hold the tolerance on disk (point data re-interpolated on reading; see
+    :func:`write_checked`).
 
+    Parameters
+    ----------
+    report : dict
+        The ``report`` of the :class:`curvefair.FairingResult` of the fair; not modified.
+    original : curve
+        The curve read from the input, the one that was faired.
+    written : curve
+        The curve read back from the written file (``read_back[i]`` of the
+        :class:`WriteCheck` that :func:`write_checked` returned).
+    scale : float
+        The factor its moves were scaled by (``move_scale[i]`` of that check).
+
+    Returns
+    -------
+    dict
+        A copy of ``report`` with the figures below recomputed for ``written``.
+
+    Notes
+    -----
     Recomputed: every ``<figure>_after`` of :func:`curvefair.analyze` (energies, jumps,
     Sapidis sum, inflections, extrema), the data point moves (``moved``, ``n_moved``,
     ``max_point_displacement``, ``max_point_index``) and the deviation from ``original``
@@ -448,7 +486,7 @@ def rescaled_report(report: dict[str, Any], original: Any, written: Any,
     recomputed and becomes None. ``move_scale`` and ``after_figures`` say what was done.
     """
     from ..analysis import deviation
-    from ..fairing._tolerance import point_report
+    from ..fairing import point_report
     from ..fairing.fair import analysis_block
 
     out = dict(report)

@@ -194,7 +194,7 @@ def _open_binary(path: Any) -> Any:
     _fonttools("OpenType/TrueType fonts")
     from fontTools.ttLib import TTFont
     try:
-        font = TTFont(os.fspath(path))  # type: ignore[arg-type]
+        font = TTFont(os.fspath(path))
         font.getGlyphOrder()
     except Exception as exc:  # fontTools raises many kinds for a garbled file
         raise FileFormatError(f"not a font fontTools can read ({exc})", path) from None
@@ -213,7 +213,7 @@ def _open_binary(path: Any) -> Any:
 def _open_ufo(path: Any) -> Any:
     ufoLib2 = _ufolib2("UFO sources")
     try:
-        return ufoLib2.Font.open(os.fspath(path), lazy=True)  # type: ignore[arg-type]
+        return ufoLib2.Font.open(os.fspath(path), lazy=True)
     except Exception as exc:
         raise FileFormatError(f"not a UFO ufoLib2 can read ({exc})", path) from None
 
@@ -221,7 +221,7 @@ def _open_ufo(path: Any) -> Any:
 def _open_glyphs(path: Any) -> Any:
     glyphsLib = lazy_import("glyphsLib", "glyphsLib", "fonts", "Glyphs sources")
     try:
-        return glyphsLib.GSFont(os.fspath(path))  # type: ignore[arg-type]
+        return glyphsLib.GSFont(os.fspath(path))
     except Exception as exc:
         raise FileFormatError(f"not a Glyphs source glyphsLib can read ({exc})", path) from None
 
@@ -377,7 +377,7 @@ def _select(names: list[str], glyphs: Sequence[str] | None, path: Any) -> list[s
     missing = [g for g in glyphs if g not in set(names)]
     if missing:
         raise InputError(f"glyphs: {', '.join(map(repr, missing[:10]))} not in "
-                         f"{os.fspath(path)!r}")  # type: ignore[arg-type]
+                         f"{os.fspath(path)!r}")
     want = set(glyphs)
     return [g for g in names if g in want]
 

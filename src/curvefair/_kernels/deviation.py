@@ -1,0 +1,245 @@
+"""Compiled kernels of :func:`curvefair.deviation` and
+:func:`curvefair.analysis.matched_hermite_bound` (:mod:`curvefair.analysis._deviation`).
+
+:func:`first_pass` bounds every merged piece of the difference curve by its Bernstein control
+points and samples it; :func:`branch_and_bound` runs the halving levels of the parametric
+search; :func:`matched_bound_kernel` is the per-span bound of two cubic Hermite curves through
+the same number of points, and :func:`matched_hermite_bound_reference` the same bound in numpy,
+the plain form the kernel is tested against.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from .._jit import njit
+from .._typing import FloatArray
+
+#: values at 0, 1/3, 2/3, 1 -> Bernstein control points of a cubic
+TO_BERNSTEIN = np.linalg.inv(np.array([[(1 - x) ** 3, 3 * x * (1 - x) ** 2, 3 * x * x * (1 - x),
+                                        x ** 3] for x in (0.0, 1 / 3, 2 / 3, 1.0)]))
+
+
+@njit(cache=True, error_model="numpy")
+def first_pass(d, w, M, U):
+    """Per piece: ``U[i]`` = max norm of the Bernstein control points of ``d`` on piece ``i``
+    (``M`` maps scaled power coefficients to Bernstein ones); returns the largest sampled
+    ``|d|`` (ends and quarter points), its piece and fraction."""
+    m, q, dim = d.shape
+    ds = np.empty((q, dim))
+    best = -1.0
+    bi = 0
+    bf = 0.0
+    fr = np.array([0.0, 0.25, 0.5, 0.75, 1.0])
+    for i in range(m):
+        hp = 1.0
+        for j in range(q):
+            for c in range(dim):
+                ds[j, c] = d[i, j, c] * hp
+            hp *= w[i]
+        u = 0.0
+        for r in range(q):
+            nn = 0.0
+            for c in range(dim):
+                acc = 0.0
+                for k in range(r + 1):
+                    acc += M[r, k] * ds[k, c]
+                nn += acc * acc
+            if nn > u:
+                u = nn
+        U[i] = np.sqrt(u)
+        for t in range(5):
+            f = fr[t]
+            nn = 0.0
+            for c in range(dim):
+                acc = 0.0
+                for j in range(q - 1, -1, -1):
+                    acc = acc * f + ds[j, c]
+                nn += acc * acc
+            if nn > best:
+                best = nn
+                bi = i
+                bf = f
+    return np.sqrt(max(best, 0.0)), bi, bf
+
+
+@njit(cache=True, error_model="numpy")
+def _norm_row(v):
+    """``sqrt(sum(v * v))`` summed in index order (as the numpy ``_norms`` of
+    :mod:`curvefair.analysis._deviation` rounds it)."""
+    acc = v[0] * v[0]
+    for c in range(1, v.shape[0]):
+        acc += v[c] * v[c]
+    return np.sqrt(acc)
+
+
+@njit(cache=True, error_model="numpy")
+def branch_and_bound(cb, lo, hi, best, best_t, ub, rtol, atol, levels, cap):
+    """The levels of :func:`curvefair.deviation`'s branch-and-bound in one compiled pass.
+
+    Per level, for the pieces left (Bernstein control points ``cb`` (k, q, dim) on
+    ``[lo, hi]``): halve each piece (de Casteljau at 1/2: left halves first, then right
+    halves), sample every child at its midpoint and the split points, keep the children whose
+    bound ``max_i |b_i|`` exceeds ``best + rtol best + atol``; the bounds of the others raise
+    ``ub``. The same operations in the same order as the array code it replaces (bitwise the
+    same figures). Stops early, before a level, when more than ``cap`` pieces are left (the
+    caller trims them) and returns ``(cb, lo, hi, best, best_t, ub, levels done)``.
+    """
+    q = cb.shape[1]
+    dim = cb.shape[2]
+    cur = np.empty((q, dim))
+    done = 0
+    for _ in range(levels):
+        k = cb.shape[0]
+        if k == 0 or k > cap:
+            break
+        k2 = 2 * k
+        nb = np.empty((k2, q, dim))
+        nlo = np.empty(k2)
+        nhi = np.empty(k2)
+        for i in range(k):
+            for j in range(q):
+                for c in range(dim):
+                    cur[j, c] = cb[i, j, c]
+            for c in range(dim):
+                nb[i, 0, c] = cur[0, c]
+                nb[k + i, q - 1, c] = cur[q - 1, c]
+            for r in range(1, q):
+                for j in range(q - r):
+                    for c in range(dim):
+                        cur[j, c] = 0.5 * (cur[j, c] + cur[j + 1, c])
+                for c in range(dim):
+                    nb[i, r, c] = cur[0, c]
+                    nb[k + i, q - 1 - r, c] = cur[q - 1 - r, c]
+            mid = 0.5 * (lo[i] + hi[i])
+            nlo[i] = lo[i]
+            nhi[i] = mid
+            nlo[k + i] = mid
+            nhi[k + i] = hi[i]
+        # each child's midpoint: de Casteljau at 1/2 of its control points
+        sbest = -1.0
+        skk = 0
+        for i in range(k2):
+            for j in range(q):
+                for c in range(dim):
+                    cur[j, c] = nb[i, j, c]
+            for r in range(1, q):
+                for j in range(q - r):
+                    for c in range(dim):
+                        cur[j, c] = 0.5 * (cur[j, c] + cur[j + 1, c])
+            v = _norm_row(cur[0])
+            if v > sbest:
+                sbest = v
+                skk = i
+        if sbest > best:
+            best = sbest
+            best_t = 0.5 * (nlo[skk] + nhi[skk])
+        # the split points: the last control point of each left child
+        ebest = -1.0
+        ekk = 0
+        for i in range(k):
+            v = _norm_row(nb[i, q - 1])
+            if v > ebest:
+                ebest = v
+                ekk = i
+        if ebest > best:
+            best = ebest
+            best_t = nhi[ekk]
+        thr = best + (rtol * best + atol)
+        U = np.empty(k2)
+        n_keep = 0
+        for i in range(k2):
+            u = -1.0
+            for j in range(q):
+                v = _norm_row(nb[i, j])
+                if v > u:
+                    u = v
+            U[i] = u
+            if u > thr:
+                n_keep += 1
+            elif u > ub:
+                ub = u
+        cb = np.empty((n_keep, q, dim))
+        lo = np.empty(n_keep)
+        hi = np.empty(n_keep)
+        w = 0
+        for i in range(k2):
+            if U[i] > thr:
+                cb[w] = nb[i]
+                lo[w] = nlo[i]
+                hi[w] = nhi[i]
+                w += 1
+        done += 1
+    return cb, lo, hi, best, best_t, ub, done
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def matched_bound_kernel(ua, ub, pa, pb, ta, tb, pieces, tob, out):
+    """:func:`curvefair.analysis.matched_hermite_bound` in one pass over the spans (no
+    ``(n, 4, dim)`` temporaries): per span and sub-piece, the difference cubic's values at
+    ``s = (j + k / 3) / pieces``, their Bernstein control points by ``tob``, the largest
+    control-point norm. :func:`matched_hermite_bound_reference` is the same in numpy."""
+    dim = pa.shape[1]
+    vals = np.empty((4, dim))
+    herm = np.empty((dim, 4))  # the span's Hermite data d0, m0, d1, m1 per coordinate
+    for i in range(out.shape[0]):
+        ha = ua[i + 1] - ua[i]
+        hb = ub[i + 1] - ub[i]
+        r = ha / hb
+        for c in range(dim):
+            herm[c, 0] = pa[i, c] - pb[i, c]
+            herm[c, 1] = ta[i, c] * r * hb - tb[i, c] * hb
+            herm[c, 2] = pa[i + 1, c] - pb[i + 1, c]
+            herm[c, 3] = ta[i + 1, c] * r * hb - tb[i + 1, c] * hb
+        best = 0.0
+        for j in range(pieces):
+            for kk in range(4):
+                s = (j + kk / 3.0) / pieces
+                s2 = s * s  # products, not pow: the same roundings on every CPU
+                s3 = s2 * s
+                h00 = 2 * s3 - 3 * s2 + 1
+                h10 = s3 - 2 * s2 + s
+                h01 = -2 * s3 + 3 * s2
+                h11 = s3 - s2
+                for c in range(dim):
+                    vals[kk, c] = (herm[c, 0] * h00 + herm[c, 1] * h10 + herm[c, 2] * h01
+                                   + herm[c, 3] * h11)
+            for q in range(4):
+                acc = 0.0
+                for c in range(dim):
+                    v = (tob[q, 0] * vals[0, c] + tob[q, 1] * vals[1, c]
+                         + tob[q, 2] * vals[2, c] + tob[q, 3] * vals[3, c])
+                    acc += v * v
+                if acc > best:
+                    best = acc
+        out[i] = math.sqrt(best) * (1.0 + 1e-12)
+
+
+def matched_hermite_bound_reference(a: Any, b: Any, pieces: int = 4) -> FloatArray:
+    """:func:`curvefair.analysis.matched_hermite_bound` with numpy arrays of all spans at once
+    (the plain form the compiled kernel :func:`matched_bound_kernel` is tested against)."""
+    ua, ub = np.asarray(a.params), np.asarray(b.params)
+    ha, hb = np.diff(ua), np.diff(ub)
+    pa, pb = np.asarray(a.points), np.asarray(b.points)
+    ta, tb = np.asarray(a.tangents), np.asarray(b.tangents)
+    r = (ha / hb)[:, None]
+    d0, d1 = pa[:-1] - pb[:-1], pa[1:] - pb[1:]
+    # derivatives with respect to the span's unit parameter s = (t - t_i) / hb
+    m0 = ta[:-1] * r * hb[:, None] - tb[:-1] * hb[:, None]
+    m1 = ta[1:] * r * hb[:, None] - tb[1:] * hb[:, None]
+    best = np.zeros(len(ha))
+    k = np.arange(4) / 3.0
+    for j in range(pieces):
+        s = (j + k) / pieces
+        h00 = 2 * s ** 3 - 3 * s ** 2 + 1
+        h10 = s ** 3 - 2 * s ** 2 + s
+        h01 = -2 * s ** 3 + 3 * s ** 2
+        h11 = s ** 3 - s ** 2
+        vals = (d0[:, None, :] * h00[None, :, None] + m0[:, None, :] * h10[None, :, None]
+                + d1[:, None, :] * h01[None, :, None] + m1[:, None, :] * h11[None, :, None])
+        ctrl = np.einsum("kv,svd->skd", TO_BERNSTEIN, vals)
+        best = np.maximum(best, np.sqrt(np.max(np.sum(ctrl * ctrl, axis=2), axis=1)))
+    return best * (1.0 + 1e-12)
