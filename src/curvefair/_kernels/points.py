@@ -23,7 +23,7 @@ from .global_fair import band_cholesky, band_solve
 
 
 @njit(cache=True)
-def assemble_newton(L0, Aw, B, dim, L):  # type: ignore[no-untyped-def]
+def assemble_newton(L0, Aw, B, dim, L):
     """``L = L0 + band(sum_i A_i^T B_i A_i)`` for a tridiagonal ``A`` (``A[i, i - 1 + s] =
     Aw[i, s]``): ``L0`` the lower band of the (interleaved) energy matrix, ``L`` of the same
     shape ``(N dim, 5 dim)``."""
@@ -56,7 +56,7 @@ def assemble_newton(L0, Aw, B, dim, L):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def energy_band(jstart, JV, Wk, gstart, GV, gw, L):  # type: ignore[no-untyped-def]
+def energy_band(jstart, JV, Wk, gstart, GV, gw, L):
     """Lower band ``L[r, k] = K[r + k, r]`` (interleaved, ``kd = 5 dim - 1``) of
     ``K = sum_k J_k^T Wk_k J_k + sum_k gw_k g_k^T g_k`` (``(x) I``): ``J_k`` the jump rows,
     ``JV[k, s]`` at columns ``jstart_k + s`` (``s = 0 .. 4``), ``Wk`` their ``dim x dim``
@@ -95,7 +95,7 @@ def energy_band(jstart, JV, Wk, gstart, GV, gw, L):  # type: ignore[no-untyped-d
 
 
 @njit(cache=True)
-def band_quad(Kb, x):  # type: ignore[no-untyped-def]
+def band_quad(Kb, x):
     """``x^T K x`` for the symmetric band ``Kb[r, k] = K[r + k, r]`` (``x`` 1-D)."""
     n = x.shape[0]
     kd = Kb.shape[1] - 1
@@ -111,7 +111,7 @@ def band_quad(Kb, x):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def apply_rows(start, W, x, out):  # type: ignore[no-untyped-def]
+def apply_rows(start, W, x, out):
     """``out = C x`` (``x`` shape (N, dim), ``out`` shape (m, dim))."""
     m = start.shape[0]
     dim = x.shape[1]
@@ -125,7 +125,7 @@ def apply_rows(start, W, x, out):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def _rows_t(start, W, v, out):  # type: ignore[no-untyped-def]
+def _rows_t(start, W, v, out):
     """``out += C^T v`` (``v`` shape (m, dim), ``out`` shape (N, dim))."""
     m = start.shape[0]
     dim = v.shape[1]
@@ -139,7 +139,7 @@ def _rows_t(start, W, v, out):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def _band_mv(Kb, x, out):  # type: ignore[no-untyped-def]
+def _band_mv(Kb, x, out):
     """``out = K x`` for the symmetric band ``Kb[r, k] = K[r + k, r]`` (``x``, ``out`` 1-D)."""
     n = x.shape[0]
     kd = Kb.shape[1] - 1
@@ -155,7 +155,7 @@ def _band_mv(Kb, x, out):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def _residuals(Kb, start, W, Y, t2, x, lam, tinv, v, fi, rd, rc):  # type: ignore[no-untyped-def]
+def _residuals(Kb, start, W, Y, t2, x, lam, tinv, v, fi, rd, rc):
     """``v = C x - Y``, ``f_i = (|v_i|^2 / t2_i - 1) / 2``, ``rd = K x + C^T (lam v / t2)``,
     ``rc = -lam f - tinv``; returns the residual norm squared without ``rd``'s scaling."""
     m, dim = Y.shape
@@ -179,7 +179,7 @@ def _residuals(Kb, start, W, Y, t2, x, lam, tinv, v, fi, rd, rc):  # type: ignor
 
 
 @njit(cache=True)
-def _assemble(start, W, v, fi, lam, t2, a, L):  # type: ignore[no-untyped-def]
+def _assemble(start, W, v, fi, lam, t2, a, L):
     """``L += band(sum_i C_i^T B_i C_i)``, ``B_i = lam_i / t2_i I + ww_i a_i a_i^T`` with
     ``a_i = v_i / t2_i`` (stored in ``a``) and ``ww_i = lam_i / (-f_i)``: the constraint part
     of the Newton matrix of :func:`tube_ipm`."""
@@ -211,7 +211,7 @@ def _assemble(start, W, v, fi, lam, t2, a, L):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def _assemble2(start, W, v, fi, lam, t2, a, L):  # type: ignore[no-untyped-def]
+def _assemble2(start, W, v, fi, lam, t2, a, L):
     """:func:`_assemble` for ``dim = 2`` without branches: the same products added in the
     same order (a zero weight adds an exact zero), so the same band to the last bit."""
     m = v.shape[0]
@@ -244,7 +244,7 @@ def _assemble2(start, W, v, fi, lam, t2, a, L):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def tube_ipm(Kb, start, W, Y, rad, x, lam, max_steps, gap, stall):  # type: ignore[no-untyped-def]
+def tube_ipm(Kb, start, W, Y, rad, x, lam, max_steps, gap, stall):
     """Primal-dual interior point for ``min x^T K x / 2`` (``K`` the scaled energy, lower band
     ``Kb``) s.t. ``|C_i x - Y_i| <= rad_i``, from a strictly feasible ``x`` and positive ``lam``
     (both updated in place). Boyd & Vandenberghe sec. 11.7: surrogate gap ``eta = -f.lam``,
