@@ -66,8 +66,6 @@ def test_method_functions_refuse_tol_zero_like_fair():
 def test_every_builtin_method_is_a_solver_of_the_problem():
     c3, c5, b = interpolate_cubic(_pts()), interpolate_quintic(_pts()), _bs()
     for name, spec in METHODS.items():
-        if name == "points-l1":
-            continue  # registered through the keyword driver form (also supported)
         assert spec.solver is not None, name
         curve = c5 if name == "wang-quintic" else (b if name in (
             "eck-hadenfeld", "knot-removal", "global", "cheng-yu") else c3)
@@ -85,6 +83,18 @@ def test_every_builtin_method_is_a_solver_of_the_problem():
         np.testing.assert_array_equal(np.asarray(out.curve(np.linspace(*curve.domain, 7))),
                                       np.asarray(out2.curve(np.linspace(*curve.domain, 7))))
 
+
+
+def test_points_l1_without_a_tolerance_runs_poliakoff_on_the_same_problem():
+    # no tube to work in: the solver hands the problem to poliakoff (and says so); the same
+    # curve as poliakoff's own solver gives for that problem
+    c = interpolate_cubic(_pts())
+    out = METHODS["points-l1"].solver(make_problem(c, max_steps=7))
+    ref = METHODS["poliakoff"].solver(make_problem(c, max_steps=7))
+    assert "poliakoff" in out.extra["points_l1"]
+    u = np.linspace(*c.domain, 11)
+    np.testing.assert_array_equal(np.asarray(out.curve(u)), np.asarray(ref.curve(u)))
+    assert out.steps == ref.steps
 
 def test_fair_history_says_what_it_counts():
     r = fair(_bs(), "knot-removal", tol=0.05)

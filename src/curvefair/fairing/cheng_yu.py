@@ -368,13 +368,7 @@ def solve(problem: FairingProblem, *, pair: bool = True, relative: bool = True) 
 
 def _register() -> None:
     from ..curves.bspline import BSplineCurve
-
-    try:
-        from .fair import MethodSpec, register_method
-    except ModuleNotFoundError as exc:  # the registry not written yet: nothing to register with
-        if exc.name != f"{__package__}.fair":
-            raise
-        return
+    from .fair import MethodSpec, register_method
 
     register_method(MethodSpec(
         name="cheng-yu",

@@ -106,6 +106,7 @@ from ..curves.hermite import CubicHermite
 from ..curves.interpolate import interpolate_cubic
 from ..curves.parameterize import parameterize
 from ..errors import InputError
+from .problem import FairingHistory, FairingProblem, Outcome
 from .stop import StopReason
 
 __all__ = ["points_l1", "PointsL1Result", "natural_operators"]
@@ -1004,19 +1005,28 @@ def _prefer(curve: Any) -> bool:
             and _is_natural_chord_interpolant(curve))
 
 
-def _driver(curve: CubicHermite, *, tol: float | None, eps: float | None,
-            max_steps: int | None, clamp: Any, protect: Any, rounds: int | None = None,
-            delta: float = 1e-5, curve_tol: bool = True, samples: int = 3,
-            backoff: int = 4, scale: str = "none", select: int | None = None) -> Any:
-    from .fair import DriverOutput, FairingHistory
+def solve(problem: FairingProblem, *, rounds: int | None = None, delta: float = 1e-5,
+          curve_tol: bool = True, samples: int = 3, backoff: int = 4, scale: str = "none",
+          select: int | None = None) -> Outcome:
+    """``points-l1`` as a solver of ``problem`` (``fair(curve, "points-l1", ...)``): the
+    points of ``problem.curve`` moved by :func:`points_l1` within ``problem.tol``, the clamp
+    pair and protected points held; ``eps`` has no meaning here (one convex problem, no
+    ranking loop). ``rounds`` (default 10 up to ``SELECT_MAX_POINTS`` points, else 5),
+    ``select`` (formulations tried, default 3 up to ``SELECT_MAX_POINTS``, else 1), ``scale``,
+    ``delta``, ``curve_tol``, ``samples``: as in :func:`points_l1`; ``backoff``: solves in half
+    the tube when the result adds inflections or curvature extrema."""
+    import dataclasses
 
+    curve = cast(CubicHermite, problem.curve)
+    tol, max_steps, clamp, protect = (problem.tol_or_none, problem.max_steps, problem.clamp,
+                                      problem.protect)
     if tol is None:
         # no bound on the moves: the convex problem has no tube to work in (its minimiser
         # would be a straight line); the local Poliakoff loop is run instead, and said so
         from .fair import METHODS
 
-        out = METHODS["poliakoff"].driver(curve, tol=None, eps=eps, max_steps=max_steps,
-                                          clamp=clamp, protect=protect, mode="spline")
+        out = METHODS["poliakoff"].run(dataclasses.replace(problem, mode="spline", options={}),
+                                       {})
         out.extra["points_l1"] = "no tol given: the poliakoff loop was run instead"
         return out
     n = curve.n_points
@@ -1046,8 +1056,8 @@ def _driver(curve: CubicHermite, *, tol: float | None, eps: float | None,
     p_all = np.asarray(curve.points)
     p0 = p_all[:-1] if closed else p_all
     if steps == 0:
-        return DriverOutput(curve=curve, steps=0, stop_reason="max_steps",
-                            history=FairingHistory.empty(), curve_within_tol=False)
+        return Outcome(curve=curve, steps=0, stop_reason="max_steps",
+                       history=FairingHistory.empty(), curve_within_tol=False)
     # ``select`` formulations, the call's own first, then the jump costs of
     # :func:`_jump_costs` it does not use (defaults: SELECT_MAX_POINTS)
     small = n <= SELECT_MAX_POINTS
@@ -1117,12 +1127,12 @@ def _driver(curve: CubicHermite, *, tol: float | None, eps: float | None,
     moved = np.flatnonzero(np.any(p0 != p1, axis=1))
     disp = np.sqrt(np.sum((p1[moved] - p0[moved]) ** 2, axis=1))
     hist = FairingHistory.from_arrays(moved, np.zeros(moved.size), disp)
-    return DriverOutput(curve=res.curve, steps=total,
-                        stop_reason=cast(StopReason, res.report["stop_reason"]), history=hist,
-                        max_steps=steps, extra={"points_l1": res.report,
-                                                "history_is": "one entry per moved point "
-                                                              "(simultaneous solve)"},
-                        curve_within_tol=True)
+    return Outcome(curve=res.curve, steps=total,
+                   stop_reason=cast(StopReason, res.report["stop_reason"]), history=hist,
+                   max_steps=steps, extra={"points_l1": res.report,
+                                           "history_is": "one entry per moved point "
+                                                         "(simultaneous solve)"},
+                   curve_within_tol=True)
 
 
 def _register() -> None:
@@ -1131,7 +1141,7 @@ def _register() -> None:
     register_method(MethodSpec(
         name="points-l1",
         curve_types=(CubicHermite,),
-        driver=_driver,
+        solver=solve,
         summary="Point data: moves the points (each within tol, the curve within tol at equal "
                 "parameter) so that their natural cubic on the input's parameters -- and the "
                 "one rebuilt from the written file -- has the sparsest third-derivative jumps "
