@@ -32,7 +32,7 @@ from curvefair._kernels.ranking import tt_build, tt_top, tt_update
 from curvefair._validate import as_nonnegative, as_step_count
 from curvefair.curves.bspline import basis_derivatives
 from curvefair.errors import InputError
-from curvefair.fairing.eck_hadenfeld import check_bspline, movable_mask
+from curvefair.fairing.eck_hadenfeld import movable_mask
 from curvefair.fairing.knot_removal import (
     ROUNDING_FLOOR,
     VARIANTS,
@@ -43,6 +43,7 @@ from curvefair.fairing.knot_removal import (
     knot_removal_fair,
     sapidis_measure,
 )
+from curvefair.fairing.problem import check_bspline
 
 
 # ------------------------------------------------------------------------------------------

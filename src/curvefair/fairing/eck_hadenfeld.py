@@ -28,6 +28,7 @@ from .._typing import FloatArray
 from .._validate import as_step_count, check_finite, choice, parse_clamp
 from ..curves.bspline import BSplineCurve
 from ..errors import InputError
+from .problem import check_bspline
 from .stop import StopReason
 
 if TYPE_CHECKING:
@@ -48,12 +49,6 @@ STOP_REASONS: dict[int, StopReason] = {0: "converged", 1: "max_steps", 2: "no_mo
 # ------------------------------------------------------------------------------------------
 # argument checks shared by the B-spline methods
 # ------------------------------------------------------------------------------------------
-def check_bspline(curve: object, name: str = "curve") -> BSplineCurve:
-    if not isinstance(curve, BSplineCurve):
-        raise InputError(f"{name} must be a BSplineCurve, got {type(curve).__name__}")
-    return curve
-
-
 def check_l(l: object, degree: int) -> int:  # noqa: E741
     if isinstance(l, bool) or not isinstance(l, (int, np.integer)) or int(l) not in (2, 3):
         raise InputError(f"l must be 2 or 3, got {l!r}")

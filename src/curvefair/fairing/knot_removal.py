@@ -24,7 +24,7 @@ from .._typing import FloatArray
 from .._validate import as_step_count
 from ..curves.bspline import BSplineCurve, basis_derivatives
 from ..errors import InputError
-from .eck_hadenfeld import check_bspline
+from .problem import check_bspline
 from .stop import StopReason
 
 if TYPE_CHECKING:

@@ -42,6 +42,7 @@ from typing import Any, Literal
 import numpy as np
 
 from .._validate import as_nonnegative, as_positive, as_step_count, parse_clamp
+from ..curves.bspline import BSplineCurve
 from ..curves.piecewise import PiecewiseCurve, readonly
 from ..errors import InputError
 from .stop import StopReason
@@ -56,6 +57,7 @@ __all__ = [
     "fixed_mask",
     "eps_threshold",
     "CLAMP_POINTS",
+    "check_bspline",
 ]
 
 #: What :attr:`FairingHistory.index` counts.
@@ -65,6 +67,14 @@ HistoryIndex = Literal["data point", "control point", "knot"]
 #: contact (ERRATA, Eck & Hadenfeld).
 CLAMP_POINTS = {"none": 0, "g0": 1, "g1": 2, "g2": 3}
 
+
+
+def check_bspline(curve: object, name: str = "curve") -> BSplineCurve:
+    """``curve`` if it is a :class:`~curvefair.BSplineCurve` (the B-spline methods' argument
+    check), else an :class:`~curvefair.InputError` naming ``name``."""
+    if not isinstance(curve, BSplineCurve):
+        raise InputError(f"{name} must be a BSplineCurve, got {type(curve).__name__}")
+    return curve
 
 def _finite_or_none(v: Any) -> Any:
     if isinstance(v, float) and not math.isfinite(v):
