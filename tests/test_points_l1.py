@@ -362,14 +362,15 @@ def test_local_shrink_factors_match_a_span_by_span_reference(closed) -> None:
         assert pf.shape == (ns if closed else ns + 1,)
 
 
-def _noisy_spiral(n: int, seed: int) -> tuple[np.ndarray, float]:
+def _noisy_spiral(n: int, seed: int, noise: float = 0.1) -> tuple[np.ndarray, float]:
     """``n`` samples of a spiral arc at uniformly random parameters (some spans far shorter
-    than the noise, where the input's interpolant kinks), noise 0.1 of the mean spacing."""
+    than the noise, where the input's interpolant kinks), noise ``noise`` times the mean
+    spacing; ``tol`` 4 sigma."""
     rng = np.random.default_rng(seed)
     s = np.sort(rng.uniform(0.0, 1.0, n))
     s[0], s[-1] = 0.0, 1.0
     pts = np.c_[(1.0 + 0.5 * s) * np.cos(6.0 * s), (1.0 + 0.5 * s) * np.sin(6.0 * s)]
-    sigma = 0.1 * float(np.sum(np.linalg.norm(np.diff(pts, axis=0), axis=1))) / (n - 1)
+    sigma = noise * float(np.sum(np.linalg.norm(np.diff(pts, axis=0), axis=1))) / (n - 1)
     return pts + rng.normal(0.0, sigma, pts.shape), 4.0 * sigma
 
 
@@ -396,3 +397,49 @@ def test_long_lists_shrink_the_tube_only_near_a_rebuilt_curve_excess(monkeypatch
         return analyze(interpolate_cubic(np.asarray(r.points), "chord", "natural")).extrema
 
     assert extrema(local) < 0.7 * extrema(glob)
+
+
+def test_point_data_back_off_judges_the_curve_rebuilt_from_the_written_points() -> None:
+    # 3,000 noisy spiral points: the result on the input's parameters adds no curvature
+    # extremum or inflection, but the chord-length cubic a reader rebuilds from its points does
+    # (fair()'s never-worse guard sees only the former); points-l1 backs off to a narrower
+    # tube until the rebuilt curve adds none either
+    from curvefair.fairing.fair import _analysis_block
+
+    pts, tol = _noisy_spiral(3000, 3000)
+    c = interpolate_cubic(pts, "chord", "natural")
+    a0 = _analysis_block(c)
+
+    def adds(a):
+        return a["inflections"] > a0["inflections"] or a["extrema"] > a0["extrema"]
+
+    def rebuilt(r):
+        return _analysis_block(interpolate_cubic(np.asarray(r.curve.points), "chord", "natural"))
+
+    raw = fair(c, "points-l1", tol=tol, backoff=0, guard=False)
+    assert not adds(_analysis_block(raw.curve)) and adds(rebuilt(raw))
+    res = fair(c, "points-l1", tol=tol, guard=False)
+    assert res.report["points_l1"]["backoff"] >= 1
+    assert not adds(rebuilt(res)) and not adds(_analysis_block(res.curve))
+    q = np.asarray(res.curve.points)
+    assert np.all(np.sqrt(np.sum((q - pts) ** 2, axis=1)) <= tol) and res.report["n_moved"] > 0
+
+
+
+def test_point_data_whose_every_tube_rebuilds_worse_keep_the_input() -> None:
+    # 6,000 spiral points with noise 0.3 of the spacing: every tube down to tol / 16 gives
+    # points whose rebuilt curve has more curvature extrema or inflections than the input's;
+    # the input is returned unmoved, and the report says why
+    from curvefair.fairing.fair import _analysis_block
+
+    pts, tol = _noisy_spiral(6000, 6000, noise=0.3)
+    c = interpolate_cubic(pts, "chord", "natural")
+    a0 = _analysis_block(c)
+    raw = fair(c, "points-l1", tol=tol, backoff=0, guard=False)
+    ar = _analysis_block(interpolate_cubic(np.asarray(raw.curve.points), "chord", "natural"))
+    assert ar["extrema"] > a0["extrema"] or ar["inflections"] > a0["inflections"]
+    res = fair(c, "points-l1", tol=tol, guard=False)
+    rep = res.report["points_l1"]
+    assert rep["kept"] == "input" and "kept" in rep["reason"] and rep["backoff"] == 4
+    assert res.report["n_moved"] == 0
+    np.testing.assert_array_equal(np.asarray(res.curve.points), pts)
