@@ -2,8 +2,8 @@
 
 Usage (from the repository root)::
 
-    PYTHONPATH=src python benchmarks/bench_points_default.py [--sizes 20000 100000 200000]
-        [--noise 0.1 3] [--tools points-l1 poliakoff csaps]
+    PYTHONPATH=src python benchmarks/bench_points_default.py [--sizes 20000 100000]
+        [--noise 0.1 0.5] [--tools points-l1 poliakoff csaps]
 
 For each size ``n`` and noise level (sigma as a multiple of the mean point spacing): ``n``
 noisy samples of a planar spiral arc (r = 1 + s/2, theta = 6 s: curvature monotone, so the
@@ -30,6 +30,7 @@ import resource
 import time
 
 import numpy as np
+from _child import in_child
 
 
 def _data(n: int, noise: float) -> tuple[np.ndarray, float]:
@@ -93,19 +94,13 @@ def _run(tool: str, n: int, noise: float, q: mp.Queue) -> None:
 
 
 def measure(tool: str, n: int, noise: float) -> tuple:
-    ctx = mp.get_context("spawn")
-    q: mp.Queue = ctx.Queue()
-    p = ctx.Process(target=_run, args=(tool, n, noise, q))
-    p.start()
-    out = q.get()
-    p.join()
-    return out
+    return in_child(_run, tool, n, noise)  # type: ignore[no-any-return]
 
 
 def main() -> None:
     ap = argparse.ArgumentParser()
-    ap.add_argument("--sizes", type=int, nargs="+", default=[20_000, 100_000, 200_000])
-    ap.add_argument("--noise", type=float, nargs="+", default=[0.1, 3.0])
+    ap.add_argument("--sizes", type=int, nargs="+", default=[20_000, 100_000])
+    ap.add_argument("--noise", type=float, nargs="+", default=[0.1, 0.5])
     ap.add_argument("--tools", nargs="+", default=["points-l1", "poliakoff", "csaps"])
     args = ap.parse_args()
     print("| points | noise / spacing | input extrema / inflections | tool | extrema | "

@@ -21,6 +21,7 @@ import resource
 import time
 
 import numpy as np
+from _child import in_child
 
 
 def _data(n: int) -> tuple[np.ndarray, float]:
@@ -59,13 +60,7 @@ def _run(tool: str, n: int, q: mp.Queue) -> None:
 
 
 def measure(tool: str, n: int) -> tuple[float, float, float, str]:
-    ctx = mp.get_context("spawn")
-    q: mp.Queue = ctx.Queue()
-    p = ctx.Process(target=_run, args=(tool, n, q))
-    p.start()
-    out = q.get()
-    p.join()
-    return out
+    return in_child(_run, tool, n)  # type: ignore[no-any-return]
 
 
 def main() -> None:
