@@ -92,7 +92,7 @@ points of ``benchmarks/bench_points_l1.py``), far beyond any equal-parameter tol
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, cast
 
 import numpy as np
@@ -796,7 +796,6 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
     return PointsL1Result(q_out, curve, report)
 
 
-
 #: above this many points (and only when a global factor would be harsh, see
 #: ``LOCAL_SHRINK_BELOW``) the radii are shrunk near the spans whose rebuilt curve strays
 #: beyond ``tol`` instead of everywhere: with tens of thousands of points the offending spans
@@ -1013,10 +1012,11 @@ def solve(problem: FairingProblem, *, rounds: int | None = None, delta: float = 
     pair and protected points held; ``eps`` has no meaning here (one convex problem, no
     ranking loop). ``rounds`` (default 10 up to ``SELECT_MAX_POINTS`` points, else 5),
     ``select`` (formulations tried, default 3 up to ``SELECT_MAX_POINTS``, else 1), ``scale``,
-    ``delta``, ``curve_tol``, ``samples``: as in :func:`points_l1`; ``backoff``: solves in half
-    the tube when the result adds inflections or curvature extrema."""
-    import dataclasses
-
+    ``delta``, ``curve_tol``, ``samples``: as in :func:`points_l1`; ``backoff``: how many
+    times the problem is solved again in half the tube when the result adds inflections or
+    curvature extrema, on the input's parameters or (point data) on the curve rebuilt from its
+    points; if that rebuilt curve is still worse than the input after the last one, the input
+    is returned unmoved (``extra["points_l1"]["kept"] == "input"``)."""
     curve = cast(CubicHermite, problem.curve)
     tol, max_steps, clamp, protect = (problem.tol_or_none, problem.max_steps, problem.clamp,
                                       problem.protect)
@@ -1025,7 +1025,7 @@ def solve(problem: FairingProblem, *, rounds: int | None = None, delta: float = 
         # would be a straight line); the local Poliakoff loop is run instead, and said so
         from .fair import METHODS
 
-        out = METHODS["poliakoff"].run(dataclasses.replace(problem, mode="spline", options={}),
+        out = METHODS["poliakoff"].run(replace(problem, mode="spline", options={}),
                                        {})
         out.extra["points_l1"] = "no tol given: the poliakoff loop was run instead"
         return out
