@@ -13,6 +13,7 @@ import pytest
 from scipy.optimize import minimize
 
 from curvefair import BSplineCurve, InputError, interpolate_bspline, steps
+from curvefair._kernels.eck_hadenfeld import eh_loop_reference
 from curvefair.fairing.eck_hadenfeld import (
     eck_hadenfeld,
     eck_hadenfeld_fair,
@@ -136,39 +137,6 @@ def test_step_errors():
 
 
 # -- the ranking-list loop -----------------------------------------------------------------
-def slow_ranking_loop(c, l, tol, n_steps, mask, eps_rel):  # noqa: E741
-    """Reference: recompute every ranking number from scratch with numpy each step."""
-    d = np.array(c.control_points)
-    orig = d.copy()
-    G = c.gram_matrix(l).toarray()
-    eps_abs = eps_rel * np.sum(d * (G @ d))
-    idx = []
-    for _ in range(n_steps):
-        g = G @ d
-        best, best_z, best_x = -1, -1.0, None
-        for i in range(len(d)):
-            if not mask[i]:
-                continue
-            xs = d[i] - g[i] / G[i, i]
-            x = xs
-            floor = 4e-16 * (np.abs(d[i]).max() + (tol or 0.0))
-            if tol is not None:
-                v = xs - orig[i]
-                nv = np.linalg.norm(v)
-                if nv > tol:
-                    x = orig[i] + v * tol / nv
-            if np.linalg.norm(x - d[i]) <= floor or np.linalg.norm(xs - d[i]) <= floor:
-                continue  # a move below rounding is no move
-            zi = G[i, i] * (np.sum((d[i] - xs) ** 2) - np.sum((x - xs) ** 2))
-            if zi > best_z:
-                best, best_z, best_x = i, zi, x
-        if best_z <= 0 or best_z < eps_abs:
-            break
-        d[best] = best_x
-        idx.append(best)
-    return d, idx
-
-
 @pytest.mark.parametrize("closed", [False, True])
 @pytest.mark.parametrize("tol", [None, 0.05])
 def test_loop_matches_slow_reference(closed, tol):
@@ -177,7 +145,7 @@ def test_loop_matches_slow_reference(closed, tol):
     mask = movable_mask(c, ("g1", "g0"), protect=[10])
     # eps: stop before the ranking numbers reach rounding noise (~1e-15 E, where the
     # incremental and the from-scratch residuals may order near-ties differently)
-    d_ref, idx_ref = slow_ranking_loop(c, 2, tol, 400, mask, 1e-12)
+    d_ref, idx_ref = eh_loop_reference(c, 2, tol, 400, mask, 1e-12)
     res = eck_hadenfeld_fair(c, l=2, tol=tol, eps=1e-12, max_steps=400, clamp=("g1", "g0"),
                              protect=[10])
     assert len(idx_ref) > 20
@@ -322,7 +290,7 @@ def test_loop_matches_slow_reference_mixed_knots(closed, tol):
     # rows inside the longest uniform run are read from one pattern, the others from pat
     c = mixed_knot_curve(np.random.default_rng(7 + closed), 60, closed)
     mask = movable_mask(c, "g1")
-    d_ref, idx_ref = slow_ranking_loop(c, 2, tol, 600, mask, 1e-12)
+    d_ref, idx_ref = eh_loop_reference(c, 2, tol, 600, mask, 1e-12)
     res = eck_hadenfeld_fair(c, l=2, tol=tol, eps=1e-12, max_steps=600, clamp="g1")
     idx = res.history[:, 0].astype(int).tolist()
     assert len(idx_ref) > 60

@@ -10,75 +10,17 @@ with the fixed points held.
 
 from __future__ import annotations
 
-from collections import deque
-
 import numpy as np
 import pytest
 
 import curvefair as cf
 from curvefair import BSplineCurve, InputError, interpolate_bspline
+from curvefair._kernels.eck_hadenfeld import eh_drop_reference, eh_sweep_reference
 from curvefair.fairing.eck_hadenfeld import eck_hadenfeld_fair, movable_mask
 
 
 def dense_gram(c: BSplineCurve, l: int) -> np.ndarray:  # noqa: E741
     return c.gram_matrix(l).toarray()
-
-
-def exact_drop(G, d, orig, i, tol):
-    """(drop, move) of the tolerance-clamped energy minimiser over d_i, from scratch."""
-    g = G[i] @ d
-    s = -g / G[i, i]
-    x = d[i] + s
-    v = x - orig[i]
-    nv = np.linalg.norm(v)
-    if tol is not None and nv > tol:
-        x = orig[i] + v * (tol / nv)
-    e = x - d[i]
-    floor = 4e-16 * (np.abs(d[i]).max() + (tol or 0.0))
-    if np.linalg.norm(s) <= floor or np.linalg.norm(e) <= floor:
-        return 0.0, np.zeros_like(e)
-    return max(G[i, i] * (2 * e @ s - e @ e), 0.0), e
-
-
-def band(c: BSplineCurve, i: int) -> list[int]:
-    """Indices whose residual a move of d_i changes, in the order the schedule queues them."""
-    n, p = c.n_ctrl, c.degree
-    if c.closed:
-        if 2 * p + 1 >= n:
-            return list(range(n))
-        return [(i + o) % n for o in range(-p, p + 1)]
-    return [i + o for o in range(-p, p + 1) if 0 <= i + o < n]
-
-
-def slow_sweep(c, l, tol, eps_abs, mask, max_steps):  # noqa: E741
-    """The documented schedule: queue (index order) every movable point whose drop reaches the
-    threshold; pop, fair it if its drop (recomputed) still does; queue every non-queued movable
-    point of its band whose unconstrained drop |(G d)_j|^2 / G_jj reaches the threshold."""
-    G = dense_gram(c, l)
-    d = np.array(c.control_points)
-    orig = d.copy()
-
-    def reaches(z):
-        return z > 0.0 and z >= eps_abs
-
-    q = deque(i for i in range(len(d)) if mask[i] and reaches(exact_drop(G, d, orig, i, tol)[0]))
-    queued = set(q)
-    order = []
-    while q and len(order) < max_steps:
-        i = q.popleft()
-        queued.discard(i)
-        z, e = exact_drop(G, d, orig, i, tol)
-        if not reaches(z):
-            continue
-        d[i] += e
-        order.append(i)
-        for j in band(c, i):
-            if mask[j] and j not in queued:
-                g = G[j] @ d
-                if reaches(g @ g / G[j, j]):
-                    q.append(j)
-                    queued.add(j)
-    return d, order
 
 
 def random_curve(rng, n, p, dim, closed, mixed=False):
@@ -121,7 +63,7 @@ def test_sweep_matches_slow_reference(seed, n, p, dim, closed, tol, mixed):
     mask = movable_mask(c, clamp if clamp else (None, None), protect)
     res = eck_hadenfeld_fair(c, l=l, tol=tol, eps=1e-4 / n, max_steps=50 * n, clamp=clamp or
                              (None, None), protect=protect, schedule="sweep")
-    d_ref, order = slow_sweep(c, l, tol, res.eps_absolute, mask, res.steps)
+    d_ref, order = eh_sweep_reference(c, l, tol, res.eps_absolute, mask, res.steps)
     assert len(order) == res.steps > 0
     assert res.history[:, 0].astype(int).tolist() == order
     scale = max(1.0, np.abs(c.control_points).max())
@@ -144,7 +86,7 @@ def test_sweep_stops_only_below_threshold(closed, tol, l):  # noqa: E741
     d = np.asarray(res.curve.control_points)
     orig = np.asarray(c.control_points)
     mask = movable_mask(c, ("g2", "g1"), [20])
-    drops = [exact_drop(G, d, orig, i, tol)[0] for i in np.flatnonzero(mask)]
+    drops = [eh_drop_reference(G, d, orig, i, tol)[0] for i in np.flatnonzero(mask)]
     assert max(drops) < res.eps_absolute * (1 + 1e-9)
     # energy: exact bookkeeping against d^T G d of input and output
     e_in = float(np.sum(orig * (G @ orig)))

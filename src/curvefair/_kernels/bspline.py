@@ -87,6 +87,38 @@ def ders_kernel(knots, p, span, x, nder, local, out):
                   out, q)
 
 
+def basis_reference(t, p, i, x):
+    """Slow reference of :func:`ders_kernel`'s basis values: ``N_{i,p}(x)`` by recursion.
+
+    The Cox-de Boor recursion, right-continuous, for one basis function at one scalar ``x``:
+    the textbook definition, exponential in ``p`` and with no shared triangle, against which
+    the kernel's order-0 output is tested (``tests/test_bspline_curve.py``).
+
+    Parameters
+    ----------
+    t : numpy.ndarray
+        Knot vector.
+    p : int
+        Degree.
+    i : int
+        Index of the basis function.
+    x : float
+        Parameter.
+
+    Returns
+    -------
+    float
+        ``N_{i,p}(x)``.
+    """
+    if p == 0:
+        return 1.0 if t[i] <= x < t[i + 1] else 0.0
+    a = (0.0 if t[i + p] == t[i] else
+         (x - t[i]) / (t[i + p] - t[i]) * basis_reference(t, p - 1, i, x))
+    b = (0.0 if t[i + p + 1] == t[i + 1] else
+         (t[i + p + 1] - x) / (t[i + p + 1] - t[i + 1]) * basis_reference(t, p - 1, i + 1, x))
+    return a + b
+
+
 @njit(cache=True)
 def _factorials(p):
     fact = np.empty(p + 1)

@@ -12,6 +12,8 @@ rows of the Gram band (:func:`curvefair.fairing.eck_hadenfeld.band_patterns`). T
 
 from __future__ import annotations
 
+from collections import deque
+
 import numpy as np
 
 from .._jit import njit, prefetch
@@ -595,3 +597,141 @@ def setup_state(W, p, closed, d, mask, X, z):
         e = energy_row(W, p, closed, d, i, e)
         z[i] = 0.0 if mask[i] else -1.0
     return e
+
+
+# -- slow references (plain numpy, not compiled) ----------------------------------------------
+def eh_loop_reference(c, l, tol, n_steps, mask, eps_rel):  # noqa: E741
+    """Slow reference of :func:`eh_loop`: every ranking number recomputed from scratch.
+
+    Each step builds the residual ``G d`` anew from the dense Gram matrix and scans every
+    movable point for the largest tolerance-clamped energy drop, instead of the kernel's
+    incremental residuals, band patterns and tournament tree: the obvious form of the ranking
+    list the compiled loop is tested against (``tests/test_eck_hadenfeld.py``).
+
+    Parameters
+    ----------
+    c : curvefair.BSplineCurve
+        The curve (its ``control_points`` and ``gram_matrix(l)`` are read).
+    l : int
+        Order of the energy's derivative.
+    tol : float or None
+        Radius of the ball around each original control point, ``None`` for no tolerance.
+    n_steps : int
+        Largest number of steps.
+    mask : numpy.ndarray
+        ``True`` for the movable control points.
+    eps_rel : float
+        Stopping threshold relative to the initial energy.
+
+    Returns
+    -------
+    tuple of (numpy.ndarray, list of int)
+        The faired control points and the indices moved, in order.
+    """
+    d = np.array(c.control_points)
+    orig = d.copy()
+    G = c.gram_matrix(l).toarray()
+    eps_abs = eps_rel * np.sum(d * (G @ d))
+    idx = []
+    for _ in range(n_steps):
+        g = G @ d
+        best, best_z, best_x = -1, -1.0, None
+        for i in range(len(d)):
+            if not mask[i]:
+                continue
+            xs = d[i] - g[i] / G[i, i]
+            x = xs
+            floor = 4e-16 * (np.abs(d[i]).max() + (tol or 0.0))
+            if tol is not None:
+                v = xs - orig[i]
+                nv = np.linalg.norm(v)
+                if nv > tol:
+                    x = orig[i] + v * tol / nv
+            if np.linalg.norm(x - d[i]) <= floor or np.linalg.norm(xs - d[i]) <= floor:
+                continue  # a move below rounding is no move
+            zi = G[i, i] * (np.sum((d[i] - xs) ** 2) - np.sum((x - xs) ** 2))
+            if zi > best_z:
+                best, best_z, best_x = i, zi, x
+        if best_z <= 0 or best_z < eps_abs:
+            break
+        d[best] = best_x
+        idx.append(best)
+    return d, idx
+
+
+def eh_drop_reference(G, d, orig, i, tol):
+    """Slow reference of one step of :func:`eh_sweep`: ``(drop, move)`` of point ``i``.
+
+    The tolerance-clamped energy minimiser over ``d_i``, from the dense Gram matrix ``G`` and
+    the whole residual ``G[i] @ d`` computed from scratch (the kernel keeps it up to date);
+    used by :func:`eh_sweep_reference` and by ``tests/test_eh_sweep.py``'s stopping test.
+
+    Returns
+    -------
+    tuple of (float, numpy.ndarray)
+        The energy drop (0 for a move below rounding) and the move of ``d_i``.
+    """
+    g = G[i] @ d
+    s = -g / G[i, i]
+    x = d[i] + s
+    v = x - orig[i]
+    nv = np.linalg.norm(v)
+    if tol is not None and nv > tol:
+        x = orig[i] + v * (tol / nv)
+    e = x - d[i]
+    floor = 4e-16 * (np.abs(d[i]).max() + (tol or 0.0))
+    if np.linalg.norm(s) <= floor or np.linalg.norm(e) <= floor:
+        return 0.0, np.zeros_like(e)
+    return max(G[i, i] * (2 * e @ s - e @ e), 0.0), e
+
+
+def _sweep_band(c, i):
+    """Indices whose residual a move of d_i changes, in the order the schedule queues them."""
+    n, p = c.n_ctrl, c.degree
+    if c.closed:
+        if 2 * p + 1 >= n:
+            return list(range(n))
+        return [(i + o) % n for o in range(-p, p + 1)]
+    return [i + o for o in range(-p, p + 1) if 0 <= i + o < n]
+
+
+def eh_sweep_reference(c, l, tol, eps_abs, mask, max_steps):  # noqa: E741
+    """Slow reference of :func:`eh_sweep`: the documented first-in first-out schedule.
+
+    Queue (index order) every movable point whose drop reaches the threshold; pop, fair it if
+    its drop (recomputed) still does; queue every non-queued movable point of its band whose
+    unconstrained drop ``|(G d)_j|^2 / G_jj`` reaches the threshold. Dense Gram matrix and
+    every residual recomputed from scratch (no incremental updates): the obvious form the
+    compiled sweep is tested against (``tests/test_eh_sweep.py``).
+
+    Returns
+    -------
+    tuple of (numpy.ndarray, list of int)
+        The faired control points and the indices moved, in order.
+    """
+    G = c.gram_matrix(l).toarray()
+    d = np.array(c.control_points)
+    orig = d.copy()
+
+    def reaches(z):
+        return z > 0.0 and z >= eps_abs
+
+    q = deque(i for i in range(len(d))
+              if mask[i] and reaches(eh_drop_reference(G, d, orig, i, tol)[0]))
+    queued = set(q)
+    order = []
+    while q and len(order) < max_steps:
+        i = q.popleft()
+        queued.discard(i)
+        z, e = eh_drop_reference(G, d, orig, i, tol)
+        if not reaches(z):
+            continue
+        d[i] += e
+        order.append(i)
+        for j in _sweep_band(c, i):
+            if mask[j] and j not in queued:
+                g = G[j] @ d
+                if reaches(g @ g / G[j, j]):
+                    q.append(j)
+                    queued.add(j)
+    return d, order

@@ -37,7 +37,7 @@ import numpy as np
 
 from .._jit import njit
 
-__all__ = ["tt_build", "tt_update", "tt_top", "tt_value", "tt_update_range"]
+__all__ = ["tt_build", "tt_update", "tt_top", "tt_value", "tt_update_range", "tt_top_reference"]
 
 _SHIFT = 4  # 16 entries per block above _BLOCKED entries
 _BLOCKED = 1 << 16
@@ -241,3 +241,29 @@ def tt_value(tv, i):
     """Current value of entry ``i``."""
     n = int(tv[0])
     return tv[tv.shape[0] - n + i]
+
+
+def tt_top_reference(values):
+    """Slow reference of :func:`tt_top`: ``(index, value)`` of the largest of ``values``.
+
+    A plain ``numpy`` argmax over the entries' current values (first index among ties, as the
+    tree breaks them), with no tree to keep up to date: the obvious form the tournament tree is
+    tested against after random updates (``tests/test_ranking.py``).
+
+    Parameters
+    ----------
+    values : numpy.ndarray
+        The entries' values, ``-inf`` for ineligible ones.
+
+    Returns
+    -------
+    tuple of (int, float)
+        Index and value of the largest entry (``(-1, -inf)`` if there is none).
+    """
+    finite = np.isfinite(values) | (values > 0)
+    if not finite.any() or np.all(values == -np.inf):
+        if not values.size:
+            return -1, -np.inf
+        return int(np.argmax(values)), float(values.max())
+    m = values.max()
+    return int(np.flatnonzero(values == m)[0]), float(m)
