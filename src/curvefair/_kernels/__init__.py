@@ -23,8 +23,33 @@ the kernels and read their results live in the public packages (:mod:`curvefair.
 
 Every kernel is decorated with :func:`curvefair._jit.njit`, and no module outside this package
 defines one (``tests/test_numba_layering.py`` checks it). A slow reference that a kernel is
-tested against (plain numpy or Python) lives beside it, named ``*_reference``
-(:func:`.deviation.matched_hermite_bound_reference`, :func:`.corners.chord_turns_reference`).
+tested against (plain numpy or Python, never compiled) lives beside it, named ``*_reference``;
+the other kernels are checked by independent computations in their tests:
+
+* :mod:`.bspline` -- :func:`.bspline.basis_reference` (Cox-de Boor recursion, for
+  ``ders_kernel``'s values); the rest against scipy's ``BSpline``, finite differences and
+  Gram matrices by dense quadrature;
+* :mod:`.cheng_yu` -- no reference: a step against an independent minimisation of ``E_2``
+  (quadrature, scipy.optimize), the loop by dense sampling and a replay with the public step;
+* :mod:`.corners` -- :func:`.corners.chord_turns_reference`;
+* :mod:`.deviation` -- :func:`.deviation.matched_hermite_bound_reference`; the search against
+  brute-force dense sampling;
+* :mod:`.eck_hadenfeld` -- :func:`.eck_hadenfeld.eh_loop_reference` (ranking list) and
+  :func:`.eck_hadenfeld.eh_sweep_reference` with :func:`.eck_hadenfeld.eh_drop_reference`
+  (sweep), all from the dense Gram matrix recomputed from scratch;
+* :mod:`.global_fair` -- no reference: KKT conditions, a dense direct solve, scipy's SLSQP;
+* :mod:`.hermite` -- no reference: scipy's Hermite and interpolating splines, quadrature,
+  finite differences, a replay of the loop's history with the public steps;
+* :mod:`.joins` -- the numpy formula it replaced, kept in ``tests/test_joins_straight.py``
+  (it reads the driver's ``curvefair.fairing.joins`` constant and the curve's index helpers);
+* :mod:`.knot_removal` -- the old Python loop ``reference_knot_removal_fair``, kept in
+  ``tests/test_knot_removal_compiled.py`` (it is built on the public package's step, checks and
+  helpers, which this package may not import);
+* :mod:`.points` -- no reference: scipy's ``CubicSpline``, scipy.optimize, KKT conditions;
+* :mod:`.ranking` -- :func:`.ranking.tt_top_reference` (argmax over the values);
+* :mod:`.sampling` -- no reference: scipy evaluation and quadrature, brute-force dense
+  sampling, closed forms on curves of known shape.
+
 The package is private, but its public names (no leading underscore) may be imported by every
 other curvefair package (``tests/test_layering.py`` treats it as a shared internal, like
 ``curvefair._typing``). The package itself imports nothing, so that importing one kernel module
