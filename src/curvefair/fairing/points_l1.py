@@ -755,13 +755,12 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
             # (:func:`_rebuilt_distance`: an O(n) bound, sampled where it is not sharp; the
             # geometric distance of :func:`curvefair.deviation` takes seconds at 10,000 points)
             rebuilt: Any = spline(np.array(q_out), "chord")
-            curve_dev = _rebuilt_distance(ref, rebuilt, tol_out)
+            per = matched_hermite_bound(ref, rebuilt)
+            curve_dev = _rebuilt_distance(ref, rebuilt, tol_out, per=per)
             if curve_dev > tol_out:
                 g = 0.98 * tol_out / curve_dev
-                per = matched_hermite_bound(ref, rebuilt) if (
-                    N > LOCAL_SHRINK_MIN_POINTS and (went_local or g < LOCAL_SHRINK_BELOW)) \
-                    else None
-                if per is not None and np.any(per > tol_out):
+                if (N > LOCAL_SHRINK_MIN_POINTS and (went_local or g < LOCAL_SHRINK_BELOW)
+                        and np.any(per > tol_out)):
                     went_local = True
                     local = _local_factors(per, tol_out, closed)
                 else:
@@ -826,10 +825,11 @@ def _local_factors(per: FloatArray, tol: float, closed: bool
     gets the smallest factor ``LOCAL_SHRINK_FACTOR * 0.98 tol / per_s`` of the spans ``s``
     within ``LOCAL_SHRINK_REACH`` spans of it whose bound exceeds ``tol``, 1 where there is
     none (point ``i`` ends spans ``i - 1`` and ``i``)."""
+    from scipy.ndimage import minimum_filter1d
+
     f = np.where(per > tol, LOCAL_SHRINK_FACTOR * 0.98 * tol / np.maximum(per, 1e-300), 1.0)
-    ns, r = f.shape[0], LOCAL_SHRINK_REACH
-    pad = np.r_[f[-r:], f, f[:r]] if closed and ns >= r else np.r_[np.ones(r), f, np.ones(r)]
-    sf = np.min(np.stack([pad[k:k + ns] for k in range(2 * r + 1)]), axis=0)
+    sf = minimum_filter1d(f, 2 * LOCAL_SHRINK_REACH + 1, mode="wrap" if closed else "constant",
+                          cval=1.0)
     if closed:
         pf = np.minimum(sf, np.roll(sf, 1))
     else:
@@ -860,7 +860,8 @@ def _polyline_distance(x: FloatArray, poly: FloatArray,
     return best
 
 
-def _rebuilt_distance(a: CubicHermite, b: CubicHermite, tol: float, dense: int = 32) -> float:
+def _rebuilt_distance(a: CubicHermite, b: CubicHermite, tol: float, dense: int = 32,
+                      per: FloatArray | None = None) -> float:
     """The Hausdorff distance of ``a`` and ``b`` (same number of points), as far as it matters
     against ``tol``: the per-span upper bound
     :func:`curvefair.analysis.matched_hermite_bound` where it is within
@@ -870,7 +871,7 @@ def _rebuilt_distance(a: CubicHermite, b: CubicHermite, tol: float, dense: int =
     ``4 max(bound)`` (chord length along ``a``'s points) of a refined span: the matched point
     is within the bound, so the nearest point is within twice of it; a nearest point left out
     could only make the figure larger, never smaller than the true distance."""
-    per = matched_hermite_bound(a, b)
+    per = matched_hermite_bound(a, b) if per is None else per  # the caller's, if it has it
     bad = np.flatnonzero(per > tol)
     if bad.size == 0:
         return float(per.max()) if per.size else 0.0
@@ -1082,12 +1083,16 @@ def solve(problem: FairingProblem, *, rounds: int | None = None, delta: float = 
     total = int(res.report["newton_steps"])
     from .fair import _analysis_block
 
+    seen: dict[int, tuple[PointsL1Result, dict[str, Any]]] = {}
+
     def rebuilt(r: PointsL1Result) -> dict[str, Any]:
         """Analysis of the curve a reader rebuilds from the result's points (chord-length
-        natural or periodic cubic)."""
-        return _analysis_block(interpolate_cubic(
-            np.vstack([r.points, r.points[:1]]) if closed else np.array(r.points),
-            "chord", "periodic" if closed else "natural"))
+        natural or periodic cubic), made once per result."""
+        if id(r) not in seen:
+            seen[id(r)] = (r, _analysis_block(interpolate_cubic(
+                np.vstack([r.points, r.points[:1]]) if closed else np.array(r.points),
+                "chord", "periodic" if closed else "natural")))
+        return seen[id(r)][1]
 
     if len(variants) > 1:
         # the formulation whose written points rebuild into the curve with the fewest

@@ -68,13 +68,13 @@ HistoryIndex = Literal["data point", "control point", "knot"]
 CLAMP_POINTS = {"none": 0, "g0": 1, "g1": 2, "g2": 3}
 
 
-
 def check_bspline(curve: object, name: str = "curve") -> BSplineCurve:
     """``curve`` if it is a :class:`~curvefair.BSplineCurve` (the B-spline methods' argument
     check), else an :class:`~curvefair.InputError` naming ``name``."""
     if not isinstance(curve, BSplineCurve):
         raise InputError(f"{name} must be a BSplineCurve, got {type(curve).__name__}")
     return curve
+
 
 def _finite_or_none(v: Any) -> Any:
     if isinstance(v, float) and not math.isfinite(v):
