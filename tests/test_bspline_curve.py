@@ -7,6 +7,8 @@ derivatives for the Gram matrices, interpolate_cubic for the natural cubic inter
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from scipy.interpolate import BSpline
@@ -43,6 +45,36 @@ def test_evaluation_matches_scipy(p, closed):
         ref = spl(u, nu)
         scale = np.abs(ref).max()
         np.testing.assert_allclose(c(u, nu), ref, rtol=0, atol=1e-10 * scale)
+
+
+@pytest.mark.parametrize("closed", [False, True])
+@pytest.mark.parametrize("dim", [2, 3])
+def test_cubic_power_form_copy_is_the_general_loop(closed, dim):
+    # power_form_kernel and power_form_pair_kernel run a copy compiled for degree 3; it must
+    # give bitwise what the general loop gives: that loop run by the interpreter (py_func:
+    # no degree known at compile time, the same float64 operations in the same order)
+    from curvefair._kernels import bspline as kb
+
+    rng = np.random.default_rng(40 + 2 * dim + closed)
+    c = _random_closed(rng, 23, 3, dim) if closed else _random_open(rng, 23, 3, dim)
+    t = np.ascontiguousarray(c.knots)
+    s = np.ascontiguousarray(c.spans, dtype=np.int64)
+    ctrl = np.ascontiguousarray(c.control_points)
+    base = ctrl + 1e-3 * rng.normal(size=ctrl.shape)
+    shape = (s.size, 4, dim)
+    got, got2, gotd = np.empty(shape), np.empty(shape), np.empty(shape)
+    kb.power_form_kernel(t, 3, s, ctrl, closed, got)
+    kb.power_form_pair_kernel(t, 3, s, ctrl, base, closed, got2, gotd)
+    ref, refd = np.empty(shape), np.empty(shape)
+    kb._power_form_body.py_func(t, 3, s, ctrl, base, closed, ref, refd, True)
+    assert np.array_equal(got, ref) and np.array_equal(got2, ref)
+    assert np.array_equal(gotd, refd)
+    # and it is the curve's derivatives at the span starts (scipy's de Boor evaluation)
+    spl = c.to_scipy()
+    for k in range(4):
+        want = spl(t[s], k) / math.factorial(k)
+        np.testing.assert_allclose(got[:, k], want, rtol=0,
+                                   atol=1e-11 * max(np.abs(want).max(), 1.0))
 
 
 def test_basis_matches_naive_recursion():

@@ -30,7 +30,7 @@ from .._jit import njit
 # ------------------------------------------------------------------------------------------
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _ders_one(knots, p, s, u, base, nder, ndu, left, right, a, out, q):
     """Basis derivatives at one parameter into ``out[q]`` (Piegl & Tiller A2.3); work arrays
     ``ndu`` (p+1, p+1), ``left``/``right`` (p+1,), ``a`` (2, p+1)."""
@@ -128,7 +128,7 @@ def _factorials(p):
     return fact
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _span_basis(knots, p, s, prev, have, ndu, left, right, a, d):
     """Basis derivatives of span ``s`` into ``d[0]`` (local offsets), unless its local knot
     pattern equals the previous span's (kept in ``prev``): then ``d`` already holds bitwise the
@@ -144,41 +144,13 @@ def _span_basis(knots, p, s, prev, have, ndu, left, right, a, d):
     return True
 
 
-@njit(cache=True)
-def power_form_kernel(knots, p, spans, ctrl, closed, out):
-    """``out[m, k, :] = sum_a N_{s-p+a}^(k)(t_s) d_{s-p+a} / k!`` for ``s = spans[m]`` (control
-    indices mod ``n`` for a closed curve): the piecewise power form of the B-spline. A span
-    whose local knot pattern equals the previous span's reuses its basis derivatives."""
-    n = ctrl.shape[0]
-    dim = ctrl.shape[1]
-    ndu = np.empty((p + 1, p + 1))
-    left = np.empty(p + 1)
-    right = np.empty(p + 1)
-    a = np.empty((2, p + 1))
-    d = np.empty((1, p + 1, p + 1))
-    fact = _factorials(p)
-    prev = np.empty(2 * p)
-    have = np.bool_(False)
-    for m in range(spans.shape[0]):
-        s = spans[m]
-        have = _span_basis(knots, p, s, prev, have, ndu, left, right, a, d)
-        for k in range(p + 1):
-            for e in range(dim):
-                acc = 0.0
-                for b in range(p + 1):
-                    i = s - p + b
-                    if closed:
-                        i = i % n
-                    acc += d[0, k, b] * ctrl[i, e]
-                out[m, k, e] = acc / fact[k]
-
-
-@njit(cache=True)
-def power_form_pair_kernel(knots, p, spans, ctrl, base, closed, out, out_diff):
-    """:func:`power_form_kernel` of ``ctrl`` into ``out`` and of ``ctrl - base`` into
-    ``out_diff`` in one pass: the basis derivatives of each span (most of the work) are
-    computed once for both. The same operations in the same order as two calls of
-    :func:`power_form_kernel` (the second on the array ``ctrl - base``): bitwise the same."""
+@njit(cache=True, inline="always")
+def _power_form_body(knots, p, spans, ctrl, base, closed, out, out_diff, pair):
+    """The loop of :func:`power_form_kernel` (``pair`` False; ``base`` and ``out_diff`` unused)
+    and of :func:`power_form_pair_kernel` (``pair`` True). Inlined into both with ``p`` and
+    ``pair`` as they are passed, so a call with a constant degree is compiled for that degree
+    (its loops unrolled, the work arrays in registers) and performs the same operations in
+    the same order as the general one: bitwise the same results."""
     n = ctrl.shape[0]
     dim = ctrl.shape[1]
     ndu = np.empty((p + 1, p + 1))
@@ -201,9 +173,36 @@ def power_form_pair_kernel(knots, p, spans, ctrl, base, closed, out, out_diff):
                     if closed:
                         i = i % n
                     acc += d[0, k, b] * ctrl[i, e]
-                    acc2 += d[0, k, b] * (ctrl[i, e] - base[i, e])
+                    if pair:
+                        acc2 += d[0, k, b] * (ctrl[i, e] - base[i, e])
                 out[m, k, e] = acc / fact[k]
-                out_diff[m, k, e] = acc2 / fact[k]
+                if pair:
+                    out_diff[m, k, e] = acc2 / fact[k]
+
+
+@njit(cache=True)
+def power_form_kernel(knots, p, spans, ctrl, closed, out):
+    """``out[m, k, :] = sum_a N_{s-p+a}^(k)(t_s) d_{s-p+a} / k!`` for ``s = spans[m]`` (control
+    indices mod ``n`` for a closed curve): the piecewise power form of the B-spline. A span
+    whose local knot pattern equals the previous span's reuses its basis derivatives. Cubics
+    (most B-splines) run a copy compiled for degree 3: the same operations, about three times
+    faster than the general loop, whose trip counts are only known at run time."""
+    if p == 3:
+        _power_form_body(knots, 3, spans, ctrl, ctrl, closed, out, out, False)
+    else:
+        _power_form_body(knots, p, spans, ctrl, ctrl, closed, out, out, False)
+
+
+@njit(cache=True)
+def power_form_pair_kernel(knots, p, spans, ctrl, base, closed, out, out_diff):
+    """:func:`power_form_kernel` of ``ctrl`` into ``out`` and of ``ctrl - base`` into
+    ``out_diff`` in one pass: the basis derivatives of each span (most of the work) are
+    computed once for both. The same operations in the same order as two calls of
+    :func:`power_form_kernel` (the second on the array ``ctrl - base``): bitwise the same."""
+    if p == 3:
+        _power_form_body(knots, 3, spans, ctrl, base, closed, out, out_diff, True)
+    else:
+        _power_form_body(knots, p, spans, ctrl, base, closed, out, out_diff, True)
 
 
 @njit(cache=True)
