@@ -50,7 +50,7 @@ def run(prep: tuple, steps: int) -> tuple[float, int]:
     hist = np.zeros(steps + 1)
     moves = np.zeros((steps, 4))
     t0 = time.perf_counter()
-    done, _ = cy_loop(Qw, Q, W, lw, mw, False, True, mask, tol, 0.0, steps, True, hist, moves)
+    done = cy_loop(Qw, Q, W, lw, mw, False, True, mask, tol, 0.0, steps, True, hist, moves)[0]
     return time.perf_counter() - t0, int(done)
 
 

@@ -240,3 +240,22 @@ def test_registered_and_runs_through_fair():
     np.testing.assert_array_equal(res.curve.control_points, direct.curve.control_points)
     closed = fair(noisy_closed(12), "cheng-yu", tol=0.02)  # clamp ignored on closed curves
     assert closed.report["steps"] > 0
+
+
+@pytest.mark.parametrize("closed", [False, True])
+def test_history_buffers_grow_with_the_steps(monkeypatch, closed):
+    # the step history starts small and doubles when full (allocated up front for the cap of
+    # 100 n steps, 1e7 control points asked for 30 GB); a run that outgrows it many times is
+    # the run with one buffer of the full size, step for step
+    from curvefair.fairing import cheng_yu as cy
+
+    c0 = noisy_closed(4) if closed else noisy_open(4, n=60)
+    monkeypatch.setattr(cy, "HISTORY_START", 10**9)
+    whole = cheng_yu_driver(c0, tol=0.05, eps=0.0)
+    monkeypatch.setattr(cy, "HISTORY_START", 1)
+    grown = cheng_yu_driver(c0, tol=0.05, eps=0.0)
+    assert whole.steps > 8  # the small run's buffers doubled at least three times
+    assert grown.steps == whole.steps and grown.stop_reason == whole.stop_reason
+    assert np.array_equal(grown.curve.control_points, whole.curve.control_points)
+    for key in whole.history:
+        assert np.array_equal(grown.history[key], whole.history[key], equal_nan=True), key

@@ -358,8 +358,12 @@ def _try_step(Q, Q0, W, lw, mw, K, t, D, n, closed, planar, m0, pair, e, min_dro
 def cy_loop(Q, Q0, W, lw, mw, closed, planar, movable, e, eps, max_steps,
             allow_pair, hist, moves):
     """The ranking loop. ``hist[k]`` = x after ``k`` accepted steps; ``moves[k]`` = (first moved
-    index, 1 or 2 points, ``z`` of the top bad point, largest displacement). Returns
-    ``(steps, reason)``."""
+    index, 1 or 2 points, ``z`` of the top bad point, largest displacement). ``hist`` (at least
+    one row) and ``moves`` are the first buffers: when a step finds them full they are
+    replaced by copies of twice the length (at most what ``max_steps`` needs), so memory
+    follows the steps taken, not the cap (``100 n`` by default: 30 GB of buffers at 1e7 control
+    points if allocated up front). Returns ``(steps, reason, hist, moves)``, the last two the
+    buffers in use."""
     n = Q.shape[0]
     K = np.zeros(n)
     t = np.full(n, 0.5)
@@ -424,6 +428,16 @@ def cy_loop(Q, Q0, W, lw, mw, closed, planar, movable, e, eps, max_steps,
             continue
         steps += 1
         x += dx
+        if steps >= hist.shape[0] or steps > moves.shape[0]:
+            cap = 2 * hist.shape[0]
+            if cap > max_steps + 1:
+                cap = max_steps + 1
+            h2 = np.zeros(cap)
+            h2[:steps] = hist[:steps]
+            m2 = np.zeros((cap - 1, 4))
+            m2[:steps - 1] = moves[:steps - 1]
+            hist = h2
+            moves = m2
         hist[steps] = x
         moves[steps - 1, 0] = first
         moves[steps - 1, 1] = 2 if pair else 1
@@ -444,4 +458,4 @@ def cy_loop(Q, Q0, W, lw, mw, closed, planar, movable, e, eps, max_steps,
         for j in _index_range(first - 4, last + 4, n, closed):
             flags[j] = _flags_at(K, t, j, n, closed)
             tt_update(tv, ti, j, _priority(D, flags, movable, frozen, j))
-    return steps, reason
+    return steps, reason, hist, moves

@@ -291,6 +291,10 @@ def cheng_yu_driver(curve: Any, *, tol: float | None = None, eps: float = 1e-8,
     return _solve(prob, pair=pair, relative=relative)
 
 
+#: first length of the step history buffers; they grow with the steps taken
+HISTORY_START = 4096
+
+
 def _solve(problem: FairingProblem, *, pair: bool, relative: bool) -> CYResult:
     from .problem import eps_threshold
 
@@ -317,11 +321,13 @@ def _solve(problem: FairingProblem, *, pair: bool, relative: bool) -> CYResult:
         _, eps_abs = eps_threshold(problem.eps, x0, 1e-8)
     else:
         eps_abs = 0.0 if problem.eps is None else problem.eps
-    hist = np.zeros(int(max_steps) + 1)
-    moves = np.zeros((int(max_steps), 4))
+    # the history buffers grow with the steps taken (the kernel doubles them when full)
+    cap = min(int(max_steps), HISTORY_START)
+    hist = np.zeros(cap + 1)
+    moves = np.zeros((cap, 4))
     planar = Q.shape[1] == 2
-    steps, code = _k.cy_loop(Q, Q0, W, lw, mw, closed, planar, mask, e, eps_abs, int(max_steps),
-                             bool(pair), hist, moves)
+    steps, code, hist, moves = _k.cy_loop(Q, Q0, W, lw, mw, closed, planar, mask, e, eps_abs,
+                                          int(max_steps), bool(pair), hist, moves)
     steps = int(steps)
     out = curve.replace(control_points=Q)
     x1 = second_discrete_curvature(out).indicator
