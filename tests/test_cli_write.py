@@ -148,9 +148,12 @@ def test_temp_files_removed_when_killed_mid_write(tmp_path: Path, ex1: Path, sig
         pytest.skip(f"no {signame} here")
     sig = getattr(signal, signame)
     before = ex1.read_bytes()
+    # the child starts with the signal's default action: under nohup (SIGHUP ignored, as the
+    # test run may be) the command rightly keeps ignoring it and would not be killed
     p = subprocess.Popen([sys.executable, "-c", _SLOW_WRITE, "fair", "ex1.csv", "-o", "out.csv",
                           "--tol", "0.5", "-q"], cwd=tmp_path, stdout=subprocess.PIPE,
-                         stderr=subprocess.PIPE, text=True, env=_env())
+                         stderr=subprocess.PIPE, text=True, env=_env(),
+                         preexec_fn=lambda: signal.signal(sig, signal.SIG_DFL))
     try:
         line = p.stdout.readline()  # type: ignore[union-attr]
         assert line.strip() == "WRITING", (line, p.stderr.read())  # type: ignore[union-attr]
