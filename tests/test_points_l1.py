@@ -443,3 +443,96 @@ def test_point_data_whose_every_tube_rebuilds_worse_keep_the_input() -> None:
     assert rep["kept"] == "input" and "kept" in rep["reason"] and rep["backoff"] == 4
     assert res.report["n_moved"] == 0
     np.testing.assert_array_equal(np.asarray(res.curve.points), pts)
+
+
+def _counts_of(curve) -> tuple[int, int]:
+    a = analyze(curve)
+    return a.extrema, a.inflections
+
+
+def _rebuilt_counts(points: np.ndarray) -> tuple[int, int]:
+    # what a reader of the written file gets: scipy's natural cubic at the chord lengths of
+    # the points (independent of curvefair's interpolation), as a curvefair curve for the counts
+    from curvefair import CubicHermite
+
+    q = np.asarray(points)
+    u = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(q, axis=0), axis=1))]
+    s = CubicSpline(u, q, bc_type="natural")
+    return _counts_of(CubicHermite(q, s(u, 1), u))
+
+
+def test_fair_guard_judges_the_curve_rebuilt_from_the_points_of_any_method() -> None:
+    # fair()'s never-worse guard, for every method on point data: a result whose points
+    # rebuild (chord-length natural cubic, what a reader of the written file gets) into more
+    # curvature extrema or inflections than the input is worse, even when the curve on the
+    # input's parameters is not. points-l1 without its own back-off gives such a result on
+    # the 3,000 spiral points above; the guard keeps a fraction of the move (or the input)
+    # whose rebuilt curve adds neither
+    pts, tol = _noisy_spiral(3000, 3000)
+    c = interpolate_cubic(pts, "chord", "natural")
+    e0, i0 = _counts_of(c)
+    raw = fair(c, "points-l1", tol=tol, backoff=0, guard=False)
+    er, ir = _counts_of(raw.curve)
+    eb, ib = _rebuilt_counts(raw.curve.points)
+    assert er <= e0 and ir <= i0 and (eb > e0 or ib > i0)  # the case: rebuilt worse only
+    res = fair(c, "points-l1", tol=tol, backoff=0)
+    g = res.report["guard"]
+    assert g["kept"] in ("partial", "input") and "rebuilt" in g["reason"]
+    assert g["method_result"]["rebuilt"] == {"extrema": eb, "inflections": ib}
+    e1, i1 = _rebuilt_counts(res.curve.points)
+    assert e1 <= e0 and i1 <= i0
+    assert g["rebuilt"] == {"extrema": e1, "inflections": i1}
+    ea, ia = _counts_of(res.curve)
+    assert ea <= e0 and ia <= i0
+    q = np.asarray(res.curve.points)
+    assert np.all(np.sqrt(np.sum((q - pts) ** 2, axis=1)) <= tol)
+    if g["kept"] == "partial":  # the move blended: q = p + lam (q_raw - p) up to rounding
+        lam = g["fraction"]
+        np.testing.assert_allclose(q, pts + lam * (np.asarray(raw.curve.points) - pts),
+                                   rtol=0, atol=1e-12)
+
+
+def test_fair_guard_leaves_a_result_alone_whose_rebuilt_curve_is_not_worse() -> None:
+    pts, tol = _noisy_spiral(3000, 3000)
+    c = interpolate_cubic(pts, "chord", "natural")
+    res = fair(c, "points-l1", tol=tol)  # with its own back-off
+    off = fair(c, "points-l1", tol=tol, guard=False)
+    assert res.report["guard"]["kept"] == "output"
+    np.testing.assert_array_equal(np.asarray(res.curve.points), np.asarray(off.curve.points))
+    e0, i0 = _counts_of(c)
+    eb, ib = _rebuilt_counts(res.curve.points)
+    assert res.report["guard"]["rebuilt"] == {"extrema": eb, "inflections": ib}
+    assert eb <= e0 and ib <= i0
+    # a B-spline or a non-point Hermite curve: no rebuilt curve is judged
+    from curvefair import interpolate_bspline
+
+    b = fair(interpolate_bspline(pts[:200]), tol=tol)
+    assert "rebuilt" not in b.report["guard"]
+
+
+def test_cli_writes_a_point_file_whose_rebuilt_curve_is_not_worse(tmp_path) -> None:
+    # the whole command on a CSV, the method's own back-off off: the file read back (by
+    # curvefair and by a plain chord-length spline through its numbers) is not worse than the
+    # input and within tol of it, point by point
+    from click.testing import CliRunner
+
+    from curvefair import read_curves
+    from curvefair.cli import main
+
+    pts, tol = _noisy_spiral(3000, 3000)
+    src = tmp_path / "in.csv"
+    np.savetxt(src, pts, delimiter=",", header="x,y", comments="", fmt="%.17g")
+    out = tmp_path / "out.csv"
+    r = CliRunner().invoke(main, ["fair", str(src), "-o", str(out), "--tol", repr(tol),
+                                  "--method", "points-l1", "-O", "backoff=0",
+                                  "--corner-angle", "180"])
+    assert r.exit_code == 0, r.output
+    assert "rebuilt" in r.output  # the guard said what it kept and why
+    q = np.loadtxt(out, delimiter=",", skiprows=1)
+    assert q.shape == pts.shape
+    assert np.all(np.sqrt(np.sum((q - pts) ** 2, axis=1)) <= tol)
+    e0, i0 = _counts_of(interpolate_cubic(pts, "chord", "natural"))
+    eb, ib = _rebuilt_counts(q)
+    assert eb <= e0 and ib <= i0
+    back = read_curves(out, corner_angle=None)
+    assert len(back) == 1 and _counts_of(back[0].curve) == (eb, ib)

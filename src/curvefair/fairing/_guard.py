@@ -9,6 +9,15 @@ same way and stays within ``lam`` times the method's deviation: inside the toler
 fixed point, clamp and held join unchanged (each is the same in both curves, and the
 derivatives at an end are linear in the data) -- and keeps the largest that is not worse; if
 none is, the input itself. The report says which and why.
+
+Point data. A point file (CSV, airfoil ``.dat``, polyline) is read as the chord-length natural
+(closed: periodic) cubic through its points, and what a reader of the written file gets back is
+that cubic through the *moved* points, at their own chord lengths -- not the curve a Hermite
+method returns on the input's parameters (the tangents it holds or moves are not written). When
+the input is such an interpolant (:func:`is_chord_interpolant`) and the result a cubic Hermite
+curve on the same parameters, the guard also judges the rebuilt curve
+(:func:`rebuilt_curve`): a result whose rebuilt curve adds inflections or curvature extrema is
+worse, and a fraction of the move is kept only if neither curve adds any.
 """
 
 from __future__ import annotations
@@ -23,6 +32,58 @@ from ..curves.hermite import CubicHermite, HermiteSpline, QuinticHermite
 from ..curves.piecewise import PiecewiseCurve
 
 FRACTIONS = (0.5, 0.25, 0.125)
+
+
+def is_chord_interpolant(curve: PiecewiseCurve) -> bool:
+    """Whether ``curve`` is the chord-length natural (closed: periodic) cubic through its points
+    -- what a point file is read as -- up to an affine change of parameter: only then is the
+    curve rebuilt from written points the same kind of curve as the input."""
+    from ..curves.interpolate import interpolate_cubic
+    from ..errors import InputError
+
+    if type(curve) is not CubicHermite:
+        return False
+    try:
+        ref = interpolate_cubic(curve.points, "chord",
+                                "periodic" if curve.closed else "natural")
+    except InputError:
+        return False
+    t, r = np.asarray(curve.params), np.asarray(ref.params)
+    st, sr = t[-1] - t[0], r[-1] - r[0]
+    if not (st > 0 and sr > 0):
+        return False
+    if not np.allclose((t - t[0]) / st, (r - r[0]) / sr, rtol=0.0, atol=1e-9):
+        return False
+    d, dr = np.asarray(curve.tangents) * st, np.asarray(ref.tangents) * sr
+    scale = max(float(np.max(np.abs(dr))), 1e-300)
+    return bool(np.max(np.abs(d - dr)) <= 1e-7 * scale)
+
+
+def rebuilt_curve(curve: CubicHermite) -> CubicHermite | None:
+    """The curve a reader rebuilds from ``curve``'s points: the chord-length natural (closed:
+    periodic) cubic through them; None if they do not make one (coincident points)."""
+    from ..curves.interpolate import interpolate_cubic
+    from ..errors import InputError
+
+    try:
+        return interpolate_cubic(np.array(curve.points), "chord",
+                                 "periodic" if curve.closed else "natural")
+    except InputError:
+        return None
+
+
+def _counts(a: dict[str, Any]) -> dict[str, int]:
+    return {"inflections": int(a["inflections"]), "extrema": int(a["extrema"])}
+
+
+def _adds(a: dict[str, Any], before: dict[str, Any]) -> list[str]:
+    """What ``a`` has more of than ``before`` (empty: not worse)."""
+    out = []
+    if a["inflections"] > before["inflections"]:
+        out.append(f"inflections {before['inflections']} -> {a['inflections']}")
+    if a["extrema"] > before["extrema"]:
+        out.append(f"curvature extrema {before['extrema']} -> {a['extrema']}")
+    return out
 
 
 def blend(a: PiecewiseCurve, b: PiecewiseCurve, lam: float) -> PiecewiseCurve | None:
@@ -54,31 +115,47 @@ def blend(a: PiecewiseCurve, b: PiecewiseCurve, lam: float) -> PiecewiseCurve | 
 
 def never_worse(curve: PiecewiseCurve, new: PiecewiseCurve, before: dict[str, Any],
                 after: dict[str, Any], jp: Any, work_out: PiecewiseCurve,
-                analysis: Callable[[PiecewiseCurve], dict[str, Any]]
+                analysis: Callable[[PiecewiseCurve], dict[str, Any]],
+                rebuilt: Callable[[PiecewiseCurve], dict[str, Any] | None] | None = None,
+                rebuilt_after: dict[str, Any] | None = None
                 ) -> tuple[PiecewiseCurve, dict[str, Any], dict[str, Any]]:
     """The guarded result ``(curve, its analysis block, report entry)`` (module docstring).
 
     ``jp`` is the :class:`~curvefair.fairing.joins.JoinPlan`: blending happens on the curve
     the method faired (``jp.curve`` and ``work_out``), then :meth:`JoinPlan.restore`.
+    ``rebuilt`` (point data): the analysis block of the curve rebuilt from a candidate's points
+    (None: it cannot be rebuilt, which counts as worse); ``rebuilt_after`` that of ``new``.
+    ``before`` is the input's, which is its own rebuilt curve.
     """
-    worse = []
-    if after["inflections"] > before["inflections"]:
-        worse.append(f"inflections {before['inflections']} -> {after['inflections']}")
-    if after["extrema"] > before["extrema"]:
-        worse.append(f"curvature extrema {before['extrema']} -> {after['extrema']}")
-    why = "the method's result has more " + " and ".join(worse)
-    info: dict[str, Any] = {"method_result": {"inflections": after["inflections"],
-                                              "extrema": after["extrema"]}}
+    worse = _adds(after, before)
+    why = "the method's result has more " + " and ".join(worse) if worse else ""
+    info: dict[str, Any] = {"method_result": _counts(after)}
+    if rebuilt is not None:
+        rb = rebuilt_after if rebuilt_after is not None else rebuilt(new)
+        info["method_result"]["rebuilt"] = None if rb is None else _counts(rb)
+        rworse = ["its points make no curve"] if rb is None else _adds(rb, before)
+        if rworse:
+            why += ("; " if why else "") + ("the curve rebuilt from the result's points (what "
+                                             "a reader of the written file gets) has more "
+                                             + " and ".join(rworse))
     for lam in FRACTIONS:
         b = blend(jp.curve, work_out, lam)
         if b is None:
             break
         cand = jp.restore(b)
         a = analysis(cand)
-        if a["inflections"] <= before["inflections"] and a["extrema"] <= before["extrema"]:
-            info.update(kept="partial", fraction=lam,
-                        reason=f"{why}; kept {lam:g} of the move, which adds neither")
-            return cand, a, info
+        if _adds(a, before):
+            continue
+        if rebuilt is not None:
+            rc = rebuilt(cand)
+            if rc is None or _adds(rc, before):
+                continue
+            info["rebuilt"] = _counts(rc)
+        info.update(kept="partial", fraction=lam,
+                    reason=f"{why}; kept {lam:g} of the move, which adds neither")
+        return cand, a, info
+    if rebuilt is not None:
+        info["rebuilt"] = _counts(before)
     info.update(kept="input", fraction=0.0,
                 reason=f"{why}; kept the input (no fraction of the move tried was not worse)")
     return curve, before, info

@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any, cast
 import numpy as np
 
 from .._typing import FloatArray
+from ..curves.hermite import CubicHermite
 from ..curves.piecewise import PiecewiseCurve, readonly
 from ..errors import InputError
 from ..interop import as_curve as _as_curve
@@ -476,7 +477,12 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
         Default True: if the faired curve has more inflections or curvature extrema than the
         input (curvefair's own counts, :func:`curvefair.analyze`), the largest fraction of the
         move (1/2, 1/4, 1/8) that does not is returned instead, or else the input itself;
-        ``report["guard"]`` says what was kept and why. False: the method's result as it is.
+        ``report["guard"]`` says what was kept and why. Point data (the input is the
+        chord-length natural or periodic cubic through its points, as a point file is read,
+        and the result a cubic Hermite curve on its parameters): the curve a reader rebuilds
+        from the result's points (the same interpolant at their own chord lengths) is judged
+        too, its counts in ``report["guard"]["rebuilt"]``. False: the method's result as it
+        is.
     structure : {"keep", "free"}
         B-splines: ``"keep"`` (default) keeps the degree, knot vector and number of control
         points; ``"free"`` accepts fewer knots (:mod:`curvefair.fairing.structure`: the fewest
@@ -627,12 +633,32 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
     primed = prime_power_forms(curve, new)
     after = analysis_block(new)
     guard_info: dict[str, Any] = {"kept": "output"}
-    if guard and (after["inflections"] > before["inflections"]
-                  or after["extrema"] > before["extrema"]):
+    worse = after["inflections"] > before["inflections"] or after["extrema"] > before["extrema"]
+    rebuilt = rb_after = None
+    if guard:
+        from ._guard import is_chord_interpolant, rebuilt_curve
+
+        if (type(new) is CubicHermite and type(curve) is CubicHermite
+                and np.array_equal(new.params, curve.params)
+                and not np.array_equal(new.points, curve.points)
+                and is_chord_interpolant(curve)):
+            # point data: also judge the curve a reader rebuilds from the written points
+            def rebuilt(c: PiecewiseCurve) -> dict[str, Any] | None:
+                r = rebuilt_curve(cast(CubicHermite, c))
+                return None if r is None else analysis_block(r)
+
+            rb_after = rebuilt(new)
+            worse = worse or rb_after is None or (
+                rb_after["inflections"] > before["inflections"]
+                or rb_after["extrema"] > before["extrema"])
+            if rb_after is not None:
+                guard_info["rebuilt"] = {"inflections": rb_after["inflections"],
+                                         "extrema": rb_after["extrema"]}
+    if guard and worse:
         from ._guard import never_worse
 
         new, after, guard_info = never_worse(curve, new, before, after, jp, out.curve,
-                                             analysis_block)
+                                             analysis_block, rebuilt, rb_after)
     if progress is not None:
         progress(3, PHASES)
     # the one final guarantee every result passes through (after the joins are restored and

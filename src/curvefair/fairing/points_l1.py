@@ -106,6 +106,7 @@ from ..curves.hermite import CubicHermite
 from ..curves.interpolate import interpolate_cubic
 from ..curves.parameterize import parameterize
 from ..errors import InputError
+from ._guard import is_chord_interpolant as _is_natural_chord_interpolant
 from .problem import FairingHistory, FairingProblem, Outcome
 from .stop import StopReason
 
@@ -961,28 +962,6 @@ SELECT_MAX_POINTS = 5_000
 #: whether ``points-l1`` is also the default for closed point lists (chord-length periodic
 #: cubics, e.g. a CSV whose last row repeats the first); False: ``poliakoff``
 DEFAULT_CLOSED = True
-
-
-def _is_natural_chord_interpolant(curve: CubicHermite) -> bool:
-    """Whether ``curve`` is the chord-length natural cubic through its points (what a point
-    file is read as), up to an affine change of parameter: only then is the curve rebuilt
-    from the written points the same kind of curve as the input."""
-    from ..curves.interpolate import interpolate_cubic
-
-    try:
-        ref = interpolate_cubic(curve.points, "chord",
-                                "periodic" if curve.closed else "natural")
-    except InputError:
-        return False
-    t, r = np.asarray(curve.params), np.asarray(ref.params)
-    st, sr = t[-1] - t[0], r[-1] - r[0]
-    if not (st > 0 and sr > 0):
-        return False
-    if not np.allclose((t - t[0]) / st, (r - r[0]) / sr, rtol=0.0, atol=1e-9):
-        return False
-    d, dr = np.asarray(curve.tangents) * st, np.asarray(ref.tangents) * sr
-    scale = max(float(np.max(np.abs(dr))), 1e-300)
-    return bool(np.max(np.abs(d - dr)) <= 1e-7 * scale)
 
 
 def _has_natural_ends(curve: CubicHermite) -> bool:
