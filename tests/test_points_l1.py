@@ -536,3 +536,22 @@ def test_cli_writes_a_point_file_whose_rebuilt_curve_is_not_worse(tmp_path) -> N
     assert eb <= e0 and ib <= i0
     back = read_curves(out, corner_angle=None)
     assert len(back) == 1 and _counts_of(back[0].curve) == (eb, ib)
+
+
+def test_fair_guard_catches_a_poliakoff_result_that_rebuilds_worse() -> None:
+    # the guard on the rebuilt curve for a paper's method at its own defaults but eps = 0:
+    # 1,500 spiral points with noise 0.2 of the spacing, where poliakoff's result is not worse
+    # on the input's parameters (the old guard kept it) but rebuilds into more inflections
+    pts, tol = _noisy_spiral(1500, 1500, noise=0.2)
+    c = interpolate_cubic(pts, "chord", "natural")
+    e0, i0 = _counts_of(c)
+    raw = fair(c, "poliakoff", tol=tol, eps=0, guard=False)
+    assert raw.report["inflections_after"] <= i0 and raw.report["extrema_after"] <= e0
+    eb, ib = _rebuilt_counts(raw.curve.points)
+    assert ib > i0 or eb > e0
+    res = fair(c, "poliakoff", tol=tol, eps=0)
+    g = res.report["guard"]
+    assert g["kept"] != "output" and "rebuilt" in g["reason"]
+    e1, i1 = _rebuilt_counts(res.curve.points)
+    assert e1 <= e0 and i1 <= i0
+    assert np.all(np.linalg.norm(np.asarray(res.curve.points) - pts, axis=1) <= tol)
