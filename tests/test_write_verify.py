@@ -369,3 +369,48 @@ def test_point_file_spans_over_the_bound_are_refined(tmp_path):
     assert whole * (1 - 1e-9) <= chk.deviations[0] <= tol
     np.testing.assert_array_equal(np.loadtxt(tmp_path / "o.csv", delimiter=",", skiprows=1),
                                   r.curve.points)
+
+
+def test_reports_count_point_data_on_the_curve_rebuilt_from_the_written_file(tmp_path):
+    """Point data whose moves need no scaling: the command's and the batch runner's report
+    after-figures are those of the file read back (the curve rebuilt through the written
+    points at their own chord lengths, counted by analyze() on a fresh read), not those of
+    the faired curve on the input's parameters, which stay under ``fair_after``."""
+    import json
+
+    from click.testing import CliRunner
+
+    from curvefair import analyze, fair
+    from curvefair.batch import fair_file
+    from curvefair.cli import main
+
+    rng = np.random.default_rng(5)
+    t = np.linspace(0.0, 6.0, 400)
+    h = t[1] - t[0]
+    pts = np.c_[t, np.sin(t)] + rng.normal(scale=0.3 * h, size=(t.size, 2))
+    src = tmp_path / "in.csv"
+    np.savetxt(src, pts, delimiter=",", header="x,y", comments="", fmt="%.10f")
+    rec = read_curves(src)[0]
+    opts = ["--tol", str(h), "--method", "poliakoff", "--eps", "0"]
+    out, rep_path = tmp_path / "out.csv", tmp_path / "r.json"
+    res = CliRunner().invoke(main, ["fair", str(src), "-o", str(out), "--report",
+                                    str(rep_path), *opts])
+    assert res.exit_code == 0, res.output
+    report = json.loads(rep_path.read_text())
+    assert report["output_check"]["move_scale"] == [1.0]
+    row = report["curves"][0]["report"]
+    a = analyze(read_curves(out)[0].curve)
+    assert row["extrema_after"] == a.extrema and row["inflections_after"] == a.inflections
+    assert row["energy_after"] == a.energy2 and "read back" in row["after_figures"]
+    own = fair(rec.curve, "poliakoff", tol=h, eps=0.0).report
+    assert row["fair_after"]["extrema"] == own["extrema_after"]
+    assert row["fair_after"]["inflections"] == own["inflections_after"]
+    assert (own["extrema_after"], own["inflections_after"]) != (a.extrema, a.inflections)
+    # the batch runner's report says the same
+    out2 = tmp_path / "out2.csv"
+    rep2 = fair_file(str(src), str(out2), {"tol": h, "method": "poliakoff", "eps": 0.0})
+    assert rep2["status"] == "ok"
+    r2 = rep2["curves"][0]["report"]
+    a2 = analyze(read_curves(out2)[0].curve)
+    assert r2["extrema_after"] == a2.extrema and r2["inflections_after"] == a2.inflections
+    assert r2["fair_after"]["extrema"] == own["extrema_after"]

@@ -777,8 +777,15 @@ def _fair_file(infile: str, outfile: str | None, options: Mapping[str, Any] | No
         except (CurvefairError, OSError) as exc:
             rep["error"] = _err(exc)
         else:
-            for row, d, kind in zip(rows, check.deviations, check.kinds, strict=True):
+            from .io import on_disk_report
+
+            for i, (row, d, kind) in enumerate(zip(rows, check.deviations, check.kinds,
+                                                   strict=True)):
                 if row["status"] == "ok":
+                    if check.read_back:  # the after-figures of what is on disk
+                        row["report"] = _jsonable(on_disk_report(
+                            row["report"], records[i].curve, faired[i].curve,
+                            check.read_back[i], check.move_scale[i]))
                     row["report"]["on_disk_deviation"] = d
                     row["report"]["on_disk_deviation_kind"] = kind
             rep["output_check"] = _jsonable(check.to_dict())

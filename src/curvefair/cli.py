@@ -1108,17 +1108,18 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
                                   format=out_fmt, overwrite=in_place, decimals=decimals)
             if prog is not None:
                 prog[0].advance(prog[1])
-            from .io import rescaled_report
+            from .io import on_disk_report
 
             kept_notes: list[str] = []
             for i, (row, d, kind) in enumerate(zip(rows, check.deviations, check.kinds,
                                                    strict=True)):
                 if row["status"] == "ok":
-                    if check.move_scale[i] != 1.0 and check.read_back:
-                        # what is on disk is not the fair: its after-figures are recomputed
-                        row["report"] = rescaled_report(row["report"], records[i].curve,
-                                                        check.read_back[i],
-                                                        check.move_scale[i])
+                    if check.read_back:
+                        # the after-figures of what is on disk: scaled moves, or point data
+                        # rebuilt through the written points
+                        row["report"] = on_disk_report(row["report"], records[i].curve,
+                                                       faired[i].curve, check.read_back[i],
+                                                       check.move_scale[i])
                     row["report"]["on_disk_deviation"] = d
                     row["report"]["on_disk_deviation_kind"] = kind
                     if d == 0.0 and "outline" in records[i].source and \

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import importlib
 
+from ._guard import is_chord_interpolant, rebuilt_curve
 from ._tolerance import point_report
 from .fair import (
     METHODS,
@@ -39,6 +40,8 @@ __all__ = [
     "StopReason",
     "STOP_REASONS",
     "point_report",
+    "is_chord_interpolant",
+    "rebuilt_curve",
 ]
 
 METHOD_MODULES = [

@@ -452,6 +452,55 @@ def write_checked(path: str | os.PathLike[str], records: Sequence[CurveRecord],
     raise AssertionError("unreachable")  # pragma: no cover
 
 
+def on_disk_report(report: dict[str, Any], original: Any, faired: Any, written: Any,
+                   scale: float) -> dict[str, Any]:
+    """A :func:`curvefair.fair` report whose after-figures describe the written file.
+
+    The command line and :func:`curvefair.batch.fair_file` report what is on disk:
+
+    * moves scaled by ``scale != 1`` to hold the tolerance on disk: :func:`rescaled_report`;
+    * point data (``original`` the chord-length natural or periodic cubic through its points,
+      as a point file is read) that moved: a reader rebuilds the curve through the written
+      points at their own chord lengths, not the curve ``fair()`` returned on the input's
+      parameters, so every ``<figure>_after`` of :func:`curvefair.analyze` (energies, jumps,
+      Sapidis sum, inflections, extrema) is recomputed for ``written``; the faired curve's
+      figures stay under ``fair_after`` and ``after_figures`` says so;
+    * otherwise ``report`` itself (the curve read back is the faired one).
+
+    Parameters
+    ----------
+    report : dict
+        The ``report`` of the fair; not modified.
+    original, faired, written : curve
+        The curve read from the input, the faired curve, and the curve read back from the
+        written file (``read_back[i]`` of the :class:`WriteCheck`).
+    scale : float
+        ``move_scale[i]`` of that check.
+
+    Returns
+    -------
+    dict
+        ``report`` or an updated copy.
+    """
+    if scale != 1.0:
+        return rescaled_report(report, original, written, scale)
+    from ..fairing import is_chord_interpolant
+    from ..fairing.fair import analysis_block
+
+    if written is None or faired is original or not is_chord_interpolant(original):
+        return report
+    out = dict(report)
+    after = analysis_block(written)
+    out["fair_after"] = {k: report.get(f"{k}_after") for k in after}
+    for k, v in after.items():
+        out[f"{k}_after"] = v
+    out["after_figures"] = ("counted on the curve read back from the written file: point data "
+                            "are rebuilt through the written points at their own chord "
+                            "lengths, as a reader does (fair_after: the faired curve on the "
+                            "input's parameters)")
+    return out
+
+
 def rescaled_report(report: dict[str, Any], original: Any, written: Any,
                     scale: float) -> dict[str, Any]:
     """A :func:`curvefair.fair` report whose after-figures describe ``written``, the curve read
