@@ -185,8 +185,9 @@ def power_form_kernel(knots, p, spans, ctrl, closed, out):
     """``out[m, k, :] = sum_a N_{s-p+a}^(k)(t_s) d_{s-p+a} / k!`` for ``s = spans[m]`` (control
     indices mod ``n`` for a closed curve): the piecewise power form of the B-spline. A span
     whose local knot pattern equals the previous span's reuses its basis derivatives. Cubics
-    (most B-splines) run a copy compiled for degree 3: the same operations, about three times
-    faster than the general loop, whose trip counts are only known at run time."""
+    (most B-splines) run a copy compiled for degree 3: the same operations, with its loops
+    unrolled and its work arrays in registers, which the general loop (trip counts known only
+    at run time) cannot have."""
     if p == 3:
         _power_form_body(knots, 3, spans, ctrl, ctrl, closed, out, out, False)
     else:
