@@ -459,12 +459,12 @@ def on_disk_report(report: dict[str, Any], original: Any, faired: Any, written: 
     The command line and :func:`curvefair.batch.fair_file` report what is on disk:
 
     * moves scaled by ``scale != 1`` to hold the tolerance on disk: :func:`rescaled_report`;
-    * point data (``original`` the chord-length natural or periodic cubic through its points,
-      as a point file is read) that moved: a reader rebuilds the curve through the written
-      points at their own chord lengths, not the curve ``fair()`` returned on the input's
-      parameters, so every ``<figure>_after`` of :func:`curvefair.analyze` (energies, jumps,
-      Sapidis sum, inflections, extrema) is recomputed for ``written``; the faired curve's
-      figures stay under ``fair_after`` and ``after_figures`` says so;
+    * a cubic Hermite curve read back on other parameters than the faired one -- point data
+      that moved: a reader rebuilds the curve through the written points at their own chord
+      lengths, not the curve ``fair()`` returned on the input's parameters --: every
+      ``<figure>_after`` of :func:`curvefair.analyze` (energies, jumps, Sapidis sum,
+      inflections, extrema) is recomputed for ``written``; the faired curve's figures stay
+      under ``fair_after`` and ``after_figures`` says so;
     * otherwise ``report`` itself (the curve read back is the faired one).
 
     Parameters
@@ -484,10 +484,13 @@ def on_disk_report(report: dict[str, Any], original: Any, faired: Any, written: 
     """
     if scale != 1.0:
         return rescaled_report(report, original, written, scale)
-    from ..fairing import is_chord_interpolant
+    from ..curves.hermite import CubicHermite
     from ..fairing.fair import analysis_block
 
-    if written is None or faired is original or not is_chord_interpolant(original):
+    # the parameters tell (no O(n) test of the input): a point list read back has the chord
+    # lengths of the written points, the faired curve kept the input's
+    if (type(faired) is not CubicHermite or type(written) is not CubicHermite
+            or faired is original or np.array_equal(written.params, faired.params)):
         return report
     out = dict(report)
     after = analysis_block(written)
