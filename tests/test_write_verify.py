@@ -402,6 +402,9 @@ def test_reports_count_point_data_on_the_curve_rebuilt_from_the_written_file(tmp
     a = analyze(read_curves(out)[0].curve)
     assert row["extrema_after"] == a.extrema and row["inflections_after"] == a.inflections
     assert row["energy_after"] == a.energy2 and "read back" in row["after_figures"]
+    # fair()'s guard analysed the same rebuilt curve: its figures are the written file's
+    assert row["guard"]["rebuilt"]["energy"] == a.energy2
+    assert row["guard"]["rebuilt"]["sapidis_sum"] == row["sapidis_sum_after"] == a.sapidis_sum
     own = fair(rec.curve, "poliakoff", tol=h, eps=0.0).report
     assert row["fair_after"]["extrema"] == own["extrema_after"]
     assert row["fair_after"]["inflections"] == own["inflections_after"]

@@ -125,7 +125,9 @@ def never_worse(curve: PiecewiseCurve, new: PiecewiseCurve, before: dict[str, An
     the method faired (``jp.curve`` and ``work_out``), then :meth:`JoinPlan.restore`.
     ``rebuilt`` (point data): the analysis block of the curve rebuilt from a candidate's points
     (None: it cannot be rebuilt, which counts as worse); ``rebuilt_after`` that of ``new``.
-    ``before`` is the input's, which is its own rebuilt curve.
+    ``before`` is the input's, which is its own rebuilt curve (up to an affine change of
+    parameter: the same counts). The report entry's ``"rebuilt"`` holds the rebuilt curve's
+    analysis block for a result that moved, its counts when the input is kept.
     """
     worse = _adds(after, before)
     why = "the method's result has more " + " and ".join(worse) if worse else ""
@@ -150,11 +152,11 @@ def never_worse(curve: PiecewiseCurve, new: PiecewiseCurve, before: dict[str, An
             rc = rebuilt(cand)
             if rc is None or _adds(rc, before):
                 continue
-            info["rebuilt"] = _counts(rc)
+            info["rebuilt"] = dict(rc)
         info.update(kept="partial", fraction=lam,
                     reason=f"{why}; kept {lam:g} of the move, which adds neither")
         return cand, a, info
-    if rebuilt is not None:
+    if rebuilt is not None:  # the input's counts (its figures are on its own parameters)
         info["rebuilt"] = _counts(before)
     info.update(kept="input", fraction=0.0,
                 reason=f"{why}; kept the input (no fraction of the move tried was not worse)")

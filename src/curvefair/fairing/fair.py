@@ -388,6 +388,11 @@ def _default_method(curve: PiecewiseCurve, clamp: object = "g0") -> MethodSpec:
     raise InputError(f"no fairing method is registered for {type(curve).__name__}")
 
 
+#: the keys of :func:`analysis_block`
+ANALYSIS_FIGURES = ("energy", "energy3", "max_jump", "max_top_jump", "sapidis_sum",
+                    "dkds_energy", "inflections", "extrema")
+
+
 def analysis_block(curve: PiecewiseCurve) -> dict[str, Any]:
     """The report's figures of one curve (:func:`curvefair.analyze`): energies, largest jumps,
     Sapidis sum, ``int (dkappa/ds)^2 ds``, inflection and curvature-extremum counts."""
@@ -481,7 +486,8 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
         chord-length natural or periodic cubic through its points, as a point file is read,
         and the result a cubic Hermite curve on its parameters): the curve a reader rebuilds
         from the result's points (the same interpolant at their own chord lengths) is judged
-        too, its counts in ``report["guard"]["rebuilt"]``. False: the method's result as it
+        too: ``report["guard"]["rebuilt"]`` holds its figures (those of :func:`analyze`:
+        energies, jumps, counts) for the curve returned; False: the method's result as it
         is.
     structure : {"keep", "free"}
         B-splines: ``"keep"`` (default) keeps the degree, knot vector and number of control
@@ -652,8 +658,7 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
                 rb_after["inflections"] > before["inflections"]
                 or rb_after["extrema"] > before["extrema"])
             if rb_after is not None:
-                guard_info["rebuilt"] = {"inflections": rb_after["inflections"],
-                                         "extrema": rb_after["extrema"]}
+                guard_info["rebuilt"] = dict(rb_after)
     if guard and worse:
         from ._guard import never_worse
 
@@ -668,6 +673,10 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
                                       primed=primed)
     if checked is not new:
         new, after = checked, analysis_block(checked)
+        if rebuilt is not None and "rebuilt" in guard_info:
+            # the pulled-back points make their own rebuilt curve
+            rb_final = rebuilt(new)
+            guard_info["rebuilt"] = None if rb_final is None else dict(rb_final)
     if progress is not None:
         progress(4, PHASES)
 
