@@ -357,6 +357,15 @@ def lazy_import(module: str, package: str, extra: str, what: str) -> Any:
 # ------------------------------------------------------------------------------------------
 # points, corners
 # ------------------------------------------------------------------------------------------
+def frozen_index(values: Any) -> np.ndarray:
+    """An index map of a record's ``source`` (e.g. ``row_map``: file data row -> point) as a
+    read-only int64 array: one machine word per row, not a Python int object each (a
+    million-row file's map was 36 MB of ints and 0.15 s to build)."""
+    out = np.array(values, dtype=np.int64).reshape(-1)
+    out.setflags(write=False)
+    return out
+
+
 def check_points(pts: FloatArray, path: object, lines: Sequence[int | None] | None = None,
                  what: str = "point") -> None:
     """FileFormatError for NaN/inf coordinates and duplicate consecutive points.

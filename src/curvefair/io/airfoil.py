@@ -54,6 +54,7 @@ from ._common import (
     atomic_write,
     check_points,
     drop_duplicates,
+    frozen_index,
     joined_points,
     piece_values,
     point_records,
@@ -125,7 +126,7 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
     notes = () if lay.notes_from is None else lay.lines[lay.notes_from:]
     src = {"format": FORMAT, "path": os.path.abspath(path), "layout": lay,
            "airfoil_layout": kind_layout, "counts": counts,
-           "row_map": tuple(int(i) for i in row_map),
+           "row_map": frozen_index(row_map),
            "leading_lines": tuple(lay.lines[i] for i in lay.leading),
            "notes": tuple(notes)}
     return point_records(contour, closed=False, corner_angle=corner_angle, kind="airfoil",

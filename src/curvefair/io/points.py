@@ -41,6 +41,7 @@ from ._common import (
     atomic_write,
     check_points,
     drop_duplicates,
+    frozen_index,
     joined_points,
     piece_values,
     point_records,
@@ -81,7 +82,7 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
         row_map = where
     name = os.path.splitext(os.path.basename(path))[0]
     src = {"format": FORMAT, "path": os.path.abspath(path), "layout": lay,
-           "row_map": tuple(int(i) for i in row_map), "header": lay.header_text}
+           "row_map": frozen_index(row_map), "header": lay.header_text}
     return point_records(distinct, closed=loop, corner_angle=corner_angle, kind="points",
                          name=name, source=src)
 
