@@ -284,6 +284,29 @@ def test_band_patterns_vs_brute_force(closed):
     assert (hi - lo, ulo, uhi) == (length, lo, hi) and np.all(pat[lo:hi] == upat)
 
 
+@pytest.mark.parametrize("knots", ["uniform", "random"])
+def test_band_patterns_few_and_many(knots):
+    # uniform knots: a handful of distinct rows, returned as their own small array; knots from
+    # random spans: nearly one pattern per row, returned in the working buffer (no copy) --
+    # the same identities either way
+    from curvefair.fairing.eck_hadenfeld import band_patterns
+
+    n = 200
+    rng = np.random.default_rng(5)
+    h = np.ones(n - 3) if knots == "uniform" else rng.uniform(0.5, 1.5, n - 3)
+    br = np.r_[0.0, np.cumsum(h)]
+    c = BSplineCurve(rng.normal(size=(n, 2)), np.r_[[0.0] * 3, br, [br[-1]] * 3], 3)
+    W = c.gram_band(2)
+    Wu, pat, upat, ulo, uhi = band_patterns(W)
+    np.testing.assert_array_equal(Wu[pat, :-1], W)
+    np.testing.assert_array_equal(Wu[:, -1], 1.0 / Wu[:, 3])
+    assert Wu.shape[0] == len(np.unique(pat)) and Wu.flags.c_contiguous
+    if knots == "uniform":
+        assert Wu.shape[0] <= 16 and Wu.base is None  # the rows near the clamped ends
+    else:
+        assert Wu.shape[0] > n // 2
+
+
 @pytest.mark.parametrize("closed", [False, True])
 @pytest.mark.parametrize("tol", [None, 0.05])
 def test_loop_matches_slow_reference_mixed_knots(closed, tol):
