@@ -222,3 +222,51 @@ def test_missing_rhino3dm(tmp_path, monkeypatch):
     monkeypatch.setitem(sys.modules, "rhino3dm", None)
     with pytest.raises(MissingDependencyError, match=r"curvefair\[rhino\]"):
         read_curves(p)
+
+
+def test_periodic_curve_with_few_control_points_is_skipped_not_fatal(tmp_path):
+    # openNURBS' v5_example_file.3dm (see tests/data/README.md): a periodic degree-5
+    # NurbsCurve with 10 control points, 5 of them distinct -- a curve Rhino draws and
+    # curvefair's closed B-spline cannot hold (it needs degree + 1). It is skipped with a
+    # warning and written back as it was; the file's other curves are faired.
+    from pathlib import Path
+
+    from click.testing import CliRunner
+
+    from curvefair.cli import main
+
+    src = Path(__file__).parent / "data" / "real" / "opennurbs" / "v5_example_file.3dm"
+    m0 = rh.File3dm.Read(str(src))
+    ident = "e43f7908-793f-4793-85d3-c11d2d7bffb5"
+    obj0 = {str(o.Attributes.Id): o for o in m0.Objects}
+    g0 = obj0[ident].Geometry
+    assert g0.IsPeriodic and g0.Degree == 5 and len(g0.Points) == 10  # the case
+    with pytest.raises(FileFormatError, match=f"{ident}.*periodic degree-5.*5 distinct"):
+        read_curves(src)
+    out = tmp_path / "out.3dm"
+    res = CliRunner().invoke(main, ["fair", str(src), "-o", str(out), "--tol", "0.05"])
+    assert res.exit_code == 0, res.output
+    assert ident in res.output and "wrote" in res.output
+    m1 = rh.File3dm.Read(str(out))
+    obj1 = {str(o.Attributes.Id): o for o in m1.Objects}
+    assert set(obj1) == set(obj0)
+    g1 = obj1[ident].Geometry
+    def cps(g):
+        return [(q.X, q.Y, q.Z, q.W) for q in (g.Points[i] for i in range(len(g.Points)))]
+
+    assert cps(g1) == cps(g0)
+    assert list(g1.Knots) == list(g0.Knots)
+    # at least one other curve was faired, each within tol where it moved
+    moved = 0
+    for k, o in obj0.items():
+        g, h = o.Geometry, obj1[k].Geometry
+        if k == ident or not isinstance(g, rh.NurbsCurve) or not isinstance(h, rh.NurbsCurve):
+            continue
+        a, b = np.array(cps(g)), np.array(cps(h))
+        if a.shape == b.shape and np.any(a != b):
+            moved += 1
+            t = np.linspace(g.Domain.T0, g.Domain.T1, 400)
+            pa = np.array([(q.X, q.Y, q.Z) for q in map(g.PointAt, t)])
+            pb = np.array([(q.X, q.Y, q.Z) for q in map(h.PointAt, t)])
+            assert np.max(np.linalg.norm(pa - pb, axis=1)) <= 0.05 + 1e-9
+    assert moved >= 1

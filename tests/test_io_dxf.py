@@ -360,3 +360,47 @@ def test_missing_ezdxf_names_the_extra(tmp_path, monkeypatch):
         read_curves(p)
     with pytest.raises(MissingDependencyError, match="ezdxf"):
         write_curves(tmp_path / "o.dxf", interpolate_cubic([[0, 0], [1, 1], [2, 0]]))
+
+
+def test_bezier_style_spline_is_skipped_not_fatal(tmp_path):
+    # bjnortier/dxf's issue50.dxf (see tests/data/README.md): a cubic SPLINE whose interior
+    # knots have multiplicity 4 (a chain of Bezier pieces), which ezdxf reads and draws. It
+    # is unsupported (skipped and written back untouched), not a broken file: another curve
+    # of the same drawing is still faired.
+    from click.testing import CliRunner
+
+    from curvefair.cli import main
+
+    src = DATA / "real" / "bjnortier-dxf" / "issue50.dxf"
+    orig = ezdxf.readfile(src)
+    spl = [e for e in orig.modelspace() if e.dxftype() == "SPLINE"]
+    assert len(spl) == 1
+    handle = spl[0].dxf.handle
+    knots = np.asarray(spl[0].knots)
+    assert np.max(np.unique(knots[4:-4], return_counts=True)[1]) == 4  # the case
+    with pytest.raises(FileFormatError, match=f"SPLINE {handle}.*multiplicity"):
+        read_curves(src)
+    with pytest.warns(UserWarning, match=f"skipped SPLINE {handle}.*multiplicity"), \
+            pytest.raises(FileFormatError, match="no curves"):
+        read_curves(src, on_unsupported="skip")
+    # the same drawing with one ordinary spline more
+    doc = ezdxf.readfile(src)
+    t = np.linspace(0.0, 4.0, 25)
+    fit = np.c_[t, 0.5 * np.sin(t) + 0.01 * np.cos(37 * t), np.zeros_like(t)]
+    new = doc.modelspace().add_spline(fit).dxf.handle
+    doc.saveas(tmp_path / "in.dxf")
+    out = tmp_path / "out.dxf"
+    res = CliRunner().invoke(main, ["fair", str(tmp_path / "in.dxf"), "-o", str(out),
+                                    "--tol", "0.01"])
+    assert res.exit_code == 0, res.output
+    assert "multiplicity" in res.output and "wrote" in res.output
+    back = ezdxf.readfile(out)
+    by = {e.dxf.handle: e for e in back.modelspace() if e.dxftype() == "SPLINE"}
+    assert set(by) == {handle, new}
+    kept = by[handle]  # untouched
+    np.testing.assert_array_equal(np.asarray(kept.knots), knots)
+    np.testing.assert_array_equal(np.asarray(kept.control_points),
+                                  np.asarray(spl[0].control_points))
+    faired = np.asarray(by[new].fit_points)
+    assert faired.shape == fit.shape and np.all(np.linalg.norm(faired - fit, axis=1) <= 0.01)
+    assert np.any(faired != fit)

@@ -148,7 +148,10 @@ def _spline_record(e: Any, base: dict[str, Any], path: object, corner_angle: flo
     except CurvefairError as exc:
         if isinstance(exc, FileFormatError):
             raise
-        raise FileFormatError(f"SPLINE {base['handle']}: {exc}", path) from None
+        # a knot vector curvefair's B-spline does not take (e.g. an interior knot of
+        # multiplicity degree + 1, a Bezier-style chain that ezdxf and CAD read): the entity
+        # is unsupported, not the file broken -- skipped and written back untouched
+        raise Unsupported(f"knot vector: {exc}") from None
     src = dict(base, z=z, spline_layout=layout, had_fit_points=bool(fits.shape[0]))
     return [CurveRecord(curve, base["name"], "bspline", src)]
 

@@ -173,6 +173,10 @@ def _records_of(obj: Any, i: int, base: dict[str, Any], path: object, rh: Any,
             curve = BSplineCurve(pts, full, p, closed=False)
             layout = "clamped"
         elif g.IsPeriodic and N > 2 * p - 1 and np.array_equal(xyz[N - p:], xyz[:p]):
+            if N - p < p + 1:
+                raise Unsupported(f"periodic degree-{p} NurbsCurve with {N - p} distinct "
+                                  f"control points (curvefair's closed B-spline needs at "
+                                  f"least degree + 1 = {p + 1})")
             curve = BSplineCurve(pts[: N - p], full, p, closed=True)
             layout = "periodic"
         else:
@@ -180,7 +184,10 @@ def _records_of(obj: Any, i: int, base: dict[str, Any], path: object, rh: Any,
     except CurvefairError as exc:
         if isinstance(exc, FileFormatError):
             raise
-        raise FileFormatError(f"object {base['id']}: {exc}", path) from None
+        # a curve curvefair's B-spline does not take (e.g. a periodic degree-5 curve with 5
+        # distinct control points, which Rhino draws): the object is unsupported, not the
+        # file broken -- skipped and written back untouched
+        raise Unsupported(f"NurbsCurve: {exc}") from None
     src = dict(base, z=z, nurbs_layout=layout, index=index)
     return [CurveRecord(curve, base["name"], "bspline", src)]
 
