@@ -417,3 +417,39 @@ def test_reports_count_point_data_on_the_curve_rebuilt_from_the_written_file(tmp
     a2 = analyze(read_curves(out2)[0].curve)
     assert r2["extrema_after"] == a2.extrema and r2["inflections_after"] == a2.inflections
     assert r2["fair_after"]["extrema"] == own["extrema_after"]
+
+
+def test_svg_element_merged_by_its_own_decimals_is_written_exactly(tmp_path):
+    """A tiny closed subpath (an octagon 3 units across, inside a scaled group) faired at a
+    tolerance of its own size shrinks to nearly a point; written with the element's own
+    decimals (4) its points merge and the file reads back with one curve fewer. The writer
+    then uses exact numbers, as it does for a deviation beyond tol, instead of refusing the
+    file with a count (the hunt of session 18 found this on an OCCT drawing)."""
+    from click.testing import CliRunner
+
+    from curvefair.cli import main
+
+    spt = pytest.importorskip("svgpathtools")
+    a = np.arange(8) * (np.pi / 4)
+    octagon = np.c_[525.0 + 1.8 * np.cos(a), 1178.25 + 1.45 * np.sin(a)]
+    d = "M " + " L ".join(f"{x:.4f},{y:.4f}" for x, y in octagon) + " Z"
+    src = tmp_path / "in.svg"
+    src.write_text(
+        '<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 640 690">\n'
+        '<g transform="matrix(0.45772011,0,0,0.45774785,-4.5349213,-19.50284)">\n'
+        f'<path style="fill:none;stroke:#00f" d="{d}" id="oct"/>\n'
+        '<path style="fill:none;stroke:#000" d="M 0,0 L 100,0 L 100,100" id="other"/>\n'
+        '</g>\n</svg>\n')
+    out = tmp_path / "out.svg"
+    res = CliRunner().invoke(main, ["fair", str(src), "-o", str(out), "--tol", "1"])
+    assert res.exit_code == 0, res.output
+    assert "exact numbers" in res.output
+    paths_in, attr_in = spt.svg2paths(str(src))
+    paths_out, attr_out = spt.svg2paths(str(out))
+    assert [x["id"] for x in attr_out] == [x["id"] for x in attr_in]
+    assert attr_out[1]["d"] == attr_in[1]["d"]  # the other element as it was
+    p0 = np.array([[s.start.real, s.start.imag] for s in paths_in[0]])
+    p1 = np.array([[s.start.real, s.start.imag] for s in paths_out[0]])
+    assert p1.shape == p0.shape and paths_out[0].isclosed()
+    # every vertex within tol in the user's units (the group's transform scales by 0.4577)
+    assert np.max(np.linalg.norm(p1 - p0, axis=1)) * 0.45775 <= 1.0

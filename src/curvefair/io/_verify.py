@@ -405,9 +405,21 @@ def write_checked(path: str | os.PathLike[str], records: Sequence[CurveRecord],
                 raise WriteCheckError(f"{where}: not written: {lost}{hint}")
             curves = _matched(reference, back)
             if curves is None:
+                if precision == "file" and fmt == "svg":
+                    # e.g. a tiny closed subpath faired nearly to a point: the element's own
+                    # decimals merge its points, exact numbers keep them apart
+                    precision = "exact"
+                    notes.append(f"the file's own precision gave {len(back)} curves where the "
+                                 f"input had {len(reference)}; written with exact numbers")
+                    continue
+                seen = {_entity(b) for b in back}
+                gone = [_label(r, i) for i, r in enumerate(reference)
+                        if _entity(r) is not None and _entity(r) not in seen]
                 raise WriteCheckError(
                     f"{where}: not written: it reads back as {len(back)} curves, the input "
-                    f"had {len(reference)}")
+                    f"had {len(reference)}"
+                    + (f" ({', '.join(gone[:3])}{' ...' if len(gone) > 3 else ''} not read "
+                       "back)" if gone else ""))
             try:
                 devs, kinds, mpd = _measure(reference, curves, tol)
             except CurvefairError:
