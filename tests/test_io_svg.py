@@ -471,3 +471,28 @@ def test_vertex_equal_up_to_rounding_dropped_with_warning(tmp_path):
     with pytest.warns(UserWarning, match=r"<polyline> element 0 \(id='pl'\).*up to rounding"):
         recs = read_curves(p, corner_angle=None)
     assert len(recs) == 1 and np.asarray(recs[0].points).shape == (4, 2)
+
+
+def test_open_path_ending_at_its_start_stays_open(tmp_path):
+    """svgpathtools' path.svg: an open path (no z) whose last point is its first. Faired and
+    written back it stays open (two caps, not a join), within tol."""
+    from test_cli import cli
+
+    (tmp_path / "in.svg").write_bytes((REAL / "svgpathtools" / "path.svg").read_bytes())
+    res = cli(["fair", "in.svg", "-o", "out.svg", "--tol", "0.257", "-q"], tmp_path)
+    assert res.returncode == 0, res.stderr
+    d_in = spt.svg2paths(str(tmp_path / "in.svg"))[1][0]["d"]
+    d_out = spt.svg2paths(str(tmp_path / "out.svg"))[1][0]["d"]
+    assert d_in != d_out                                   # it was rewritten
+    assert "z" not in d_in.lower() and "z" not in d_out.lower()
+    a, b = _spt_subpaths(tmp_path / "in.svg"), _spt_subpaths(tmp_path / "out.svg")
+    assert len(a) == len(b) == 1 and _hausdorff(a[0], b[0]) <= 0.257 + 0.01
+    # a polyline subpath ending at its start without z, changed: written without Z too
+    q = tmp_path / "pl.svg"
+    q.write_text(_svg('<path id="o" d="M 0 0 L 10 0 L 10 10 L 0 10 L 0 0"/>'))
+    recs = read_curves(q, corner_angle=None)
+    moved = [r.with_curve(r.curve.replace(points=np.asarray(r.curve.points) + [0, 1]))
+             for r in recs]
+    write_curves(tmp_path / "pl2.svg", moved, template=q)
+    d2 = spt.svg2paths(str(tmp_path / "pl2.svg"))[1][0]["d"]
+    assert "z" not in d2.lower() and d2.count("L") == 4, d2

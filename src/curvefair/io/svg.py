@@ -35,9 +35,11 @@ product of its own and its ancestors' ``transform`` attributes, SVG 1.1 sec. 7.5
 svgpathtools) is applied on read, and its inverse on write, so the file keeps every element's
 own coordinates and ``transform`` attributes. ``source`` keys: ``element`` (index among the
 curve elements), ``node`` (index among all elements), ``tag``, ``id``, ``subpath``,
-``n_subpaths``, ``svg_closed``, ``transform`` (the element's own attribute), ``ctm`` (the
-2x3 matrix row by row, or None for the identity), ``beziers`` (the original segments of a
-bspline record, in document coordinates, to tell unchanged curves) and the point-list keys.
+``n_subpaths``, ``svg_closed`` (closed by a ``z``: a subpath that merely ends at its start is
+read as a loop but written back open, without ``Z``), ``transform`` (the element's own
+attribute), ``ctm`` (the 2x3 matrix row by row, or None for the identity), ``beziers`` (the
+original segments of a bspline record, in document coordinates, to tell unchanged curves) and
+the point-list keys.
 
 Write
 -----
@@ -397,9 +399,10 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
             raise FileFormatError(f"<path> element {k} (id={ident!r}): bad path data "
                                   f"({type(exc).__name__}: {exc})", path) from None
         subs = parsed.continuous_subpaths() if len(parsed) else []
+        zs = _closed_by_z(d, parsed, subs, spt)
         for j, sub in enumerate(subs):
             name = f"{ident or 'path' + str(k)}" + (f"/{j}" if len(subs) > 1 else "")
-            sbase = dict(base, subpath=j, n_subpaths=len(subs), svg_closed=bool(sub.isclosed()))
+            sbase = dict(base, subpath=j, n_subpaths=len(subs), svg_closed=zs[j])
             try:
                 records.extend(_subpath_records(sub, spt, sbase, name, corner_angle, path,
                                                 len(records), ctm))
@@ -504,6 +507,21 @@ def _degenerate(g: Any, spt: Any, tiny: float = 0.0) -> bool:
         return True
     return bool(all(max(abs(z.real - g.start.real), abs(z.imag - g.start.imag)) <= tiny
                     for z in pts))
+
+
+def _closed_by_z(d: str, parsed: Any, subs: list[Any], spt: Any) -> list[bool]:
+    """For every continuous subpath: closed by a ``z``/``Z`` command (it ends where it
+    starts and its text ends with the closepath). An open subpath that merely ends at its
+    start point is drawn with two caps, not a join, and is written back without ``Z``.
+    When the text does not split into the subpaths, where it ends at its start."""
+    geo = [bool(sub.isclosed()) for sub in subs]
+    if not any(geo):
+        return geo
+    spans = _subpath_spans(d, parsed, spt)
+    if spans is None or len(spans) != len(subs):
+        return geo
+    return [c and d[a:b].rstrip()[-1:] in ("z", "Z")
+            for c, (a, b, _, _) in zip(geo, spans, strict=True)]
 
 
 def _subpath_records(sub: Any, spt: Any, base: dict[str, Any], name: str,
@@ -730,7 +748,11 @@ def _record_d(recs: list[CurveRecord], decimals: int | None) -> tuple[str, bool]
     r0 = recs[0]
     if kind == "bspline":
         return _d_cubics(geo, bool(r0.source.get("svg_closed", r0.curve.closed)), decimals), True
-    return _d_points(geo, bool(r0.source.get("closed")), decimals), True
+    closed = bool(r0.source.get("closed"))
+    if closed and not r0.source.get("svg_closed", True):
+        # read as a loop, but the subpath had no Z (it ends at its start): it stays open
+        return _d_points(np.vstack([geo, geo[:1]]), False, decimals), True
+    return _d_points(geo, closed, decimals), True
 
 
 def _start_tag_attrs(raw: bytes, i: int) -> dict[str, tuple[int, int]]:
