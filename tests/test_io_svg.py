@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import re
 import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -19,6 +20,7 @@ from scipy.interpolate import BSpline, insert
 from curvefair import (
     BSplineCurve,
     FileFormatError,
+    InputError,
     MissingDependencyError,
     interpolate_cubic,
     read_curves,
@@ -340,3 +342,157 @@ def _piece_subpaths(d):
     ends = np.cumsum([len(s) for s in spt.parse_path(d).continuous_subpaths()])
     return [int(np.searchsorted(ends, len(spt.parse_path(d[:b])) - 1, side="right"))
             for b in cuts[1:]]
+
+
+# ------------------------------------------------------------------------------------------
+# session 18: rounding-level segments and vertices, open paths ending at their start
+# ------------------------------------------------------------------------------------------
+REAL = DATA / "real"
+
+
+def _spt_subpaths(path):
+    """Dense samples of every continuous subpath of every <path> element (svgpathtools
+    only; no transforms in these files)."""
+    paths, _ = spt.svg2paths(str(path), convert_lines_to_paths=False,
+                                 convert_polylines_to_paths=False,
+                                 convert_polygons_to_paths=False,
+                                 convert_rectangles_to_paths=False)
+    out = []
+    for p in paths:
+        if not len(p):
+            continue
+        for sub in p.continuous_subpaths():
+            z = np.concatenate([np.array([g.point(t) for t in _ts(g)]) for g in sub])
+            out.append(np.c_[z.real, z.imag])
+    return out
+
+
+def _ts(g):
+    """Parameters 1/100 of a unit apart or closer along a segment (its control polygon)."""
+    cps = [g.start, g.end] + [getattr(g, c) for c in ("control", "control1", "control2")
+                              if hasattr(g, c)]
+    if isinstance(g, spt.Arc):
+        cps = [g.point(t) for t in np.linspace(0.0, 1.0, 33)]
+    n = max(65, int(sum(abs(b - a) for a, b in zip(cps[:-1], cps[1:], strict=True)) * 100))
+    return np.linspace(0.0, 1.0, n)
+
+
+def _hausdorff(a, b):
+    """Hausdorff distance of two dense sample sets (scipy), plus half the larger sample gap
+    (an upper bound for the curves they sample)."""
+    from scipy.spatial import cKDTree
+
+    gap = max(float(np.linalg.norm(np.diff(x, axis=0), axis=1).max()) for x in (a, b))
+    return max(cKDTree(b).query(a)[0].max(), cKDTree(a).query(b)[0].max()) + gap / 2
+
+
+def test_closing_segment_of_rounding_length_is_dropped_real_logo(tmp_path, monkeypatch):
+    """ezdxf's logo: relative commands closed by z leave closing segments ~1e-15 long; they
+    used to give a knot of multiplicity 5 and refuse the file. Every subpath is read, a closed
+    one ends exactly at its start, and a changed subpath written back reads back."""
+    src = REAL / "ezdxf" / "ezdxf-logo-dark-bg.svg"
+    n_sub = len(_spt_subpaths(src))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        recs = read_curves(src)
+    keys = sorted({(r.source["element"], r.source["subpath"]) for r in recs
+                   if r.source["tag"] == "path"})
+    assert len(keys) == n_sub == 7
+    curves = [r for r in recs if r.kind == "bspline"]
+    assert len(curves) == 7
+    for r in curves:
+        assert r.source["svg_closed"]
+        cp = np.asarray(r.curve.control_points)
+        assert r.curve.closed or np.array_equal(cp[0], cp[-1])
+        assert np.diff(np.unique(r.curve.knots)).min() > 1e-9
+    # move every Bezier subpath a little and write back: the file reads back, same subpaths
+    shift = np.array([0.01, -0.02])
+    moved = [r.with_curve(r.curve.replace(control_points=np.asarray(r.curve.control_points)
+                                          + shift)) if r.kind == "bspline" else r
+             for r in recs]
+    out = tmp_path / "o.svg"
+    write_curves(out, moved, template=src)
+    back = read_curves(out)
+    assert len(back) == len(recs)
+    bkeys = {(r.source["element"], r.source["subpath"]) for r in curves}
+    for key, a, b in zip(keys, _spt_subpaths(src), _spt_subpaths(out), strict=True):
+        # written at the element's 3 decimals (<= 7.1e-4), sampled 1/100 apart (<= 0.01)
+        assert _hausdorff(a + (shift if key in bkeys else 0), b) <= 0.011, key
+    # an error that remains names the file and the path element
+    import curvefair.io.svg as svgmod
+
+    def refuse(P, closed):
+        raise InputError("knot refused")
+
+    monkeypatch.setattr(svgmod, "bezier_chain_to_bspline", refuse)
+    with pytest.raises(FileFormatError, match=r"<path> element 2 .*subpath 0: knot refused"
+                       ) as exc:
+        read_curves(src)
+    assert exc.value.path == str(src)
+
+
+def test_fair_real_icon_with_rounding_length_closing_segment(tmp_path):
+    """simple-icons' sparkfun.svg through the CLI: written, every subpath kept, closed ones
+    still closed by Z, within tol of the input (svgpathtools samples)."""
+    from test_cli import cli
+
+    (tmp_path / "in.svg").write_bytes((REAL / "simple-icons" / "sparkfun.svg").read_bytes())
+    res = cli(["fair", "in.svg", "-o", "out.svg", "--tol", "0.6", "-q"], tmp_path)
+    assert res.returncode == 0, res.stderr
+    a, b = _spt_subpaths(tmp_path / "in.svg"), _spt_subpaths(tmp_path / "out.svg")
+    assert len(a) == len(b) == 1
+    assert all(_hausdorff(x, y) <= 0.6 + 0.01 for x, y in zip(a, b, strict=True))
+    d_in = spt.svg2paths(str(tmp_path / "in.svg"))[1][0]["d"]
+    d_out = spt.svg2paths(str(tmp_path / "out.svg"))[1][0]["d"]
+    assert d_in != d_out and d_in.lower().count("z") == d_out.lower().count("z") == 1
+
+
+@pytest.mark.parametrize("name, n_sub", [("simple-icons/volvo.svg", (7, 9)),
+                                         ("occt/operations_image013.svg", None)])
+def test_vertices_equal_up_to_rounding_real(name, n_sub):
+    """Closed subpaths of straight segments whose last vertex equals the first up to float
+    noise (relative commands) used to be refused as coincident points: read, every subpath."""
+    src = REAL / name
+    recs = read_curves(src, on_unsupported="skip", corner_angle=None)
+    subs = {(r.source["element"], r.source["subpath"]) for r in recs}
+    if n_sub is not None:
+        # every subpath read but the two with arcs (skipped, kept untouched)
+        assert (len(subs), len(_spt_subpaths(src))) == n_sub
+    for r in recs:
+        if r.kind == "polyline":
+            p = np.asarray(r.points)
+            step = np.abs(np.diff(p, axis=0)).max(axis=1)
+            assert step.min() > 1e-9
+
+
+def test_vertex_equal_up_to_rounding_dropped_with_warning(tmp_path):
+    p = tmp_path / "n.svg"
+    p.write_text(_svg('<polyline id="pl" points="0,0 10.1,0 10.100000000000001,0 10,5 0,7"/>'))
+    with pytest.warns(UserWarning, match=r"<polyline> element 0 \(id='pl'\).*up to rounding"):
+        recs = read_curves(p, corner_angle=None)
+    assert len(recs) == 1 and np.asarray(recs[0].points).shape == (4, 2)
+
+
+def test_open_path_ending_at_its_start_stays_open(tmp_path):
+    """svgpathtools' path.svg: an open path (no z) whose last point is its first. Faired and
+    written back it stays open (two caps, not a join), within tol."""
+    from test_cli import cli
+
+    (tmp_path / "in.svg").write_bytes((REAL / "svgpathtools" / "path.svg").read_bytes())
+    res = cli(["fair", "in.svg", "-o", "out.svg", "--tol", "0.257", "-q"], tmp_path)
+    assert res.returncode == 0, res.stderr
+    d_in = spt.svg2paths(str(tmp_path / "in.svg"))[1][0]["d"]
+    d_out = spt.svg2paths(str(tmp_path / "out.svg"))[1][0]["d"]
+    assert d_in != d_out                                   # it was rewritten
+    assert "z" not in d_in.lower() and "z" not in d_out.lower()
+    a, b = _spt_subpaths(tmp_path / "in.svg"), _spt_subpaths(tmp_path / "out.svg")
+    assert len(a) == len(b) == 1 and _hausdorff(a[0], b[0]) <= 0.257 + 0.01
+    # a polyline subpath ending at its start without z, changed: written without Z too
+    q = tmp_path / "pl.svg"
+    q.write_text(_svg('<path id="o" d="M 0 0 L 10 0 L 10 10 L 0 10 L 0 0"/>'))
+    recs = read_curves(q, corner_angle=None)
+    moved = [r.with_curve(r.curve.replace(points=np.asarray(r.curve.points) + [0, 1]))
+             for r in recs]
+    write_curves(tmp_path / "pl2.svg", moved, template=q)
+    d2 = spt.svg2paths(str(tmp_path / "pl2.svg"))[1][0]["d"]
+    assert "z" not in d2.lower() and d2.count("L") == 4, d2

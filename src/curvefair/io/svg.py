@@ -24,17 +24,22 @@ subpaths:
 
 Segments of length zero (an ``L`` to the current point, as matplotlib writes at the end of
 closed lines) carry no geometry and are dropped; a subpath rewritten on write-back loses them.
-Exactly repeated consecutive vertices are dropped with a warning (written back with their
-twin's value).
+So are segments no longer than rounding noise (256 ulps of the subpath's largest coordinate:
+relative commands closed by ``z`` leave closing segments ~1e-15 long); the segments kept are
+joined exactly, a closed subpath ending exactly at its start. Exactly repeated consecutive
+vertices are dropped with a warning (written back with their twin's value), and so, with a
+warning naming the element, are vertices equal to the one before up to rounding noise.
 
 Coordinates are those of the document: the element's current transformation matrix (the
 product of its own and its ancestors' ``transform`` attributes, SVG 1.1 sec. 7.5, parsed by
 svgpathtools) is applied on read, and its inverse on write, so the file keeps every element's
 own coordinates and ``transform`` attributes. ``source`` keys: ``element`` (index among the
 curve elements), ``node`` (index among all elements), ``tag``, ``id``, ``subpath``,
-``n_subpaths``, ``svg_closed``, ``transform`` (the element's own attribute), ``ctm`` (the
-2x3 matrix row by row, or None for the identity), ``beziers`` (the original segments of a
-bspline record, in document coordinates, to tell unchanged curves) and the point-list keys.
+``n_subpaths``, ``svg_closed`` (closed by a ``z``: a subpath that merely ends at its start is
+read as a loop but written back open, without ``Z``), ``transform`` (the element's own
+attribute), ``ctm`` (the 2x3 matrix row by row, or None for the identity), ``beziers`` (the
+original segments of a bspline record, in document coordinates, to tell unchanged curves) and
+the point-list keys.
 
 Write
 -----
@@ -69,7 +74,7 @@ import numpy as np
 
 from .._typing import FloatArray
 from ..curves.bspline import BSplineCurve
-from ..errors import FileFormatError, InputError
+from ..errors import FileFormatError, InputError, MissingDependencyError
 from ._common import (
     CurveRecord,
     Unsupported,
@@ -394,14 +399,20 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
             raise FileFormatError(f"<path> element {k} (id={ident!r}): bad path data "
                                   f"({type(exc).__name__}: {exc})", path) from None
         subs = parsed.continuous_subpaths() if len(parsed) else []
+        zs = _closed_by_z(d, parsed, subs, spt)
         for j, sub in enumerate(subs):
             name = f"{ident or 'path' + str(k)}" + (f"/{j}" if len(subs) > 1 else "")
-            sbase = dict(base, subpath=j, n_subpaths=len(subs), svg_closed=bool(sub.isclosed()))
+            sbase = dict(base, subpath=j, n_subpaths=len(subs), svg_closed=zs[j])
             try:
                 records.extend(_subpath_records(sub, spt, sbase, name, corner_angle, path,
                                                 len(records), ctm))
             except Unsupported as exc:
                 skip(f"<path> element {k} (id={ident!r}) subpath {j}: unsupported {exc}")
+            except (FileFormatError, MissingDependencyError):
+                raise
+            except ValueError as exc:   # e.g. a knot vector refused: name the file and element
+                raise FileFormatError(f"<path> element {k} (id={ident!r}) subpath {j}: {exc}",
+                                      path) from None
     return records
 
 
@@ -427,10 +438,11 @@ def _polyline_records(pts: FloatArray, closed: bool, base: dict[str, Any], name:
     """Records of a vertex list (polyline subpath, polygon, polyline, line, rect): exact
     repeats dropped (written back with their twin), a closed list not repeating its start."""
     what = f"<{base['tag']}> element {base['element']} vertex"
-    if closed and pts.shape[0] > 1 and np.array_equal(pts[0], pts[-1]):
+    tiny = _rounding_level(pts)
+    if closed and pts.shape[0] > 1 and np.abs(pts[0] - pts[-1]).max() <= tiny:
         pts = pts[:-1]
-    kept, where = drop_duplicates(pts, path, None, what=what)
-    if closed and kept.shape[0] > 1 and np.array_equal(kept[0], kept[-1]):
+    kept, where = _drop_repeats(pts, tiny, path, what, base.get("id"))
+    if closed and kept.shape[0] > 1 and np.abs(kept[0] - kept[-1]).max() <= tiny:
         kept = kept[:-1]
         where = np.where(where == kept.shape[0], 0, where)
     check_points(kept, path, None, what=what)
@@ -443,22 +455,85 @@ def _polyline_records(pts: FloatArray, closed: bool, base: dict[str, Any], name:
                          name=name, source=src, first_index=index)
 
 
-def _degenerate(g: Any, spt: Any) -> bool:
-    """A segment that does not move (``L`` to the current point: matplotlib writes these)."""
+# A segment or vertex step no longer than this many units in the last place of the
+# coordinates' magnitude is rounding noise (relative commands summed in floating point leave
+# a closing ``z`` segment of ~1e-15), not geometry: it is treated as length zero.
+_ROUNDING_ULPS = 256
+
+
+def _rounding_level(xy: Any) -> float:
+    """The length below which a step between the points ``xy`` is rounding noise."""
+    a = np.abs(np.asarray(xy, dtype=float))
+    a = a[np.isfinite(a)]
+    return _ROUNDING_ULPS * float(np.finfo(float).eps) * (float(a.max()) if a.size else 0.0)
+
+
+def _drop_repeats(pts: FloatArray, tiny: float, path: object, what: str,
+                  ident: str | None) -> tuple[FloatArray, np.ndarray]:
+    """:func:`drop_duplicates` that also drops a vertex equal to the one before it up to
+    rounding noise (``tiny``), with a warning naming the element; ``where`` as there."""
+    pts = np.asarray(pts, dtype=float)
+    if pts.shape[0] < 2:
+        return drop_duplicates(pts, path, None, what=what)
+    step = np.abs(np.diff(pts, axis=0)).max(axis=1)
+    near = np.r_[False, step <= tiny]
+    exact = np.r_[False, np.all(pts[1:] == pts[:-1], axis=1)]
+    if not (near & ~exact).any():
+        return drop_duplicates(pts, path, None, what=what)
+    drop = np.flatnonzero(near)
+    at = ", ".join(str(int(i)) for i in drop[:5])
+    more = f" and {drop.size - 5} more" if drop.size > 5 else ""
+    warnings.warn(f"{os.fspath(path) if path is not None else '<data>'}: "  # type: ignore[call-overload]
+                  f"{what.rsplit(' vertex', 1)[0]} (id={ident!r}): dropped {drop.size} "
+                  f"consecutive vertex(es) equal to the one before up to rounding ({at}{more}); "
+                  "they are written back with the value of the vertex they repeat",
+                  UserWarning, stacklevel=4)
+    return pts[~near], np.cumsum(~near) - 1
+
+
+def _degenerate(g: Any, spt: Any, tiny: float = 0.0) -> bool:
+    """A segment that does not move (``L`` to the current point: matplotlib writes these),
+    or moves no farther than ``tiny`` (rounding noise)."""
+    pts: tuple[Any, ...]
     if isinstance(g, spt.Line):
-        return bool(g.start == g.end)
-    if isinstance(g, spt.CubicBezier):
-        return bool(g.start == g.control1 == g.control2 == g.end)
-    if isinstance(g, spt.QuadraticBezier):
-        return bool(g.start == g.control == g.end)
-    return False
+        pts = (g.start, g.end)
+    elif isinstance(g, spt.CubicBezier):
+        pts = (g.start, g.control1, g.control2, g.end)
+    elif isinstance(g, spt.QuadraticBezier):
+        pts = (g.start, g.control, g.end)
+    else:
+        return False
+    if all(z == g.start for z in pts):
+        return True
+    return bool(all(max(abs(z.real - g.start.real), abs(z.imag - g.start.imag)) <= tiny
+                    for z in pts))
+
+
+def _closed_by_z(d: str, parsed: Any, subs: list[Any], spt: Any) -> list[bool]:
+    """For every continuous subpath: closed by a ``z``/``Z`` command (it ends where it
+    starts and its text ends with the closepath). An open subpath that merely ends at its
+    start point is drawn with two caps, not a join, and is written back without ``Z``.
+    When the text does not split into the subpaths, where it ends at its start."""
+    geo = [bool(sub.isclosed()) for sub in subs]
+    if not any(geo):
+        return geo
+    spans = _subpath_spans(d, parsed, spt)
+    if spans is None or len(spans) != len(subs):
+        return geo
+    return [c and d[a:b].rstrip()[-1:] in ("z", "Z")
+            for c, (a, b, _, _) in zip(geo, spans, strict=True)]
 
 
 def _subpath_records(sub: Any, spt: Any, base: dict[str, Any], name: str,
                      corner_angle: float | None, path: object, index: int,
                      ctm: np.ndarray | None = None) -> list[CurveRecord]:
     closed = bool(sub.isclosed())
-    segs = [g for g in sub if not _degenerate(g, spt)]
+    # segments no longer than rounding noise are dropped like zero-length ones; the
+    # segments kept are joined exactly (a dropped one's gap closed) and a closed subpath
+    # ends exactly at its start
+    tiny = _rounding_level([c for g in sub if not isinstance(g, spt.Arc)
+                            for z in (g.start, g.end) for c in (z.real, z.imag)])
+    segs = [g for g in sub if not _degenerate(g, spt, tiny)]
     if not segs:
         return []
     sub = spt.Path(*segs)
@@ -467,11 +542,16 @@ def _subpath_records(sub: Any, spt: Any, base: dict[str, Any], name: str,
         if not np.isfinite(pts).all():
             raise FileFormatError(f"<path> element {base['element']}: non-finite coordinate",
                                   path)
+        if closed:
+            pts[-1] = pts[0]
         return _polyline_records(_apply(ctm, pts), closed, base, name, corner_angle, path,
                                  index)
     P = _segments_to_cubics(sub, spt)
     if not np.isfinite(P).all():
         raise FileFormatError(f"<path> element {base['element']}: non-finite coordinate", path)
+    P[1:, 0] = P[:-1, 3]
+    if closed:
+        P[-1, 3] = P[0, 0]
     P = _apply(ctm, P)
     curve = bezier_chain_to_bspline(P, closed)
     src = dict(base, index=index, beziers=P.tolist())
@@ -668,7 +748,11 @@ def _record_d(recs: list[CurveRecord], decimals: int | None) -> tuple[str, bool]
     r0 = recs[0]
     if kind == "bspline":
         return _d_cubics(geo, bool(r0.source.get("svg_closed", r0.curve.closed)), decimals), True
-    return _d_points(geo, bool(r0.source.get("closed")), decimals), True
+    closed = bool(r0.source.get("closed"))
+    if closed and not r0.source.get("svg_closed", True):
+        # read as a loop, but the subpath had no Z (it ends at its start): it stays open
+        return _d_points(np.vstack([geo, geo[:1]]), False, decimals), True
+    return _d_points(geo, closed, decimals), True
 
 
 def _start_tag_attrs(raw: bytes, i: int) -> dict[str, tuple[int, int]]:
