@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
-from curvefair import BSplineCurve, read_curves, write_curves
+from curvefair import BSplineCurve, interpolate_cubic, read_curves, write_curves
 from curvefair.io import WriteCheck, WriteCheckError
 
 DATA = Path(__file__).parent / "data"
@@ -420,15 +420,12 @@ def test_reports_count_point_data_on_the_curve_rebuilt_from_the_written_file(tmp
 
 
 def test_svg_element_merged_by_its_own_decimals_is_written_exactly(tmp_path):
-    """A tiny closed subpath (an octagon 3 units across, inside a scaled group) faired at a
-    tolerance of its own size shrinks to nearly a point; written with the element's own
-    decimals (4) its points merge and the file reads back with one curve fewer. The writer
-    then uses exact numbers, as it does for a deviation beyond tol, instead of refusing the
-    file with a count (the hunt of session 18 found this on an OCCT drawing)."""
-    from click.testing import CliRunner
-
-    from curvefair.cli import main
-
+    """A small closed subpath (an octagon inside a scaled group) whose moved points lie closer
+    together than the element's own decimals (4) resolve: written with them, its points merge
+    and the file reads back with one curve fewer. The writer then uses exact numbers, as it
+    does for a deviation beyond tol, instead of refusing the file with a count (the hunt of
+    session 18 met this on an OCCT drawing: a tiny octagon faired at a tolerance of its own
+    size)."""
     spt = pytest.importorskip("svgpathtools")
     a = np.arange(8) * (np.pi / 4)
     octagon = np.c_[525.0 + 1.8 * np.cos(a), 1178.25 + 1.45 * np.sin(a)]
@@ -440,16 +437,19 @@ def test_svg_element_merged_by_its_own_decimals_is_written_exactly(tmp_path):
         f'<path style="fill:none;stroke:#00f" d="{d}" id="oct"/>\n'
         '<path style="fill:none;stroke:#000" d="M 0,0 L 100,0 L 100,100" id="other"/>\n'
         '</g>\n</svg>\n')
+    recs = read_curves(src)
+    assert [r.source["id"] for r in recs] == ["oct", "other", "other"]  # split at its corner
+    p = np.asarray(recs[0].curve.points)[:-1]  # document coordinates, closing point dropped
+    c = p.mean(axis=0)
+    q = c + 2e-5 * (p - c)  # 3e-5 across: below the element's 4 decimals
+    new = interpolate_cubic(np.vstack([q, q[:1]]), "chord", "periodic")
     out = tmp_path / "out.svg"
-    res = CliRunner().invoke(main, ["fair", str(src), "-o", str(out), "--tol", "1"])
-    assert res.exit_code == 0, res.output
-    assert "exact numbers" in res.output
+    with pytest.warns(UserWarning, match="exact numbers"):
+        check = write_curves(out, [recs[0].with_curve(new), *recs[1:]], template=src, tol=1.0)
+    assert check.precision == "exact"
     paths_in, attr_in = spt.svg2paths(str(src))
     paths_out, attr_out = spt.svg2paths(str(out))
-    assert [x["id"] for x in attr_out] == [x["id"] for x in attr_in]
+    assert [x["id"] for x in attr_out] == ["oct", "other"]
     assert attr_out[1]["d"] == attr_in[1]["d"]  # the other element as it was
-    p0 = np.array([[s.start.real, s.start.imag] for s in paths_in[0]])
-    p1 = np.array([[s.start.real, s.start.imag] for s in paths_out[0]])
-    assert p1.shape == p0.shape and paths_out[0].isclosed()
-    # every vertex within tol in the user's units (the group's transform scales by 0.4577)
-    assert np.max(np.linalg.norm(p1 - p0, axis=1)) * 0.45775 <= 1.0
+    back = read_curves(out)
+    np.testing.assert_allclose(np.asarray(back[0].curve.points)[:-1], q, rtol=0, atol=1e-9)
