@@ -787,3 +787,61 @@ def test_glyph_plots_right_way_up_with_a_comb_per_contour():
         assert xy[:, 1].min() >= ymin - 1e-6 and xy[:, 1].max() <= ymax + 1e-6
         hairs = [c for c in ax.collections if c.get_gid() == "curvefair-comb-hairs"]
         assert len(hairs) == 1 and len(hairs[0].get_segments()) > 10
+
+
+def _cff_nodes(path: Path, name: str) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """``(incoming handle, node, outgoing handle)`` at every on-curve point between two
+    curve segments of glyph ``name``, drawn by fontTools (independent of curvefair)."""
+    pen = RecordingPen()
+    TTFont(path).getGlyphSet()[name].draw(pen)
+    out, segs, cur = [], [], None
+    for op, args in pen.value:
+        if op == "moveTo":
+            cur, segs = np.array(args[0]), []
+        elif op == "lineTo":
+            segs.append(None)
+            cur = np.array(args[0])
+        elif op == "curveTo":
+            a, b, c = (np.array(x) for x in args)
+            segs.append((cur, a, b, c))
+            cur = c
+        elif op in ("closePath", "endPath"):
+            for s0, s1 in zip(segs, segs[1:] + segs[:1], strict=True):
+                if s0 is not None and s1 is not None:
+                    out.append((s0[2], s0[3], s1[1]))
+    return out
+
+
+def _turn(h: tuple[np.ndarray, np.ndarray, np.ndarray]) -> float:
+    d1, d2 = h[1] - h[0], h[2] - h[1]
+    c = float(d1 @ d2) / float(np.linalg.norm(d1) * np.linalg.norm(d2))
+    return float(np.degrees(np.arccos(np.clip(c, -1.0, 1.0))))
+
+
+def test_cff_fractional_coordinates_keep_smooth_joins_smooth(tmp_path):
+    # Linux Libertine (a fontTools test font, subset; tests/data/README.md) has on-curve points
+    # at tenths of a unit. Its handles used to be rounded to integers while the nodes kept
+    # their tenths: two.inferior's node at (135.4, 94), smooth to 0.26 degrees, became a
+    # 12.45-degree kink (found by the hunt of session 18)
+    from click.testing import CliRunner
+
+    from curvefair.cli import main
+
+    src = Path(__file__).parent / "data" / "real" / "fonttools" / "LinLibertine_RBI.subset.otf"
+    out = tmp_path / "out.otf"
+    res = CliRunner().invoke(main, ["fair", str(src), "-o", str(out), "--tol", "1",
+                                    "--glyphs", "two.inferior,onehalf"])
+    assert res.exit_code == 0, res.output
+    changed = 0
+    for name in ("two.inferior", "onehalf"):
+        before, after = _cff_nodes(src, name), _cff_nodes(out, name)
+        assert len(after) == len(before)
+        smooth = [k for k, h in enumerate(before) if _turn(h) < 0.5]
+        assert smooth  # the case: nearly smooth joins in fractional coordinates
+        assert max(_turn(after[k]) for k in smooth) < 1.0
+        nb = np.array([h[1] for h in before])
+        na = np.array([h[1] for h in after])
+        assert np.all(np.linalg.norm(na - nb, axis=1) <= 1.0 + 1e-9)
+        changed += int(np.any(na != nb) or any(np.any(x[0] != y[0]) for x, y in
+                                                zip(before, after, strict=True)))
+    assert changed >= 1

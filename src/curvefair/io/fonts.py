@@ -32,8 +32,10 @@ Only with the source as template (a font is never made from curves alone). The f
 points become the contour's points with the outline's rules enforced
 (:func:`curvefair.io._outline.constrained_points`: same points in the same order, smooth
 nodes exactly smooth, extrema keep their horizontal/vertical tangent, corners and straight
-segments unmoved, integers in binary fonts), each contour no farther from its input than the
-record's faired control points are (so within the fairing's ``tol``), and never less fair than
+segments unmoved, integers in TrueType and in CFF contours drawn on integers -- a CFF contour
+with fractional coordinates keeps them and its nearly smooth nodes smooth), each contour no
+farther from its input than the record's faired control points are (so within the fairing's
+``tol``), and never less fair than
 its input as written (:func:`record_points`: no more curvature extrema, no more bending
 energy; else the input contour is written). The layers of a multi-master ``.glyphs`` source
 share that decision per contour, instances between them included (:func:`shared_points`).
@@ -186,8 +188,23 @@ def _cff_walk(cmds: list[tuple[str, list[Any]]]) -> list[tuple[list[FloatArray],
 
 
 def _cff_contours(font: Any, name: str) -> list[Contour]:
+    """A CFF glyph's contours. Charstrings hold 16.16 fixed-point numbers, not only
+    integers: a contour whose coordinates are all integers keeps to the integer grid (its
+    smooth nodes those exactly collinear with their handles); one with fractional coordinates
+    (Linux Libertine: on-curve points at tenths) is not put on the grid -- rounding its
+    handles but not its nodes kinked joins that were smooth to 0.26 degrees into 12 -- and
+    every node whose handles are collinear within ``_outline.SMOOTH_ANGLE`` (0.5 degrees) is
+    kept smooth, as in a UFO."""
     walked = _cff_walk(_cff_commands(font, name))
-    return [_binary_contour(np.array(p), o, False) for p, o, _ in walked]
+    out = []
+    for p, o, _ in walked:
+        xy = np.array(p)
+        if np.array_equal(xy, np.round(xy)):
+            out.append(_binary_contour(xy, o, False))
+        else:
+            out.append(Contour(xy, tuple(bool(v) for v in o), tuple(bool(v) for v in o), True,
+                               False, grid=False))
+    return out
 
 
 def _open_binary(path: Any) -> Any:
