@@ -845,3 +845,40 @@ def test_cff_fractional_coordinates_keep_smooth_joins_smooth(tmp_path):
         changed += int(np.any(na != nb) or any(np.any(x[0] != y[0]) for x, y in
                                                 zip(before, after, strict=True)))
     assert changed >= 1
+
+
+@pytest.mark.parametrize("name", ["GlyphsFileFormatv3", "CornerComponents"])
+def test_glyphs_source_with_nothing_faired_is_copied_byte_for_byte(tmp_path, name):
+    # glyphsLib's round trip drops or adds data in these format-3 sources (fontType, kernTop,
+    # background imagePath, an instance's visible; an axes block): when no curve changes the
+    # output is the input's bytes (the hunt of session 18 found them rewritten)
+    pytest.importorskip("glyphsLib")
+    from click.testing import CliRunner
+
+    from curvefair.cli import main
+
+    src = Path(__file__).parent / "data" / "real" / "glyphsLib" / f"{name}.glyphs"
+    out = tmp_path / f"{name}.glyphs"
+    res = CliRunner().invoke(main, ["fair", str(src), "-o", str(out), "--tol", "1"])
+    assert res.exit_code == 0, res.output
+    assert out.read_bytes() == src.read_bytes()
+
+
+def test_glyphs_source_glyphslib_changes_is_warned_about(tmp_path):
+    # some curves faired: glyphsLib writes the file, and where its round trip of the unchanged
+    # source differs from the source the user is told (first line it changes)
+    pytest.importorskip("glyphsLib")
+    import glyphsLib
+    from click.testing import CliRunner
+
+    from curvefair.cli import main
+
+    src = Path(__file__).parent / "data" / "real" / "glyphsLib" / "GlyphsFileFormatv3.glyphs"
+    rt = tmp_path / "roundtrip.glyphs"
+    glyphsLib.GSFont(str(src)).save(str(rt))
+    assert rt.read_bytes() != src.read_bytes()  # the case: glyphsLib does not round-trip it
+    out = tmp_path / "out.glyphs"
+    res = CliRunner().invoke(main, ["fair", str(src), "-o", str(out), "--tol", "5"])
+    assert res.exit_code == 0, res.output
+    assert "glyphsLib does not write this source back as it read it" in res.output
+    assert "line 45" in res.output and out.read_bytes() != src.read_bytes()

@@ -46,8 +46,11 @@ A variable TrueType binary (``gvar``) is refused: its sources are faired instead
   features, groups, lib, other layers, components, anchors, guidelines come back byte for byte.
 - TrueType: the changed glyphs' coordinates are replaced (instructions, flags and point
   counts kept), bounds recomputed, the left side bearing follows ``xMin`` where it was equal.
-- Glyphs: glyphsLib loads the source, the changed layers' nodes are moved and it saves
-  the file again (glyphsLib writes what it read: unchanged sources come back byte for byte).
+- Glyphs: nothing changed, the source's bytes are copied; else glyphsLib loads the source,
+  the changed layers' nodes are moved and it saves the file again. glyphsLib does not
+  round-trip every source (format 3 files lose e.g. ``fontType``, ``kernTop``, background
+  images): when its save of the unchanged source differs from it, a ``UserWarning`` names the
+  first line it changes (:func:`write_glyphs`).
   Integer coordinates stay integers (Glyphs' default grid); other coordinates are written
   with glyphsLib's 5 decimals.
 - CFF: the charstrings are desubroutinized and each changed glyph's drawing operators
@@ -238,7 +241,14 @@ def _open_ufo(path: Any) -> Any:
 def _open_glyphs(path: Any) -> Any:
     glyphsLib = lazy_import("glyphsLib", "glyphsLib", "fonts", "Glyphs sources")
     try:
-        return glyphsLib.GSFont(os.fspath(path))
+        # what GSFont(path) does, with the file closed again (glyphsLib's own open is not)
+        font = glyphsLib.GSFont()
+        with open(os.fspath(path), encoding="utf-8") as f:
+            glyphsLib.load(f, font)
+        font.filepath = os.fsdecode(os.fspath(path))
+        for master in font.masters:
+            master.font = font
+        return font
     except Exception as exc:
         raise FileFormatError(f"not a Glyphs source glyphsLib can read ({exc})", path) from None
 
@@ -723,8 +733,20 @@ def _write_layer(dest: str, template: str, layer_name: str | None,
 
 def write_glyphs(path: str | os.PathLike[str], changes: dict[str, dict[int, FloatArray]],
                  template: str) -> None:
-    """Save a copy of the Glyphs source ``template`` with the changed layers' nodes moved
-    (glyphsLib writes the rest of the file as it read it)."""
+    """Save a copy of the Glyphs source ``template`` with the changed layers' nodes moved.
+
+    Nothing changed: the template's bytes, exactly. Otherwise glyphsLib writes the file, and
+    glyphsLib does not round-trip every source (format 3 files lose e.g. ``fontType``,
+    ``kernTop``, background ``imagePath`` entries, an instance's ``visible``): the unmodified
+    source is saved through glyphsLib too, and if that differs from the template a
+    ``UserWarning`` names the file and the first line glyphsLib changes, so that a loss the
+    fairing did not cause is not silent."""
+    with open(template, "rb") as f:
+        raw = f.read()
+    if not any(changes.values()):
+        with open(os.fspath(path), "wb") as f:
+            f.write(raw)
+        return
     font = _open_glyphs(template)
     names = sorted({k.split("@")[0] for k in changes})
     for g, label, layer, _ in _glyphs_layers(font, [n for n in names if n in font.glyphs]):
@@ -736,6 +758,25 @@ def write_glyphs(path: str | os.PathLike[str], changes: dict[str, dict[int, Floa
             for node, (x, y) in zip(paths[ci].nodes, pts, strict=True):
                 node.position = (_number(x), _number(y))
     font.save(os.fspath(path))
+    probe = os.fspath(path) + ".roundtrip"
+    try:
+        _open_glyphs(template).save(probe)
+        with open(probe, "rb") as f:
+            same = f.read()
+    finally:
+        if os.path.exists(probe):
+            os.remove(probe)
+    if same != raw:
+        a = raw.decode("utf-8", "replace").splitlines()
+        b = same.decode("utf-8", "replace").splitlines()
+        k = next((i for i, (x, y) in enumerate(zip(a, b, strict=False)) if x != y),
+                 min(len(a), len(b)))
+        was = a[k].strip() if k < len(a) else "(end of file)"
+        now = b[k].strip() if k < len(b) else "(end of file)"
+        warnings.warn(f"{template}: glyphsLib does not write this source back as it read it, "
+                      f"so the output differs from it beyond the faired nodes (first at line "
+                      f"{k + 1}: {was!r} becomes {now!r}); compare before replacing the source",
+                      UserWarning, stacklevel=2)
 
 
 def _number(v: float) -> float | int:
