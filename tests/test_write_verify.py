@@ -453,3 +453,25 @@ def test_svg_element_merged_by_its_own_decimals_is_written_exactly(tmp_path):
     assert attr_out[1]["d"] == attr_in[1]["d"]  # the other element as it was
     back = read_curves(out)
     np.testing.assert_allclose(np.asarray(back[0].curve.points)[:-1], q, rtol=0, atol=1e-9)
+
+
+def test_count_mismatch_names_the_curves_not_read_back(tmp_path):
+    """A file that reads back with fewer curves than were written (here a reader that loses
+    the second DXF spline) is not written, and the error names the curve that is missing."""
+    ezdxf = pytest.importorskip("ezdxf")
+    from curvefair.io import write_checked
+
+    doc = ezdxf.new("R2010")
+    msp = doc.modelspace()
+    for k in range(2):
+        msp.add_open_spline([(0, k), (1, k + 1), (2, k), (3, k + 1), (4, k)], degree=3)
+    src = tmp_path / "in.dxf"
+    doc.saveas(src)
+    recs = read_curves(src)
+    lost = recs[1].source["handle"]
+    out = tmp_path / "out.dxf"
+    with pytest.raises(WriteCheckError, match=rf"reads back as 1 curves, the input had 2 "
+                                              rf"\(curve 1 \([^)]*{lost}[^)]*\) not read back\)"):
+        write_checked(out, recs, recs, tol=0.1, reader=lambda p: read_curves(p)[:1],
+                      template=str(src), format="dxf", overwrite=False)
+    assert not out.exists()
