@@ -639,10 +639,11 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
     primed = prime_power_forms(curve, new)
     after = analysis_block(new)
     guard_info: dict[str, Any] = {"kept": "output"}
-    worse = after["inflections"] > before["inflections"] or after["extrema"] > before["extrema"]
+    from ._guard import _adds, is_chord_interpolant, rebuilt_curve
+
+    worse = bool(_adds(after, before))
     rebuilt = rb_after = None
     if guard:
-        from ._guard import is_chord_interpolant, rebuilt_curve
 
         if (type(new) is CubicHermite and type(curve) is CubicHermite
                 and np.array_equal(new.params, curve.params)
@@ -654,9 +655,7 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
                 return None if r is None else analysis_block(r)
 
             rb_after = rebuilt(new)
-            worse = worse or rb_after is None or (
-                rb_after["inflections"] > before["inflections"]
-                or rb_after["extrema"] > before["extrema"])
+            worse = worse or rb_after is None or bool(_adds(rb_after, before))
             if rb_after is not None:
                 guard_info["rebuilt"] = dict(rb_after)
     if guard and worse:

@@ -406,12 +406,15 @@ def check_points(pts: FloatArray, path: object, lines: Sequence[int | None] | No
 
 
 def drop_duplicates(pts: FloatArray, path: object, lines: Sequence[int | None] | None = None,
-                    what: str = "point") -> tuple[FloatArray, np.ndarray]:
+                    what: str = "point", tiny: float = 0.0) -> tuple[FloatArray, np.ndarray]:
     """Drop exactly-duplicate consecutive points, with a warning naming them.
 
     A point equal in every coordinate to the one before it carries no geometry (exporters
     write them at the joins of pieces) but makes the chord-length parameterisation singular.
-    Points that are merely close stay and are refused by :func:`check_points`.
+    Points that are merely close stay and are refused by :func:`check_points` -- unless they
+    differ by no more than ``tiny`` in every coordinate (a reader's rounding level, e.g. SVG
+    relative coordinates summed in floating point): those are dropped too, and the warning
+    says "equal up to rounding".
 
     Returns
     -------
@@ -425,9 +428,10 @@ def drop_duplicates(pts: FloatArray, path: object, lines: Sequence[int | None] |
     m = pts.shape[0]
     if m < 2:
         return pts, np.arange(m)
-    rep = np.r_[False, np.all(pts[1:] == pts[:-1], axis=1)]
+    rep = np.r_[False, np.all(np.abs(pts[1:] - pts[:-1]) <= tiny, axis=1)]
     if not rep.any():
         return pts, np.arange(m)
+    exact = bool(np.all(pts[1:][rep[1:]] == pts[:-1][rep[1:]]))
     where = np.cumsum(~rep) - 1
     drop = np.flatnonzero(rep)
     if lines is not None and lines[int(drop[0])] is not None:
@@ -438,7 +442,8 @@ def drop_duplicates(pts: FloatArray, path: object, lines: Sequence[int | None] |
     import warnings
 
     warnings.warn(f"{os.fspath(path) if path is not None else '<data>'}: dropped "  # type: ignore[call-overload]
-                  f"{drop.size} exactly repeated consecutive {what}(s) ({at}{more}); they are "
+                  f"{drop.size} {'exactly ' if exact else ''}repeated consecutive {what}(s) "
+                  f"{'' if exact else '(equal up to rounding) '}({at}{more}); they are "
                   "written back with the value of the point they repeat", UserWarning,
                   stacklevel=3)
     return pts[~rep], where

@@ -441,7 +441,8 @@ def _polyline_records(pts: FloatArray, closed: bool, base: dict[str, Any], name:
     tiny = _rounding_level(pts)
     if closed and pts.shape[0] > 1 and np.abs(pts[0] - pts[-1]).max() <= tiny:
         pts = pts[:-1]
-    kept, where = _drop_repeats(pts, tiny, path, what, base.get("id"))
+    label = f"<{base['tag']}> element {base['element']} (id={base.get('id')!r}) vertex"
+    kept, where = drop_duplicates(pts, path, None, what=label, tiny=tiny)
     if closed and kept.shape[0] > 1 and np.abs(kept[0] - kept[-1]).max() <= tiny:
         kept = kept[:-1]
         where = np.where(where == kept.shape[0], 0, where)
@@ -466,29 +467,6 @@ def _rounding_level(xy: Any) -> float:
     a = np.abs(np.asarray(xy, dtype=float))
     a = a[np.isfinite(a)]
     return _ROUNDING_ULPS * float(np.finfo(float).eps) * (float(a.max()) if a.size else 0.0)
-
-
-def _drop_repeats(pts: FloatArray, tiny: float, path: object, what: str,
-                  ident: str | None) -> tuple[FloatArray, np.ndarray]:
-    """:func:`drop_duplicates` that also drops a vertex equal to the one before it up to
-    rounding noise (``tiny``), with a warning naming the element; ``where`` as there."""
-    pts = np.asarray(pts, dtype=float)
-    if pts.shape[0] < 2:
-        return drop_duplicates(pts, path, None, what=what)
-    step = np.abs(np.diff(pts, axis=0)).max(axis=1)
-    near = np.r_[False, step <= tiny]
-    exact = np.r_[False, np.all(pts[1:] == pts[:-1], axis=1)]
-    if not (near & ~exact).any():
-        return drop_duplicates(pts, path, None, what=what)
-    drop = np.flatnonzero(near)
-    at = ", ".join(str(int(i)) for i in drop[:5])
-    more = f" and {drop.size - 5} more" if drop.size > 5 else ""
-    warnings.warn(f"{os.fspath(path) if path is not None else '<data>'}: "  # type: ignore[call-overload]
-                  f"{what.rsplit(' vertex', 1)[0]} (id={ident!r}): dropped {drop.size} "
-                  f"consecutive vertex(es) equal to the one before up to rounding ({at}{more}); "
-                  "they are written back with the value of the vertex they repeat",
-                  UserWarning, stacklevel=4)
-    return pts[~near], np.cumsum(~near) - 1
 
 
 def _degenerate(g: Any, spt: Any, tiny: float = 0.0) -> bool:
