@@ -149,3 +149,107 @@ def test_bad_input_errors(call, fragment):
         call()
     assert isinstance(exc.value, (InputError, ValueError))
     assert fragment in str(exc.value)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_power_form_kernels_exact_and_machine_independent(dim):
+    """The compiled power forms (one pass, no temporaries) against exact rational arithmetic:
+    every coefficient within 2 ulp of the magnitude of its terms, on spacings over six
+    decades; the powers of the width correctly rounded (``pow``), so the numbers do not
+    depend on the CPU; and within rounding of the vectorised numpy formulas."""
+    from fractions import Fraction as Fr
+
+    from curvefair._kernels.hermite_power import (
+        cubic_power_reference,
+        quintic_power_reference,
+    )
+    from curvefair.curves.hermite import (
+        cubic_hermite_coefficients,
+        quintic_hermite_coefficients,
+    )
+
+    rng = np.random.default_rng(7)
+    eps = np.finfo(float).eps
+    for n in (2, 3, 40):
+        t = np.cumsum(10.0 ** rng.uniform(-3, 3, n))
+        p, m, s = (rng.normal(size=(n, dim)) * 10.0 ** rng.uniform(-2, 4) for _ in range(3))
+        c = cubic_hermite_coefficients(p, m, t)
+        q = quintic_hermite_coefficients(p, m, s, t)
+        assert c.shape == (n - 1, 4, dim) and q.shape == (n - 1, 6, dim)
+        for i in range(n - 1):
+            D = Fr(t[i + 1]) - Fr(t[i])
+            for d in range(dim):
+                p0, p1, m0, m1, s0, s1 = (Fr(v) for v in (p[i, d], p[i + 1, d], m[i, d],
+                                                          m[i + 1, d], s[i, d], s[i + 1, d]))
+                dp = p1 - p0
+                exact = [(p0, abs(p0)), (m0, abs(m0)),
+                         (3 * dp / D**2 - (2 * m0 + m1) / D,
+                          abs(3 * dp / D**2) + abs((2 * m0 + m1) / D)),
+                         (-2 * dp / D**3 + (m0 + m1) / D**2,
+                          abs(2 * dp / D**3) + abs((m0 + m1) / D**2))]
+                for j, (v, size) in enumerate(exact):
+                    assert abs(Fr(c[i, j, d]) - v) <= 16 * eps * size, (i, j, d)
+                b1 = dp - m0 * D - s0 * D**2 / 2
+                b2 = m1 - m0 - s0 * D
+                b3 = s1 - s0
+                qx = [(p0, abs(p0)), (m0, abs(m0)), (s0 / 2, abs(s0 / 2)),
+                      ((10 * b1 - 4 * b2 * D + b3 * D**2 / 2) / D**3,
+                       (abs(10 * b1) + abs(4 * b2 * D) + abs(b3 * D**2 / 2)) / D**3),
+                      ((-15 * b1 + 7 * b2 * D - b3 * D**2) / D**4,
+                       (abs(15 * b1) + abs(7 * b2 * D) + abs(b3 * D**2)) / D**4),
+                      ((6 * b1 - 3 * b2 * D + b3 * D**2 / 2) / D**5,
+                       (abs(6 * b1) + abs(3 * b2 * D) + abs(b3 * D**2 / 2)) / D**5)]
+                # b1, b2 themselves cancel: their rounding is relative to their terms
+                slack = (abs(dp) + abs(m0 * D) + abs(s0 * D**2)) * 64 * eps
+                for j, (v, size) in enumerate(qx):
+                    bound = 64 * eps * size + (0 if j < 3 else 15 * slack / D ** j)
+                    assert abs(Fr(q[i, j, d]) - v) <= bound, (i, j, d)
+        # the widths' cubes are the correctly rounded ones (pow), whatever the CPU: with
+        # p = (0, 1) and zero tangents, a_3 = -2 / D^3 is one rounding of the rounded cube
+        for x in np.diff(t):
+            one = cubic_hermite_coefficients(np.array([[0.0] * dim, [1.0] * dim]),
+                                             np.zeros((2, dim)), np.array([0.0, x]))
+            assert one[0, 3, 0] == -2.0 / float(Fr(float(x)) ** 3)
+        # and within rounding of numpy's vectorised formulas
+        np.testing.assert_allclose(c, cubic_power_reference(p, m, t), rtol=1e-9,
+                                   atol=1e-12 * float(np.abs(c).max()))
+        np.testing.assert_allclose(q, quintic_power_reference(p, m, s, t), rtol=1e-6,
+                                   atol=1e-9 * float(np.abs(q).max()))
+        # strided (non-contiguous) input gives the same numbers
+        assert np.array_equal(cubic_hermite_coefficients(np.asfortranarray(p), m, t), c)
+
+
+def test_is_chord_interpolant_marker_and_full_check():
+    """fair()'s guard recognises the curve a point file is read as: at once when
+    interpolate_cubic made it, otherwise by rebuilding it; affine changes of parameter
+    allowed, anything else refused."""
+    from curvefair.fairing._guard import is_chord_interpolant
+
+    rng = np.random.default_rng(3)
+    s = np.linspace(0, 3, 30)
+    P = np.c_[s, np.sin(s)] + 1e-3 * rng.normal(size=(30, 2))
+    c = cf.interpolate_cubic(P, "chord", "natural")
+    assert c._chord_natural and is_chord_interpolant(c)
+    ring = np.c_[np.cos(2 * np.pi * s[:-1] / 3), np.sin(2 * np.pi * s[:-1] / 3)]
+    cp = cf.interpolate_cubic(ring, "chord", "periodic")
+    assert cp._chord_natural and cp.closed and is_chord_interpolant(cp)
+    # the same data built by hand (no marker): the full check agrees, for both
+    for k in (c, cp):
+        bare = cf.CubicHermite(k.points, k.tangents, k.params, closed=k.closed)
+        assert not bare._chord_natural and is_chord_interpolant(bare)
+        # an affine change of parameter: t -> 2.5 t + 7, tangents / 2.5
+        aff = cf.CubicHermite(k.points, np.asarray(k.tangents) / 2.5,
+                              2.5 * np.asarray(k.params) + 7.0, closed=k.closed)
+        assert is_chord_interpolant(aff)
+    # not the chord natural interpolant: other parameters, other ends, moved tangents
+    assert not cf.interpolate_cubic(P, "uniform", "natural")._chord_natural
+    assert not is_chord_interpolant(cf.interpolate_cubic(P, "uniform", "natural"))
+    assert not is_chord_interpolant(cf.interpolate_cubic(P, "chord", "not-a-knot"))
+    bent = np.array(c.tangents)
+    bent[10] *= 1.01
+    assert not is_chord_interpolant(cf.CubicHermite(c.points, bent, c.params))
+    # a replaced curve does not inherit the marker: moved points are checked again
+    moved = np.array(c.points)
+    moved[5, 1] += 0.01
+    r = c.replace(points=moved)
+    assert not r._chord_natural and not is_chord_interpolant(r)

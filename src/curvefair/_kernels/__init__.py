@@ -7,6 +7,9 @@ the kernels and read their results live in the public packages (:mod:`curvefair.
 
 * :mod:`.bspline` -- B-spline basis functions, power form and Gram band, and the energy and
   residual in difference form that the B-spline methods share;
+* :mod:`.hermite_power` -- the power form of cubic and quintic Hermite data;
+* :mod:`.cubic_spline` -- the slopes of the C2 cubic spline through points (natural, clamped,
+  periodic ends);
 * :mod:`.hermite` -- the local Hermite steps (Kjellander, Poliakoff, Wang-Cao, Wang quintic)
   and their automatic loop;
 * :mod:`.eck_hadenfeld`, :mod:`.knot_removal`, :mod:`.cheng_yu` -- the steps and automatic
@@ -38,6 +41,10 @@ the other kernels are checked by independent computations in their tests:
   :func:`.eck_hadenfeld.eh_sweep_reference` with :func:`.eck_hadenfeld.eh_drop_reference`
   (sweep), all from the dense Gram matrix recomputed from scratch;
 * :mod:`.global_fair` -- no reference: KKT conditions, a dense direct solve, scipy's SLSQP;
+* :mod:`.cubic_spline` -- no reference: exact rational elimination of the same system and
+  scipy's ``CubicSpline`` (``tests/test_cubic_slopes.py``);
+* :mod:`.hermite_power` -- :func:`.hermite_power.cubic_power_reference` and
+  :func:`.hermite_power.quintic_power_reference` (numpy), exact rational arithmetic and scipy;
 * :mod:`.hermite` -- no reference: scipy's Hermite and interpolating splines, quadrature,
   finite differences, a replay of the loop's history with the public steps;
 * :mod:`.joins` -- the numpy formula it replaced, kept in ``tests/test_joins_straight.py``

@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from .._kernels.hermite_power import cubic_power_kernel, quintic_power_kernel
 from .._typing import ArrayLike, FloatArray
 from .._validate import as_params, as_points, as_vectors, magnitude
 from ..errors import InputError
@@ -141,6 +142,10 @@ class CubicHermite(HermiteSpline):
 
     degree = 3
     _deriv_names = ("tangents",)
+    #: set by :func:`curvefair.interpolate_cubic` on the chord-length natural (periodic) cubic
+    #: it makes, the curve a point file is read as (``fair()``'s guard then need not rebuild
+    #: it to recognise it); never set on a curve made any other way
+    _chord_natural: bool = False
 
     def __init__(self, points: ArrayLike, tangents: ArrayLike, params: ArrayLike,
                  closed: bool = False) -> None:
@@ -214,30 +219,24 @@ class QuinticHermite(HermiteSpline):
         )
 
 
+def _c64(a: ArrayLike) -> FloatArray:
+    return np.ascontiguousarray(a, dtype=np.float64)
+
+
 def cubic_hermite_coefficients(p: FloatArray, m: FloatArray, t: FloatArray) -> FloatArray:
-    """Seed 001 eq. (6), vectorised: ``(n-1, 4, dim)``."""
-    D = np.diff(t)[:, None]
-    dp = p[1:] - p[:-1]
-    c = np.empty((p.shape[0] - 1, 4, p.shape[1]))
-    c[:, 0] = p[:-1]
-    c[:, 1] = m[:-1]
-    c[:, 2] = 3.0 * dp / D**2 - (2.0 * m[:-1] + m[1:]) / D
-    c[:, 3] = -2.0 * dp / D**3 + (m[:-1] + m[1:]) / D**2
+    """Seed 001 eq. (6): ``(n-1, 4, dim)`` (:class:`CubicHermite`'s Notes), one compiled
+    pass (:func:`curvefair._kernels.hermite_power.cubic_power_kernel`)."""
+    p, m, t = _c64(p), _c64(m), _c64(t)
+    c = np.empty((max(p.shape[0] - 1, 0), 4, p.shape[1]))
+    cubic_power_kernel(p, m, t, c)
     return c
 
 
 def quintic_hermite_coefficients(p: FloatArray, m: FloatArray, s: FloatArray,
                                  t: FloatArray) -> FloatArray:
-    """Seed 000 eq. (2), vectorised: ``(n-1, 6, dim)``."""
-    D = np.diff(t)[:, None]
-    b1 = p[1:] - p[:-1] - m[:-1] * D - 0.5 * s[:-1] * D**2
-    b2 = m[1:] - m[:-1] - s[:-1] * D
-    b3 = s[1:] - s[:-1]
-    c = np.empty((p.shape[0] - 1, 6, p.shape[1]))
-    c[:, 0] = p[:-1]
-    c[:, 1] = m[:-1]
-    c[:, 2] = 0.5 * s[:-1]
-    c[:, 3] = (10.0 * b1 - 4.0 * b2 * D + 0.5 * b3 * D**2) / D**3
-    c[:, 4] = (-15.0 * b1 + 7.0 * b2 * D - b3 * D**2) / D**4
-    c[:, 5] = (6.0 * b1 - 3.0 * b2 * D + 0.5 * b3 * D**2) / D**5
+    """Seed 000 eq. (2): ``(n-1, 6, dim)`` (:class:`QuinticHermite`'s Notes), one compiled
+    pass (:func:`curvefair._kernels.hermite_power.quintic_power_kernel`)."""
+    p, m, s, t = _c64(p), _c64(m), _c64(s), _c64(t)
+    c = np.empty((max(p.shape[0] - 1, 0), 6, p.shape[1]))
+    quintic_power_kernel(p, m, s, t, c)
     return c

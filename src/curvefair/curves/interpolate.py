@@ -13,6 +13,7 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 from scipy.linalg.lapack import dgbsv
 
+from .._kernels.cubic_spline import cubic_slopes_kernel, periodic_slopes_kernel
 from .._typing import ArrayLike, FloatArray
 from .._validate import as_points, as_vectors, choice, magnitude
 from ..errors import InputError
@@ -111,6 +112,33 @@ def _bc_pair(bc: Any, dim: int, natural_orders: tuple[int, ...],
             _end_condition(right, "right", dim, natural_orders, tangents[1]))
 
 
+def cubic_slopes(t: FloatArray, pts: FloatArray, bc: Any) -> FloatArray:
+    """The slopes (first derivatives) at ``t`` of the C2 cubic spline through ``pts``.
+
+    ``bc``: ``"periodic"`` (``pts[-1]`` repeats ``pts[0]``; at least 3 distinct points), or a
+    pair of scipy-style ends, each ``(order, vector)`` with order 1 (given slope) or 2 (given
+    second derivative; zero: natural) or ``"not-a-knot"``. Given slopes and second derivatives
+    go through the compiled tridiagonal solve of :mod:`curvefair._kernels.cubic_spline` (its
+    docstring has the equations); a not-a-knot end through scipy's ``CubicSpline``."""
+    t = np.ascontiguousarray(t, dtype=np.float64)
+    y = np.ascontiguousarray(pts, dtype=np.float64)
+    n, dim = y.shape
+    out = np.empty((n, dim))
+    cp = np.empty(n)
+    if isinstance(bc, str) and bc == "periodic":
+        periodic_slopes_kernel(t, y, cp, np.empty(n), out)
+        return out
+    left, right = bc
+    if isinstance(left, str) or isinstance(right, str):
+        spl = CubicSpline(t, y, bc_type=(left, right), axis=0)
+        return np.asarray(spl(t, 1))
+    (lo, lv), (hi, hv) = left, right
+    cubic_slopes_kernel(t, y, int(lo), np.ascontiguousarray(lv, dtype=np.float64).reshape(dim),
+                        int(hi), np.ascontiguousarray(hv, dtype=np.float64).reshape(dim), cp,
+                        out)
+    return out
+
+
 def interpolate_cubic(points: ArrayLike, param: str | ArrayLike = "chord", bc: Any = "natural",
                       *, end_tangents: ArrayLike | None = None) -> CubicHermite:
     """C2 interpolating parametric cubic spline, returned as a :class:`CubicHermite`.
@@ -137,8 +165,9 @@ def interpolate_cubic(points: ArrayLike, param: str | ArrayLike = "chord", bc: A
 
     Notes
     -----
-    The tangents solve the usual tridiagonal C2 system (scipy's ``CubicSpline``); the Hermite
-    form is then exactly the interpolating spline.
+    The tangents solve the usual tridiagonal C2 system (:func:`cubic_slopes`: compiled, the
+    same system scipy's ``CubicSpline`` solves; a not-a-knot end goes through scipy); the
+    Hermite form is then exactly the interpolating spline.
 
     Examples
     --------
@@ -152,18 +181,21 @@ def interpolate_cubic(points: ArrayLike, param: str | ArrayLike = "chord", bc: A
     """
     pts, t, periodic = _prepare(points, param, bc, min_points=2)
     if periodic:
-        spl = CubicSpline(t, pts, bc_type="periodic", axis=0)
+        tangents = cubic_slopes(t, pts, "periodic")
     else:
         left, right = _bc_pair(bc, pts.shape[1], (2,), end_tangents)
         scipy_bc = tuple("not-a-knot" if c == "not-a-knot" else c[0] for c in (left, right))
         if pts.shape[0] < 4 and "not-a-knot" in scipy_bc and scipy_bc != ("not-a-knot",) * 2:
             raise InputError("a not-a-knot end needs at least 4 points unless both ends are "
                              "not-a-knot")
-        spl = CubicSpline(t, pts, bc_type=scipy_bc, axis=0)
-    tangents = spl(t, 1)
-    if periodic:
-        tangents[-1] = tangents[0]
-    return CubicHermite(pts, tangents, t, closed=periodic)
+        tangents = cubic_slopes(t, pts, scipy_bc)
+    out = CubicHermite(pts, tangents, t, closed=periodic)
+    if isinstance(param, str) and param == "chord" and isinstance(bc, str) \
+            and bc in ("natural", "periodic"):
+        # what a point file is read as: fair()'s guard need not rebuild it to recognise it
+        # (curvefair.fairing._guard.is_chord_interpolant)
+        out._chord_natural = True
+    return out
 
 
 # ----------------------------------------------------------------------------------------------

@@ -39,21 +39,26 @@ def is_chord_interpolant(curve: PiecewiseCurve) -> bool:
     -- what a point file is read as -- up to an affine change of parameter: only then is the
     curve rebuilt from written points the same kind of curve as the input."""
     from ..curves.interpolate import interpolate_cubic
+    from ..curves.parameterize import parameterize
     from ..errors import InputError
 
     if type(curve) is not CubicHermite:
+        return False
+    if getattr(curve, "_chord_natural", False):
+        return True  # made by interpolate_cubic(points, "chord", natural or periodic)
+    # the parameters first (O(n), no solve): the chord lengths interpolate_cubic would use
+    t, r = np.asarray(curve.params), parameterize(curve.points, "chord")
+    st, sr = t[-1] - t[0], r[-1] - r[0]
+    if not (st > 0 and sr > 0):
+        return False
+    if not np.allclose((t - t[0]) / st, (r - r[0]) / sr, rtol=0.0, atol=1e-9):
         return False
     try:
         ref = interpolate_cubic(curve.points, "chord",
                                 "periodic" if curve.closed else "natural")
     except InputError:
         return False
-    t, r = np.asarray(curve.params), np.asarray(ref.params)
-    st, sr = t[-1] - t[0], r[-1] - r[0]
-    if not (st > 0 and sr > 0):
-        return False
-    if not np.allclose((t - t[0]) / st, (r - r[0]) / sr, rtol=0.0, atol=1e-9):
-        return False
+    sr = float(np.asarray(ref.params)[-1] - np.asarray(ref.params)[0])
     d, dr = np.asarray(curve.tangents) * st, np.asarray(ref.tangents) * sr
     scale = max(float(np.max(np.abs(dr))), 1e-300)
     return bool(np.max(np.abs(d - dr)) <= 1e-7 * scale)

@@ -30,6 +30,7 @@ spline interpolant only up to the pull-back (a few ulp of the coordinates).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -160,6 +161,26 @@ def prime_power_forms(original: PiecewiseCurve, new: PiecewiseCurve
     return new, PiecewisePolynomial(breaks, diff)
 
 
+def delta_deviation(a: PiecewiseCurve, delta: dict[str, FloatArray]) -> Any:
+    """:func:`curvefair.deviation` between ``a`` and the curve with ``a``'s knots / parameters
+    and data ``a``'s plus ``delta`` (:func:`curve_fields` names), measured on the difference
+    curve itself: one power form of the data's differences (exactly linear, no rounding of
+    the coordinates' offset) against the zero curve, no power form of the second curve."""
+    pp = _difference_form(a, delta)
+    return _against_zero(pp, a.closed)
+
+
+def _against_zero(pp: PiecewisePolynomial, closed: bool) -> Any:
+    """:func:`curvefair.deviation` of the power form ``pp`` from the zero curve."""
+    from ..analysis import deviation
+
+    # the zero curve on the same breaks: one frozen 0.0 broadcast to the coefficients'
+    # shape (PiecewisePolynomial keeps a frozen array as it is: no 8-byte-per-entry
+    # zeros and copy of them)
+    zero = PiecewisePolynomial(pp.breaks, np.broadcast_to(_ZERO, pp.coeffs.shape))
+    return deviation(_PowerForm(pp, closed), _PowerForm(zero, closed))
+
+
 def difference_deviation(a: PiecewiseCurve, b: PiecewiseCurve,
                          form: PiecewisePolynomial | None = None) -> tuple[float, float, float]:
     """``(max_distance, upper_bound, param)`` of ``max_t |a(t) - b(t)|``.
@@ -171,19 +192,12 @@ def difference_deviation(a: PiecewiseCurve, b: PiecewiseCurve,
     """
     from ..analysis import deviation
 
-    if form is not None or _comparable(a, b):
-        if form is not None:
-            pp = form
-        else:
-            fa, fb = curve_fields(a), curve_fields(b)
-            assert fa is not None and fb is not None
-            delta = {k: fb[k] - fa[k] for k in fa}
-            pp = _difference_form(a, delta)
-        # the zero curve on the same breaks: one frozen 0.0 broadcast to the coefficients'
-        # shape (PiecewisePolynomial keeps a frozen array as it is: no 8-byte-per-entry
-        # zeros and copy of them)
-        zero = PiecewisePolynomial(pp.breaks, np.broadcast_to(_ZERO, pp.coeffs.shape))
-        d = deviation(_PowerForm(pp, a.closed), _PowerForm(zero, a.closed))
+    if form is not None:
+        d = _against_zero(form, a.closed)
+    elif _comparable(a, b):
+        fa, fb = curve_fields(a), curve_fields(b)
+        assert fa is not None and fb is not None
+        d = delta_deviation(a, {k: fb[k] - fa[k] for k in fa})
     else:
         d = deviation(a, b)
     # a geometric deviation (other parameter domains, e.g. point data re-interpolated at

@@ -111,12 +111,11 @@ from functools import partial
 from typing import Any, cast
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
 from .._kernels import hermite as _k
 from .._typing import FloatArray
 from ..curves.hermite import CubicHermite, HermiteSpline, QuinticHermite
-from ..curves.interpolate import quintic_hermite_data
+from ..curves.interpolate import cubic_slopes, quintic_hermite_data
 from ..errors import InputError
 from .fair import MethodSpec, register_method
 from .hermite_data import distinct_data, rebuild, uniform_spacing
@@ -166,8 +165,7 @@ def spline_derivatives(curve: HermiteSpline, P: FloatArray, clamp: tuple[str, st
     pts = np.vstack([P, P[:1]]) if curve.closed else P
     if curve.degree == 3:
         if curve.closed:
-            spl = CubicSpline(t, pts, bc_type="periodic", axis=0)
-            ders = [spl(t, 1)]
+            ders = [cubic_slopes(t, pts, "periodic")]
         else:
             T0 = np.asarray(cast(CubicHermite, curve).tangents, dtype=np.float64)
             lo = 1 if g2_segment[0] else 0
@@ -176,8 +174,7 @@ def spline_derivatives(curve: HermiteSpline, P: FloatArray, clamp: tuple[str, st
             if hi > lo:
                 left = (1, T0[1]) if g2_segment[0] else _end_bc(curve, clamp[0], 0)[0]
                 right = (1, T0[-2]) if g2_segment[1] else _end_bc(curve, clamp[1], -1)[0]
-                spl = CubicSpline(t[lo:hi + 1], pts[lo:hi + 1], bc_type=(left, right), axis=0)
-                d1[lo:hi + 1] = spl(t[lo:hi + 1], 1)
+                d1[lo:hi + 1] = cubic_slopes(t[lo:hi + 1], pts[lo:hi + 1], (left, right))
             ders = [d1]
     else:
         # the banded Hermite solve of interpolate_quintic (make_interp_spline(k=5) is far less
@@ -434,10 +431,22 @@ def _retarget(snap: dict[str, Any], tol: float) -> dict[str, Any]:
 
 
 def _curve_deviation(curve: HermiteSpline, P: FloatArray, D: FloatArray) -> float:
-    """Certified upper bound of ``max_t |curve(t) - new(t)|`` (Bernstein hull bound)."""
-    from ..analysis import deviation
+    """Certified upper bound of ``max_t |curve(t) - new(t)|`` (Bernstein hull bound), ``new``
+    the curve with ``curve``'s parameters and distinct data ``P``, ``D``: measured on the
+    difference curve (:func:`curvefair.fairing._tolerance.delta_deviation`), whose data are
+    the differences of the two curves' data (the seam repeated if closed)."""
+    from ._tolerance import delta_deviation
 
-    return float(cast(float, deviation(curve, rebuild(curve, P, D)).upper_bound))
+    dP = P - np.asarray(curve.points)[:P.shape[0]]
+    dD = D - np.stack([np.asarray(d)[:P.shape[0]] for d in curve._derivs], axis=1)
+    if curve.closed:
+        dP = np.vstack([dP, dP[:1]])
+        dD = np.concatenate([dD, dD[:1]], axis=0)
+    if isinstance(curve, QuinticHermite):
+        delta = {"points": dP, "d1": dD[:, 0], "d2": dD[:, 1]}
+    else:
+        delta = {"points": dP, "tangents": dD[:, 0]}
+    return float(cast(float, delta_deviation(curve, delta).upper_bound))
 
 
 def _enforce_curve_tol(curve: HermiteSpline, st: dict[str, Any], tol: float,
