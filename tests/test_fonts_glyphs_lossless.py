@@ -145,6 +145,18 @@ def test_glyphs_faired_output_bytes_outside_node_numbers_are_the_source(tmp_path
         assert '"146.0 178 LINE"' in text and '"332.1 180 LINE"' in text
 
 
+def test_glyphs_source_with_crlf_line_ends_keeps_them(tmp_path):
+    # the text is patched as bytes decoded, not re-read with universal newlines
+    src = tmp_path / "IntegerFloat.glyphs"
+    src.write_bytes((DATA / "IntegerFloat.glyphs").read_bytes().replace(b"\n", b"\r\n"))
+    out = tmp_path / "out.glyphs"
+    _, warned = _fair_and_write(src, out, 1.0)
+    assert not [w for w in warned if ROUND_TRIP in w], warned
+    a, b = src.read_bytes().split(b"\r\n"), out.read_bytes().split(b"\r\n")
+    assert len(a) == len(b) and b"\n" not in b"".join(b)
+    assert sum(x != y for x, y in zip(a, b, strict=True)) == 2  # the two off-curve nodes
+
+
 def test_glyphs_cli_writes_the_source_with_the_faired_nodes_only(tmp_path):
     from click.testing import CliRunner
 

@@ -798,7 +798,10 @@ def _check_patched(path: str | os.PathLike[str], targets: Sequence[tuple[Any, ..
     (the unmoved numbers as they were, the others as written)."""
     from ._glyphs_text import NotPatchable, format_number
 
-    back = _open_glyphs(path)
+    try:
+        back = _open_glyphs(path)
+    except FileFormatError as exc:
+        raise NotPatchable(f"glyphsLib does not read the patched text ({exc})") from None
     for g, layer_id, ci, old, new in targets:
         glyph = back.glyphs[g]
         layer = glyph.layers[layer_id] if glyph is not None else None
