@@ -864,21 +864,5 @@ def test_glyphs_source_with_nothing_faired_is_copied_byte_for_byte(tmp_path, nam
     assert out.read_bytes() == src.read_bytes()
 
 
-def test_glyphs_source_glyphslib_changes_is_warned_about(tmp_path):
-    # some curves faired: glyphsLib writes the file, and where its round trip of the unchanged
-    # source differs from the source the user is told (first line it changes)
-    pytest.importorskip("glyphsLib")
-    import glyphsLib
-    from click.testing import CliRunner
-
-    from curvefair.cli import main
-
-    src = Path(__file__).parent / "data" / "real" / "glyphsLib" / "GlyphsFileFormatv3.glyphs"
-    rt = tmp_path / "roundtrip.glyphs"
-    glyphsLib.GSFont(str(src)).save(str(rt))
-    assert rt.read_bytes() != src.read_bytes()  # the case: glyphsLib does not round-trip it
-    out = tmp_path / "out.glyphs"
-    res = CliRunner().invoke(main, ["fair", str(src), "-o", str(out), "--tol", "5"])
-    assert res.exit_code == 0, res.output
-    assert "glyphsLib does not write this source back as it read it" in res.output
-    assert "line 45" in res.output and out.read_bytes() != src.read_bytes()
+# faired Glyphs sources (written into the source's own text, glyphsLib's save only as a
+# fallback with a warning): tests/test_fonts_glyphs_lossless.py

@@ -46,13 +46,15 @@ A variable TrueType binary (``gvar``) is refused: its sources are faired instead
   features, groups, lib, other layers, components, anchors, guidelines come back byte for byte.
 - TrueType: the changed glyphs' coordinates are replaced (instructions, flags and point
   counts kept), bounds recomputed, the left side bearing follows ``xMin`` where it was equal.
-- Glyphs: nothing changed, the source's bytes are copied; else glyphsLib loads the source,
-  the changed layers' nodes are moved and it saves the file again. glyphsLib does not
-  round-trip every source (format 3 files lose e.g. ``fontType``, ``kernTop``, background
-  images): when its save of the unchanged source differs from it, a ``UserWarning`` names the
-  first line it changes (:func:`write_glyphs`).
-  Integer coordinates stay integers (Glyphs' default grid); other coordinates are written
-  with glyphsLib's 5 decimals.
+- Glyphs: nothing changed, the source's bytes are copied; else the faired coordinates are
+  patched into the source's own text (:mod:`curvefair.io._glyphs_text`): the output is the
+  source except for the numbers of the nodes that moved, so what glyphsLib does not
+  round-trip (format 3: ``fontType``, ``kernTop``, background images, an instance's
+  ``visible``; format 2: e.g. an ``Axes`` custom parameter, ``146.0``) is kept. Integer
+  coordinates stay integers (Glyphs' default grid); others are written with the shortest
+  decimals that read back as the exact float. A source whose text cannot be patched safely
+  falls back to glyphsLib's save (5 decimals), with a ``UserWarning`` naming the first line
+  that save changes (:func:`write_glyphs`).
 - CFF: the charstrings are desubroutinized and each changed glyph's drawing operators
   rewritten as ``rmoveto``/``rlineto``/``rrcurveto`` (hints, hint masks and width kept).
 
@@ -735,12 +737,27 @@ def write_glyphs(path: str | os.PathLike[str], changes: dict[str, dict[int, Floa
                  template: str) -> None:
     """Save a copy of the Glyphs source ``template`` with the changed layers' nodes moved.
 
-    Nothing changed: the template's bytes, exactly. Otherwise glyphsLib writes the file, and
-    glyphsLib does not round-trip every source (format 3 files lose e.g. ``fontType``,
-    ``kernTop``, background ``imagePath`` entries, an instance's ``visible``): the unmodified
-    source is saved through glyphsLib too, and if that differs from the template a
-    ``UserWarning`` names the file and the first line glyphsLib changes, so that a loss the
-    fairing did not cause is not silent."""
+    Nothing changed: the template's bytes, exactly. Otherwise the faired coordinates are
+    patched into the template's own text (:func:`curvefair.io._glyphs_text.patch_nodes`):
+    the output equals the template except for the numbers of the nodes that moved -- node
+    types, ``smooth`` flags, userData, unmoved numbers and every other byte are kept, so the
+    data glyphsLib does not round-trip (format 3: ``fontType``, ``kernTop``, background
+    ``imagePath`` entries, an instance's ``visible``; format 2: e.g. an ``Axes`` custom
+    parameter, numbers with more than 5 decimals) is not lost. New numbers are integers when
+    integral, else the shortest decimals that read back as exactly the float computed (not
+    glyphsLib's 5 decimals, whose rounding could move a node past ``tol``); glyphsLib reads
+    the patched file back and must find exactly those numbers at the changed nodes.
+
+    Fallback: a source whose text cannot be patched safely (it is not UTF-8, the tokenizer's
+    reading differs from ``openstep_plist``'s, a glyph or layer is not found exactly once, a
+    path's nodes are not those glyphsLib read, the patched text reads back with other
+    changes, or a ``.glyphspackage``) is written as before: glyphsLib loads the source, the
+    nodes are moved and it saves the file; if its save of the unmodified source differs from
+    the template, a ``UserWarning`` names the file and the first line glyphsLib changes
+    (and why the text could not be patched). glyphsLib then writes non-integers with 5
+    decimals."""
+    from ._glyphs_text import NotPatchable, patch_nodes
+
     with open(template, "rb") as f:
         raw = f.read()
     if not any(changes.values()):
@@ -749,10 +766,60 @@ def write_glyphs(path: str | os.PathLike[str], changes: dict[str, dict[int, Floa
         return
     font = _open_glyphs(template)
     names = sorted({k.split("@")[0] for k in changes})
+    moves = []
     for g, label, layer, _ in _glyphs_layers(font, [n for n in names if n in font.glyphs]):
         conts = changes.get(_glyphs_label(font, g, label, layer))
-        if not conts:
-            continue
+        if conts:
+            moves.append((g, layer, conts))
+    why = ""
+    try:
+        text = raw.decode("utf-8")
+        targets = []
+        for g, layer, conts in moves:
+            paths = list(layer.paths)
+            for ci, pts in sorted(conts.items()):
+                old = [(float(n.position.x), float(n.position.y)) for n in paths[ci].nodes]
+                targets.append((g, str(layer.layerId), ci, old,
+                                [(float(x), float(y)) for x, y in pts]))
+        patched = patch_nodes(text, int(font.format_version or 2), targets)
+        with open(os.fspath(path), "wb") as f:
+            f.write(patched.encode("utf-8"))
+        _check_patched(path, targets)
+        return
+    except UnicodeDecodeError:
+        why = "the source is not UTF-8 text"
+    except NotPatchable as exc:
+        why = str(exc)
+    _write_glyphs_through_glyphslib(path, font, moves, template, raw, why)
+
+
+def _check_patched(path: str | os.PathLike[str], targets: Sequence[tuple[Any, ...]]) -> None:
+    """glyphsLib reads the patched file back with the changed nodes where they were written
+    (the unmoved numbers as they were, the others as written)."""
+    from ._glyphs_text import NotPatchable, format_number
+
+    try:
+        back = _open_glyphs(path)
+    except FileFormatError as exc:
+        raise NotPatchable(f"glyphsLib does not read the patched text ({exc})") from None
+    for g, layer_id, ci, old, new in targets:
+        glyph = back.glyphs[g]
+        layer = glyph.layers[layer_id] if glyph is not None else None
+        if layer is None:
+            raise NotPatchable(f"glyph {g!r}: layer {layer_id!r} not read back")
+        got = [(float(n.position.x), float(n.position.y)) for n in list(layer.paths)[ci].nodes]
+        want = [tuple(a if a == b else float(format_number(b)) for a, b in zip(o, n, strict=True))
+                for o, n in zip(old, new, strict=True)]
+        if got != want:
+            raise NotPatchable(f"glyph {g!r} path {ci}: glyphsLib reads the patched nodes "
+                               "back elsewhere")
+
+
+def _write_glyphs_through_glyphslib(path: str | os.PathLike[str], font: Any, moves: list[Any],
+                                    template: str, raw: bytes, why: str) -> None:
+    """The fallback of :func:`write_glyphs`: glyphsLib moves the nodes of ``moves`` (layers
+    of ``font``, the template as glyphsLib read it) and saves the file."""
+    for _g, layer, conts in moves:
         paths = list(layer.paths)
         for ci, pts in conts.items():
             for node, (x, y) in zip(paths[ci].nodes, pts, strict=True):
@@ -775,8 +842,9 @@ def write_glyphs(path: str | os.PathLike[str], changes: dict[str, dict[int, Floa
         now = b[k].strip() if k < len(b) else "(end of file)"
         warnings.warn(f"{template}: glyphsLib does not write this source back as it read it, "
                       f"so the output differs from it beyond the faired nodes (first at line "
-                      f"{k + 1}: {was!r} becomes {now!r}); compare before replacing the source",
-                      UserWarning, stacklevel=2)
+                      f"{k + 1}: {was!r} becomes {now!r}; the faired nodes could not be "
+                      f"written into the source's own text: {why}); compare before replacing "
+                      "the source", UserWarning, stacklevel=3)
 
 
 def _number(v: float) -> float | int:
