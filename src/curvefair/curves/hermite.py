@@ -70,6 +70,11 @@ class HermiteSpline(PiecewiseCurve):
         return self._params
 
     @property
+    def domain(self) -> tuple[float, float]:
+        """``(t_start, t_end)``: the first and last parameter (no power form needed)."""
+        return float(self._params[0]), float(self._params[-1])
+
+    @property
     def dim(self) -> int:
         return int(self._points.shape[1])
 
