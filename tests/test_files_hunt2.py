@@ -11,6 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from curvefair import read_curves, write_curves
 
@@ -72,3 +73,35 @@ def test_airfoil_with_a_latin1_name_line_is_written_in_latin1(tmp_path):
     a, b = src.read_bytes(), out.read_bytes()
     assert b.split(b"\n")[0] == a.split(b"\n")[0]
     assert _line_diff(a, b) == [6]
+
+
+# ------------------------------------------------------------------------------------------
+# binary DXF: written back binary (it was written as ASCII DXF, silently)
+# ------------------------------------------------------------------------------------------
+BIN_SENTINEL = b"AutoCAD Binary DXF\r\n\x1a\x00"
+
+
+def test_binary_dxf_is_written_back_binary(tmp_path):
+    import ezdxf
+    # trimesh's spline.DXF (AC1015, 6 SPLINEs, 4 LINEs) saved by ezdxf as a binary DXF, as
+    # netDxf's "sample binary.dxf" (263 kB, same behaviour) is
+    src = tmp_path / "spline_bin.dxf"
+    ezdxf.readfile(REAL / "trimesh" / "spline.DXF").saveas(src, fmt="bin")
+    assert src.read_bytes().startswith(BIN_SENTINEL)
+    with pytest.warns(UserWarning, match="degree-1 spline"):
+        recs = read_curves(src, on_unsupported="skip")
+    rec = recs[0]
+    assert rec.kind == "bspline"
+    cp = np.array(rec.curve.control_points)
+    cp[1, 1] += 1e-3
+    out = tmp_path / "out.dxf"
+    write_curves(out, [rec.with_curve(rec.curve.replace(control_points=cp))] + recs[1:],
+                 template=src)
+    assert out.read_bytes().startswith(BIN_SENTINEL)
+    a, b = ezdxf.readfile(src), ezdxf.readfile(out)
+    ea = sorted((e.dxftype(), e.dxf.handle) for e in a.modelspace())
+    eb = sorted((e.dxftype(), e.dxf.handle) for e in b.modelspace())
+    assert ea == eb
+    h = rec.source["handle"]
+    got = np.array([tuple(p) for p in b.entitydb[h].control_points])[:, : cp.shape[1]]
+    np.testing.assert_allclose(got, cp, rtol=0, atol=1e-12)
