@@ -105,3 +105,76 @@ def test_binary_dxf_is_written_back_binary(tmp_path):
     h = rec.source["handle"]
     got = np.array([tuple(p) for p in b.entitydb[h].control_points])[:, : cp.shape[1]]
     np.testing.assert_allclose(got, cp, rtol=0, atol=1e-12)
+
+
+# ------------------------------------------------------------------------------------------
+# SVG: a nested <svg> maps its viewBox onto its viewport (curves in document units)
+# ------------------------------------------------------------------------------------------
+def _icon_d() -> str:
+    import re
+    text = (REAL / "fontawesome" / "3.svg").read_text(encoding="utf-8")
+    return re.search(r' d="([^"]+)"', text).group(1)
+
+
+def _nested_doc(d: str, extra: str = "") -> str:
+    # the layout icon tools write (an app icon master: a 512-unit glyph placed on a
+    # 1024 canvas, <svg x y width height viewBox>), and the same icon placed by the
+    # transform a browser applies for that viewport (preserveAspectRatio xMidYMid meet)
+    s = 824 / 512
+    tx = 100 + (824 - 320 * s) / 2
+    return ('<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 1024 1024">\n'
+            f'<svg x="100" y="100" width="824" height="824" viewBox="0 0 320 512">'
+            f'<path id="nested" d="{d}"/></svg>\n'
+            f'<g transform="matrix({s!r},0,0,{s!r},{tx!r},100)"><path id="placed" d="{d}"/></g>\n'
+            f'{extra}</svg>\n')
+
+
+def test_nested_svg_viewport_is_applied_both_ways(tmp_path):
+    import svgpathtools as spt
+    d = _icon_d()
+    src = tmp_path / "icon.svg"
+    src.write_text(_nested_doc(d), encoding="utf-8")
+    recs = read_curves(src, corner_angle=None)
+    nested = [r for r in recs if r.source["id"] == "nested"]
+    placed = [r for r in recs if r.source["id"] == "placed"]
+    assert len(nested) == len(placed) > 0
+    size = 1024.0
+    for a, b in zip(nested, placed, strict=True):
+        # was: the nested icon in its own viewBox units, 1.61 times smaller, so a --tol in
+        # document units allowed moves 1.61 times larger than asked there
+        np.testing.assert_allclose(np.asarray(a.curve.control_points),
+                                   np.asarray(b.curve.control_points), rtol=0, atol=1e-9 * size)
+    # write: a move of 1 document unit comes back as 1 document unit (1/1.61 in the icon's)
+    rec = next(r for r in nested if r.kind == "bspline")
+    cp = np.array(rec.curve.control_points)
+    cp[2] += (0.0, 1.0)
+    moved = rec.curve.replace(control_points=cp)
+    out = tmp_path / "out.svg"
+    write_curves(out, [rec.with_curve(moved) if r is rec else r for r in recs], template=src)
+    text = out.read_text(encoding="utf-8")
+    assert text.count("<path") == 2 and 'id="placed" d="' + d + '"' in text
+    import xml.etree.ElementTree as ET
+    el = next(e for e in ET.fromstring(text).iter() if e.get("id") == "nested")
+    path = spt.parse_path(el.get("d"))
+    s = 824 / 512
+    tx = 100 + (824 - 320 * s) / 2
+    sub = path.continuous_subpaths()[rec.source["subpath"]]
+    t = np.linspace(0, 1, 2001)
+    got = np.array([sub.point(v) for v in t])
+    got = np.c_[got.real * s + tx, got.imag * s + 100]
+    want = moved(np.linspace(moved.knots[3], moved.knots[-4], 400001))
+    from scipy.spatial import cKDTree
+    dist = cKDTree(want).query(got)[0].max()
+    assert dist < 0.05                                # the sampling's own resolution
+
+
+def test_nested_svg_with_a_viewport_it_cannot_resolve_is_skipped(tmp_path):
+    d = _icon_d()
+    src = tmp_path / "icon.svg"
+    src.write_text(_nested_doc(d).replace('width="824"', 'width="calc(50% - 16px)"'),
+                   encoding="utf-8")
+    with pytest.raises(Exception, match="calc"):
+        read_curves(src)
+    with pytest.warns(UserWarning, match=r"id='nested'.*in a nested <svg> with width="):
+        recs = read_curves(src, on_unsupported="skip")
+    assert recs and all(r.source["id"] == "placed" for r in recs)
