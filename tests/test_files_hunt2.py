@@ -178,3 +178,32 @@ def test_nested_svg_with_a_viewport_it_cannot_resolve_is_skipped(tmp_path):
     with pytest.warns(UserWarning, match=r"id='nested'.*in a nested <svg> with width="):
         recs = read_curves(src, on_unsupported="skip")
     assert recs and all(r.source["id"] == "placed" for r in recs)
+
+
+# ------------------------------------------------------------------------------------------
+# the command: -o OUT without an extension writes IN's format (as --help says)
+# ------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("name, fmt, tol", [
+    ("clarky.dat", "airfoil", 1e-4),                       # UIUC, via aerosandbox
+    ("real/occt/trj7_c2-ac-214.stp", "step", 0.01),         # AutoCAD 2000i STEP (OCCT data)
+])
+def test_output_without_extension_is_written_in_the_input_format(tmp_path, name, fmt, tol):
+    import shutil
+
+    from test_cli import assert_user_error, cli
+    src = tmp_path / Path(name).name
+    shutil.copyfile(DATA / name, src)
+    res = cli(["fair", src.name, "--tol", str(tol), "-o", "faired", "-q"], tmp_path)
+    # was: exit 1, "Error: '/.../.faired.x1y2z3': cannot tell the format from the extension
+    # '.x1y2z3'" -- the read-back check guessed the format of its temporary file
+    assert_user_error(res, 0)
+    assert ".faired." not in res.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([src.name, "faired"])
+    back = read_curves(tmp_path / "faired", format=fmt)
+    orig = read_curves(src, format=fmt, on_unsupported="skip")
+    assert len(back) == len(orig)
+    if fmt == "airfoil":
+        d = np.abs(np.vstack([b.points for b in back]) - np.vstack([o.points for o in orig]))
+        assert 0 < d.max() <= tol
+    else:
+        assert (tmp_path / "faired").read_bytes()[:20] == src.read_bytes()[:20]
