@@ -207,3 +207,31 @@ def test_output_without_extension_is_written_in_the_input_format(tmp_path, name,
         assert 0 < d.max() <= tol
     else:
         assert (tmp_path / "faired").read_bytes()[:20] == src.read_bytes()[:20]
+
+
+# ------------------------------------------------------------------------------------------
+# 3dm: the geometry of instance definitions (blocks) is not read, as documented
+# ------------------------------------------------------------------------------------------
+def test_3dm_instance_definition_geometry_is_not_read(tmp_path):
+    rh = pytest.importorskip("rhino3dm")
+    # openNURBS' own example model (archive version 3, curves and layers) with a block
+    # definition added by openNURBS: a copy of one of its curves, wiggled
+    m = rh.File3dm.Read(str(REAL / "opennurbs" / "v3_my_curves.3dm"))
+    ids = [str(m.Objects[k].Attributes.Id) for k in range(len(m.Objects))]
+    t = np.linspace(0.0, 3.0, 20)
+    g = rh.Curve.CreateControlPointCurve(
+        [rh.Point3d(float(a) * 10, float(np.sin(a) * 10 + 0.05 * np.sin(37 * a)), 0.0)
+         for a in t], 3)
+    m.InstanceDefinitions.Add("wiggle", "", "", "", rh.Point3d(0, 0, 0), (g,),
+                              (rh.ObjectAttributes(),))
+    src = tmp_path / "blocks.3dm"
+    assert m.Write(str(src), 7)
+    back = rh.File3dm.Read(str(src))
+    modes = [back.Objects[k].Attributes.Mode for k in range(len(back.Objects))]
+    assert modes.count(rh.ObjectMode.InstanceDefinitionObject) == 1
+    recs = read_curves(src, on_unsupported="skip")
+    # was: the block's curve was a record too (faired in block coordinates, then drawn by
+    # every instance through its transform, scaled ones beyond --tol)
+    assert recs and {r.source["id"] for r in recs} <= set(ids)
+    plain = read_curves(REAL / "opennurbs" / "v3_my_curves.3dm", on_unsupported="skip")
+    assert len(recs) == len(plain)
