@@ -235,3 +235,46 @@ def test_3dm_instance_definition_geometry_is_not_read(tmp_path):
     assert recs and {r.source["id"] for r in recs} <= set(ids)
     plain = read_curves(REAL / "opennurbs" / "v3_my_curves.3dm", on_unsupported="skip")
     assert len(recs) == len(plain)
+
+
+# ------------------------------------------------------------------------------------------
+# SVG: a curve drawn by <use> larger than it is read is not faired
+# ------------------------------------------------------------------------------------------
+def _use_doc(d: str) -> str:
+    # the icon defined once and drawn by <use>: at its own size (an icon sprite), twice as
+    # large, and as a <symbol> whose viewBox a <use> maps onto a larger viewport
+    return ('<svg xmlns="http://www.w3.org/2000/svg" '
+            'xmlns:xlink="http://www.w3.org/1999/xlink" viewBox="0 0 2048 1024">\n'
+            f'<defs><path id="same" d="{d}"/><path id="big" d="{d}"/></defs>\n'
+            f'<symbol id="sym" viewBox="0 0 320 512"><path id="insym" d="{d}"/></symbol>\n'
+            '<use xlink:href="#same" x="10" y="10" transform="rotate(30)"/>\n'
+            '<use xlink:href="#big" transform="translate(400,0) scale(2)"/>\n'
+            '<use href="#sym" x="1000" y="0" width="640" height="1024"/>\n'
+            '</svg>\n')
+
+
+def test_curves_drawn_larger_by_use_are_skipped_and_kept(tmp_path):
+    import re
+    d = _icon_d()
+    src = tmp_path / "sprite.svg"
+    src.write_text(_use_doc(d), encoding="utf-8")
+    with pytest.warns(UserWarning) as got:
+        recs = read_curves(src, on_unsupported="skip")
+    msgs = [str(w.message) for w in got]
+    # was: all three read and faired in the icon's own units; the copies drawn twice as
+    # large then moved up to twice --tol in the drawing
+    assert {r.source["id"] for r in recs} == {"same"}
+    assert any(re.search(r"id='big'.*drawn by <use>.*2 times larger", m) for m in msgs)
+    assert any(re.search(r"id='insym'.*drawn by <use>.*2 times larger", m) for m in msgs)
+    with pytest.raises(Exception, match="drawn by <use>"):
+        read_curves(src)
+    # written back: the skipped elements keep their bytes
+    rec = next(r for r in recs if r.kind == "bspline")
+    cp = np.array(rec.curve.control_points)
+    cp[2] += (0.0, 1.0)
+    out = tmp_path / "out.svg"
+    write_curves(out, [rec.with_curve(rec.curve.replace(control_points=cp)) if r is rec
+                       else r for r in recs], template=src)
+    text = out.read_text(encoding="utf-8")
+    assert f'<path id="big" d="{d}"/>' in text and f'<path id="insym" d="{d}"/>' in text
+    assert f'<path id="same" d="{d}"/>' not in text

@@ -355,11 +355,19 @@ def _shape_elements(root: ET.Element, spt: Any, path: object
     out: list[tuple[int, ET.Element, np.ndarray | None, str | None]] = []
     count = 0
 
+    before: dict[int, np.ndarray] = {}      # id(element): its parent's matrix
+    after: dict[int, np.ndarray] = {}       # id(element): its own (children's) matrix
+    sizes: dict[int, tuple[float, float] | None] = {}
+    below: dict[int, list[int]] = {}        # id(element): positions in out of its shapes
+
     def walk(el: ET.Element, ctm: np.ndarray, size: tuple[float, float] | None,
-             why: str | None) -> None:
+             why: str | None, chain: tuple[int, ...] = ()) -> None:
         nonlocal count
         k = count
         count += 1
+        before[id(el)] = ctm
+        sizes[id(el)] = size
+        chain = (*chain, id(el))
         tf = el.get("transform")
         if tf is not None and tf.strip():
             with warnings.catch_warnings():
@@ -376,14 +384,72 @@ def _shape_elements(root: ET.Element, spt: Any, path: object
                 ctm = ctm @ m
             except Unsupported as exc:
                 why = str(exc)
+        after[id(el)] = ctm
         if _local(el.tag) in _SHAPES:
             ident = np.allclose(ctm, np.eye(3), rtol=0, atol=0)
+            for a in chain:
+                below.setdefault(a, []).append(len(out))
             out.append((k, el, None if ident else ctm[:2].copy(), why))
         for child in el:
-            walk(child, ctm, size, why)
+            walk(child, ctm, size, why, chain)
 
     walk(root, np.eye(3), _root_viewport(root), None)
+    _drawn_by_use(root, out, before, after, sizes, below)
     return out
+
+
+_XLINK_HREF = "{http://www.w3.org/1999/xlink}href"
+
+
+def _drawn_by_use(root: ET.Element,
+                  out: list[tuple[int, ET.Element, np.ndarray | None, str | None]],
+                  before: dict[int, np.ndarray], after: dict[int, np.ndarray],
+                  sizes: dict[int, tuple[float, float] | None],
+                  below: dict[int, list[int]]) -> None:
+    """Mark (in ``out``, in place) the curve elements a ``<use>`` draws larger than curvefair
+    reads them: a ``<use>`` draws its target (and everything in it) through its own matrix,
+    its ``x``/``y`` and, for a ``<symbol>``, the symbol's viewport (SVG 1.1 sec. 5.6), not
+    through the target's ancestors. A move of ``tol`` in the element's document coordinates
+    is a move of at most ``s tol`` in that copy, ``s`` the largest singular value of the
+    linear map between the two; where ``s > 1`` the tolerance would not hold in the drawing,
+    and the element is unsupported (a copy drawn at the same size or smaller is fine)."""
+    ids = {el.get("id"): el for el in root.iter() if el.get("id")}
+    worst: dict[int, tuple[float, str]] = {}
+    for use in root.iter():
+        if _local(use.tag) != "use":
+            continue
+        href = (use.get("href") or use.get(_XLINK_HREF) or "").strip()
+        target = ids.get(href[1:]) if href.startswith("#") else None
+        if target is None or id(target) not in below or id(use) not in after:
+            continue
+        lin = after[id(use)][:2, :2]
+        what = f"drawn by <use> (id={use.get('id')!r}, href={href!r})"
+        try:
+            if _local(target.tag) == "symbol":
+                # the symbol's viewport: the <use>'s width/height (default 100%) on the
+                # symbol's viewBox and preserveAspectRatio
+                vp = ET.Element("svg", {k: v for k, v in (
+                    ("viewBox", target.get("viewBox")),
+                    ("preserveAspectRatio", target.get("preserveAspectRatio")),
+                    ("width", use.get("width")), ("height", use.get("height")))
+                    if v is not None})
+                m, _ = _nested_viewport(vp, sizes.get(id(use)))
+                lin = lin @ m[:2, :2]
+            rel = lin @ np.linalg.inv(before[id(target)][:2, :2])
+            scale = float(np.linalg.svd(rel, compute_uv=False)[0])
+        except (Unsupported, np.linalg.LinAlgError) as exc:
+            scale, what = float("inf"), f"{what}, at a size curvefair cannot tell ({exc})"
+        if not scale <= 1.0 + 1e-9:
+            for pos in below[id(target)]:
+                if scale > worst.get(pos, (0.0, ""))[0]:
+                    worst[pos] = (scale, what)
+    for pos, (scale, what) in worst.items():
+        k, el, ctm, why = out[pos]
+        if why is None:
+            size = f" {scale:.6g} times larger" if scale < float("inf") else ""
+            why = (f"{what}{size} than it is read: a fairing within --tol would not be "
+                   "within it there")
+            out[pos] = (k, el, ctm, why)
 
 
 def _path_elements(text: str, path: object) -> list[ET.Element]:
@@ -472,7 +538,7 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
         k += 1
         base["element"] = k
         if why is not None:
-            skip(f"{what}: unsupported: in a {why}")
+            skip(f"{what}: unsupported: {why if why.startswith('drawn') else 'in a ' + why}")
             continue
         if tag in ("polygon", "polyline", "line", "rect"):
             try:
