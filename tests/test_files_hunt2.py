@@ -278,3 +278,19 @@ def test_curves_drawn_larger_by_use_are_skipped_and_kept(tmp_path):
     text = out.read_text(encoding="utf-8")
     assert f'<path id="big" d="{d}"/>' in text and f'<path id="insym" d="{d}"/>' in text
     assert f'<path id="same" d="{d}"/>' not in text
+
+
+# ------------------------------------------------------------------------------------------
+# SVG: a CSS transform in a style attribute (browsers draw it) makes the element unsupported
+# ------------------------------------------------------------------------------------------
+def test_css_transform_in_style_is_not_ignored(tmp_path):
+    d = _icon_d()
+    src = tmp_path / "css.svg"
+    src.write_text('<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 1024 1024">\n'
+                   f'<g style="fill:red; transform: scale(2)"><path id="css" d="{d}"/></g>\n'
+                   f'<path id="plain" style="text-transform: none; transform: none" d="{d}"/>\n'
+                   '</svg>\n', encoding="utf-8")
+    # was: read in the path's own units and faired there, drawn twice as large by a browser
+    with pytest.warns(UserWarning, match=r"id='css'.*CSS transform"):
+        recs = read_curves(src, on_unsupported="skip")
+    assert {r.source["id"] for r in recs} == {"plain"}

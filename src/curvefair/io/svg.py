@@ -378,6 +378,11 @@ def _shape_elements(root: ET.Element, spt: Any, path: object
                     raise FileFormatError(f"<{_local(el.tag)}> element (id={el.get('id')!r}): "
                                           f"bad transform {tf!r} ({exc})", path) from None
             ctm = ctm @ m
+        if why is None and _CSS_TRANSFORM_RE.search(el.get("style") or ""):
+            # CSS transform property (SVG 2; browsers apply it): not parsed here, so the
+            # element's drawn size is unknown
+            why = (f"<{_local(el.tag)}> (id={el.get('id')!r}) with a CSS transform in its "
+                   "style attribute, which curvefair does not read")
         if el is not root and _local(el.tag) == "svg" and why is None:
             try:
                 m, size = _nested_viewport(el, size)
@@ -399,6 +404,7 @@ def _shape_elements(root: ET.Element, spt: Any, path: object
 
 
 _XLINK_HREF = "{http://www.w3.org/1999/xlink}href"
+_CSS_TRANSFORM_RE = re.compile(r"(?:^|;)\s*transform\s*:\s*(?!none\s*(?:;|$|!))[^;\s]", re.I)
 
 
 def _drawn_by_use(root: ET.Element,
@@ -538,7 +544,8 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
         k += 1
         base["element"] = k
         if why is not None:
-            skip(f"{what}: unsupported: {why if why.startswith('drawn') else 'in a ' + why}")
+            skip(f"{what}: unsupported: "
+                 f"{why if why.startswith(('drawn', '<')) else 'in a ' + why}")
             continue
         if tag in ("polygon", "polyline", "line", "rect"):
             try:
