@@ -294,3 +294,30 @@ def test_css_transform_in_style_is_not_ignored(tmp_path):
     with pytest.warns(UserWarning, match=r"id='css'.*CSS transform"):
         recs = read_curves(src, on_unsupported="skip")
     assert {r.source["id"] for r in recs} == {"plain"}
+
+
+# ------------------------------------------------------------------------------------------
+# SVG: content drawn in a coordinate system of its own (markers, bounding-box units)
+# ------------------------------------------------------------------------------------------
+def test_marker_and_bounding_box_content_are_unsupported(tmp_path):
+    d = _icon_d()
+    src = tmp_path / "units.svg"
+    src.write_text(
+        '<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 1024 1024">\n<defs>'
+        # the icon scaled into the unit box, as a clip path in bounding-box units
+        f'<clipPath id="c" clipPathUnits="objectBoundingBox" transform="scale(0.001953125)">'
+        f'<path id="inbox" d="{d}"/></clipPath>\n'
+        f'<clipPath id="u"><path id="inuser" d="{d}"/></clipPath>\n'
+        f'<marker id="m" viewBox="0 0 320 512" markerWidth="3" markerHeight="3">'
+        f'<path id="inmarker" d="{d}"/></marker></defs>\n'
+        '<rect width="1024" height="1024" clip-path="url(#c)"/>\n'
+        '<path id="line" d="M 0 0 L 500 500" marker-end="url(#m)"/>\n'
+        '</svg>\n', encoding="utf-8")
+    with pytest.warns(UserWarning) as got:
+        recs = read_curves(src, on_unsupported="skip")
+    msgs = " ".join(str(w.message) for w in got)
+    # was: the clip path read in units of 1/512 of the box using it (a --tol of 0.05 became
+    # 0.05 box widths), the marker in units the stroke width scales
+    assert "id='inbox'" in msgs and "objectBoundingBox" in msgs
+    assert "id='inmarker'" in msgs and "<marker>" in msgs
+    assert {r.source["id"] for r in recs} == {"inuser", "line", None}   # None: the <rect>

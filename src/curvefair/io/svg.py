@@ -383,6 +383,8 @@ def _shape_elements(root: ET.Element, spt: Any, path: object
             # element's drawn size is unknown
             why = (f"<{_local(el.tag)}> (id={el.get('id')!r}) with a CSS transform in its "
                    "style attribute, which curvefair does not read")
+        if why is None:
+            why = _own_units(el)
         if el is not root and _local(el.tag) == "svg" and why is None:
             try:
                 m, size = _nested_viewport(el, size)
@@ -401,6 +403,26 @@ def _shape_elements(root: ET.Element, spt: Any, path: object
     walk(root, np.eye(3), _root_viewport(root), None)
     _drawn_by_use(root, out, before, after, sizes, below)
     return out
+
+
+def _own_units(el: ET.Element) -> str | None:
+    """Why the content of ``el`` is drawn in a coordinate system of its own, not the one of
+    its ancestors (SVG 1.1 sec. 11.6, 14.3.5, 14.4, 13.3), else None: a ``<marker>`` (scaled
+    by the stroke width and its viewBox), a ``<clipPath>``/``<mask>``/``<pattern>`` whose
+    content is in ``objectBoundingBox`` units (0..1 of the box of the element using it), a
+    ``<pattern>`` with a viewBox or a ``patternTransform``."""
+    tag = _local(el.tag)
+    ident = el.get("id")
+    if tag == "marker":
+        return f"<marker> (id={ident!r}), drawn scaled by the stroke it marks"
+    units = {"clipPath": "clipPathUnits", "mask": "maskContentUnits",
+             "pattern": "patternContentUnits"}.get(tag)
+    if units is not None and (el.get(units) or "").strip() == "objectBoundingBox":
+        return (f"<{tag}> (id={ident!r}) with {units}='objectBoundingBox' (drawn scaled to "
+                "the box of the element using it)")
+    if tag == "pattern" and (el.get("viewBox") or el.get("patternTransform")):
+        return f"<pattern> (id={ident!r}) with its own viewBox or patternTransform"
+    return None
 
 
 _XLINK_HREF = "{http://www.w3.org/1999/xlink}href"
@@ -545,7 +567,7 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
         base["element"] = k
         if why is not None:
             skip(f"{what}: unsupported: "
-                 f"{why if why.startswith(('drawn', '<')) else 'in a ' + why}")
+                 f"{why if why.startswith('drawn') else 'in a ' + why}")
             continue
         if tag in ("polygon", "polyline", "line", "rect"):
             try:
