@@ -396,18 +396,19 @@ class _AllSkipped(Exception):
 
 def _read(path: str, corner_angle: float | None, strict: bool = False,
           quiet: bool = False, glyphs: str | None = None,
-          all_skipped_ok: bool = False) -> list[Any]:
+          all_skipped_ok: bool = False, fmt: str | None = None) -> list[Any]:
     """The records of a file; entities curvefair cannot represent are skipped with a warning
     (kept untouched on write-back) unless ``strict``, which refuses the file. With
     ``all_skipped_ok``, a file whose every curve entity was skipped raises
     :class:`_AllSkipped` (the caller writes it back unchanged) instead of failing."""
     from . import read_curves
 
-    _format_of(path)  # a CLI message (the API's names format=, which the CLI lacks)
+    if fmt is None:
+        _format_of(path)  # a CLI message (the API's names format=, which the CLI lacks)
     seen: list[str] = []
     try:
         with _warnings_to_stderr(quiet, into=seen):
-            return read_curves(path, corner_angle=corner_angle,
+            return read_curves(path, corner_angle=corner_angle, format=cast(Any, fmt),
                                on_unsupported="raise" if strict else "skip",
                                **cast(dict[str, Any], {} if glyphs is None else {"glyphs": glyphs}))
     except CurvefairError as exc:
@@ -1103,7 +1104,10 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
             # written to a temporary file, read back and measured against the input; moved
             # onto OUT only when every curve read back is within tol
             check = write_checked(out, faired, records, tol=tol,
-                                  reader=lambda p: _read(p, corner, strict, True, glyphs),
+                                  # the temporary file has OUT's extension, which need
+                                  # not name a format (-o OUT without one: IN's format)
+                                  reader=lambda p: _read(p, corner, strict, True, glyphs,
+                                                         fmt=out_fmt),
                                   template=infile if out_fmt == in_fmt else None,
                                   format=out_fmt, overwrite=in_place, decimals=decimals)
             if prog is not None:

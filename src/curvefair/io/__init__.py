@@ -215,7 +215,9 @@ def read_curves(path: str | os.PathLike[str], *, format: FormatName | None = Non
         raise FileFormatError("is a folder, not a file", path)
     if glyphs is not None and fmt not in FONT_FORMATS:
         raise InputError(f"glyphs= is for fonts (ufo, opentype, glyphs), not {fmt} files")
-    extra = {} if glyphs is None else {"glyphs": glyphs}
+    extra: dict[str, Any] = {} if glyphs is None else {"glyphs": glyphs}
+    if fmt in ("iges", "step"):
+        extra["format"] = fmt       # one module reads both; the path may have no extension
     records = _module(fmt).read(path, corner_angle=corner_angle, on_unsupported=on_unsupported,
                                 **extra)
     if not records:
@@ -387,7 +389,9 @@ def _write_plain(path: str | os.PathLike[str], records: Sequence[CurveRecord], f
     """The format's writer, without the read-back (records already filled from a point
     template)."""
     writer: Callable[..., None] = _module(fmt).write
-    writer(path, list(records), template=tpath, decimals=decimals, precision=precision)
+    extra = {"format": fmt} if fmt in ("iges", "step") else {}
+    writer(path, list(records), template=tpath, decimals=decimals, precision=precision,
+           **extra)
 
 
 def _reference(records: list[CurveRecord], reference: object, tol: float | None,

@@ -265,6 +265,8 @@ class TextLayout:
     column_decimals : tuple of int
         Largest number of decimals per column in the file.
     encoding : str
+        ``"utf-8"``, ``"utf-8-sig"`` (UTF-8 with a byte order mark) or ``"latin-1"`` (not
+        UTF-8): the file is written back in it.
     values : ndarray, shape (rows, ncols)
     leading : tuple of int
         0-based indices of the non-numeric lines before the data other than the header
@@ -473,7 +475,10 @@ def read_lines(path: str | os.PathLike[str]) -> tuple[list[str], str, bool, str]
     if b"\x00" in raw:
         line = raw[: raw.index(b"\x00")].count(b"\n") + 1
         raise FileFormatError("binary data (NUL byte) in a text file", path, line)
-    encoding = "utf-8"
+    # the BOM, if any, is part of the encoding's name so that a writer given ``encoding``
+    # writes it back (``utf-8-sig``); a file that is not UTF-8 is written back as Latin-1,
+    # byte for byte where its text is unchanged
+    encoding = "utf-8-sig" if raw.startswith(b"\xef\xbb\xbf") else "utf-8"
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError:

@@ -152,7 +152,7 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
         keep = np.flatnonzero(row_map < 0)
         use = row_map >= 0
         rows[use] = contour[row_map[use]]
-        atomic_write(path, lay.render(rows, decimals, keep_rows=keep))
+        atomic_write(path, lay.render(rows, decimals, keep_rows=keep), encoding=lay.encoding)
         return
     pts = joined_points(records, "write_curves")
     if pts.shape[1] != 2:

@@ -451,8 +451,19 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
             _add_new(msp, recs[0], recs[0].source.get("z"))
     if template is not None:
         _upgrade_r12(doc, template)
+    # a binary DXF template is written back binary (ezdxf saves ASCII unless told)
+    fmt = "bin" if template is not None and _is_binary(template) else "asc"
     with atomic_path(path, suffix=".dxf") as tmp:
-        doc.saveas(os.fspath(tmp))
+        doc.saveas(os.fspath(tmp), fmt=fmt)
+
+
+def _is_binary(path: str | os.PathLike[str]) -> bool:
+    """Whether the DXF file at ``path`` is a binary DXF (starts with its sentinel)."""
+    try:
+        with open(os.fspath(path), "rb") as fh:
+            return fh.read(len(_BINARY_SENTINEL)) == _BINARY_SENTINEL
+    except OSError:
+        return False
 
 
 def _eq(a: FloatArray | None, b: FloatArray | None) -> bool:

@@ -204,9 +204,10 @@ def _bspline_of_edge(edge: Any) -> tuple[BSplineCurve, float | None]:
 
 
 def read(path: str | os.PathLike[str], *, on_unsupported: str = "raise",
-         **_: Any) -> list[CurveRecord]:
-    """Read the free B-spline curves of an IGES or STEP file; see the module docstring."""
-    fmt = _fmt_of(path)
+         format: str | None = None, **_: Any) -> list[CurveRecord]:
+    """Read the free B-spline curves of an IGES or STEP file (``format`` ``"iges"`` or
+    ``"step"``, else by the extension); see the module docstring."""
+    fmt = format if format in ("iges", "step") else _fmt_of(path)
     shape = _read_shape(path, fmt, f"reading {fmt.upper()} files")
     records: list[CurveRecord] = []
     model: dict[str, Any] = {}           # the IGES text's entities, parsed once when needed
@@ -418,9 +419,10 @@ def _verify(written: object, fmt: str, shape: Any, edges: list[Any],
 
 
 def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
-          template: str | None = None, **_: Any) -> None:
-    """Write an IGES or STEP file; see the module docstring."""
-    fmt = _fmt_of(path)
+          template: str | None = None, format: str | None = None, **_: Any) -> None:
+    """Write an IGES or STEP file (``format`` ``"iges"`` or ``"step"``, else by the
+    extension: a temporary file or an output without one); see the module docstring."""
+    fmt = format if format in ("iges", "step") else _fmt_of(path)
     _occ(f"writing {fmt.upper()} files")
     if template is None:
         _write_new(path, fmt, records)

@@ -115,7 +115,7 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
     lay = _layout_of(records)
     if lay is not None and all(r.format == FORMAT for r in records):
         rows = assemble(records, lay, "write_curves")
-        atomic_write(path, lay.render(rows, decimals))
+        atomic_write(path, lay.render(rows, decimals), encoding=lay.encoding)
         return
     pts = joined_points(records, "write_curves")
     sep = "," if str(path).lower().endswith(".csv") else " "

@@ -225,6 +225,11 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
     for i in range(len(model.Objects)):
         obj = model.Objects[i]
         attr = obj.Attributes
+        if attr.Mode == rh.ObjectMode.InstanceDefinitionObject:
+            # the geometry of a block definition, drawn by its instances through their
+            # transforms (a scaled instance would carry a fairing beyond --tol into the model;
+            # every instance would change): not read, like DXF block definitions
+            continue
         ident = str(attr.Id)
         li = int(attr.LayerIndex)
         layer = layers[li] if 0 <= li < len(layers) else None

@@ -32,7 +32,8 @@ warning naming the element, are vertices equal to the one before up to rounding 
 
 Coordinates are those of the document: the element's current transformation matrix (the
 product of its own and its ancestors' ``transform`` attributes, SVG 1.1 sec. 7.5, parsed by
-svgpathtools) is applied on read, and its inverse on write, so the file keeps every element's
+svgpathtools, and of the viewport transformation of each nested ``<svg>`` it is in, sec. 7.9)
+is applied on read, and its inverse on write, so the file keeps every element's
 own coordinates and ``transform`` attributes. ``source`` keys: ``element`` (index among the
 curve elements), ``node`` (index among all elements), ``tag``, ``id``, ``subpath``,
 ``n_subpaths``, ``svg_closed`` (closed by a ``z``: a subpath that merely ends at its start is
@@ -256,18 +257,117 @@ def _root(text: str, path: object) -> ET.Element:
     return root
 
 
+# CSS absolute units in user units (px), CSS Values 3 sec. 5.2: 96 px to the inch
+_UNITS = {"": 1.0, "px": 1.0, "in": 96.0, "cm": 96.0 / 2.54, "mm": 96.0 / 25.4,
+          "q": 96.0 / 101.6, "pt": 96.0 / 72.0, "pc": 16.0}
+_LENGTH_RE = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([a-zA-Z]*|%)\s*$")
+
+
+def _viewport_length(el: ET.Element, name: str, default: str, ref: float | None) -> float:
+    """The length attribute ``name`` of a nested ``<svg>`` in its parent's user units
+    (percentages of ``ref``, the parent viewport's width or height); Unsupported when it
+    cannot be resolved (font-relative units, a percentage of an unknown viewport)."""
+    v = el.get(name)
+    v = default if v is None or not v.strip() else v
+    m = _LENGTH_RE.match(v)
+    unit = m.group(2).lower() if m else None
+    if m is None or (unit != "%" and unit not in _UNITS) or (unit == "%" and ref is None):
+        raise Unsupported(f"nested <svg> with {name}={v!r}, which curvefair cannot convert to "
+                          "the document's units")
+    x = float(m.group(1))
+    if unit == "%":
+        assert ref is not None
+        return x / 100.0 * ref
+    return x * _UNITS[str(unit)]
+
+
+def _viewbox(el: ET.Element) -> tuple[float, float, float, float] | None:
+    vb = el.get("viewBox")
+    if vb is None or not vb.strip():
+        return None
+    try:
+        x, y, w, h = (float(t) for t in vb.replace(",", " ").split())
+    except ValueError:
+        raise Unsupported(f"<svg> with viewBox={vb!r} (not four numbers)") from None
+    return x, y, w, h
+
+
+def _nested_viewport(el: ET.Element, size: tuple[float, float] | None
+                     ) -> tuple[np.ndarray, tuple[float, float] | None]:
+    """The matrix from a nested ``<svg>``'s user units to its parent's (its ``x``, ``y``,
+    ``width``, ``height``, ``viewBox`` and ``preserveAspectRatio``, SVG 1.1 sec. 7.7-7.9) and
+    the size of the viewport it gives its children (for their percentages)."""
+    vw, vh = (None, None) if size is None else size
+    x = _viewport_length(el, "x", "0", vw)
+    y = _viewport_length(el, "y", "0", vh)
+    vb = _viewbox(el)
+    if vb is None:
+        try:
+            inner = (_viewport_length(el, "width", "100%", vw),
+                     _viewport_length(el, "height", "100%", vh))
+        except Unsupported:
+            inner = None                  # only the children's percentages need it
+        return np.array([[1.0, 0.0, x], [0.0, 1.0, y], [0.0, 0.0, 1.0]]), inner
+    w = _viewport_length(el, "width", "100%", vw)
+    h = _viewport_length(el, "height", "100%", vh)
+    bx, by, bw, bh = vb
+    if not (w > 0 and h > 0 and bw > 0 and bh > 0):
+        raise Unsupported(f"nested <svg> with an empty viewport or viewBox (width={w}, "
+                          f"height={h}, viewBox={el.get('viewBox')!r}: not rendered)")
+    par = (el.get("preserveAspectRatio") or "xMidYMid meet").split()
+    if par and par[0] == "defer":
+        par = par[1:]
+    align = par[0] if par else "xMidYMid"
+    sx, sy = w / bw, h / bh
+    tx, ty = x, y
+    if align != "none":
+        sx = sy = max(sx, sy) if len(par) > 1 and par[1] == "slice" else min(sx, sy)
+        fx = 0.5 if "xMid" in align else 1.0 if "xMax" in align else 0.0
+        fy = 0.5 if "YMid" in align else 1.0 if "YMax" in align else 0.0
+        tx += fx * (w - bw * sx)
+        ty += fy * (h - bh * sy)
+    m = np.array([[sx, 0.0, tx - bx * sx], [0.0, sy, ty - by * sy], [0.0, 0.0, 1.0]])
+    return m, (bw, bh)
+
+
+def _root_viewport(root: ET.Element) -> tuple[float, float] | None:
+    """The size of the root's viewport in its user units (what a nested ``<svg>``'s
+    percentages refer to): its viewBox's, else its plain width and height, else unknown."""
+    try:
+        vb = _viewbox(root)
+        if vb is not None:
+            return vb[2], vb[3]
+        return (_viewport_length(root, "width", "", None),
+                _viewport_length(root, "height", "", None))
+    except Unsupported:
+        return None
+
+
 def _shape_elements(root: ET.Element, spt: Any, path: object
-                    ) -> list[tuple[int, ET.Element, np.ndarray | None]]:
-    """(index in document order among all elements, element, 2x3 affine matrix or None)
-    of every curve element, the matrix being the product of the ``transform`` attributes of
-    the element and its ancestors (its current transformation matrix, SVG 1.1 sec. 7.5)."""
-    out: list[tuple[int, ET.Element, np.ndarray | None]] = []
+                    ) -> list[tuple[int, ET.Element, np.ndarray | None, str | None]]:
+    """(index in document order among all elements, element, 2x3 affine matrix or None, why
+    not) of every curve element, the matrix being the product of the ``transform`` attributes
+    of the element and its ancestors (its current transformation matrix, SVG 1.1 sec. 7.5)
+    and of the viewport transformations of the nested ``<svg>`` elements it is in (their
+    ``x``, ``y`` and ``viewBox``, sec. 7.9), so that curves are in the root's user units;
+    "why not" is the reason an element's matrix is unknown (a nested ``<svg>`` whose
+    viewport curvefair cannot resolve), else None."""
+    out: list[tuple[int, ET.Element, np.ndarray | None, str | None]] = []
     count = 0
 
-    def walk(el: ET.Element, ctm: np.ndarray) -> None:
+    before: dict[int, np.ndarray] = {}      # id(element): its parent's matrix
+    after: dict[int, np.ndarray] = {}       # id(element): its own (children's) matrix
+    sizes: dict[int, tuple[float, float] | None] = {}
+    below: dict[int, list[int]] = {}        # id(element): positions in out of its shapes
+
+    def walk(el: ET.Element, ctm: np.ndarray, size: tuple[float, float] | None,
+             why: str | None, chain: tuple[int, ...] = ()) -> None:
         nonlocal count
         k = count
         count += 1
+        before[id(el)] = ctm
+        sizes[id(el)] = size
+        chain = (*chain, id(el))
         tf = el.get("transform")
         if tf is not None and tf.strip():
             with warnings.catch_warnings():
@@ -278,14 +378,106 @@ def _shape_elements(root: ET.Element, spt: Any, path: object
                     raise FileFormatError(f"<{_local(el.tag)}> element (id={el.get('id')!r}): "
                                           f"bad transform {tf!r} ({exc})", path) from None
             ctm = ctm @ m
+        if why is None and _CSS_TRANSFORM_RE.search(el.get("style") or ""):
+            # CSS transform property (SVG 2; browsers apply it): not parsed here, so the
+            # element's drawn size is unknown
+            why = (f"<{_local(el.tag)}> (id={el.get('id')!r}) with a CSS transform in its "
+                   "style attribute, which curvefair does not read")
+        if why is None:
+            why = _own_units(el)
+        if el is not root and _local(el.tag) == "svg" and why is None:
+            try:
+                m, size = _nested_viewport(el, size)
+                ctm = ctm @ m
+            except Unsupported as exc:
+                why = str(exc)
+        after[id(el)] = ctm
         if _local(el.tag) in _SHAPES:
             ident = np.allclose(ctm, np.eye(3), rtol=0, atol=0)
-            out.append((k, el, None if ident else ctm[:2].copy()))
+            for a in chain:
+                below.setdefault(a, []).append(len(out))
+            out.append((k, el, None if ident else ctm[:2].copy(), why))
         for child in el:
-            walk(child, ctm)
+            walk(child, ctm, size, why, chain)
 
-    walk(root, np.eye(3))
+    walk(root, np.eye(3), _root_viewport(root), None)
+    _drawn_by_use(root, out, before, after, sizes, below)
     return out
+
+
+def _own_units(el: ET.Element) -> str | None:
+    """Why the content of ``el`` is drawn in a coordinate system of its own, not the one of
+    its ancestors (SVG 1.1 sec. 11.6, 14.3.5, 14.4, 13.3), else None: a ``<marker>`` (scaled
+    by the stroke width and its viewBox), a ``<clipPath>``/``<mask>``/``<pattern>`` whose
+    content is in ``objectBoundingBox`` units (0..1 of the box of the element using it), a
+    ``<pattern>`` with a viewBox or a ``patternTransform``."""
+    tag = _local(el.tag)
+    ident = el.get("id")
+    if tag == "marker":
+        return f"<marker> (id={ident!r}), drawn scaled by the stroke it marks"
+    units = {"clipPath": "clipPathUnits", "mask": "maskContentUnits",
+             "pattern": "patternContentUnits"}.get(tag)
+    if units is not None and (el.get(units) or "").strip() == "objectBoundingBox":
+        return (f"<{tag}> (id={ident!r}) with {units}='objectBoundingBox' (drawn scaled to "
+                "the box of the element using it)")
+    if tag == "pattern" and (el.get("viewBox") or el.get("patternTransform")):
+        return f"<pattern> (id={ident!r}) with its own viewBox or patternTransform"
+    return None
+
+
+_XLINK_HREF = "{http://www.w3.org/1999/xlink}href"
+_CSS_TRANSFORM_RE = re.compile(r"(?:^|;)\s*transform\s*:\s*(?!none\s*(?:;|$|!))[^;\s]", re.I)
+
+
+def _drawn_by_use(root: ET.Element,
+                  out: list[tuple[int, ET.Element, np.ndarray | None, str | None]],
+                  before: dict[int, np.ndarray], after: dict[int, np.ndarray],
+                  sizes: dict[int, tuple[float, float] | None],
+                  below: dict[int, list[int]]) -> None:
+    """Mark (in ``out``, in place) the curve elements a ``<use>`` draws larger than curvefair
+    reads them: a ``<use>`` draws its target (and everything in it) through its own matrix,
+    its ``x``/``y`` and, for a ``<symbol>``, the symbol's viewport (SVG 1.1 sec. 5.6), not
+    through the target's ancestors. A move of ``tol`` in the element's document coordinates
+    is a move of at most ``s tol`` in that copy, ``s`` the largest singular value of the
+    linear map between the two; where ``s > 1`` the tolerance would not hold in the drawing,
+    and the element is unsupported (a copy drawn at the same size or smaller is fine)."""
+    ids = {el.get("id"): el for el in root.iter() if el.get("id")}
+    worst: dict[int, tuple[float, str]] = {}
+    for use in root.iter():
+        if _local(use.tag) != "use":
+            continue
+        href = (use.get("href") or use.get(_XLINK_HREF) or "").strip()
+        target = ids.get(href[1:]) if href.startswith("#") else None
+        if target is None or id(target) not in below or id(use) not in after:
+            continue
+        lin = after[id(use)][:2, :2]
+        what = f"drawn by <use> (id={use.get('id')!r}, href={href!r})"
+        try:
+            if _local(target.tag) == "symbol":
+                # the symbol's viewport: the <use>'s width/height (default 100%) on the
+                # symbol's viewBox and preserveAspectRatio
+                vp = ET.Element("svg", {k: v for k, v in (
+                    ("viewBox", target.get("viewBox")),
+                    ("preserveAspectRatio", target.get("preserveAspectRatio")),
+                    ("width", use.get("width")), ("height", use.get("height")))
+                    if v is not None})
+                m, _ = _nested_viewport(vp, sizes.get(id(use)))
+                lin = lin @ m[:2, :2]
+            rel = lin @ np.linalg.inv(before[id(target)][:2, :2])
+            scale = float(np.linalg.svd(rel, compute_uv=False)[0])
+        except (Unsupported, np.linalg.LinAlgError) as exc:
+            scale, what = float("inf"), f"{what}, at a size curvefair cannot tell ({exc})"
+        if not scale <= 1.0 + 1e-9:
+            for pos in below[id(target)]:
+                if scale > worst.get(pos, (0.0, ""))[0]:
+                    worst[pos] = (scale, what)
+    for pos, (scale, what) in worst.items():
+        k, el, ctm, why = out[pos]
+        if why is None:
+            size = f" {scale:.6g} times larger" if scale < float("inf") else ""
+            why = (f"{what}{size} than it is read: a fairing within --tol would not be "
+                   "within it there")
+            out[pos] = (k, el, ctm, why)
 
 
 def _path_elements(text: str, path: object) -> list[ET.Element]:
@@ -361,7 +553,7 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
                       stacklevel=4)
 
     k = -1
-    for node, el, ctm in _shape_elements(root, spt, path):
+    for node, el, ctm, why in _shape_elements(root, spt, path):
         tag = _local(el.tag)
         ident = el.get("id")
         base = {"format": FORMAT, "path": apath, "id": ident, "tag": tag, "node": node,
@@ -373,6 +565,10 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
             continue
         k += 1
         base["element"] = k
+        if why is not None:
+            skip(f"{what}: unsupported: "
+                 f"{why if why.startswith('drawn') else 'in a ' + why}")
+            continue
         if tag in ("polygon", "polyline", "line", "rect"):
             try:
                 pts, closed = _shape_points(el, tag, what, path)
