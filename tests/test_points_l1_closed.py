@@ -168,3 +168,72 @@ def test_select_keeps_the_formulation_with_the_fewest_rebuilt_extrema() -> None:
         assert res.report["max_deviation"] <= tol
         counts.append(analyze(interpolate_cubic(q)).extrema)
     assert counts[1] <= counts[0]
+
+
+def test_small_polygons_do_not_collapse_real_svg(tmp_path) -> None:
+    """OCCT's documentation drawing has closed 8-vertex dots 1.7-3.7 units across; at tol 2 and
+    5 points-l1 shrank them to a point (4e-12 across, or an internal error), and the written
+    file read back without them, so the command refused to write. The tube radius is now at
+    most SHRINK_CAP of a curve's extent: the command writes, svgpathtools reads back every
+    path with its segments, every vertex within tol, and the dots keep 3/4 of their size
+    (each extent loses at most two radii)."""
+    import os
+    import subprocess
+    import sys
+
+    import svgpathtools
+
+    from curvefair.fairing.points_l1 import SHRINK_CAP
+
+    src = os.path.join(os.path.dirname(__file__), "data", "real", "occt",
+                       "modeling_data_continuity_curves.svg")
+    paths0, attrs0 = svgpathtools.svg2paths(src)
+    ids = {a.get("id"): k for k, a in enumerate(attrs0)}
+    dots = [ids[i] for i in ("path19", "path203", "path359", "path621")]
+    for tol in (2.0, 5.0):
+        out = tmp_path / f"out_{tol:g}.svg"
+        env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+        run = subprocess.run([sys.executable, "-m", "curvefair", "fair", src, "--tol", str(tol),
+                              "-o", str(out), "--quiet"], capture_output=True, text=True,
+                             env=env)
+        assert run.returncode == 0, run.stderr
+        paths1, attrs1 = svgpathtools.svg2paths(str(out))
+        assert [a.get("id") for a in attrs1] == [a.get("id") for a in attrs0]
+        assert [len(p) for p in paths1] == [len(p) for p in paths0]
+        # in the drawing's units (svgpathtools applies the groups' transforms): every
+        # vertex within tol
+        drawn0 = svgpathtools.Document(src).paths()
+        drawn1 = svgpathtools.Document(str(out)).paths()
+        assert len(drawn1) == len(drawn0)
+        for p0, p1 in zip(drawn0, drawn1, strict=True):
+            assert len(p1) == len(p0)
+            if len(p0):
+                v0 = np.array([s.start for s in p0] + [p0[-1].end])
+                v1 = np.array([s.start for s in p1] + [p1[-1].end])
+                assert np.all(np.abs(v1 - v0) <= tol * (1 + 1e-9))
+        for k in dots:
+            v0 = np.array([s.start for s in paths0[k]])
+            v1 = np.array([s.start for s in paths1[k]])
+            big = max(np.ptp(v0.real), np.ptp(v0.imag))
+            for part in (np.real, np.imag):  # each extent loses at most 2 radii
+                assert np.ptp(part(v1)) >= np.ptp(part(v0)) - 2 * SHRINK_CAP * big - 1e-9
+            assert max(np.ptp(v1.real), np.ptp(v1.imag)) >= (1 - 2 * SHRINK_CAP) * big - 1e-9
+            steps = np.abs(np.diff(np.r_[v1, v1[:1]]))
+            assert steps.min() > 0.05 * np.abs(np.diff(np.r_[v0, v0[:1]])).min()
+
+
+def test_curve_smaller_than_tol_keeps_its_size() -> None:
+    """A closed 8-point polygon 1.8 across faired at tol 5: no internal error (its points used
+    to coincide), the radius used is reported, and the size is kept within SHRINK_CAP."""
+    from curvefair.fairing.points_l1 import SHRINK_CAP
+
+    a = 2 * np.pi * np.arange(8) / 8
+    P = np.c_[235.0 + 0.9 * np.cos(a), 519.0 + 0.9 * np.sin(a)]
+    c = interpolate_cubic(P, "chord", "periodic")
+    res = fair(c, "points-l1", tol=5.0)
+    q = np.asarray(res.curve.points)
+    assert np.all(np.linalg.norm(q - np.asarray(c.points), axis=1) <= 5.0)
+    ext0, ext1 = np.ptp(P, axis=0).max(), np.ptp(q, axis=0)
+    assert np.all(ext1 >= np.ptp(P, axis=0) - 2 * SHRINK_CAP * ext0 - 1e-12)
+    assert ext1.max() >= 0.5 * ext0  # was 1e-12 across (or an internal error)
+    assert res.report["points_l1"]["tube_radius"] == SHRINK_CAP * ext0

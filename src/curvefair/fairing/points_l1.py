@@ -131,7 +131,8 @@ class PointsL1Result:
         equal-parameter deviation), ``curve_deviation`` (upper bound of the Hausdorff
         distance of the curve rebuilt from the points, chord lengths of ``q``, from the
         input's chord interpolant, :func:`_rebuilt_distance`; None without ``curve_tol``),
-        ``scale`` (factor of a final scaling of the moves, 1.0: none).
+        ``scale`` (factor of a final scaling of the moves, 1.0: none), ``tube_radius`` (only
+        when ``tol`` exceeds ``SHRINK_CAP`` of the input's largest extent: the radius used).
     """
 
     points: np.ndarray
@@ -643,7 +644,12 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
                                            "attempts": 0, "pulled_back": 0, "scale": 1.0})
     pts = (pts - centre) / size
     tol_out = tolv
-    tolv = min(tolv / size, 1e6)
+    # the objective falls with the curve's scale: a curve that fits in the tube would shrink
+    # towards a point (an 8-point circle 3.5 across at tol 5 came out 4e-12 across); the
+    # radius is at most SHRINK_CAP of the largest extent, so no extent loses more than
+    # 2 SHRINK_CAP of the largest (the largest keeps 3/4 of itself)
+    capped = tolv / size > SHRINK_CAP
+    tolv = min(tolv / size, SHRINK_CAP)
     margin = min(0.25 * tolv, 1e-9 * tolv + 64.0 * np.finfo(float).eps * float(np.abs(pts).max()))
     # the parameters, affinely onto the chord length of the unit-size data (conditioning)
     chord = float(np.sum(np.sqrt(np.sum(np.diff(np.vstack([pts, pts[:1]]) if closed else pts,
@@ -792,9 +798,19 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
               "pulled_back": int(pulled) + int(cert.pulled_back), "attempts": attempts,
               "curve_deviation": curve_dev, "param_deviation": float(cert.upper_bound),
               "scale": float(cert.scale)}
+    if capped:
+        report["tube_radius"] = SHRINK_CAP * size
     q_out.setflags(write=False)
     return PointsL1Result(q_out, curve, report)
 
+
+#: the largest tube radius of :func:`points_l1`, as a fraction of the input's largest
+#: coordinate extent (a larger ``tol`` is used as this; ``report["tube_radius"]`` then says
+#: the radius used): sparse third-derivative jumps are cheaper on a smaller curve, so without
+#: it a curve smaller than the tolerance collapses to a point (the small closed polygons of
+#: OCCT's ``modeling_data_continuity_curves.svg`` at tol 2 and 5, whose written files read
+#: back without them)
+SHRINK_CAP = 0.125
 
 #: above this many points (and only when a global factor would be harsh, see
 #: ``LOCAL_SHRINK_BELOW``) the radii are shrunk near the spans whose rebuilt curve strays
