@@ -24,17 +24,20 @@ import numpy as np
 from .._jit import njit
 
 
+@njit(cache=True, inline="always")
+def _widths(t, i):  # pragma: no cover - compiled
+    """``D = t[i + 1] - t[i]``, ``D * D`` and ``pow(D, 3)``."""
+    D = t[i + 1] - t[i]
+    return D, D * D, math.pow(D, 3.0)
+
+
 @njit(cache=True)
 def cubic_power_kernel(p, m, t, out):  # pragma: no cover - compiled
     """``out[i, j, d]`` (shape ``(n - 1, 4, dim)``) from points ``p``, tangents ``m`` and
     parameters ``t`` (``n`` of each)."""
-    n1 = out.shape[0]
-    dim = out.shape[2]
-    for i in range(n1):
-        D = t[i + 1] - t[i]
-        D2 = D * D
-        D3 = math.pow(D, 3.0)
-        for d in range(dim):
+    for i in range(out.shape[0]):
+        D, D2, D3 = _widths(t, i)
+        for d in range(out.shape[2]):
             dp = p[i + 1, d] - p[i, d]
             out[i, 0, d] = p[i, d]
             out[i, 1, d] = m[i, d]
@@ -46,15 +49,11 @@ def cubic_power_kernel(p, m, t, out):  # pragma: no cover - compiled
 def quintic_power_kernel(p, m, s, t, out):  # pragma: no cover - compiled
     """``out[i, j, d]`` (shape ``(n - 1, 6, dim)``) from points ``p``, first and second
     derivatives ``m``, ``s`` and parameters ``t``."""
-    n1 = out.shape[0]
-    dim = out.shape[2]
-    for i in range(n1):
-        D = t[i + 1] - t[i]
-        D2 = D * D
-        D3 = math.pow(D, 3.0)
+    for i in range(out.shape[0]):
+        D, D2, D3 = _widths(t, i)
         D4 = math.pow(D, 4.0)
         D5 = math.pow(D, 5.0)
-        for d in range(dim):
+        for d in range(out.shape[2]):
             b1 = p[i + 1, d] - p[i, d] - m[i, d] * D - 0.5 * s[i, d] * D2
             b2 = m[i + 1, d] - m[i, d] - s[i, d] * D
             b3 = s[i + 1, d] - s[i, d]
