@@ -275,6 +275,14 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
                 continue
             handle = e.dxf.handle
             layer = e.dxf.get("layer", "0")
+            why = _protected(doc, layer)
+            if why:
+                # what the drawing's owner protected (CAD tools do not let it be selected or
+                # edited) is not read, so it is written back as it was
+                warnings.warn(f"{os.fspath(path)}: left {t} {handle} as it is: its layer "
+                              f"{layer!r} is {why} (unlock or thaw it to fair it)",
+                              UserWarning, stacklevel=3)
+                continue
             base = {"format": FORMAT, "path": os.path.abspath(path), "handle": handle,
                     "dxftype": t, "layer": layer, "layout": layout.name,
                     "name": f"{layer}:{t}:{handle}"}
@@ -296,6 +304,17 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
                 src["index"] = len(records)
                 records.append(CurveRecord(r.curve, r.name, r.kind, src, r.points, r.corners))
     return records
+
+
+def _protected(doc: Any, layer: str) -> str:
+    """``"locked"``, ``"frozen"`` (both: ``"locked and frozen"``) or ``""`` for the layer
+    named ``layer`` (a layer missing from the table is not protected)."""
+    try:
+        lay = doc.layers.get(layer)
+    except Exception:  # noqa: BLE001 - ezdxf raises its own DXFTableEntryError
+        return ""
+    kinds = [k for k, on in (("locked", lay.is_locked()), ("frozen", lay.is_frozen())) if on]
+    return " and ".join(kinds)
 
 
 # ------------------------------------------------------------------------------------------

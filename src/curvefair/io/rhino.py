@@ -145,6 +145,11 @@ def _nurbs(g: Any) -> tuple[FloatArray, FloatArray, FloatArray, int]:
     return xyzw[:, :3], xyzw[:, 3], full, int(g.Degree)
 
 
+def _is_curve(obj: Any, rh: Any) -> bool:
+    """Whether ``obj`` holds a curve curvefair reads (or would report as unsupported)."""
+    return isinstance(obj.Geometry, (rh.PolylineCurve, rh.NurbsCurve, rh.PolyCurve))
+
+
 def _records_of(obj: Any, i: int, base: dict[str, Any], path: object, rh: Any,
                 corner_angle: float | None, index: int) -> list[CurveRecord]:
     g = obj.Geometry
@@ -221,6 +226,11 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
     rh = _rhino("reading 3dm files")
     model = _load(path, "reading 3dm files")
     layers = [model.Layers[k].Name for k in range(len(model.Layers))]
+    # what the model's owner protected (Rhino does not let it be selected or edited): not
+    # read, so it is written back as it was
+    layer_state = [", ".join(k for k, on in (("locked", model.Layers[j].Locked),
+                                             ("hidden", not model.Layers[j].Visible)) if on)
+                   for j in range(len(model.Layers))]
     records: list[CurveRecord] = []
     for i in range(len(model.Objects)):
         obj = model.Objects[i]
@@ -233,6 +243,14 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
         ident = str(attr.Id)
         li = int(attr.LayerIndex)
         layer = layers[li] if 0 <= li < len(layers) else None
+        why = ("locked" if attr.Mode == rh.ObjectMode.Locked
+               else "hidden" if attr.Mode == rh.ObjectMode.Hidden else "")
+        if not why and 0 <= li < len(layers) and layer_state[li]:
+            why = f"on a {layer_state[li]} layer ({layer!r})"
+        if why and _is_curve(obj, rh):
+            warnings.warn(f"{os.fspath(path)}: left object {ident} as it is: it is {why} "
+                          "(unlock or show it to fair it)", UserWarning, stacklevel=3)
+            continue
         name = attr.Name or f"{type(obj.Geometry).__name__}:{ident}"
         base = {"format": FORMAT, "path": os.path.abspath(path), "id": ident, "object": i,
                 "layer": layer, "geometry": type(obj.Geometry).__name__, "name": name}
