@@ -85,3 +85,23 @@ def test_3dm_locked_and_hidden_objects_are_left_as_they_are(tmp_path):
     for k in range(4):
         assert np.array_equal(cps[k], orig), kinds[k][0]  # bit for bit
     assert not np.array_equal(cps[4], orig)  # the free one was faired
+
+
+def test_cli_file_with_only_protected_curves_is_copied(tmp_path):
+    """Every curve on a locked layer: nothing to fair; the command copies the file and exits
+    0 (it said 'no curves in the dxf file' and exited 1)."""
+    import os
+    import subprocess
+    import sys
+
+    ezdxf = pytest.importorskip("ezdxf")
+    doc = ezdxf.readfile(REAL / "trimesh" / "spline.DXF")
+    doc.layers.get("0").lock()
+    src, out = tmp_path / "in.dxf", tmp_path / "out.dxf"
+    doc.saveas(src)
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    run = subprocess.run([sys.executable, "-m", "curvefair", "fair", str(src), "--tol", "0.5",
+                          "-o", str(out)], capture_output=True, text=True, env=env)
+    assert run.returncode == 0, run.stderr
+    assert "is locked; left as it is" in run.stderr
+    assert out.read_bytes() == src.read_bytes()

@@ -279,9 +279,9 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
             if why:
                 # what the drawing's owner protected (CAD tools do not let it be selected or
                 # edited) is not read, so it is written back as it was
-                warnings.warn(f"{os.fspath(path)}: left {t} {handle} as it is: its layer "
-                              f"{layer!r} is {why} (unlock or thaw it to fair it)",
-                              UserWarning, stacklevel=3)
+                warnings.warn(f"{os.fspath(path)}: skipped {t} {handle}: its layer "
+                              f"{layer!r} is {why}; left as it is (unlock or thaw it to fair "
+                              "it)", UserWarning, stacklevel=3)
                 continue
             base = {"format": FORMAT, "path": os.path.abspath(path), "handle": handle,
                     "dxftype": t, "layer": layer, "layout": layout.name,

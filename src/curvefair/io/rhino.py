@@ -248,8 +248,8 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
         if not why and 0 <= li < len(layers) and layer_state[li]:
             why = f"on a {layer_state[li]} layer ({layer!r})"
         if why and _is_curve(obj, rh):
-            warnings.warn(f"{os.fspath(path)}: left object {ident} as it is: it is {why} "
-                          "(unlock or show it to fair it)", UserWarning, stacklevel=3)
+            warnings.warn(f"{os.fspath(path)}: skipped object {ident}: it is {why}; left as "
+                          "it is (unlock or show it to fair it)", UserWarning, stacklevel=3)
             continue
         name = attr.Name or f"{type(obj.Geometry).__name__}:{ident}"
         base = {"format": FORMAT, "path": os.path.abspath(path), "id": ident, "object": i,
