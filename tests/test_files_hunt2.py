@@ -321,3 +321,34 @@ def test_marker_and_bounding_box_content_are_unsupported(tmp_path):
     assert "id='inbox'" in msgs and "objectBoundingBox" in msgs
     assert "id='inmarker'" in msgs and "<marker>" in msgs
     assert {r.source["id"] for r in recs} == {"inuser", "line", None}   # None: the <rect>
+
+
+def test_css_transform_in_a_style_sheet_makes_every_curve_unsupported(tmp_path):
+    """A ``<style>`` sheet rule with a CSS transform: curvefair does not evaluate selectors, so
+    no element's drawn size is known; every curve is left as it is (was: faired in units a
+    browser draws 40 times larger). Comments, ``transform: none``, ``transform-origin`` and
+    ``text-transform`` do not count."""
+    import os
+    import subprocess
+    import sys
+
+    d = _icon_d()
+    head = '<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 1024 1024">\n'
+    body = (f'<path id="a" class="big" d="{d}"/>\n<path id="b" d="{d}"/>\n</svg>\n')
+    harmless = tmp_path / "harmless.svg"
+    harmless.write_text(head + "<style>/* .big{transform:scale(40)} */ .big{fill:red;"
+                        "transform:none; transform-origin:center; text-transform:uppercase}"
+                        "</style>\n" + body, encoding="utf-8")
+    assert {r.source["id"] for r in read_curves(harmless)} == {"a", "b"}
+    src = tmp_path / "sheet.svg"
+    src.write_text(head + "<style>.big { fill: red; transform: scale(40) }</style>\n" + body,
+                   encoding="utf-8")
+    with pytest.warns(UserWarning, match=r"<style> sheet that sets a CSS transform"):
+        with pytest.raises(Exception, match="no curves"):
+            read_curves(src, on_unsupported="skip")
+    out = tmp_path / "out.svg"
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    run = subprocess.run([sys.executable, "-m", "curvefair", "fair", str(src), "--tol", "0.5",
+                          "-o", str(out)], capture_output=True, text=True, env=env)
+    assert run.returncode == 0, run.stderr
+    assert out.read_bytes() == src.read_bytes()  # nothing faired, the file as it was

@@ -400,9 +400,29 @@ def _shape_elements(root: ET.Element, spt: Any, path: object
         for child in el:
             walk(child, ctm, size, why, chain)
 
-    walk(root, np.eye(3), _root_viewport(root), None)
+    walk(root, np.eye(3), _root_viewport(root), _sheet_transform(root))
     _drawn_by_use(root, out, before, after, sizes, below)
     return out
+
+
+_SHEET_TRANSFORM_RE = re.compile(r"(?:^|[{;\s])transform\s*:\s*(?!none\s*(?:;|}|!|$))[^;}\s]",
+                                 re.I)
+
+
+def _sheet_transform(root: ET.Element) -> str | None:
+    """Why no element's drawn size is known when a ``<style>`` sheet sets a CSS ``transform``
+    (SVG 2: browsers apply it to whatever its selectors match; curvefair does not evaluate
+    selectors), else None. Every curve element of such a document is then unsupported: left
+    as it is, rather than faired in units that may not be the drawing's."""
+    for el in root.iter():
+        if _local(el.tag) != "style":
+            continue
+        text = "".join(el.itertext())
+        text = re.sub(r"/\*.*?\*/", " ", text, flags=re.S)  # CSS comments
+        if _SHEET_TRANSFORM_RE.search(text):
+            return ("a <style> sheet that sets a CSS transform (curvefair does not evaluate "
+                    "its selectors, so no element's drawn size is known)")
+    return None
 
 
 def _own_units(el: ET.Element) -> str | None:
