@@ -353,6 +353,36 @@ def test_ufo_round_trip_and_files_kept(ufo_pair, tmp_path):
             sorted(x.relative_to(p) for x in Path(p).rglob("*"))
 
 
+def test_ufo_integer_contours_stay_on_the_grid(ufo_pair, tmp_path):
+    """A UFO contour drawn on the integer grid (DejaVu's outlines, as most UFO sources) is
+    written back on it, within tol, like a Glyphs source's (it got 17-digit coordinates); a
+    contour with a fractional coordinate is not put on the grid."""
+    p = ufo_pair["tt"]
+    u = ufoLib2.Font.open(p)
+    frac = "o"
+    for c in u[frac].contours:  # one glyph off the grid by half a unit
+        for pt in c.points:
+            pt.x += 0.5
+    u.save(p, overwrite=True)
+    recs = read_curves(p)
+    out = tmp_path / "grid.ufo"
+    write_curves(out, _fair_records(recs, 2.0), template=p)
+    a, b = ufoLib2.Font.open(p), ufoLib2.Font.open(out)
+    moved = {"grid": 0, "frac": 0}
+    for name in sorted({r.source["glyph"] for r in recs}):
+        for c0, c1 in zip(a[name].contours, b[name].contours, strict=True):
+            p0 = np.array([(q.x, q.y) for q in c0.points], dtype=float)
+            p1 = np.array([(q.x, q.y) for q in c1.points], dtype=float)
+            assert np.all(np.linalg.norm(p1 - p0, axis=1) <= 2.0)
+            key = "frac" if name == frac else "grid"
+            moved[key] += int(np.any(p1 != p0))
+            if key == "grid":
+                assert np.array_equal(p1, np.round(p1)), name  # on the grid
+    assert moved["grid"] > 0 and moved["frac"] > 0
+    pts = np.array([(q.x, q.y) for c in b[frac].contours for q in c.points], dtype=float)
+    assert not np.array_equal(pts, np.round(pts))  # the fractional one is not rounded
+
+
 def test_cli_fair_ufo_folder(ufo_pair, tmp_path):
     from click.testing import CliRunner
 

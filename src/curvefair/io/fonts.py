@@ -44,6 +44,7 @@ A variable TrueType binary (``gvar``) is refused: its sources are faired instead
 - UFO: the template folder is copied and only the ``.glif`` files of changed glyphs are
   rewritten (through fontTools' glifLib, in the glyph's own GLIF format version); kerning,
   features, groups, lib, other layers, components, anchors, guidelines come back byte for byte.
+  A contour whose coordinates are all integers keeps to the integer grid.
 - TrueType: the changed glyphs' coordinates are replaced (instructions, flags and point
   counts kept), bounds recomputed, the left side bearing follows ``xMin`` where it was equal.
 - Glyphs: nothing changed, the source's bytes are copied; else the faired coordinates are
@@ -106,7 +107,10 @@ def ufo_contour(points: Sequence[Any], path: object = None) -> Contour:
     xy = np.array([(float(p.x), float(p.y)) for p in points], dtype=np.float64)
     on = tuple(t is not None and t != "offcurve" for t in types)
     smooth = tuple(bool(p.smooth) for p in points)
-    return Contour(xy, on, smooth, closed, quad, grid=False)
+    # a contour drawn on the integer grid (most UFO sources: the editors' default) keeps to it,
+    # as a Glyphs source's does; one with fractional coordinates is not put on it
+    grid = bool(xy.size) and bool(np.array_equal(xy, np.round(xy)))
+    return Contour(xy, on, smooth, closed, quad, grid=grid)
 
 
 def exact_smooth_flags(xy: FloatArray, on: Sequence[bool]) -> tuple[bool, ...]:
