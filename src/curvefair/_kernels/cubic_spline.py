@@ -23,46 +23,49 @@ from .._jit import njit
 
 
 @njit(cache=True)
-def cubic_slopes_kernel(t, y, lo_order, lo_val, hi_order, hi_val, cp, out):  # pragma: no cover
+def cubic_slopes_kernel(t, y, lo_order, lo_val, hi_order, hi_val, cp, pv, out):  # pragma: no cover
     """Slopes ``out`` (n, dim) of the C2 cubic through ``y`` (n, dim) at increasing ``t``
-    (n >= 2) with the end conditions (``*_order`` 1 or 2, ``*_val`` (dim,)). ``cp`` (n,) is work
-    space."""
+    (n >= 2) with the end conditions (``*_order`` 1 or 2, ``*_val`` (dim,)). ``cp``, ``pv``
+    (n,) are work space: the elimination (row ``i`` becomes ``m_i + cp[i] m_{i+1}``, pivot
+    ``pv[i]``) is made once, then applied to every coordinate."""
     n = t.shape[0]
     dim = y.shape[1]
+    cp[0] = 0.0 if lo_order == 1 else 0.5
+    pv[0] = 1.0 if lo_order == 1 else 2.0
+    for i in range(1, n - 1):
+        hl = t[i] - t[i - 1]
+        hr = t[i + 1] - t[i]
+        pv[i] = 2.0 * (hl + hr) - hr * cp[i - 1]
+        cp[i] = hl / pv[i]
+    pv[n - 1] = 1.0 if hi_order == 1 else 2.0 - cp[n - 2]
+    h0 = t[1] - t[0]
+    hl = t[n - 1] - t[n - 2]
     for a in range(dim):
-        # forward elimination: row i becomes m_i + cp[i] m_{i+1} = out[i, a]
-        h0 = t[1] - t[0]
-        d0 = (y[1, a] - y[0, a]) / h0
         if lo_order == 1:
-            cp[0] = 0.0
             out[0, a] = lo_val[a]
         else:
-            cp[0] = 0.5
-            out[0, a] = (3.0 * d0 - 0.5 * lo_val[a] * h0) / 2.0
+            out[0, a] = (3.0 * ((y[1, a] - y[0, a]) / h0) - 0.5 * lo_val[a] * h0) / pv[0]
         for i in range(1, n - 1):
-            hl = t[i] - t[i - 1]
-            hr = t[i + 1] - t[i]
-            dl = (y[i, a] - y[i - 1, a]) / hl
-            dr = (y[i + 1, a] - y[i, a]) / hr
-            piv = 2.0 * (hl + hr) - hr * cp[i - 1]
-            cp[i] = hl / piv
-            out[i, a] = (3.0 * (hr * dl + hl * dr) - hr * out[i - 1, a]) / piv
-        hl = t[n - 1] - t[n - 2]
-        dl = (y[n - 1, a] - y[n - 2, a]) / hl
+            hli = t[i] - t[i - 1]
+            hri = t[i + 1] - t[i]
+            dl = (y[i, a] - y[i - 1, a]) / hli
+            dr = (y[i + 1, a] - y[i, a]) / hri
+            out[i, a] = (3.0 * (hri * dl + hli * dr) - hri * out[i - 1, a]) / pv[i]
         if hi_order == 1:
             out[n - 1, a] = hi_val[a]
         else:
-            piv = 2.0 - cp[n - 2]
-            out[n - 1, a] = (3.0 * dl + 0.5 * hi_val[a] * hl - out[n - 2, a]) / piv
+            dl = (y[n - 1, a] - y[n - 2, a]) / hl
+            out[n - 1, a] = (3.0 * dl + 0.5 * hi_val[a] * hl - out[n - 2, a]) / pv[n - 1]
         for i in range(n - 2, -1, -1):
             out[i, a] = out[i, a] - cp[i] * out[i + 1, a]
 
 
 @njit(cache=True)
-def periodic_slopes_kernel(t, y, cp, z, out):  # pragma: no cover - compiled
+def periodic_slopes_kernel(t, y, cp, pv, z, out):  # pragma: no cover - compiled
     """Slopes ``out`` (n, dim) of the periodic C2 cubic through ``y`` (n, dim; ``y[-1]`` repeats
     ``y[0]``) at increasing ``t`` (n >= 4: at least 3 distinct points); ``out[-1] = out[0]``.
-    ``cp``, ``z`` (n,) are work space."""
+    ``cp``, ``pv``, ``z`` (n,) are work space: the elimination of the tridiagonal part (made
+    once) and the Sherman-Morrison vector."""
     n = t.shape[0]
     N = n - 1  # unknowns m_0 .. m_{N-1}
     dim = y.shape[1]
@@ -71,43 +74,34 @@ def periodic_slopes_kernel(t, y, cp, z, out):  # pragma: no cover - compiled
     beta = t[1] - t[0]
     alpha = t[N - 1] - t[N - 2]
     hlast = t[N] - t[N - 1]  # h_{N-1} = h_{-1}
-    b0 = 2.0 * (hlast + beta)
-    gamma = -b0
-    # the tridiagonal part with b_0 - gamma and b_{N-1} - alpha beta / gamma: factor once (cp),
-    # solve for u = (gamma, 0, ..., 0, alpha) into z
-    # row 0: diag b0 - gamma, upper h_{-1}
-    d = b0 - gamma
-    cp[0] = hlast / d
-    z[0] = gamma / d
+    gamma = -2.0 * (hlast + beta)
+    # the tridiagonal part with b_0 - gamma and b_{N-1} - alpha beta / gamma, factored once
+    # (row 0: diagonal b_0 - gamma, upper h_{-1}); z solves it for u = (gamma, 0, .., 0, alpha)
+    pv[0] = 2.0 * (hlast + beta) - gamma
+    cp[0] = hlast / pv[0]
+    z[0] = gamma / pv[0]
     for i in range(1, N):
         hl = t[i] - t[i - 1]
         hr = t[i + 1] - t[i]
-        lower = hr
-        upper = hl
         diag = 2.0 * (hl + hr)
         if i == N - 1:
             diag = diag - alpha * beta / gamma
-        piv = diag - lower * cp[i - 1]
-        cp[i] = upper / piv
-        rhs_u = alpha if i == N - 1 else 0.0
-        z[i] = (rhs_u - lower * z[i - 1]) / piv
+        pv[i] = diag - hr * cp[i - 1]
+        cp[i] = hl / pv[i]
+        z[i] = ((alpha if i == N - 1 else 0.0) - hr * z[i - 1]) / pv[i]
     for i in range(N - 2, -1, -1):
         z[i] = z[i] - cp[i] * z[i + 1]
     zf = 1.0 + z[0] + beta * z[N - 1] / gamma
     for a in range(dim):
         dlast = (y[N, a] - y[N - 1, a]) / hlast
         d0 = (y[1, a] - y[0, a]) / beta
-        out[0, a] = 3.0 * (beta * dlast + hlast * d0) / d
+        out[0, a] = 3.0 * (beta * dlast + hlast * d0) / pv[0]
         for i in range(1, N):
             hl = t[i] - t[i - 1]
             hr = t[i + 1] - t[i]
             dl = (y[i, a] - y[i - 1, a]) / hl
             dr = (y[i + 1, a] - y[i, a]) / hr
-            diag = 2.0 * (hl + hr)
-            if i == N - 1:
-                diag = diag - alpha * beta / gamma
-            piv = diag - hr * cp[i - 1]
-            out[i, a] = (3.0 * (hr * dl + hl * dr) - hr * out[i - 1, a]) / piv
+            out[i, a] = (3.0 * (hr * dl + hl * dr) - hr * out[i - 1, a]) / pv[i]
         for i in range(N - 2, -1, -1):
             out[i, a] = out[i, a] - cp[i] * out[i + 1, a]
         f = (out[0, a] + beta * out[N - 1, a] / gamma) / zf

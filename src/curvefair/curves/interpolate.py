@@ -124,9 +124,9 @@ def cubic_slopes(t: FloatArray, pts: FloatArray, bc: Any) -> FloatArray:
     y = np.ascontiguousarray(pts, dtype=np.float64)
     n, dim = y.shape
     out = np.empty((n, dim))
-    cp = np.empty(n)
+    cp, pv = np.empty(n), np.empty(n)
     if isinstance(bc, str) and bc == "periodic":
-        periodic_slopes_kernel(t, y, cp, np.empty(n), out)
+        periodic_slopes_kernel(t, y, cp, pv, np.empty(n), out)
         return out
     left, right = bc
     if isinstance(left, str) or isinstance(right, str):
@@ -135,7 +135,7 @@ def cubic_slopes(t: FloatArray, pts: FloatArray, bc: Any) -> FloatArray:
     (lo, lv), (hi, hv) = left, right
     cubic_slopes_kernel(t, y, int(lo), np.ascontiguousarray(lv, dtype=np.float64).reshape(dim),
                         int(hi), np.ascontiguousarray(hv, dtype=np.float64).reshape(dim), cp,
-                        out)
+                        pv, out)
     return out
 
 

@@ -44,7 +44,7 @@ def is_chord_interpolant(curve: PiecewiseCurve) -> bool:
 
     if type(curve) is not CubicHermite:
         return False
-    if getattr(curve, "_chord_natural", False):
+    if curve._chord_natural:
         return True  # made by interpolate_cubic(points, "chord", natural or periodic)
     # the parameters first (O(n), no solve): the chord lengths interpolate_cubic would use
     t, r = np.asarray(curve.params), parameterize(curve.points, "chord")
@@ -58,7 +58,7 @@ def is_chord_interpolant(curve: PiecewiseCurve) -> bool:
                                 "periodic" if curve.closed else "natural")
     except InputError:
         return False
-    sr = float(np.asarray(ref.params)[-1] - np.asarray(ref.params)[0])
+    # ref's parameters are r (the same parameterize of the same points)
     d, dr = np.asarray(curve.tangents) * st, np.asarray(ref.tangents) * sr
     scale = max(float(np.max(np.abs(dr))), 1e-300)
     return bool(np.max(np.abs(d - dr)) <= 1e-7 * scale)

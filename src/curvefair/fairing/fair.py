@@ -644,7 +644,6 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
     worse = bool(_adds(after, before))
     rebuilt = rb_after = None
     if guard:
-
         if (type(new) is CubicHermite and type(curve) is CubicHermite
                 and np.array_equal(new.params, curve.params)
                 and not np.array_equal(new.points, curve.points)

@@ -7,7 +7,7 @@ import numpy as np
 from .._typing import FloatArray
 from ..curves.hermite import CubicHermite, HermiteSpline, QuinticHermite
 
-__all__ = ["distinct_data", "rebuild", "uniform_spacing"]
+__all__ = ["distinct_data", "full_data", "rebuild", "uniform_spacing"]
 
 
 def distinct_data(curve: HermiteSpline) -> tuple[FloatArray, FloatArray, FloatArray]:
@@ -26,11 +26,17 @@ def distinct_data(curve: HermiteSpline) -> tuple[FloatArray, FloatArray, FloatAr
     return np.ascontiguousarray(pts), D, np.ascontiguousarray(h)
 
 
+def full_data(curve: HermiteSpline, P: FloatArray, D: FloatArray
+              ) -> tuple[FloatArray, FloatArray]:
+    """Distinct data ``P``, ``D`` laid out as ``curve``'s arrays: the seam repeated if closed."""
+    if curve.closed:
+        return np.vstack([P, P[:1]]), np.concatenate([D, D[:1]], axis=0)
+    return P, D
+
+
 def rebuild(curve: HermiteSpline, P: FloatArray, D: FloatArray) -> HermiteSpline:
     """A curve like ``curve`` with distinct data ``P``, ``D`` (the seam is repeated if closed)."""
-    if curve.closed:
-        P = np.vstack([P, P[:1]])
-        D = np.concatenate([D, D[:1]], axis=0)
+    P, D = full_data(curve, P, D)
     if isinstance(curve, QuinticHermite):
         return QuinticHermite(P, D[:, 0], D[:, 1], curve.params, closed=curve.closed)
     return CubicHermite(P, D[:, 0], curve.params, closed=curve.closed)

@@ -118,7 +118,7 @@ from ..curves.hermite import CubicHermite, HermiteSpline, QuinticHermite
 from ..curves.interpolate import cubic_slopes, quintic_hermite_data
 from ..errors import InputError
 from .fair import MethodSpec, register_method
-from .hermite_data import distinct_data, rebuild, uniform_spacing
+from .hermite_data import distinct_data, full_data, rebuild, uniform_spacing
 from .problem import FairingHistory, FairingProblem, Outcome, eps_threshold
 from .stop import StopReason
 
@@ -437,11 +437,9 @@ def _curve_deviation(curve: HermiteSpline, P: FloatArray, D: FloatArray) -> floa
     the differences of the two curves' data (the seam repeated if closed)."""
     from ._tolerance import delta_deviation
 
-    dP = P - np.asarray(curve.points)[:P.shape[0]]
-    dD = D - np.stack([np.asarray(d)[:P.shape[0]] for d in curve._derivs], axis=1)
-    if curve.closed:
-        dP = np.vstack([dP, dP[:1]])
-        dD = np.concatenate([dD, dD[:1]], axis=0)
+    nd = P.shape[0]
+    dP, dD = full_data(curve, P - np.asarray(curve.points)[:nd],
+                       D - np.stack([np.asarray(d)[:nd] for d in curve._derivs], axis=1))
     if isinstance(curve, QuinticHermite):
         delta = {"points": dP, "d1": dD[:, 0], "d2": dD[:, 1]}
     else:

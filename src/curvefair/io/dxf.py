@@ -309,9 +309,11 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
 def _protected(doc: Any, layer: str) -> str:
     """``"locked"``, ``"frozen"`` (both: ``"locked and frozen"``) or ``""`` for the layer
     named ``layer`` (a layer missing from the table is not protected)."""
+    from ezdxf.lldxf.const import DXFTableEntryError
+
     try:
         lay = doc.layers.get(layer)
-    except Exception:  # noqa: BLE001 - ezdxf raises its own DXFTableEntryError
+    except DXFTableEntryError:
         return ""
     kinds = [k for k, on in (("locked", lay.is_locked()), ("frozen", lay.is_frozen())) if on]
     return " and ".join(kinds)
