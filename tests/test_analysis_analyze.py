@@ -388,3 +388,58 @@ def test_counts_do_not_depend_on_the_drawing_scale(dim):
         a = cf.analyze(cs)
         assert (a.extrema, a.inflections) == (ref.extrema, ref.inflections), s
         np.testing.assert_allclose(a.extremum_params, ref.extremum_params, rtol=0, atol=1e-6)
+
+
+def _bitwise_same(a, b):
+    da, db = a.to_dict(), b.to_dict()
+    assert da.keys() == db.keys()
+    for k in da:
+        assert np.array_equal(np.asarray(da[k]), np.asarray(db[k])), k
+
+
+@pytest.mark.parametrize("kind", ["open", "closed", "quintic", "twisted", "gaps"])
+def test_sampling_pass_in_ranges_is_bitwise_the_same(monkeypatch, kind):
+    """The sampling pass split into ranges on two threads (curvefair._threads) gives bitwise
+    the analysis of one pass on one thread: every range boundary is a breakpoint whose jumps
+    need the segment before (the range re-runs it), a closed curve's seam joins the last
+    range to the first. Sixteen ranges of a few segments each, so every kind of boundary is
+    crossed; also with the worker thread busy (the calling thread does every range)."""
+    import threading
+
+    from curvefair import _threads
+    from curvefair.analysis import _sampling
+
+    rng = np.random.default_rng(11)
+    n = 130
+    x = np.linspace(0, 9, n)
+    pts = np.c_[x, np.sin(x)] + 0.01 * rng.normal(size=(n, 2))
+    if kind == "open":
+        c = cf.interpolate_cubic(pts)
+    elif kind == "closed":
+        a = np.linspace(0, 2 * np.pi, n, endpoint=False)
+        c = cf.interpolate_bspline(np.c_[np.cos(a), 0.5 * np.sin(a)]
+                                   + 0.002 * rng.normal(size=(n, 2)), closed=True)
+    elif kind == "quintic":
+        c = cf.interpolate_quintic(pts)
+    elif kind == "twisted":
+        c = cf.interpolate_cubic(np.c_[np.cos(x), np.sin(x), 0.2 * x]
+                                 + 0.01 * rng.normal(size=(n, 3)))
+    else:  # near-straight noisy data: many gaps to refine in the sign certificates
+        c = cf.interpolate_cubic(np.c_[x, 1e-3 * rng.normal(size=n)])
+    monkeypatch.setattr(_threads, "THREADS", 1)
+    ref = cf.analyze(c)
+    monkeypatch.setattr(_threads, "THREADS", 2)
+    monkeypatch.setattr(_sampling, "PAR_MIN", 8)
+    calls = []
+    ranges = _threads.ranges
+    monkeypatch.setattr(_threads, "ranges",
+                        lambda fn, lo, hi, *a: calls.append(hi - lo) or ranges(fn, lo, hi, *a))
+    got = cf.analyze(c)
+    assert calls and ref.extrema > 0
+    _bitwise_same(ref, got)
+    gate = threading.Event()
+    _threads.pool().submit(gate.wait, 30)  # the worker is busy
+    try:
+        _bitwise_same(ref, cf.analyze(c))
+    finally:
+        gate.set()

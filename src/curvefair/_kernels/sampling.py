@@ -111,10 +111,10 @@ def _frenet_node(r1, r2, r3, sc1, sc2, speed_rtol, cross_rtol):
     return k_, ks, sp, num, enum, singular
 
 
-@njit(cache=True, fastmath=_FM, error_model="numpy")
+@njit(cache=True, nogil=True, fastmath=_FM, error_model="numpy")
 def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cross_rtol,
-                closed, kap, dks, knots, energies, quad, box, ell, pos,
-                gaps, unit):
+                kap, dks, knots, energies, quad, box, ell, pos, gaps, unit,
+                i_lo, i_hi, scratch, first, endv, ksfl):
     """One fused pass over the segments (see
     :func:`curvefair.analysis._sampling.sample_curve`).
 
@@ -132,6 +132,17 @@ def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cr
     scale; ``pos`` the norm of its start point; and ``gaps`` (rows ``(which, segment, gap)``
     whose gap Bernstein coefficients still vary at least twice). Returns ``(n_singular,
     max|kappa|, max|dkds|, n_gaps)``.
+
+    **Ranges.** Only segments ``i_lo .. i_hi - 1`` are done (their rows of the per-segment
+    outputs, their gaps, their bounding box and counts), so that ranges can run on several
+    threads. A range starting after segment 0 first runs the whole pass over segment
+    ``i_lo - 1`` (the limits at its end are what the jumps at breakpoint ``i_lo`` need),
+    writing that segment's rows to row ``scratch`` (a spare row past ``m``): every value is
+    computed by the same code from the same inputs however the segments are split, so the
+    results are bitwise the same on one thread or several. ``first`` gets the right limits of
+    the third and ``degree``-th derivative at the start of segment 0 (range with ``i_lo ==
+    0``), ``endv`` the left limits at the end of segment ``i_hi - 1``, ``ksfl`` ``dkappa/ds``
+    at those two places: :func:`seam_jumps` makes the closed curve's seam row from them.
     """
     m, p1, dim = cw.shape
     K = tab.shape[1]
@@ -151,15 +162,14 @@ def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cr
     fd = np.empty(K)
     ksa = np.empty(K)
     bb = np.empty(fits.shape[2])
-    endv = np.zeros((2, dim))  # left limits at the previous segment's end
-    first = np.zeros((2, dim))  # right limits at the first segment's start
+    endv[:, :] = 0.0  # left limits at the previous segment's end
+    i0 = i_lo - 1 if i_lo > 0 else 0  # the first segment run (see Ranges)
     for d in range(dim):
-        box[0, d] = cw[0, 0, d]
-        box[1, d] = cw[0, 0, d]
+        box[0, d] = cw[i0, 0, d]
+        box[1, d] = cw[i0, 0, d]
     ks_start = 0.0
     ks_end = 0.0
     ks_prev_end = 0.0
-    ks_first = 0.0
     hilb = np.empty(2 * p1)
     for j in range(2 * p1):
         hilb[j] = 1.0 / (j + 1.0)
@@ -167,13 +177,15 @@ def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cr
     maxk = 0.0
     maxks = 0.0
     ngap = 0
-    for i in range(m):
+    for i in range(i0, i_hi):
+        row = i if i >= i_lo else scratch
+        own = i >= i_lo
         hi = h[i]
         ih = 1.0 / hi
         ih2 = ih * ih
         ih3 = ih2 * ih
         sc1, sc2 = _setup(cw, i, hi, fall, e)
-        ell[i] = sc1 * hi
+        ell[row] = sc1 * hi
         c0n = 0.0
         for d in range(dim):
             v = cw[i, 0, d]
@@ -182,7 +194,7 @@ def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cr
                 box[0, d] = v
             if v > box[1, d]:
                 box[1, d] = v
-        pos[i] = np.sqrt(c0n)
+        pos[row] = np.sqrt(c0n)
         # exact energies: h int_0^1 |sum_j g_j u^j|^2 du with g_j = fall[j+o, o] e_{j+o} / h^o
         for o in range(2, 4):
             acc = 0.0
@@ -194,7 +206,7 @@ def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cr
                             dd += e[j + o, d] * e[k + o, d]
                         acc += dd * fall[j + o, o] * fall[k + o, o] * hilb[j + k]
                 acc *= ih2 * ih2 if o == 2 else ih3 * ih3
-            energies[i, o - 2] = acc * hi
+            energies[row, o - 2] = acc * hi
         # jumps at breakpoint i of the third and the degree-th derivative; then the left
         # limits at this segment's end for breakpoint i + 1
         for slot in range(2):
@@ -214,7 +226,7 @@ def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cr
                     for j in range(nu, p1):
                         acc += fall[j, nu] * e[j, d]
                 endv[slot, d] = acc * ihn
-            knots[i, slot] = np.sqrt(jj) if i > 0 else 0.0
+            knots[row, slot] = np.sqrt(jj) if i > 0 else 0.0
         if p1 == 4:  # cubic: derivative polynomials in u written out (the common case)
             for d in range(dim):
                 c1[d] = e[1, d] * ih
@@ -249,9 +261,9 @@ def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cr
                 good = (sp > thr) and (abs(k_) < np.inf) and (abs(ks) < np.inf)
                 k_ = k_ if good else 0.0
                 ks = ks if good else 0.0
-                nsing += not good
-                kap[i, qn] = min(max(k_ * unit, -_F32_MAX), _F32_MAX)
-                dks[i, qn] = min(max(ks * unit2, -_F32_MAX), _F32_MAX)
+                nsing += (not good) & own
+                kap[row, qn] = min(max(k_ * unit, -_F32_MAX), _F32_MAX)
+                dks[row, qn] = min(max(ks * unit2, -_F32_MAX), _F32_MAX)
                 maxk = max(maxk, abs(k_))
                 maxks = max(maxks, abs(ks))
                 ksa[qn] = ks
@@ -281,10 +293,10 @@ def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cr
                                                            cross_rtol)
                 vals[0, qn] = num
                 vals[1, qn] = enum
-                nsing += sing
+                nsing += sing & own
                 # stored in float32 (sign and rough size are all the counts need), clamped
-                kap[i, qn] = min(max(k_ * unit, -_F32_MAX), _F32_MAX)
-                dks[i, qn] = min(max(ks * unit2, -_F32_MAX), _F32_MAX)
+                kap[row, qn] = min(max(k_ * unit, -_F32_MAX), _F32_MAX)
+                dks[row, qn] = min(max(ks * unit2, -_F32_MAX), _F32_MAX)
                 if qn == 0:
                     ks_start = ks
                 ks_end = ks
@@ -316,14 +328,16 @@ def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cr
             qd += d7
             ed += abs(d7 - d4)
         sw = hi / P
-        quad[i, 0] = qa * sw
-        quad[i, 1] = ea * sw
-        quad[i, 2] = qd * sw
-        quad[i, 3] = ed * sw
-        knots[i, 2] = abs(ks_start - ks_prev_end) if i > 0 else 0.0
+        quad[row, 0] = qa * sw
+        quad[row, 1] = ea * sw
+        quad[row, 2] = qd * sw
+        quad[row, 3] = ed * sw
+        knots[row, 2] = abs(ks_start - ks_prev_end) if i > 0 else 0.0
         if i == 0:
-            ks_first = ks_start
+            ksfl[0] = ks_start
         ks_prev_end = ks_end
+        if not own:
+            continue  # the range's lead-in segment: its gaps belong to the range before
         # certificate: can a sign change of N (E) hide between two samples?
         for which in range(2):
             nb = nfit[which]
@@ -384,14 +398,9 @@ def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cr
                         gaps[ngap, 1] = i
                         gaps[ngap, 2] = gq
                     ngap += 1
-    if closed:
-        for slot in range(2):
-            jj = 0.0
-            for d in range(dim):
-                diff = first[slot, d] - endv[slot, d]
-                jj += diff * diff
-            knots[0, slot] = np.sqrt(jj)
-        knots[0, 2] = abs(ks_first - ks_prev_end)
+    ksfl[1] = ks_prev_end
+    if i_hi < m:
+        return nsing, maxk, maxks, ngap
     # the end point of the last segment
     for d in range(dim):
         acc = 0.0
@@ -402,6 +411,21 @@ def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cr
         if acc > box[1, d]:
             box[1, d] = acc
     return nsing, maxk, maxks, ngap
+
+
+@njit(cache=True, nogil=True, fastmath=_FM, error_model="numpy")
+def seam_jumps(first, endv, ksfl, knots):
+    """Row 0 of ``knots`` for a closed curve: the jumps at the seam, from the right limits at
+    the start of segment 0 (``first``, ``ksfl[0]``) and the left limits at the end of the last
+    segment (``endv``, ``ksfl[1]``) that :func:`pass_kernel` reports."""
+    dim = first.shape[1]
+    for slot in range(2):
+        jj = 0.0
+        for d in range(dim):
+            diff = first[slot, d] - endv[slot, d]
+            jj += diff * diff
+        knots[0, slot] = np.sqrt(jj)
+    knots[0, 2] = abs(ksfl[0] - ksfl[1])
 
 
 @njit(cache=True, error_model="numpy")

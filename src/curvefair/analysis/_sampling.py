@@ -27,6 +27,7 @@ from typing import cast
 
 import numpy as np
 
+from .. import _threads
 from .._kernels import sampling as _k
 from .._typing import FloatArray
 from ._core import CROSS_RTOL, SPEED_RTOL, derivs_at, falling, frenet
@@ -44,6 +45,9 @@ ROUNDING_FLOOR = 1e3 * float(np.finfo(float).eps)
 QUAD_RTOL = 1e-9
 _MAX_SPLITS = 48
 _MAX_LEVELS = 10
+#: Segments: from this many on, the sampling pass runs in ranges on two threads
+#: (:mod:`curvefair._threads`; bitwise the same results as on one).
+PAR_MIN = 50_000
 
 # Gander & Gautschi (2000): 4-point Gauss-Lobatto and 7-point Kronrod extension on [-1, 1]
 _R23 = float(np.sqrt(2.0 / 3.0))
@@ -276,26 +280,55 @@ def sample_curve(cw: FloatArray, h: FloatArray, planar: bool, closed: bool,
     for j in range(p1):
         for nu in range(j + 1):
             fall[j, nu] = falling(j, nu)[0]
-    kap = np.empty((m, K), dtype=np.float32)
-    dks = np.empty((m, K), dtype=np.float32)
+    # one spare row per range (the lead-in segment of a range, see pass_kernel); the views of
+    # the first m rows are what the analysis keeps
+    spare = _threads.CHUNKS
+    kap = np.empty((m + spare, K), dtype=np.float32)
+    dks = np.empty((m + spare, K), dtype=np.float32)
     unit = _unit(cw)
-    knots = np.empty((m, 3))
-    energies = np.empty((m, 2))
-    quad = np.empty((m, 4))
-    box = np.empty((2, dim))
-    ell = np.empty(m)
-    pos = np.empty(m)
+    knots = np.empty((m + spare, 3))
+    energies = np.empty((m + spare, 2))
+    quad = np.empty((m + spare, 4))
+    ell = np.empty(m + spare)
+    pos = np.empty(m + spare)
     cwc = np.ascontiguousarray(cw, dtype=np.float64)
     hc = np.ascontiguousarray(h, dtype=np.float64)
-    gaps = np.empty((max(1 << 12, m // 4), 3), dtype=np.int64)
-    while True:
-        nsing, maxk, maxks, ngap = _k.pass_kernel(
-            cwc, hc, plan.x, plan.tab, plan.w7, plan.w4, plan.P, fall, fits, nfit, subs, SPEED_RTOL,
-            CROSS_RTOL, bool(closed), kap, dks, knots, energies, quad, box, ell, pos, gaps,
-            unit)
-        if ngap <= gaps.shape[0]:
-            break
-        gaps = np.empty((ngap, 3), dtype=np.int64)  # rare: the buffer was too small; redo
+    first = np.zeros((2, dim))  # limits at the start of segment 0 (range 0 writes them)
+    ksfl = np.zeros(2)
+    starts = {a: q for q, a in enumerate(_threads.bounds(0, m))}
+
+    def run(a: int, b: int) -> tuple[int, float, float, np.ndarray, np.ndarray, np.ndarray,
+                                     np.ndarray]:
+        box = np.empty((2, dim))
+        endv = np.empty((2, dim))
+        fl = np.zeros(2)
+        gaps = np.empty((max(1 << 12, (b - a) // 4), 3), dtype=np.int64)
+        scratch = m + starts.get(a, 0)
+        while True:
+            nsing, maxk, maxks, ngap = _k.pass_kernel(
+                cwc, hc, plan.x, plan.tab, plan.w7, plan.w4, plan.P, fall, fits, nfit, subs,
+                SPEED_RTOL, CROSS_RTOL, kap, dks, knots, energies, quad, box, ell, pos, gaps,
+                unit, a, b, scratch, first, endv, fl)
+            if ngap <= gaps.shape[0]:
+                break
+            gaps = np.empty((ngap, 3), dtype=np.int64)  # rare: the buffer was too small; redo
+        if a == 0:
+            ksfl[0] = fl[0]
+        return nsing, maxk, maxks, box, gaps[:ngap], endv, fl
+
+    parts = _threads.ranges(run, 0, m, _threads.THREADS, PAR_MIN)
+    nsing = sum(r[0] for r in parts)
+    maxk = max(r[1] for r in parts)
+    maxks = max(r[2] for r in parts)
+    box = np.stack([np.min([r[3][0] for r in parts], axis=0),
+                    np.max([r[3][1] for r in parts], axis=0)])
+    gaps = parts[0][4] if len(parts) == 1 else np.concatenate([r[4] for r in parts])
+    ngap = gaps.shape[0]
+    kap, dks, knots, energies, quad = kap[:m], dks[:m], knots[:m], energies[:m], quad[:m]
+    ell, pos = ell[:m], pos[:m]
+    if closed:
+        ksfl[1] = parts[-1][6][1]
+        _k.seam_jumps(first, parts[-1][5], ksfl, knots)
 
     # adaptive quadrature where the 7-point/4-point estimate is too large: the worst segments
     # (a power-of-two threshold on estimate/allowance chosen so that their first refinement

@@ -24,11 +24,8 @@ Newton iterations after the warm start (10-20 with the interior point).
 
 from __future__ import annotations
 
-import os
 import threading
-import warnings
 from collections.abc import Callable, Iterable
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from functools import partial
 from typing import TYPE_CHECKING, Any
@@ -36,6 +33,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import scipy.sparse as sp
 
+from .. import _threads
 from .._kernels import global_fair as _k
 from .._kernels.bspline import band_energy
 from .._typing import FloatArray
@@ -94,112 +92,24 @@ def _absmax(a: FloatArray) -> float:
     return max(float(a.max()), -float(a.min())) if a.size else 0.0
 
 # ------------------------------------------------------------------------------------------
-# two threads for the per-point passes of the Newton iteration
+# two threads for the per-point passes of the Newton iteration (curvefair._threads)
 # ------------------------------------------------------------------------------------------
-def _cpu_count() -> int:
-    try:
-        return len(os.sched_getaffinity(0))
-    except (AttributeError, OSError):
-        return os.cpu_count() or 1
-
-
-def _thread_setting() -> int:
-    """Threads for the per-point passes: ``CURVEFAIR_THREADS`` (1 or 2; 1 keeps everything on
-    the calling thread), default 2 when the process may use 2 or more CPUs."""
-    env = os.environ.get("CURVEFAIR_THREADS", "").strip()
-    if env:
-        if env in ("1", "2"):
-            return min(int(env), max(_cpu_count(), 1))
-        warnings.warn(f"CURVEFAIR_THREADS must be 1 or 2, got {env!r}; using the default",
-                      RuntimeWarning, stacklevel=2)
-    return min(2, _cpu_count())
-
-
-_THREADS = _thread_setting()  # 1: everything on the calling thread
+_THREADS = _threads.THREADS  # 1: everything on the calling thread
 _PAR_MIN = 100_000  # points: below, one range on the calling thread
-_PAR_CHUNKS = 16
+_PAR_CHUNKS = _threads.CHUNKS
 _ASM_SPLIT = 0.5  # open planar cubics: the worker assembles the columns from this fraction on
-_POOL: list[ThreadPoolExecutor] = []
-_POOL_LOCK = threading.Lock()
-
-
-def _pool() -> ThreadPoolExecutor:
-    with _POOL_LOCK:
-        if not _POOL:
-            _POOL.append(ThreadPoolExecutor(max_workers=1, thread_name_prefix="curvefair"))
-        return _POOL[0]
+_pool = _threads.pool
 
 
 def _ranges(fn: Callable[[int, int], Any], lo: int, hi: int) -> list[Any]:
-    """``[fn(a, b) for (a, b) in chunks of lo .. hi]`` (in order), the chunks shared between
-    the calling thread and one worker thread when ``_THREADS >= 2`` and the range is long.
-    ``fn`` must be a compiled ``nogil`` kernel whose ranges are independent (each writes its
-    own points only), so the results are bitwise the same as on one thread. The chunks are
-    claimed one at a time, and the calling thread waits only for chunks the worker has
-    started: when the other core is busy (or the worker has not been scheduled yet) the
-    calling thread simply does every chunk itself."""
+    """:func:`curvefair._threads.ranges` with this module's settings (read at each call)."""
     return _ranges_start(fn, lo, hi)()
 
 
 def _ranges_start(fn: Callable[[int, int], Any], lo: int, hi: int
                   ) -> Callable[[], list[Any]]:
-    """:func:`_ranges` in two halves: the worker thread starts on the chunks now, the
-    returned function (call it exactly once) does the chunks still unclaimed on the calling
-    thread, waits for those the worker has started and returns the results. Between the two
-    the calling thread may run other ``nogil`` compiled work that neither writes what ``fn``
-    reads nor touches what it writes (e.g. a factorisation while the right-hand side is
-    prepared). Single-threaded (or a short range): everything runs in the returned
-    function."""
-    m = hi - lo
-    if _THREADS < 2 or m < _PAR_MIN:
-        return lambda: [fn(lo, hi)]
-    k = _PAR_CHUNKS
-    bounds = [lo + (m * q) // k for q in range(k + 1)]
-    out: list[Any] = [None] * k
-    lock = threading.Lock()
-    state: dict[str, Any] = {"next": 0, "pending": 0, "error": None}
-    idle = threading.Event()
-    idle.set()
-
-    def claim(worker: bool) -> int:
-        with lock:
-            q = state["next"]
-            if q >= k:
-                return -1
-            state["next"] = q + 1
-            if worker:
-                state["pending"] += 1
-                idle.clear()
-            return q
-
-    def work(worker: bool) -> None:
-        while (q := claim(worker)) >= 0:
-            try:
-                out[q] = fn(bounds[q], bounds[q + 1])
-            except BaseException as exc:  # re-raised by the calling thread
-                state["error"] = exc
-            finally:
-                if worker:
-                    with lock:
-                        state["pending"] -= 1
-                        if state["pending"] == 0:
-                            idle.set()
-
-    _pool().submit(work, True)
-
-    def finish() -> list[Any]:
-        work(False)
-        while True:
-            with lock:
-                if state["pending"] == 0:
-                    break
-            idle.wait()
-        if state["error"] is not None:
-            raise state["error"]
-        return out
-
-    return finish
-
+    """:func:`curvefair._threads.ranges_start` with this module's settings."""
+    return _threads.ranges_start(fn, lo, hi, _THREADS, _PAR_MIN, _PAR_CHUNKS)
 
 
 class _Prefault:
