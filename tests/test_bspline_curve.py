@@ -362,3 +362,38 @@ def test_interpolate_bspline_coincident_points_with_given_params():
         interpolate_bspline(pts, param=np.arange(8.0))
     pts[5, 1] = 1e-9  # a tiny but real step is accepted
     interpolate_bspline(pts, param=np.arange(8.0))
+
+
+@pytest.mark.parametrize("closed", [False, True])
+@pytest.mark.parametrize("degree", [2, 3, 5])
+def test_power_form_in_ranges_is_bitwise_one_pass(monkeypatch, closed, degree):
+    """The power form (and the pair form of fair()'s tolerance check) computed in ranges of
+    spans on two threads equals the one-pass result bit for bit: each span depends on its own
+    knots and control points, and the basis reuse between equal knot patterns starts afresh
+    in every range with the same values."""
+    from curvefair import _threads
+    from curvefair.curves import bspline as B
+    from curvefair.fairing._tolerance import prime_power_forms
+
+    rng = np.random.default_rng(degree + 10 * closed)
+    x = np.sort(rng.uniform(0, 30, 400))  # non-uniform knots: the basis is recomputed
+    c = interpolate_bspline(np.c_[x, np.sin(x)] + 0.01 * rng.normal(size=(400, 2)),
+                            degree=degree, closed=closed)
+    moved = np.asarray(c.control_points) + 1e-3 * rng.normal(size=(c.n_ctrl, 2))
+    out = {}
+    for th, pm in ((1, 10**9), (2, 7)):
+        monkeypatch.setattr(_threads, "THREADS", th)
+        monkeypatch.setattr(B, "POWER_FORM_PAR_MIN", pm)
+        own = c.replace(control_points=np.asarray(c.control_points)).piecewise.coeffs
+        new, diff = prime_power_forms(c, c.replace(control_points=moved))
+        out[th] = [np.asarray(own), np.asarray(new.piecewise.coeffs), np.asarray(diff.coeffs)]
+    for a, b in zip(out[1], out[2], strict=True):
+        assert np.array_equal(a, b)
+    # and the form is the curve's: against scipy's BSpline at the span midpoints
+    br = np.asarray(c.piecewise.breaks)
+    mid, h = 0.5 * (br[:-1] + br[1:]), 0.5 * np.diff(br)
+    val = sum(out[2][0][:, k, :] * h[:, None] ** k for k in range(degree + 1))
+    t = np.asarray(c.knots)
+    ctrl = np.asarray(c.control_points)[c.control_index(np.arange(t.size - degree - 1))]
+    ref = BSpline(t, ctrl, degree)(mid)
+    assert np.allclose(val, ref, rtol=1e-9, atol=1e-9 * np.abs(ref).max())

@@ -180,7 +180,7 @@ def _power_form_body(knots, p, spans, ctrl, base, closed, out, out_diff, pair):
                     out_diff[m, k, e] = acc2 / fact[k]
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def power_form_kernel(knots, p, spans, ctrl, closed, out):
     """``out[m, k, :] = sum_a N_{s-p+a}^(k)(t_s) d_{s-p+a} / k!`` for ``s = spans[m]`` (control
     indices mod ``n`` for a closed curve): the piecewise power form of the B-spline. A span
@@ -194,7 +194,7 @@ def power_form_kernel(knots, p, spans, ctrl, closed, out):
         _power_form_body(knots, p, spans, ctrl, ctrl, closed, out, out, False)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def power_form_pair_kernel(knots, p, spans, ctrl, base, closed, out, out_diff):
     """:func:`power_form_kernel` of ``ctrl`` into ``out`` and of ``ctrl - base`` into
     ``out_diff`` in one pass: the basis derivatives of each span (most of the work) are

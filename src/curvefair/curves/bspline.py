@@ -26,6 +26,7 @@ import numpy as np
 from scipy.interpolate import BSpline, make_interp_spline, make_lsq_spline
 from scipy.sparse import csr_matrix
 
+from .. import _threads
 from .._kernels.bspline import (
     band_energy,
     ders_kernel,
@@ -33,6 +34,7 @@ from .._kernels.bspline import (
     gram_kernel,
     natural_cubic_kernel,
     power_form_kernel,
+    power_form_pair_kernel,
 )
 from .._typing import ArrayLike, FloatArray
 from .._validate import MAX_DEGREE as MAX_DEGREE  # the degree limit, also known here
@@ -104,6 +106,31 @@ def _gauss(nq: int) -> tuple[FloatArray, FloatArray]:
 #: against exact rational evaluation on one Bezier span: 3e-15 at degree 4, 8e-14 at 8, 8e-11
 #: at 15, 1.5e-6 at 25; the basis stays within 1e-15 throughout).
 POWER_FORM_MAX_DEGREE = 5
+
+#: Knot spans: from this many on, the power form is computed in ranges on two threads.
+POWER_FORM_PAR_MIN = 50_000
+
+
+def power_form(knots: FloatArray, p: int, spans: np.ndarray, ctrl: FloatArray, closed: bool,
+               out: FloatArray, base: FloatArray | None = None,
+               out_diff: FloatArray | None = None) -> None:
+    """:func:`~curvefair._kernels.bspline.power_form_kernel` (``base`` None) or
+    :func:`~curvefair._kernels.bspline.power_form_pair_kernel` (the form of ``ctrl`` and of
+    ``ctrl - base``) over ranges of the spans, on two threads for long curves
+    (:mod:`curvefair._threads`). Each span's coefficients depend on its own knots and control
+    points only, so the result is bitwise that of one pass."""
+    closed = bool(closed)
+    if base is None:
+        def run(a: int, b: int) -> None:
+            power_form_kernel(knots, p, spans[a:b], ctrl, closed, out[a:b])
+    else:
+        assert out_diff is not None
+
+        def run(a: int, b: int) -> None:
+            power_form_pair_kernel(knots, p, spans[a:b], ctrl, base, closed, out[a:b],
+                                   out_diff[a:b])
+    _threads.ranges(run, 0, spans.shape[0], _threads.THREADS, POWER_FORM_PAR_MIN)
+
 
 
 class BSplineCurve(PiecewiseCurve):
@@ -347,8 +374,8 @@ class BSplineCurve(PiecewiseCurve):
         t = self._knots
         s = np.ascontiguousarray(self.spans, dtype=np.int64)
         coeffs = np.empty((s.size, p + 1, self._ctrl.shape[1]))
-        power_form_kernel(np.ascontiguousarray(t), p, s, np.ascontiguousarray(self._ctrl),
-                          self._closed, coeffs)
+        power_form(np.ascontiguousarray(t), p, s, np.ascontiguousarray(self._ctrl),
+                   self._closed, coeffs)
         breaks = np.append(t[s], t[s[-1] + 1])
         if p > POWER_FORM_MAX_DEGREE:
             return PiecewisePolynomial(breaks, coeffs, evaluator=self._span_values)

@@ -35,9 +35,8 @@ from typing import Any
 import numpy as np
 
 from .._distance import exceeds, point_distances
-from .._kernels.bspline import power_form_kernel, power_form_pair_kernel
 from .._typing import FloatArray
-from ..curves.bspline import POWER_FORM_MAX_DEGREE, BSplineCurve
+from ..curves.bspline import POWER_FORM_MAX_DEGREE, BSplineCurve, power_form
 from ..curves.hermite import (
     CubicHermite,
     QuinticHermite,
@@ -124,7 +123,7 @@ def _difference_form(a: PiecewiseCurve, delta: dict[str, FloatArray]) -> Piecewi
         s = np.ascontiguousarray(a.spans, dtype=np.int64)
         d = np.ascontiguousarray(delta["control_points"], dtype=np.float64)
         coeffs = np.empty((s.size, p + 1, d.shape[1]))
-        power_form_kernel(t, p, s, d, bool(a.closed), coeffs)
+        power_form(t, p, s, d, bool(a.closed), coeffs)
         return PiecewisePolynomial(np.append(t[s], t[s[-1] + 1]), coeffs)
     params = np.asarray(a.params)  # type: ignore[attr-defined]
     if isinstance(a, QuinticHermite):
@@ -153,7 +152,7 @@ def prime_power_forms(original: PiecewiseCurve, new: PiecewiseCurve
     base = np.ascontiguousarray(original.control_points, dtype=np.float64)  # type: ignore[attr-defined]
     coeffs = np.empty((s.size, p + 1, ctrl.shape[1]))
     diff = np.empty_like(coeffs)
-    power_form_pair_kernel(t, p, s, ctrl, base, bool(new.closed), coeffs, diff)
+    power_form(t, p, s, ctrl, bool(new.closed), coeffs, base, diff)
     if not (np.isfinite(coeffs).all() and np.isfinite(diff).all()):
         return None  # new.piecewise raises its own message when asked
     breaks = np.append(t[s], t[s[-1] + 1])
