@@ -26,10 +26,16 @@ the growth column measures the call, not a longer run). Columns:
   added);
 * ``steps`` and ``stop``: from the report (a faster result that did less work shows here).
 
+With ``--runs K`` every (method, size) runs in K fresh processes, one after the other, and the
+row gives the median of the K times (and of the peaks), with the smallest and largest time
+in ``range``: a single fresh run at 1e6 moves by 20-50 % from run to run (the state of the
+machine's memory), so a growth figure needs medians.
+
 Usage::
 
     python benchmarks/bench_scale.py                         # 1e6 1e7, every method
     python benchmarks/bench_scale.py --sizes 1e5 1e6 --methods eck-hadenfeld global
+    python benchmarks/bench_scale.py --sizes 1e6 1e7 --methods eck-hadenfeld --runs 3
 """
 
 from __future__ import annotations
@@ -121,6 +127,8 @@ def main() -> None:
     ap.add_argument("--wall", action="store_true", help="wall time instead of process CPU time")
     ap.add_argument("--hermite-steps", type=float, default=0.1,
                     help="max_steps of the Hermite methods, per point (default 0.1)")
+    ap.add_argument("--runs", type=int, default=1,
+                    help="fresh processes per row; the row gives medians (default 1)")
     args = ap.parse_args()
     sizes = [int(float(s)) for s in args.sizes]
     print(f"fair(curve, method, tol={args.tol:g}), default options; "
@@ -128,15 +136,22 @@ def main() -> None:
     print(f"Hermite methods: max_steps = {args.hermite_steps:g} n")
     hdr = (f"{'method':>14} {'n':>9} {'build s':>8} {'fair s':>8} {'x10':>6} {'before MB':>9} "
            f"{'peak MB':>8} {'peak/in':>8} {'call/in':>8} {'steps':>9} {'stop':>9} "
-           f"{'dev/tol':>8}")
+           f"{'dev/tol':>8}" + (f" {'range s':>13}" if args.runs > 1 else ""))
     print(hdr, flush=True)
     for method in args.methods:
         base = None
         for n in sizes:
-            r = in_child(_run, method, n, args.tol, args.wall, args.hermite_steps)
-            if "error" in r:
-                print(f"{method:>14} {n:>9} failed: {r['error']}", flush=True)
+            runs = [in_child(_run, method, n, args.tol, args.wall, args.hermite_steps)
+                    for _ in range(max(args.runs, 1))]
+            bad = [r for r in runs if "error" in r]
+            if bad:
+                print(f"{method:>14} {n:>9} failed: {bad[0]['error']}", flush=True)
                 continue
+            r = dict(runs[0])
+            times = [x["fair"] for x in runs]
+            for key in ("build", "fair", "before_mb", "peak_mb"):
+                r[key] = float(np.median([x[key] for x in runs]))
+            spread = f" {min(times):6.2f}-{max(times):6.2f}" if len(runs) > 1 else ""
             if base is None:
                 base = (n, r["fair"])
                 growth = "-"
@@ -146,7 +161,7 @@ def main() -> None:
             print(f"{method:>14} {n:>9} {r['build']:8.2f} {r['fair']:8.2f} {growth:>6} "
                   f"{r['before_mb']:9.0f} {r['peak_mb']:8.0f} {r['peak_mb'] / inp:8.1f} "
                   f"{(r['peak_mb'] - r['before_mb']) / inp:8.1f} {r['steps']:>9} "
-                  f"{r['stop']:>9} {r['max_dev'] / args.tol:8.3f}", flush=True)
+                  f"{r['stop']:>9} {r['max_dev'] / args.tol:8.3f}{spread}", flush=True)
     print("goal (issue 14): x10 <= 12 from 1e6 to 1e7, peak/in <= 16")
 
 
