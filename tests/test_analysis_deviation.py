@@ -317,3 +317,35 @@ def test_geometric_distance_on_chosen_spans_against_scipy():
         cf.deviation(a, b, kind="parametric", spans=[1])
     with pytest.raises(cf.InputError, match="0 .. 38"):
         cf.deviation(a, b, kind="geometric", spans=[39])
+
+
+def test_many_equal_maxima_searched_compiled_and_trimmed(monkeypatch):
+    """A result held on its tolerance has its largest deviation at many knots: every piece
+    is a candidate of the branch-and-bound. The compiled levels take them all (the cap grows
+    with the curve: an eighth of its pieces); with the cap forced below the candidates, the
+    array levels trim the smallest bounds into ``upper_bound``, which stays certified.
+    Checked against dense sampling of ``|a(t) - b(t)|``."""
+    from curvefair.analysis import _deviation as D
+
+    rng = np.random.default_rng(5)
+    n = 4001
+    t = np.linspace(0.0, 40.0, n)
+    a = cf.interpolate_cubic(np.c_[t, np.sin(t)], param=t)
+    # every point moved by exactly 0.01 (the tolerance ball's surface), direction random
+    ang = rng.uniform(0, 2 * np.pi, n)
+    moved = np.asarray(a.points) + 0.01 * np.c_[np.cos(ang), np.sin(ang)]
+    b = cf.interpolate_cubic(moved, param=t)
+    dense, _ = _brute(a, b, 0.0, 40.0)  # a lower bound of the true maximum, close to it
+    full = cf.deviation(a, b)
+    _check(full, dense, 40.0)  # the rounding level: 1e-13 of the largest coordinate (40)
+    monkeypatch.setattr(D, "_MAX_CANDIDATES", 8)
+    monkeypatch.setattr(D, "_CANDIDATE_SHARE", 10**9)  # cap = 8 pieces
+    seen = []
+    bnb = D._k.branch_and_bound
+    monkeypatch.setattr(D._k, "branch_and_bound",
+                        lambda cb, *x: seen.append(cb.shape[0]) or bnb(cb, *x))
+    trimmed = cf.deviation(a, b)
+    assert seen and seen[0] > 8  # more candidates than the cap: the array levels trim
+    assert dense - 1e-12 <= trimmed.upper_bound  # still certified
+    assert trimmed.max_distance <= full.upper_bound
+    assert trimmed.max_distance >= 0.999 * full.max_distance
