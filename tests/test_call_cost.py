@@ -100,6 +100,33 @@ def test_primed_power_forms_equal_separate_ones(degree, closed, dim):
     assert T.prime_power_forms(h, h) is None
 
 
+def test_difference_forms_are_borrowed_not_copied():
+    """fair()'s tolerance checks build difference curves that no user sees: their power forms
+    keep the freshly computed coefficients (no frozen copy), marked read-only; the zero curve
+    they are measured against shares their breaks. The curve's own cached form stays frozen."""
+    from curvefair.curves.piecewise import _frozen
+    from curvefair.fairing import _tolerance as T
+
+    rng = np.random.default_rng(4)
+    for c in (cf.interpolate_bspline(_noisy(60, 3)), cf.interpolate_cubic(_noisy(60, 3))):
+        f = T.curve_fields(c)
+        delta = {k: 1e-3 * rng.normal(size=v.shape) for k, v in f.items()}
+        pp = T._difference_form(c, delta)
+        assert not pp.coeffs.flags.writeable and not _frozen(pp.coeffs)
+        assert pp.coeffs.base is None or not isinstance(pp.coeffs.base, bytes)
+        with pytest.raises(ValueError):
+            pp.coeffs[0, 0, 0] = 1.0
+        # the same figures as a frozen form of the same coefficients
+        frozen = T.PiecewisePolynomial(np.array(pp.breaks), np.array(pp.coeffs))
+        assert T._against_zero(pp, c.closed).to_dict() == \
+            T._against_zero(frozen, c.closed).to_dict()
+    b = cf.interpolate_bspline(_noisy(60, 3))
+    moved = np.asarray(b.control_points) + 1e-3
+    new, diff = T.prime_power_forms(b, b.replace(control_points=moved))
+    assert _frozen(new.piecewise.coeffs) and _frozen(new.piecewise.breaks)
+    assert diff.breaks is new.piecewise.breaks and not _frozen(diff.coeffs)
+
+
 def test_readonly_of_strided_views_is_one_frozen_copy():
     """``readonly`` of a strided or Fortran-ordered view: the same values in C order, in memory
     nobody can make writeable (an immutable ``bytes`` base), the source untouched."""

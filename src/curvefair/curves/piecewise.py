@@ -102,6 +102,22 @@ class PiecewisePolynomial:
                 a = np.asarray(a, dtype=np.float64)
             object.__setattr__(self, name, readonly(a))
 
+    @classmethod
+    def _borrowed(cls, breaks: FloatArray, coeffs: FloatArray) -> PiecewisePolynomial:
+        """A power form over float64 arrays the caller has just made and never writes again,
+        marked read-only but not copied into frozen memory: for internal temporaries that are
+        never handed to a user (the difference curves of fair()'s tolerance checks; at 1e7
+        cubic pieces the frozen copy of the coefficients alone is 640 MB of fresh memory)."""
+        obj = cls.__new__(cls)
+        for name, a in (("breaks", breaks), ("coeffs", coeffs)):
+            a = np.asarray(a, dtype=np.float64)
+            if a.flags.writeable:
+                a = a.view()
+                a.flags.writeable = False
+            object.__setattr__(obj, name, a)
+        object.__setattr__(obj, "evaluator", None)
+        return obj
+
     @property
     def degree(self) -> int:
         return self.coeffs.shape[1] - 1

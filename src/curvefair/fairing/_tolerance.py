@@ -124,13 +124,13 @@ def _difference_form(a: PiecewiseCurve, delta: dict[str, FloatArray]) -> Piecewi
         d = np.ascontiguousarray(delta["control_points"], dtype=np.float64)
         coeffs = np.empty((s.size, p + 1, d.shape[1]))
         power_form(t, p, s, d, bool(a.closed), coeffs)
-        return PiecewisePolynomial(np.append(t[s], t[s[-1] + 1]), coeffs)
+        return PiecewisePolynomial._borrowed(np.append(t[s], t[s[-1] + 1]), coeffs)
     params = np.asarray(a.params)  # type: ignore[attr-defined]
     if isinstance(a, QuinticHermite):
         c = quintic_hermite_coefficients(delta["points"], delta["d1"], delta["d2"], params)
     else:
         c = cubic_hermite_coefficients(delta["points"], delta["tangents"], params)
-    return PiecewisePolynomial(np.array(params), c)
+    return PiecewisePolynomial._borrowed(params, c)
 
 
 def prime_power_forms(original: PiecewiseCurve, new: PiecewiseCurve
@@ -156,8 +156,8 @@ def prime_power_forms(original: PiecewiseCurve, new: PiecewiseCurve
     if not (np.isfinite(coeffs).all() and np.isfinite(diff).all()):
         return None  # new.piecewise raises its own message when asked
     breaks = np.append(t[s], t[s[-1] + 1])
-    new.__dict__["piecewise"] = PiecewisePolynomial(breaks, coeffs)  # the cached_property
-    return new, PiecewisePolynomial(breaks, diff)
+    own = new.__dict__["piecewise"] = PiecewisePolynomial(breaks, coeffs)  # the cached_property
+    return new, PiecewisePolynomial._borrowed(own.breaks, diff)
 
 
 def delta_deviation(a: PiecewiseCurve, delta: dict[str, FloatArray]) -> Any:
@@ -174,9 +174,8 @@ def _against_zero(pp: PiecewisePolynomial, closed: bool) -> Any:
     from ..analysis import deviation
 
     # the zero curve on the same breaks: one frozen 0.0 broadcast to the coefficients'
-    # shape (PiecewisePolynomial keeps a frozen array as it is: no 8-byte-per-entry
-    # zeros and copy of them)
-    zero = PiecewisePolynomial(pp.breaks, np.broadcast_to(_ZERO, pp.coeffs.shape))
+    # shape (no 8-byte-per-entry zeros, no copy of the breaks)
+    zero = PiecewisePolynomial._borrowed(pp.breaks, np.broadcast_to(_ZERO, pp.coeffs.shape))
     return deviation(_PowerForm(pp, closed), _PowerForm(zero, closed))
 
 
