@@ -246,3 +246,31 @@ def test_stop_reason_tolerance_when_only_blocked_knots_are_above_eps():
         assert r.stop_reason == "tolerance"
         assert z[blocked].max() > eps_abs  # a blocked knot is still worth removing
         assert not np.any(z[~blocked] > eps_abs)  # every unblocked one is below eps
+
+
+@pytest.mark.parametrize("degree,closed", [(3, False), (3, True), (5, False), (2, True)])
+def test_knot_data_in_blocks_is_bitwise_one_block(monkeypatch, degree, closed):
+    """The per-knot basis tables are built in blocks of knots (bounded fresh memory on long
+    curves); each knot's values are its own, so blocks of 7 give bitwise the tables, the
+    measure and the faired result of one block. The report lists the blocked knots as plain
+    ints, like KRResult.blocked."""
+    import curvefair as cf
+    from curvefair.fairing import knot_removal as KR
+
+    rng = np.random.default_rng(degree)
+    x = np.sort(rng.uniform(0, 12, 90))
+    c = interpolate_bspline(np.c_[x, np.sin(x)] + 0.02 * rng.normal(size=(90, 2)),
+                            degree=degree, closed=closed)
+    one = KR._KnotData(c)
+    r1 = cf.fair(c, "knot-removal", tol=0.01)
+    monkeypatch.setattr(KR, "_KNOT_BLOCK", 7)
+    many = KR._KnotData(c)
+    for name in ("c", "right", "left2", "ctrl", "js"):
+        assert np.array_equal(getattr(one, name), getattr(many, name)), name
+    d = np.asarray(c.control_points)
+    assert np.array_equal(one.jumps(d), many.jumps(d))
+    r7 = cf.fair(c, "knot-removal", tol=0.01)
+    assert np.array_equal(r1.curve.control_points, r7.curve.control_points)
+    bk = r7.report["blocked_knots"]
+    assert isinstance(bk, list) and all(type(j) is int for j in bk)
+    assert bk == KR.knot_removal_fair(c, tol=0.01).blocked

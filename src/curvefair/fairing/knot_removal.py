@@ -202,6 +202,9 @@ def knot_removal(curve: BSplineCurve, j: int, variant: Variant = "one-point") ->
 # ------------------------------------------------------------------------------------------
 # the Sapidis-Farin measure
 # ------------------------------------------------------------------------------------------
+_KNOT_BLOCK = 65536  # knots per block of basis tables in _KnotData
+
+
 class _KnotData:
     """Per-knot basis data for fast local recomputation of the jumps (depends on knots only)."""
 
@@ -214,15 +217,23 @@ class _KnotData:
         # one-sided basis derivatives at t_j up to order max(p, 2) (each order is bitwise the
         # same whatever the highest one asked): right limit from span j (N_{j-p..j}), left
         # limit from span j-1 (N_{j-1-p..j-1})
+        # (in blocks of knots: the full (k, nder+1, p+1) tables of both sides would be 256
+        # bytes per knot of fresh memory, 2.6 GB at 1e7 knots; each knot's values are its own)
         nder = max(p, 2)
-        right = basis_derivatives(t, p, js, np.zeros(js.size), nder, local=True)
-        left = basis_derivatives(t, p, js - 1, t[js] - t[js - 1], nder, local=True)
-        c = np.zeros((js.size, p + 2))  # as _jump_coefficients
-        c[:, 1:] += right[:, p, :]
-        c[:, :-1] -= left[:, p, :]
+        k = js.size
+        c = np.zeros((k, p + 2))  # as _jump_coefficients
+        self.right = np.empty((k, 2, p + 1))  # r', r'' (right limits)
+        self.left2 = np.empty((k, p + 1))  # r'' (left limit)
+        for a in range(0, k, _KNOT_BLOCK):
+            b = min(a + _KNOT_BLOCK, k)
+            jb = js[a:b]
+            right = basis_derivatives(t, p, jb, np.zeros(b - a), nder, local=True)
+            left = basis_derivatives(t, p, jb - 1, t[jb] - t[jb - 1], nder, local=True)
+            c[a:b, 1:] += right[:, p, :]
+            c[a:b, :-1] -= left[:, p, :]
+            self.right[a:b] = right[:, 1:3, :]
+            self.left2[a:b] = left[:, 2, :]
         self.c = c  # (k, p+2)
-        self.right = np.ascontiguousarray(right[:, 1:3, :])  # r', r'' (right limits)
-        self.left2 = np.ascontiguousarray(left[:, 2, :])  # r'' (left limit)
         self.ctrl = np.ascontiguousarray(  # (k, p+2)
             curve.control_index(js[:, None] + np.arange(-p - 1, 1)[None, :]), dtype=np.int64)
 
@@ -427,7 +438,8 @@ def knot_removal_fair(curve: BSplineCurve, *, variant: Variant = "one-point",
     hist = np.column_stack([h.index.astype(np.float64), h.measure, h.displacement])
     return KRResult(cast(BSplineCurve, out.curve), out.steps, out.stop_reason,
                     out.extra["sum_jump_before"], out.extra["sum_jump_after"],
-                    hist.reshape(-1, 3), out.extra["blocked_knots"], out.extra["sum_tracked"])
+                    hist.reshape(-1, 3), np.asarray(out.extra["blocked_knots"]).tolist(),
+                    out.extra["sum_tracked"])
 
 
 def solve(problem: FairingProblem, *, variant: Variant = "one-point",
@@ -454,7 +466,7 @@ def solve(problem: FairingProblem, *, variant: Variant = "one-point",
 
     def outcome(c: BSplineCurve, steps: int, reason: StopReason, hist: FloatArray,
                 epsv: float, eps_abs: float | None, sums: tuple[float, float, float],
-                blocked: list[int]) -> Outcome:
+                blocked: np.ndarray) -> Outcome:
         history = FairingHistory.from_arrays(hist[:, 0].astype(np.int64), hist[:, 1],
                                              hist[:, 2], "knot")
         return Outcome(
@@ -466,7 +478,8 @@ def solve(problem: FairingProblem, *, variant: Variant = "one-point",
 
     if nk == 0:
         e0 = (1e-6 if eps_relative else 0.0) if problem.eps is None else problem.eps
-        return outcome(curve, 0, "no_knots", np.zeros((0, 3)), e0, None, (0.0, 0.0, 0.0), [])
+        return outcome(curve, 0, "no_knots", np.zeros((0, 3)), e0, None, (0.0, 0.0, 0.0),
+                       np.zeros(0, dtype=np.int64))
     z = kd.jumps(d)
     sum0 = float(z.sum())
     if eps_relative:
@@ -477,10 +490,10 @@ def solve(problem: FairingProblem, *, variant: Variant = "one-point",
     out, steps, reason, total, hist, blocked = _run_loop(curve, kd, d, orig, mask, variant,
                                                          tolv, eps_abs, max_steps, on_tol, z,
                                                          floor)
-    if reason == "eps" and blocked:
+    if reason == "eps" and blocked.size:
         # every knot still worth removing is blocked: the tolerance stopped the loop (as in
         # eck_hadenfeld_fair); the unblocked ones left are the removed knots, z ~ 0
-        pos = np.searchsorted(js, np.asarray(blocked, dtype=np.int64))
+        pos = np.searchsorted(js, blocked)
         if float(kd.jumps(d, pos).max()) > eps_abs:
             reason = "tolerance"
     return outcome(out, steps, reason, hist, epsv, eps_abs,
@@ -500,14 +513,14 @@ ROUNDING_FLOOR = 2.0 ** -40
 def _run_loop(curve: BSplineCurve, kd: _KnotData, d: FloatArray, orig: FloatArray,
               mask: np.ndarray, variant: str, tolv: float, eps_abs: float, max_steps: int,
               on_tol: str, z: FloatArray, floor: float = 0.0
-              ) -> tuple[BSplineCurve, int, StopReason, float, FloatArray, list[int]]:
+              ) -> tuple[BSplineCurve, int, StopReason, float, FloatArray, np.ndarray]:
     """Run the compiled loop on the set-up of :func:`_loop_args`; ``d`` is updated in place."""
     steps, code, total, hist, blocked, nb = _k.kr_loop(
         *_loop_args(curve, kd, d, orig, mask, variant, tolv, eps_abs, max_steps, on_tol, z,
                     floor))
     out = curve.replace(control_points=d)
     return (out, int(steps), _REASONS[code], float(total), hist[:steps].copy(),
-            [int(j) for j in blocked[:nb]])
+            np.array(blocked[:nb], dtype=np.int64))
 
 
 def _loop_args(curve: BSplineCurve, kd: _KnotData, d: FloatArray, orig: FloatArray,
