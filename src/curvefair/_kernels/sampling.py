@@ -429,11 +429,26 @@ def seam_jumps(first, endv, ksfl, knots):
 
 
 @njit(cache=True, error_model="numpy")
-def allowances(quad, h, rtol, allow, worst, hist):
-    """Error allowance of each segment for the arc length and the dkds energy:
-    ``rtol (|Q_i| + |total| h_i / sum h)``; ``worst`` = largest estimate / allowance ratio;
-    ``hist[k]`` counts the segments with ``2^k < worst <= 2^(k+1)`` (k capped at 63).
-    Returns the number of segments over their allowance."""
+def allowance(quad, h, i, rtol, ta, td):
+    """Error allowances ``(a_arc, a_dkds)`` of segment ``i`` and its worst estimate /
+    allowance ratio: ``rtol (|Q_i| + |total| h_i / sum h)``, ``ta``/``td`` the totals over
+    ``sum h``. Compiled without fast-math and called (not inlined) by both kernels below, so
+    the pass that picks the segments and the refinement that stops on them see the same
+    bits."""
+    aa = rtol * (abs(quad[i, 0]) + ta * h[i])
+    ad = rtol * (abs(quad[i, 2]) + td * h[i])
+    wa = quad[i, 1] / aa if aa > 0.0 else (np.inf if quad[i, 1] > 0.0 else 0.0)
+    wd = quad[i, 3] / ad if ad > 0.0 else (np.inf if quad[i, 3] > 0.0 else 0.0)
+    return aa, ad, (wa if wa > wd else wd)
+
+
+@njit(cache=True, error_model="numpy")
+def allowances(quad, h, rtol, tot, hist):
+    """Totals and counts of the segments' error allowances (:func:`allowance`): ``tot`` gets
+    ``(|sum Q_arc| / sum h, |sum Q_dkds| / sum h)``; ``hist[k]`` counts the segments whose
+    worst ratio ``w`` has ``2^k < w <= 2^(k+1)`` (k capped at 63). Returns the number of
+    segments over their allowance. (No per-segment arrays: :func:`refine_kernel` recomputes
+    each allowance, 24 bytes per segment less of fresh memory.)"""
     m = quad.shape[0]
     ta = 0.0
     td = 0.0
@@ -444,16 +459,11 @@ def allowances(quad, h, rtol, allow, worst, hist):
         th += h[i]
     ta = abs(ta) / th
     td = abs(td) / th
+    tot[0] = ta
+    tot[1] = td
     n = 0
     for i in range(m):
-        aa = rtol * (abs(quad[i, 0]) + ta * h[i])
-        ad = rtol * (abs(quad[i, 2]) + td * h[i])
-        allow[i, 0] = aa
-        allow[i, 1] = ad
-        wa = quad[i, 1] / aa if aa > 0.0 else (np.inf if quad[i, 1] > 0.0 else 0.0)
-        wd = quad[i, 3] / ad if ad > 0.0 else (np.inf if quad[i, 3] > 0.0 else 0.0)
-        w = wa if wa > wd else wd
-        worst[i] = w
+        w = allowance(quad, h, i, rtol, ta, td)[2]
         if w > 1.0:
             n += 1
             k = 63 if not w < 2.0**63 else math.frexp(w)[1] - 1
@@ -462,12 +472,13 @@ def allowances(quad, h, rtol, allow, worst, hist):
 
 
 @njit(cache=True, fastmath=_FM, error_model="numpy")
-def refine_kernel(cw, h, quad, allow, worst, thresh, P, xk, w7, fall, speed_rtol,
+def refine_kernel(cw, h, quad, rtol, tot, thresh, P, xk, w7, fall, speed_rtol,
                   cross_rtol, max_levels, budget):
-    """Adaptive re-integration, in place, of the segments with ``worst > thresh``.
+    """Adaptive re-integration, in place, of the segments whose worst ratio (:func:`allowance`
+    with the totals ``tot`` of :func:`allowances`) exceeds ``thresh``.
 
     Level ``L`` integrates segment ``i`` with the 7-point rule on ``P 2^L`` equal pieces; it
-    stops when both integrals changed by at most ``allow[i, 0/1]`` from the previous level
+    stops when both integrals changed by at most their allowances from the previous level
     (level 0: the pass's values in ``quad[i]``), at ``max_levels``, or when the work budget
     (pieces) is spent. ``quad`` rows: (arc length, its error estimate, dkds energy, its error
     estimate). Returns the pieces used.
@@ -478,8 +489,11 @@ def refine_kernel(cw, h, quad, allow, worst, thresh, P, xk, w7, fall, speed_rtol
     r2 = np.empty(dim)
     r3 = np.empty(dim)
     used = 0
+    ta = tot[0]
+    td = tot[1]
     for i in range(m):
-        if not worst[i] > thresh:
+        aa, ad, w = allowance(quad, h, i, rtol, ta, td)
+        if not w > thresh:
             continue
         if used + (P << 1) > budget:
             break
@@ -524,7 +538,7 @@ def refine_kernel(cw, h, quad, allow, worst, thresh, P, xk, w7, fall, speed_rtol
             err_d = abs(qd - prev_d)
             prev_a = qa
             prev_d = qd
-            if err_a <= allow[i, 0] and err_d <= allow[i, 1]:
+            if err_a <= aa and err_d <= ad:
                 break
         quad[i, 0] = prev_a
         quad[i, 1] = err_a

@@ -333,18 +333,17 @@ def sample_curve(cw: FloatArray, h: FloatArray, planar: bool, closed: bool,
     # adaptive quadrature where the 7-point/4-point estimate is too large: the worst segments
     # (a power-of-two threshold on estimate/allowance chosen so that their first refinement
     # level fits the budget), in curve order
-    allow = np.empty((m, 2))
-    worst = np.empty(m)
+    tot = np.empty(2)
     hist = np.zeros(64, dtype=np.int64)
-    nbad = _k.allowances(quad, hc, float(rtol), allow, worst, hist)
+    nbad = _k.allowances(quad, hc, float(rtol), tot, hist)
     if nbad:
         budget = max(200_000, m // 8)
         top = budget // (2 * plan.P)  # at most this many segments get even one level
         above = np.cumsum(hist[::-1])[::-1]  # above[k]: segments with worst > 2^k
         k = int(np.argmax(above <= top)) if above[0] > top else 0
         thresh = 1.0 if k == 0 else float(2.0**k)
-        _k.refine_kernel(cwc, hc, quad, allow, worst, thresh, plan.P, plan.xk, plan.w7, fall,
-                         SPEED_RTOL, CROSS_RTOL, _MAX_LEVELS, budget)
+        _k.refine_kernel(cwc, hc, quad, float(rtol), tot, thresh, plan.P, plan.xk, plan.w7,
+                         fall, SPEED_RTOL, CROSS_RTOL, _MAX_LEVELS, budget)
 
     refined = _refine_gaps(cw, h, plan, gaps[:ngap])
     extra = []
