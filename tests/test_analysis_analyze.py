@@ -443,3 +443,35 @@ def test_sampling_pass_in_ranges_is_bitwise_the_same(monkeypatch, kind):
         _bitwise_same(ref, cf.analyze(c))
     finally:
         gate.set()
+
+
+def test_analyze_from_several_threads_at_once(monkeypatch):
+    """Several user threads analysing long curves at once share the one worker thread of
+    curvefair._threads: each gets bitwise its single-threaded analysis, none waits forever."""
+    import threading
+
+    from curvefair import _threads
+    from curvefair.analysis import _sampling
+
+    monkeypatch.setattr(_sampling, "PAR_MIN", 64)
+    rng = np.random.default_rng(21)
+    curves = []
+    for k in range(4):
+        x = np.linspace(0, 20 + k, 3000)
+        curves.append(cf.interpolate_cubic(np.c_[x, np.sin(x)] + 1e-3 * rng.normal(size=(3000, 2))))
+    monkeypatch.setattr(_threads, "THREADS", 1)
+    ref = [cf.analyze(c) for c in curves]
+    monkeypatch.setattr(_threads, "THREADS", 2)
+    got: list = [None] * len(curves)
+
+    def work(k):
+        got[k] = cf.analyze(curves[k])
+
+    ts = [threading.Thread(target=work, args=(k,)) for k in range(len(curves))]
+    for t in ts:
+        t.start()
+    for t in ts:
+        t.join(60)
+        assert not t.is_alive()
+    for a, b in zip(ref, got, strict=True):
+        _bitwise_same(a, b)
