@@ -67,8 +67,9 @@ class WriteCheck:
     max_point_displacement : float or None
         Largest data/control point displacement read back, where the counts match.
     precision : str
-        ``"file"`` (the file's own precision), ``"decimals"`` (as requested), or ``"exact"``
-        (the file's rounding exceeded the tolerance and was undone).
+        ``"file"`` (the file's own precision), ``"decimals"`` (as requested), ``"file+"``
+        (SVG: the elements' own decimals put a curve beyond the tolerance; three more were
+        enough) or ``"exact"`` (the file's rounding exceeded the tolerance and was undone).
     move_scale : tuple of float
         Per record, the factor ``s`` applied to the moves of point data (1.0: as faired).
     notes : tuple of str
@@ -314,6 +315,17 @@ def _shrinkable(rec: CurveRecord, ref: CurveRecord) -> bool:
             and a.shape == b.shape)
 
 
+#: SVG write-backs round a rewritten element's numbers to its own decimals first, then to
+#: :data:`curvefair.io.svg.MORE_DECIMALS` more, then write them exactly (what the notes say).
+_SVG_PRECISION = {"file": "the elements' own decimals",
+                  "file+": "the elements' own decimals plus 3"}
+_SVG_NEXT = {"file": "written with 3 more decimals", "file+": "written with exact numbers"}
+
+
+def _svg_next(precision: str) -> str:
+    return "file+" if precision == "file" else "exact"
+
+
 def write_checked(path: str | os.PathLike[str], records: Sequence[CurveRecord],
                   reference: Sequence[CurveRecord], *, tol: float | None,
                   reader: Callable[[str], list[CurveRecord]], template: object = None,
@@ -383,15 +395,15 @@ def write_checked(path: str | os.PathLike[str], records: Sequence[CurveRecord],
     with atomic_path(path) as tmp:
         for _attempt in range(_MAX_SHRINK + 3):
             _write_plain(tmp, recs, fmt, tpath, decimals,
-                         "exact" if precision == "exact" else "file")
+                         precision if precision in ("exact", "file+") else "file")
             try:
                 back = reader(os.fspath(tmp))
             except CurvefairError as exc:
                 msg = str(exc).replace(os.fspath(tmp), where)
-                if precision == "file" and fmt == "svg":
-                    precision = "exact"
-                    notes.append("the file's own precision gave a file that does not read "
-                                 "back; written with exact numbers")
+                if precision in ("file", "file+") and fmt == "svg":
+                    notes.append(f"{_SVG_PRECISION[precision]} gave a file that does not "
+                                 f"read back; {_SVG_NEXT[precision]}")
+                    precision = _svg_next(precision)
                     continue
                 hint = f" (--decimals {decimals} rounds too much?)" if decimals is not None \
                     else ""
@@ -405,12 +417,12 @@ def write_checked(path: str | os.PathLike[str], records: Sequence[CurveRecord],
                 raise WriteCheckError(f"{where}: not written: {lost}{hint}")
             curves = _matched(reference, back)
             if curves is None:
-                if precision == "file" and fmt == "svg":
+                if precision in ("file", "file+") and fmt == "svg":
                     # e.g. a tiny closed subpath faired nearly to a point: the element's own
                     # decimals merge its points, exact numbers keep them apart
-                    precision = "exact"
-                    notes.append(f"the file's own precision gave {len(back)} curves where the "
-                                 f"input had {len(reference)}; written with exact numbers")
+                    notes.append(f"{_SVG_PRECISION[precision]} gave {len(back)} curves where "
+                                 f"the input had {len(reference)}; {_SVG_NEXT[precision]}")
+                    precision = _svg_next(precision)
                     continue
                 seen = {_entity(b) for b in back}
                 gone = [_label(r, i) for i, r in enumerate(reference)
@@ -431,13 +443,13 @@ def write_checked(path: str | os.PathLike[str], records: Sequence[CurveRecord],
             if not over:
                 return WriteCheck(max(devs, default=0.0), tuple(devs), tuple(kinds), mpd,
                                   precision, tuple(scale), tuple(notes), tuple(curves))
-            if precision == "file" and fmt == "svg":
-                precision = "exact"
+            if precision in ("file", "file+") and fmt == "svg":
                 worst = max(over, key=lambda i: devs[i])
-                notes.append("rounded to the elements' own decimals, "
+                notes.append(f"rounded to {_SVG_PRECISION[precision]}, "
                              f"{_label(reference[worst], worst)} "
                              f"read back {devs[worst]:.6g} from the input (> tol {tol:g}); "
-                             "written with exact numbers")
+                             f"{_SVG_NEXT[precision]}")
+                precision = _svg_next(precision)
                 continue
             fix = [i for i in over if _shrinkable(records[i], reference[i])]
             if len(fix) < len(over) or precision == "decimals":

@@ -56,9 +56,11 @@ file byte for byte). A
 B-spline is written as its cubic Bezier pieces (one per knot span: the same number of
 segments as read when the knots are unchanged). Without a template, a new SVG holding one
 ``<path>`` per curve (cubic curves only: degree <= 3). Numbers of a rewritten element get the
-largest number of decimals the element had (its precision; ``decimals=`` overrides,
-``precision="exact"`` writes the shortest exact representation instead), numbers of a new file
-the shortest exact representation.
+largest number of decimals the element had (its precision; an element of whole numbers gets
+three, one with exponents the shortest exact form; ``decimals=`` overrides,
+``precision="exact"`` writes the shortest exact representation instead; when the element's
+precision puts a curve read back beyond the tolerance, the write-back tries three more decimals,
+then exact numbers), numbers of a new file the shortest exact representation.
 """
 
 from __future__ import annotations
@@ -1026,6 +1028,27 @@ def _decimals_of(text: str) -> int | None:
     return max((len(f) for f in found), default=None)
 
 
+#: The write-back's second precision: each rewritten element's own decimals plus this many
+#: (tried when the element's own decimals put a curve read back beyond the tolerance, before
+#: the shortest exact numbers).
+MORE_DECIMALS = 3
+
+
+def _element_decimals(text: str, precision: str) -> int | None:
+    """Decimals for the numbers of a rewritten element whose text is ``text``: its own largest
+    number of decimals (``"file"``), that plus :data:`MORE_DECIMALS` (``"file+"``), or None,
+    the shortest exact form (``"exact"``, or an element written with exponents, whose
+    decimals say nothing of its precision). An element written in whole numbers gets
+    :data:`MORE_DECIMALS` decimals in both: rounded to whole numbers, moves smaller than a
+    unit (what fairing makes) would be undone."""
+    if precision == "exact" or re.search(r"\d[eE][-+]?\d", text):
+        return None
+    d = _decimals_of(text)
+    if d is None:
+        return MORE_DECIMALS
+    return d + MORE_DECIMALS if precision == "file+" else d
+
+
 def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
           template: str | None = None, decimals: int | None = None, precision: str = "file",
           **_: Any) -> None:
@@ -1033,7 +1056,8 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
 
     ``precision="exact"`` (with ``decimals=None``) writes the numbers of rewritten elements
     in the shortest form that reads back as exactly the value, instead of the element's own
-    number of decimals.
+    number of decimals; ``precision="file+"`` with :data:`MORE_DECIMALS` more than the
+    element's own.
     """
     spt = _svgpathtools("writing SVG files")
     ours = [r for r in records if template is not None and r.format == FORMAT
@@ -1079,12 +1103,12 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
                                  "changed; a rectangle is written back only unchanged")
             if tag == "line":
                 for name, v in zip(("x1", "y1", "x2", "y2"), geo.reshape(-1), strict=True):
-                    dec = decimals if decimals is not None else (
-                        None if precision == "exact" else _decimals_of(el.get(name) or ""))
+                    dec = decimals if decimals is not None else _element_decimals(
+                        el.get(name) or "", precision)
                     edit(node, name, _num(v, dec))
                 continue
-            dec = decimals if decimals is not None else (
-                None if precision == "exact" else _decimals_of(el.get("points") or ""))
+            dec = decimals if decimals is not None else _element_decimals(
+                el.get("points") or "", precision)
             edit(node, "points", " ".join(_pt(p, dec) for p in geo))
             continue
         parsed = spt.parse_path(el.get("d"))
@@ -1095,8 +1119,7 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
             continue
         # the precision of the element as it was: its largest number of decimals (all digits
         # with precision="exact", when that rounding would break the tolerance on disk)
-        dec = decimals if decimals is not None else (
-            None if precision == "exact" else _decimals_of(d_text))
+        dec = decimals if decimals is not None else _element_decimals(d_text, precision)
         new_d = {j: d for j in subs for d, ch in [_record_d(subs[j], dec)] if ch}
         sp = spans[node].get("d")
         raw_d = raw[sp[0]:sp[1]].decode("utf-8") if sp is not None else ""
