@@ -396,6 +396,23 @@ def test_svg_rounding_beyond_three_more_decimals_writes_exact_numbers(tmp_path: 
     assert any("written with exact numbers" in n for n in chk.notes)
 
 
+def test_report_after_figures_are_those_of_the_rounded_file(tmp_path: Path):
+    """The numbers written are the faired ones rounded to the file's precision: the report's
+    after-figures are those of the curve read back (a rounding ripple is an extremum like any
+    other), the faired curve's under fair_after."""
+    _wavy_svg(tmp_path / "w.svg")
+    res = cli(["fair", "w.svg", "-o", "o.svg", "--tol", "0.009", "--report", "r.json"],
+              tmp_path)
+    assert res.returncode == 0, res.stderr
+    rep = json.loads((tmp_path / "r.json").read_text())["curves"][0]["report"]
+    assert "rounded to the file's precision" in rep["after_figures"]
+    (back,) = cf.read_curves(tmp_path / "o.svg")
+    a = cf.analyze(back.curve)
+    assert rep["extrema_after"] == a.extrema and rep["inflections_after"] == a.inflections
+    assert rep["energy_after"] == pytest.approx(a.energy2, rel=1e-12)
+    assert set(rep["fair_after"]) >= {"extrema", "energy"}
+
+
 def test_svg_whole_number_element_gets_three_decimals(tmp_path: Path):
     """An element written in whole numbers: rounded to whole numbers, sub-unit fairing moves
     would be undone; its rewritten numbers get 3 decimals (not 17 digits of rounding noise)."""
