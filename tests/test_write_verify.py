@@ -421,11 +421,11 @@ def test_reports_count_point_data_on_the_curve_rebuilt_from_the_written_file(tmp
 
 def test_svg_element_merged_by_its_own_decimals_is_written_exactly(tmp_path):
     """A small closed subpath (an octagon inside a scaled group) whose moved points lie closer
-    together than the element's own decimals (4) resolve: written with them, its points merge
-    and the file reads back with one curve fewer. The writer then uses exact numbers, as it
-    does for a deviation beyond tol, instead of refusing the file with a count (the hunt of
-    session 18 met this on an OCCT drawing: a tiny octagon faired at a tolerance of its own
-    size)."""
+    together than the element's own decimals (4), and even three more (7), resolve: written
+    with them, its points merge and the file reads back with one curve fewer. The writer then
+    uses exact numbers, as it does for a deviation beyond tol, instead of refusing the file
+    with a count (the hunt of session 18 met this on an OCCT drawing: a tiny octagon faired at
+    a tolerance of its own size)."""
     spt = pytest.importorskip("svgpathtools")
     a = np.arange(8) * (np.pi / 4)
     octagon = np.c_[525.0 + 1.8 * np.cos(a), 1178.25 + 1.45 * np.sin(a)]
@@ -441,12 +441,13 @@ def test_svg_element_merged_by_its_own_decimals_is_written_exactly(tmp_path):
     assert [r.source["id"] for r in recs] == ["oct", "other", "other"]  # split at its corner
     p = np.asarray(recs[0].curve.points)[:-1]  # document coordinates, closing point dropped
     c = p.mean(axis=0)
-    q = c + 2e-5 * (p - c)  # 3e-5 across: below the element's 4 decimals
+    q = c + 2e-9 * (p - c)  # 3e-9 across: below the element's 4 + 3 decimals
     new = interpolate_cubic(np.vstack([q, q[:1]]), "chord", "periodic")
     out = tmp_path / "out.svg"
     with pytest.warns(UserWarning, match="exact numbers"):
         check = write_curves(out, [recs[0].with_curve(new), *recs[1:]], template=src, tol=1.0)
     assert check.precision == "exact"
+    assert any("3 more decimals" in n for n in check.notes)
     paths_in, attr_in = spt.svg2paths(str(src))
     paths_out, attr_out = spt.svg2paths(str(out))
     assert [x["id"] for x in attr_out] == ["oct", "other"]
