@@ -413,6 +413,23 @@ def test_report_after_figures_are_those_of_the_rounded_file(tmp_path: Path):
     assert set(rep["fair_after"]) >= {"extrema", "energy"}
 
 
+def test_svg_moves_undone_by_the_elements_decimals_are_kept(tmp_path: Path):
+    """Faired at tol 0.004, every move of the 2-decimal chain is smaller than half its last
+    decimal: rounded to 2 decimals the file would hold the input unchanged (and did, with a
+    read-back deviation of 0). The write-back takes three more decimals instead."""
+    d = _wavy_svg(tmp_path / "w.svg")
+    tol = 0.004
+    res = cli(["fair", "w.svg", "-o", "o.svg", "--tol", str(tol), "--report", "r.json"],
+              tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert "were undone; written with 3 more decimals" in res.stderr
+    chk = json.loads((tmp_path / "r.json").read_text())["output_check"]
+    assert chk["precision"] == "file+" and 0.0 < chk["max_deviation"] <= tol
+    out_d = re.search(r' d="([^"]*)"', (tmp_path / "o.svg").read_text()).group(1)
+    assert out_d != d
+    assert _svg_distance(tmp_path / "w.svg", tmp_path / "o.svg", per_unit=1000) <= tol + 6e-4
+
+
 def test_svg_whole_number_element_gets_three_decimals(tmp_path: Path):
     """An element written in whole numbers: rounded to whole numbers, sub-unit fairing moves
     would be undone; its rewritten numbers get 3 decimals (not 17 digits of rounding noise)."""

@@ -440,6 +440,19 @@ def write_checked(path: str | os.PathLike[str], records: Sequence[CurveRecord],
                 raise WriteCheckError(f"{where}: not written: the curves read back could not "
                                       f"be measured against the input ({exc})") from None
             over = [i for i, d in enumerate(devs) if tol is not None and not d <= tol]
+            undone = ([i for i, d in enumerate(devs) if d == 0.0
+                       and not _same_curve(records[i].curve, reference[i].curve)]
+                      if not over and precision in ("file", "file+") and fmt == "svg" else [])
+            if undone:
+                # every move of a faired curve smaller than half the element's last decimal:
+                # rounded, the file would hold the input as it was
+                notes.append(f"rounded to {_SVG_PRECISION[precision]}, the moves of "
+                             f"{_label(reference[undone[0]], undone[0])}"
+                             + (f" and {len(undone) - 1} more curve(s)" if len(undone) > 1
+                                else "")
+                             + f" were undone; {_SVG_NEXT[precision]}")
+                precision = _svg_next(precision)
+                continue
             if not over:
                 return WriteCheck(max(devs, default=0.0), tuple(devs), tuple(kinds), mpd,
                                   precision, tuple(scale), tuple(notes), tuple(curves))
