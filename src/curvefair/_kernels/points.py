@@ -432,3 +432,56 @@ def tube_ipm(Kb, start, W, Y, rad, x, lam, max_steps, gap, stall):
         rd[:, :] = rd1
         steps += 1
     return steps, code
+
+
+@njit(cache=True)
+def polyline_distance(x, poly, idx, seg_ok, use_ok, best):
+    """``best[r]``: the distance of ``x[r]`` to the nearest of the polyline segments
+    ``poly[i] -> poly[i + 1]`` next to the vertices ``idx[r, :]`` (``i = idx - 1`` and ``idx``,
+    clipped to the segments; with ``use_ok``, segments whose ``seg_ok[i]`` is False count as
+    infinitely far). The arithmetic, operation for operation, of the numpy loop it replaces in
+    :func:`curvefair.fairing.points_l1._polyline_distance` (sums over the coordinates as
+    numpy's reductions add them, in order; NaN propagating as in ``np.minimum``)."""
+    m, dim = x.shape
+    hi = poly.shape[0] - 2
+    d = np.empty(dim)
+    for r in range(m):
+        b = np.inf
+        for col in range(idx.shape[1]):
+            for off in (-1, 0):
+                i0 = idx[r, col] + off
+                if i0 < 0:
+                    i0 = 0
+                elif i0 > hi:
+                    i0 = hi
+                for k in range(dim):
+                    d[k] = poly[i0 + 1, k] - poly[i0, k]
+                # numpy's reduction over a short axis adds the coordinates in order
+                dd = d[0] * d[0]
+                for k in range(1, dim):
+                    dd += d[k] * d[k]
+                if dd < 1e-300:
+                    dd = 1e-300
+                num = (x[r, 0] - poly[i0, 0]) * d[0]
+                for k in range(1, dim):
+                    num += (x[r, k] - poly[i0, k]) * d[k]
+                s = num / dd
+                if s < 0.0:
+                    s = 0.0
+                elif s > 1.0:
+                    s = 1.0
+                ss = 0.0
+                for k in range(dim):
+                    e = (x[r, k] - poly[i0, k]) - s * d[k]
+                    if k == 0:
+                        ss = e * e
+                    else:
+                        ss += e * e
+                dist = np.sqrt(ss)
+                if use_ok and not seg_ok[i0]:
+                    dist = np.inf
+                if np.isnan(b) or np.isnan(dist):
+                    b = np.nan
+                elif dist < b:
+                    b = dist
+        best[r] = b

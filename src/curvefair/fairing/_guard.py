@@ -22,8 +22,9 @@ worse, and a fraction of the move is kept only if neither curve adds any.
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Callable
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -64,17 +65,40 @@ def is_chord_interpolant(curve: PiecewiseCurve) -> bool:
     return bool(np.max(np.abs(d - dr)) <= 1e-7 * scale)
 
 
+#: :func:`rebuilt_curve` by curve object (a cubic Hermite curve's data are read-only): the
+#: method (points-l1) and fair()'s guard ask for the same result's rebuilt curve; points-l1
+#: also files the one it made itself (:func:`remember_rebuilt`)
+_REBUILT_MEMO: weakref.WeakKeyDictionary[Any, Any] = weakref.WeakKeyDictionary()
+_NONE = object()
+
+
 def rebuilt_curve(curve: CubicHermite) -> CubicHermite | None:
     """The curve a reader rebuilds from ``curve``'s points: the chord-length natural (closed:
-    periodic) cubic through them; None if they do not make one (coincident points)."""
+    periodic) cubic through them; None if they do not make one (coincident points). Made once
+    per curve object."""
     from ..curves.interpolate import interpolate_cubic
     from ..errors import InputError
 
+    memo = type(curve) is CubicHermite
+    if memo:
+        got = _REBUILT_MEMO.get(curve)
+        if got is not None:
+            return None if got is _NONE else cast(CubicHermite, got)
     try:
-        return interpolate_cubic(np.array(curve.points), "chord",
-                                 "periodic" if curve.closed else "natural")
+        out: CubicHermite | None = interpolate_cubic(np.array(curve.points), "chord",
+                                                     "periodic" if curve.closed else "natural")
     except InputError:
-        return None
+        out = None
+    if memo:
+        _REBUILT_MEMO[curve] = _NONE if out is None else out
+    return out
+
+
+def remember_rebuilt(curve: CubicHermite, rebuilt: CubicHermite) -> None:
+    """File ``rebuilt`` as :func:`rebuilt_curve` of ``curve``: the caller made it the same way
+    (``interpolate_cubic`` of the same points, ``"chord"``, natural or periodic)."""
+    if type(curve) is CubicHermite:
+        _REBUILT_MEMO[curve] = rebuilt
 
 
 def _counts(a: dict[str, Any]) -> dict[str, int]:

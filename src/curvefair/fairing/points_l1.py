@@ -107,6 +107,7 @@ from ..curves.interpolate import interpolate_cubic
 from ..curves.parameterize import parameterize
 from ..errors import InputError
 from ._guard import is_chord_interpolant as _is_natural_chord_interpolant
+from ._guard import rebuilt_curve, remember_rebuilt
 from .problem import FairingHistory, FairingProblem, Outcome
 from .stop import StopReason
 
@@ -554,7 +555,8 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
               tau: float = 1.0, max_steps: int = 80, curve_tol: bool = True,
               samples: int = 3, max_attempts: int = 4, warm: float = 0.9,
               round_gap: float = 1e-6, warm_lam: bool = True,
-              scale: str = "none", closed: bool = False) -> PointsL1Result:
+              scale: str = "none", closed: bool = False,
+              _shared: dict[str, Any] | None = None) -> PointsL1Result:
     """The natural cubic through moved points with the sparsest third-derivative jumps.
 
     Parameters
@@ -597,6 +599,14 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
         ``points`` are the ``N`` distinct points of a closed list (no repeated closing point;
         ``params`` then has ``N + 1`` values): the periodic cubic (:func:`periodic_operators`).
 
+    _shared : dict, optional
+        Internal: a dict kept by the caller across calls on the same ``points``, ``params``,
+        ``hold``, ``closed``, ``samples``, ``beta`` and ``curve_tol`` (only ``tol`` and the
+        reweighting options may differ), e.g. the formulations and tolerance back-offs of
+        :func:`solve`. The work that does not depend on ``tol`` (validation, parameters,
+        operators, constraint rows, the input's curves) is done by the first call and reused
+        by the others: the same arrays, so the same results bit for bit.
+
     Returns
     -------
     PointsL1Result
@@ -613,36 +623,43 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
     """
     from ._tolerance import _pull_back, difference_deviation, enforce_tolerance
 
-    pts = as_points(points, "points", min_points=4)
+    sh: dict[str, Any] = {} if _shared is None else _shared
+    first = "p_in" not in sh
+    if first:
+        sh["p_in"] = as_points(points, "points", min_points=4)
     tolv = as_positive(tol, "tol")
     assert tolv is not None
+    pts = sh["p_in"]
     N, dim = pts.shape
     bc = "periodic" if closed else "natural"
-    # a closed list: the N distinct points, parameters N + 1 (the closing point's last)
-    u_in = parameterize(np.vstack([pts, pts[:1]]) if closed else pts,
-                        "chord" if params is None else params)
 
     def spline(q: FloatArray, u: Any) -> CubicHermite:
         return interpolate_cubic(np.vstack([q, q[:1]]) if closed else q, u, bc)
 
-    held = np.zeros(N, dtype=bool)
-    for i in np.asarray(list(cast(Iterable[int], hold)), dtype=int).reshape(-1):
-        if not -N <= i < N:
-            raise InputError(f"hold index {i} out of range for {N} points")
-        held[i] = True
+    if first:
+        # a closed list: the N distinct points, parameters N + 1 (the closing point's last)
+        sh["u_in"] = parameterize(np.vstack([pts, pts[:1]]) if closed else pts,
+                                  "chord" if params is None else params)
+        held = np.zeros(N, dtype=bool)
+        for i in np.asarray(list(cast(Iterable[int], hold)), dtype=int).reshape(-1):
+            if not -N <= i < N:
+                raise InputError(f"hold index {i} out of range for {N} points")
+            held[i] = True
+        sh["held"] = held
+        sh["ref_in"] = spline(pts, sh["u_in"])
+        # solved on centred, unit-size data (conditioning; a tol of 1e300 or 1e-300 must not
+        # overflow): a radius beyond 1e6 sizes binds nothing, one below 1e-12 moves nothing
+        sh["centre"] = 0.5 * (pts.max(axis=0) + pts.min(axis=0))
+        sh["size"] = float(np.ptp(pts, axis=0).max())
+    u_in, held, ref_in = sh["u_in"], sh["held"], sh["ref_in"]
+    centre, size = sh["centre"], sh["size"]
     p_in = pts
-    ref_in = spline(p_in, u_in)
-    # solved on centred, unit-size data (conditioning; a tol of 1e300 or 1e-300 must not
-    # overflow): a radius beyond 1e6 sizes binds nothing, one below 1e-12 moves nothing
-    centre = 0.5 * (pts.max(axis=0) + pts.min(axis=0))
-    size = float(np.ptp(pts, axis=0).max())
     if not size > 0 or tolv < 1e-12 * size:
         q0 = np.array(p_in)
         q0.setflags(write=False)
         return PointsL1Result(q0, ref_in, {"rounds": 0, "newton_steps": 0,
                                            "stop_reason": "tolerance", "n_active": 0,
                                            "attempts": 0, "pulled_back": 0, "scale": 1.0})
-    pts = (pts - centre) / size
     tol_out = tolv
     # the objective falls with the curve's scale: a curve that fits in the tube would shrink
     # towards a point (an 8-point circle 3.5 across at tol 5 came out 4e-12 across); the
@@ -650,11 +667,6 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
     # 2 SHRINK_CAP of the largest (the largest keeps 3/4 of itself)
     capped = tolv / size > SHRINK_CAP
     tolv = min(tolv / size, SHRINK_CAP)
-    margin = min(0.25 * tolv, 1e-9 * tolv + 64.0 * np.finfo(float).eps * float(np.abs(pts).max()))
-    # the parameters, affinely onto the chord length of the unit-size data (conditioning)
-    chord = float(np.sum(np.sqrt(np.sum(np.diff(np.vstack([pts, pts[:1]]) if closed else pts,
-                                                axis=0) ** 2, axis=1))))
-    u = (u_in - u_in[0]) * (chord / (u_in[-1] - u_in[0]))
     ns = max(0, int(samples))
 
     def setup(u: FloatArray) -> tuple[NaturalOperators, FloatArray, Any, FloatArray, float]:
@@ -679,25 +691,49 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
         b = beta * jj / e3 if e3 > 0 and jj > 0 else beta
         return ops, xp, C, Y, b
 
-    ops, xp, C, Y, b = setup(u)
-    # open curves: the compiled solver needs the rows of C only (four B-spline values each)
-    # and the energy's band (no sparse matrix kept); closed ones wrap around (numpy solver)
-    rows = None if closed else _rows4(C)
-    rad_s = np.full(C.shape[0] - N, tolv - margin)
+    if "ops" not in sh:
+        pts = (pts - centre) / size
+        sh["pts"] = pts
+        # the parameters, affinely onto the chord length of the unit-size data (conditioning)
+        chord = float(np.sum(np.sqrt(np.sum(np.diff(np.vstack([pts, pts[:1]]) if closed
+                                                    else pts, axis=0) ** 2, axis=1))))
+        u = (u_in - u_in[0]) * (chord / (u_in[-1] - u_in[0]))
+        sh["u"] = u
+        ops, xp, C, Y, b = setup(u)
+        sh["ops"], sh["xp"], sh["Y"], sh["b"] = ops, xp, Y, b
+        sh["n_samples"] = C.shape[0] - N
+        # open curves: the compiled solver needs the rows of C only (four B-spline values
+        # each) and the energy's band (no sparse matrix kept); closed ones wrap around (numpy
+        # solver)
+        if closed:
+            sh["C"] = C
+        else:
+            sh["rows"] = _rows4(C)
+            sh["jrows"], sh["grows"] = _rows4(ops.Jm, 5), _rows4(ops.G)
+        sh["j_before"] = float(_jump_norms(ops, xp).sum())
+        sh["Pn"] = _normal_projections(pts, closed)
+        sh["ref"] = spline(p_in, "chord") if curve_tol else None
+        sh["cost"] = {}
+    pts, u, ops, xp, Y, b = sh["pts"], sh["u"], sh["ops"], sh["xp"], sh["Y"], sh["b"]
+    C = sh.get("C")
+    rows = sh.get("rows")
     if not closed:
-        C = None  # freed: the rows are all the solver needs
-        jrows, grows = _rows4(ops.Jm, 5), _rows4(ops.G)
+        jrows, grows = sh["jrows"], sh["grows"]
+    margin = min(0.25 * tolv, 1e-9 * tolv + 64.0 * np.finfo(float).eps * float(np.abs(pts).max()))
+    rad_s = np.full(sh["n_samples"], tolv - margin)
     rad_p = np.where(held, 1e-4 * tolv, tolv - margin)
-    j_before = float(_jump_norms(ops, xp).sum())
-    Pn = _normal_projections(pts, closed)
+    j_before = sh["j_before"]
+    Pn = sh["Pn"]
     newton = 0
     rounds_done = 0
     attempts = 0
     curve_dev = None
-    ref = spline(p_in, "chord") if curve_tol else None
+    ref = sh["ref"]
     reason = "converged"
     # per-jump cost c_k of the L1 norm sum_k c_k |J_k| (see ``scale``)
-    cost = _jump_costs(scale, u, ops, xp, Pn)
+    if scale not in sh["cost"]:
+        sh["cost"][scale] = _jump_costs(scale, u, ops, xp, Pn)
+    cost = sh["cost"][scale]
     nj = cost.shape[0]
     w = cost * cost
     w *= nj / float(w.sum())
@@ -787,6 +823,9 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
             shrink = min(shrink, float(pf.min()))
     # equal parameter: certified on the difference curve, every move scaled if needed
     curve_e, cert = enforce_tolerance(ref_in, curve, tol_out, curve_bound=True)
+    if curve_e is curve and ref is not None:
+        # the last attempt's rebuilt curve is that of the points returned
+        remember_rebuilt(curve, rebuilt)
     curve = cast(CubicHermite, curve_e)
     q_out = np.array(curve.points)[:N]
     x1 = _solve(ops.A, (q_out - centre) / size, closed)
@@ -859,6 +898,23 @@ def _polyline_distance(x: FloatArray, poly: FloatArray,
     """Distance of every row of ``x`` to the polyline ``poly`` (k-d tree: the segments next to
     the two nearest vertices); ``seg_ok[j]`` False leaves segment ``poly[j] -> poly[j + 1]``
     out (a polyline of several pieces: every vertex is still on a segment of its own piece)."""
+    from scipy.spatial import cKDTree
+
+    from .._kernels import points as _pk
+
+    _, idx = cKDTree(poly).query(x, k=2)
+    x = np.ascontiguousarray(x, dtype=np.float64)
+    best = np.empty(x.shape[0])
+    ok = np.ones(1, dtype=bool) if seg_ok is None else np.ascontiguousarray(seg_ok, dtype=bool)
+    _pk.polyline_distance(x, np.ascontiguousarray(poly, dtype=np.float64),
+                          np.ascontiguousarray(idx, dtype=np.int64), ok, seg_ok is not None,
+                          best)
+    return best
+
+
+def _polyline_distance_numpy(x: FloatArray, poly: FloatArray,
+                             seg_ok: np.ndarray | None = None) -> FloatArray:
+    """:func:`_polyline_distance` in numpy (the reference its kernel is tested against)."""
     from scipy.spatial import cKDTree
 
     _, idx = cKDTree(poly).query(x, k=2)
@@ -1066,13 +1122,16 @@ def solve(problem: FairingProblem, *, rounds: int | None = None, delta: float = 
         if len(variants) < max(1, int(select)) and sc != scale:
             variants.append({"scale": sc, "rounds": 5})
     chosen = variants[0]
+    # every solve below is on the same points, parameters and held points: the work that does
+    # not depend on the tube's radius is done once (points_l1's ``_shared``)
+    shared: dict[str, Any] = {}
 
     def solve_at(t: float, v: dict[str, Any] | None = None) -> PointsL1Result:
         v = chosen if v is None else v
         return points_l1(p0, t, params=np.asarray(curve.params), hold=sorted(hold),
                          rounds=int(v["rounds"]), delta=delta, max_steps=steps,
                          curve_tol=curve_tol, samples=samples, scale=str(v["scale"]),
-                         closed=closed)
+                         closed=closed, _shared=shared)
 
     res = solve_at(tol)
     total = int(res.report["newton_steps"])
@@ -1082,11 +1141,15 @@ def solve(problem: FairingProblem, *, rounds: int | None = None, delta: float = 
 
     def rebuilt(r: PointsL1Result) -> dict[str, Any]:
         """Analysis of the curve a reader rebuilds from the result's points (chord-length
-        natural or periodic cubic), made once per result."""
+        natural or periodic cubic), made once per result (the curve's points are the result's:
+        :func:`rebuilt_curve` of it, which fair()'s guard asks for again)."""
         if id(r) not in seen:
-            seen[id(r)] = (r, _analysis_block(interpolate_cubic(
-                np.vstack([r.points, r.points[:1]]) if closed else np.array(r.points),
-                "chord", "periodic" if closed else "natural")))
+            rc = rebuilt_curve(r.curve)
+            if rc is None:  # coincident points: the error of the interpolation itself
+                rc = interpolate_cubic(
+                    np.vstack([r.points, r.points[:1]]) if closed else np.array(r.points),
+                    "chord", "periodic" if closed else "natural")
+            seen[id(r)] = (r, _analysis_block(rc))
         return seen[id(r)][1]
 
     if len(variants) > 1:
