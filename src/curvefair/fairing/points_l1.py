@@ -91,6 +91,7 @@ points of ``benchmarks/bench_points_l1.py``), far beyond any equal-parameter tol
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Iterable
 from dataclasses import dataclass, field, replace
 from typing import Any, cast
@@ -933,6 +934,11 @@ def _polyline_distance_numpy(x: FloatArray, poly: FloatArray,
     return best
 
 
+#: :func:`_rebuilt_distance`'s samples of its first curve on every span, by curve (read-only)
+_SAMPLES_MEMO: weakref.WeakKeyDictionary[Any, tuple[int, FloatArray]] = \
+    weakref.WeakKeyDictionary()
+
+
 def _rebuilt_distance(a: CubicHermite, b: CubicHermite, tol: float, dense: int = 32,
                       per: FloatArray | None = None) -> float:
     """The Hausdorff distance of ``a`` and ``b`` (same number of points), as far as it matters
@@ -963,15 +969,25 @@ def _rebuilt_distance(a: CubicHermite, b: CubicHermite, tol: float, dense: int =
         t = (u[spans, None] + np.diff(u)[spans, None] * fr[None, :]).reshape(-1)
         return np.asarray(c(np.clip(t, u[0], u[-1])))
 
+    def samples_a(spans: np.ndarray) -> FloatArray:
+        # ``a`` (points-l1's reference, the input's rebuilt curve) is measured against every
+        # attempt of every solve: its samples of all spans are made once (each sample is
+        # evaluated on its own, so the rows taken are those of ``samples(a, spans)``)
+        got = _SAMPLES_MEMO.get(a)
+        if got is None or got[0] != dense:
+            got = (dense, samples(a, np.arange(ns)).reshape(ns, dense + 1, -1))
+            _SAMPLES_MEMO[a] = got
+        return cast(FloatArray, got[1][spans].reshape(-1, got[1].shape[2]))
+
     # segments of the sampled polyline: inside a span, or between the samples of two
     # consecutive spans (the same point); never across a gap between sampled spans
     inner = np.ones((near.size, dense + 1), dtype=bool)
     inner[:, -1] = np.r_[near[1:] == near[:-1] + 1, False]
     seg_ok = inner.reshape(-1)
-    pa, pb = samples(a, near), samples(b, near)
+    pa, pb = samples_a(near), samples(b, near)
     worst = float(np.max(per[per <= tol])) if np.any(per <= tol) else 0.0
     worst = max(worst, float(_polyline_distance(samples(b, bad), pa, seg_ok).max()),
-                float(_polyline_distance(samples(a, bad), pb, seg_ok).max()))
+                float(_polyline_distance(samples_a(bad), pb, seg_ok).max()))
     return worst
 
 
