@@ -485,3 +485,101 @@ def polyline_distance(x, poly, idx, seg_ok, use_ok, best):
                 elif dist < b:
                     b = dist
         best[r] = b
+
+
+# ------------------------------------------------------------------------------------------
+# the closed-curve interior point (:func:`curvefair.fairing.points_l1._tube_qp_cyclic`): its
+# sparse products, with scipy's summation orders (bit for bit the scipy.sparse results)
+# ------------------------------------------------------------------------------------------
+@njit(cache=True)
+def csr_matvecs(indptr, indices, data, X, out):
+    """``out = C @ X`` for ``C`` in CSR arrays: each row's stored entries added in their stored
+    order onto 0.0, as scipy's ``csr_matvecs`` (``X`` and ``out`` 2-D)."""
+    nv = X.shape[1]
+    for i in range(indptr.shape[0] - 1):
+        for k in range(nv):
+            out[i, k] = 0.0
+        for jj in range(indptr[i], indptr[i + 1]):
+            j = indices[jj]
+            a = data[jj]
+            for k in range(nv):
+                out[i, k] += a * X[j, k]
+
+
+@njit(cache=True)
+def csr_t_matvecs(indptr, indices, data, Z, out):
+    """``out = C.T @ Z`` for ``C`` in CSR arrays, as scipy computes it (``C.T`` is CSC on the
+    same arrays, ``csc_matvecs``): rows of ``C`` in order, each entry added onto 0.0."""
+    nv = Z.shape[1]
+    out[:, :] = 0.0
+    for j in range(indptr.shape[0] - 1):
+        for ii in range(indptr[j], indptr[j + 1]):
+            i = indices[ii]
+            a = data[ii]
+            for k in range(nv):
+                out[i, k] += a * Z[j, k]
+
+
+@njit(cache=True)
+def cyclic_newton_band(cp, ci, cx, B, kp, ki, kx, pos, dim):
+    """The lower band, in the order ``pos`` (``pos[j]``: position of unknown block ``j``), of
+    ``M = Ks + CI^T blockdiag(B) CI`` with ``CI = C (x) I_dim``: ``(band, kd)``, ``band[o, c] =
+    M[r, c]`` (permuted indices, ``o = r - c``), ``kd`` the largest ``o`` of a non-zero entry.
+
+    The values are those of ``(Pm @ (Ks + CI.T @ Bd @ CI) @ Pm.T)`` in scipy.sparse, bit for
+    bit: ``CI.T @ Bd`` has one product per entry, ``X[(p, a), (k, b)] = B[k, a, b] C[k, p]``
+    (entries that are exactly 0 dropped); ``X @ CI`` adds, onto 0.0 and over the constraint
+    rows ``k`` in ascending order, ``C[k, q] X[(p, a), (k, b)]``; then one addition of ``Ks``
+    (``C``: ``cp, ci, cx``; ``Ks``: ``kp, ki, kx``, CSR arrays)."""
+    N = pos.shape[0]
+    n = N * dim
+    m = cp.shape[0] - 1
+    kdmax = 0
+    for k in range(m):
+        for jj in range(cp[k], cp[k + 1]):
+            for ll in range(cp[k], cp[k + 1]):
+                d = abs(pos[ci[jj]] - pos[ci[ll]])
+                if d > kdmax:
+                    kdmax = d
+    kdmax = kdmax * dim + dim - 1
+    for r in range(n):
+        for jj in range(kp[r], kp[r + 1]):
+            c = ki[jj]
+            d = abs((pos[r // dim] * dim + r % dim) - (pos[c // dim] * dim + c % dim))
+            if d > kdmax:
+                kdmax = d
+    band = np.zeros((kdmax + 1, n))
+    for k in range(m):
+        for jj in range(cp[k], cp[k + 1]):
+            p = ci[jj]
+            cpv = cx[jj]
+            for ll in range(cp[k], cp[k + 1]):
+                q = ci[ll]
+                cqv = cx[ll]
+                for a in range(dim):
+                    rr = pos[p] * dim + a
+                    for b in range(dim):
+                        cc = pos[q] * dim + b
+                        if rr < cc:
+                            continue
+                        xv = B[k, a, b] * cpv
+                        if xv != 0.0:
+                            band[rr - cc, cc] += cqv * xv
+    for r in range(n):
+        rr = pos[r // dim] * dim + r % dim
+        for jj in range(kp[r], kp[r + 1]):
+            c = ki[jj]
+            cc = pos[c // dim] * dim + c % dim
+            if rr >= cc:
+                band[rr - cc, cc] = kx[jj] + band[rr - cc, cc]
+    kd = 0
+    for o in range(kdmax, 0, -1):
+        nz = False
+        for c in range(n - o):
+            if band[o, c] != 0.0:
+                nz = True
+                break
+        if nz:
+            kd = o
+            break
+    return band, kd

@@ -18,7 +18,7 @@ from .._typing import ArrayLike, FloatArray
 from .._validate import as_points, as_vectors, choice, magnitude
 from ..errors import InputError
 from .hermite import CubicHermite, QuinticHermite
-from .parameterize import _parameterize_valid, parameterize
+from .parameterize import _parameterize_valid
 
 __all__ = ["interpolate_cubic", "interpolate_quintic", "BC_NAMES"]
 

@@ -371,6 +371,8 @@ def _tube_qp_cyclic(K: sp.csr_matrix, C: sp.csr_matrix, x0: FloatArray, pts: Flo
     ``O(n)`` per step."""
     from scipy.linalg import cho_solve_banded, cholesky_banded
 
+    from .._kernels import points as _pk
+
     N, dim = x0.shape
     m = pts.shape[0]
     n = N * dim
@@ -381,18 +383,38 @@ def _tube_qp_cyclic(K: sp.csr_matrix, C: sp.csr_matrix, x0: FloatArray, pts: Flo
         return x, np.zeros(m), 0, "zero_energy"
     Ks = (K * (2.0 / E0)).tocsr()
     Cc = sp.csr_matrix(C)
-    CI = sp.kron(Cc, sp.identity(dim), format="csr")
-    pos = (_zigzag(N)[:, None] * dim + np.arange(dim)[None, :]).reshape(-1)
-    Pm = sp.csr_matrix((np.ones(n), (pos, np.arange(n))), shape=(n, n))
+    # the sparse products of each step run compiled on the CSR arrays, in scipy's summation
+    # orders (:func:`curvefair._kernels.points.cyclic_newton_band`, ``csr_matvecs``,
+    # ``csr_t_matvecs``): bitwise the scipy.sparse figures, without a matrix built per step
+    cp, ci, cx = (np.asarray(Cc.indptr, dtype=np.int64), np.asarray(Cc.indices, dtype=np.int64),
+                  np.asarray(Cc.data, dtype=np.float64))
+    kp, ki, kx = (np.asarray(Ks.indptr, dtype=np.int64), np.asarray(Ks.indices, dtype=np.int64),
+                  np.asarray(Ks.data, dtype=np.float64))
+    zpos = _zigzag(N)
+    # Pm @ y (Pm the permutation matrix of the zigzag order) is y[i] at pos_full[i], added
+    # onto 0.0 as scipy's matvec does
+    pos_full = (zpos[:, None] * dim + np.arange(dim)[None, :]).reshape(-1)
     t2 = rad * rad
     lam = np.ones(m) if lam0 is None else np.array(lam0, dtype=np.float64)
 
+    def c_mul(y: FloatArray) -> FloatArray:
+        out = np.empty((m, dim))
+        _pk.csr_matvecs(cp, ci, cx, np.ascontiguousarray(y), out)
+        return out
+
+    def ct_mul(z: FloatArray) -> FloatArray:
+        out = np.empty((N, dim))
+        _pk.csr_t_matvecs(cp, ci, cx, np.ascontiguousarray(z), out)
+        return out
+
     def resid(x: FloatArray, lam: FloatArray, tinv: float
               ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-        v = Cc @ x - pts
+        v = c_mul(x) - pts
         fi = 0.5 * (np.sum(v * v, axis=1) / t2 - 1.0)
         rc = -lam * fi - tinv
-        rd = (Ks @ x.reshape(-1)).reshape(N, dim) + Cc.T @ ((lam / t2)[:, None] * v)
+        kxv = np.empty((n, 1))
+        _pk.csr_matvecs(kp, ki, kx, np.ascontiguousarray(x).reshape(n, 1), kxv)
+        rd = kxv.reshape(N, dim) + ct_mul((lam / t2)[:, None] * v)
         return v, fi, rd, rc
 
     v, fi, rd, rc = resid(x, lam, 0.0)
@@ -410,24 +432,23 @@ def _tube_qp_cyclic(K: sp.csr_matrix, C: sp.csr_matrix, x0: FloatArray, pts: Flo
         a = v / t2[:, None]
         blocks = ww[:, None, None] * a[:, :, None] * a[:, None, :] \
             + (lam / t2)[:, None, None] * np.eye(dim)[None]
-        M = Ks + CI.T @ _block_diag(blocks) @ CI
-        Mp = (Pm @ M @ Pm.T).tocoo()
-        low = Mp.row >= Mp.col
-        kd = int(np.max(Mp.row[low] - Mp.col[low]))
-        ab = np.zeros((kd + 1, n))
-        np.add.at(ab, (Mp.row[low] - Mp.col[low], Mp.col[low]), Mp.data[low])
-        rhs = -rd - Cc.T @ ((rc / fi)[:, None] * a)
+        band, kd = _pk.cyclic_newton_band(cp, ci, cx, np.ascontiguousarray(blocks), kp, ki, kx,
+                                          zpos, dim)
+        ab = band[:kd + 1]
+        rhs = -rd - ct_mul((rc / fi)[:, None] * a)
         try:
             cb = cholesky_banded(ab, lower=True)
         except np.linalg.LinAlgError:
             code = 2
             break
-        dxp = cho_solve_banded((cb, True), Pm @ rhs.reshape(-1))
-        dx = (Pm.T @ dxp).reshape(N, dim)
+        yp = np.empty(n)
+        yp[pos_full] = rhs.reshape(-1)
+        dxp = cho_solve_banded((cb, True), yp + 0.0)
+        dx = (dxp[pos_full] + 0.0).reshape(N, dim)
         if not np.all(np.isfinite(dx)):
             code = 2
             break
-        Cdx = Cc @ dx
+        Cdx = c_mul(dx)
         adx = np.sum(a * Cdx, axis=1)
         dlam = (rc - lam * adx) / fi
         neg = dlam < 0
