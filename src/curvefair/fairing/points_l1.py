@@ -491,7 +491,16 @@ def _tube_qp_cyclic(K: sp.csr_matrix, C: sp.csr_matrix, x0: FloatArray, pts: Flo
 def _jump_norms(ops: NaturalOperators, x: FloatArray, P: FloatArray | None = None
                 ) -> FloatArray:
     """``|J_k|``, or ``|P_k J_k|`` with the per-jump projections ``P`` (shape (k, dim, dim))."""
-    J = ops.Jm @ x
+    # ``ops.Jm @ x`` compiled on its CSR arrays as they are now (scipy's summation order: the
+    # same values; the arrays are read at every call, since ``_rows4`` puts ``Jm`` in
+    # canonical order in place after the first one)
+    from .._kernels import points as _pk
+
+    Jm = ops.Jm
+    xa = np.ascontiguousarray(x, dtype=np.float64)
+    J = np.empty((Jm.shape[0], xa.shape[1]))
+    _pk.csr_matvecs(np.asarray(Jm.indptr, dtype=np.int64), np.asarray(Jm.indices, dtype=np.int64),
+                    np.asarray(Jm.data, dtype=np.float64), xa, J)
     if P is not None:
         J = np.einsum("kab,kb->ka", P, J)
     return np.sqrt(np.sum(J * J, axis=1))
@@ -696,7 +705,7 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
         constraint rows ``C`` (data points, then ``ns`` samples per span) with their
         centres ``Y``, and the E3 weight ``b``."""
         ops = periodic_operators(u) if closed else natural_operators(u)
-        xp = _solve(ops.A, pts, closed)  # the input's cubic at these parameters
+        xp = _solve(ops.A, pts, closed, ops.cache)  # the input's cubic at these parameters
         if ns:
             fr = np.arange(1, ns + 1) / (ns + 1.0)
             us = (u[:-1, None] + np.diff(u)[:, None] * fr[None, :]).reshape(-1)
@@ -850,7 +859,7 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
         remember_rebuilt(curve, rebuilt)
     curve = cast(CubicHermite, curve_e)
     q_out = np.array(curve.points)[:N]
-    x1 = _solve(ops.A, (q_out - centre) / size, closed)
+    x1 = _solve(ops.A, (q_out - centre) / size, closed, ops.cache)
     dev = np.sqrt(np.sum((q_out - p_in) ** 2, axis=1))
     report = {"rounds": rounds_done, "newton_steps": newton, "stop_reason": reason,
               "n_active": int(np.sum(dev > (1.0 - 1e-6) * tol_out)),
@@ -1012,11 +1021,12 @@ def _rebuilt_distance(a: CubicHermite, b: CubicHermite, tol: float, dense: int =
     return worst
 
 
-def _solve(A: sp.csr_matrix, rhs: FloatArray, closed: bool) -> FloatArray:
+def _solve(A: sp.csr_matrix, rhs: FloatArray, closed: bool,
+           cache: dict[Any, Any] | None = None) -> FloatArray:
     """``A^{-1} rhs``: :func:`_solve_tri`, or for the cyclic tridiagonal ``A`` of a closed
     curve the same banded solve in the order of :func:`_zigzag` (half-bandwidth 4)."""
     if not closed:
-        return _solve_tri(A, rhs)
+        return _solve_tri(A, rhs, cache)
     from scipy.linalg import solve_banded
 
     N = A.shape[0]
@@ -1032,16 +1042,23 @@ def _solve(A: sp.csr_matrix, rhs: FloatArray, closed: bool) -> FloatArray:
     return np.asarray(z[pos])
 
 
-def _solve_tri(A: sp.csr_matrix, rhs: FloatArray) -> FloatArray:
-    """``A^{-1} rhs`` for the tridiagonal collocation (LAPACK banded solve)."""
+def _solve_tri(A: sp.csr_matrix, rhs: FloatArray, cache: dict[Any, Any] | None = None
+               ) -> FloatArray:
+    """``A^{-1} rhs`` for the tridiagonal collocation (LAPACK banded solve); ``cache``: a
+    dict kept with ``A`` (:attr:`NaturalOperators.cache`) that holds its band."""
     from scipy.linalg import solve_banded
 
-    Aw = _tridiag(A)
-    N = Aw.shape[0]
-    ab = np.zeros((3, N))
-    ab[0, 1:] = Aw[:-1, 2]
-    ab[1] = Aw[:, 1]
-    ab[2, :-1] = Aw[1:, 0]
+    ab = None if cache is None else cache.get("A_band")
+    if ab is None:
+        Aw = _tridiag(A)
+        N = Aw.shape[0]
+        ab = np.zeros((3, N))
+        ab[0, 1:] = Aw[:-1, 2]
+        ab[1] = Aw[:, 1]
+        ab[2, :-1] = Aw[1:, 0]
+        if cache is not None:  # the operators' cache: made once per matrix
+            ab.setflags(write=False)
+            cache["A_band"] = ab
     return solve_banded((1, 1), ab, rhs)
 
 
