@@ -583,3 +583,54 @@ def cyclic_newton_band(cp, ci, cx, B, kp, ki, kx, pos, dim):
             kd = o
             break
     return band, kd
+
+
+@njit(cache=True)
+def csr_matmat(n_row, n_col, Ap, Aj, Ax, Bp, Bj, Bx):
+    """``C = A @ B`` in CSR arrays exactly as scipy.sparse computes it (``csr_matmat`` of its
+    sparsetools): row by row, products added onto 0.0 in the order of ``A``'s and then
+    ``B``'s stored entries; each row's columns stored in reverse order of first touch; exact
+    zeros dropped. Returns ``(indptr, indices, data)`` (int32 indices: the small operators of
+    :func:`curvefair.fairing.points_l1.natural_operators`)."""
+    nxt = np.full(n_col, -1, dtype=np.int64)
+    sums = np.zeros(n_col)
+    # an upper bound of the entries: the structural count (scipy's csr_matmat_maxnnz)
+    mask = np.full(n_col, -1, dtype=np.int64)
+    cap = 0
+    for i in range(n_row):
+        for jj in range(Ap[i], Ap[i + 1]):
+            j = Aj[jj]
+            for kk in range(Bp[j], Bp[j + 1]):
+                k = Bj[kk]
+                if mask[k] != i:
+                    mask[k] = i
+                    cap += 1
+    Cp = np.empty(n_row + 1, dtype=np.int32)
+    Cj = np.empty(cap, dtype=np.int32)
+    Cx = np.empty(cap)
+    nnz = 0
+    Cp[0] = 0
+    for i in range(n_row):
+        head = -2
+        length = 0
+        for jj in range(Ap[i], Ap[i + 1]):
+            j = Aj[jj]
+            v = Ax[jj]
+            for kk in range(Bp[j], Bp[j + 1]):
+                k = Bj[kk]
+                sums[k] += v * Bx[kk]
+                if nxt[k] == -1:
+                    nxt[k] = head
+                    head = k
+                    length += 1
+        for _ in range(length):
+            if sums[head] != 0:
+                Cj[nnz] = head
+                Cx[nnz] = sums[head]
+                nnz += 1
+            temp = head
+            head = nxt[head]
+            nxt[temp] = -1
+            sums[temp] = 0.0
+        Cp[i + 1] = nnz
+    return Cp, Cj[:nnz].copy(), Cx[:nnz].copy()

@@ -175,7 +175,62 @@ class NaturalOperators:
 
 
 def natural_operators(u: ArrayLike) -> NaturalOperators:
-    """The operators of :class:`NaturalOperators` for parameters ``u`` (N >= 3, increasing)."""
+    """The operators of :class:`NaturalOperators` for parameters ``u`` (N >= 3, increasing).
+
+    The factors (end conditions, derivative differences) are made as CSR arrays directly and
+    multiplied by :func:`curvefair._kernels.points.csr_matmat`, scipy's own product (the same
+    sums in the same order, the same stored order): bitwise the matrices of
+    :func:`_natural_operators_sparse`, without a dozen scipy.sparse constructions."""
+    from .._kernels import points as _pk
+
+    u = np.asarray(u, dtype=float)
+    N = u.shape[0]
+    n = N - 1
+    t = np.r_[[u[0]] * 4, u[1:-1], [u[-1]] * 4]
+    h = np.diff(u)
+    r0 = h[0] / (h[0] + h[1])
+    r1 = h[-1] / (h[-1] + h[-2])
+    i32 = np.int32
+    # E ((N + 2) x N), canonical CSR: row 0 (1 + r0, -r0), rows 1 .. N the identity, row N + 1
+    # (-r1 at N - 2, 1 + r1 at N - 1)
+    Ep = np.r_[0, 2 + np.arange(N + 1), N + 4].astype(i32)
+    Ej = np.r_[0, 1, np.arange(N), N - 2, N - 1].astype(i32)
+    Ex = np.r_[1.0 + r0, -r0, np.ones(N), -r1, 1.0 + r1]
+    E = sp.csr_matrix((Ex, Ej, Ep), shape=(N + 2, N))
+    Bd = BSpline.design_matrix(u, t, 3).tocsr()  # (N, N + 2)
+    Ap, Aj, Ax = _pk.csr_matmat(N, N, Bd.indptr, Bd.indices, Bd.data, Ep, Ej, Ex)
+    A = type(Bd)((Ax, Aj, Ap), shape=(N, N))  # Bd @ E is of Bd's class
+
+    def diff(ncoef: int, k: int, shift: int) -> tuple[np.ndarray, np.ndarray, FloatArray]:
+        # the matrix of _diff_op, canonical CSR: row j (-f_j at j, f_j at j + 1); k = 0: the
+        # plain first differences (-1, 1)
+        j = np.arange(ncoef - 1)
+        f = k / (t[j + k + 1 + shift] - t[j + 1 + shift]) if k else np.ones(ncoef - 1)
+        p = (2 * np.arange(ncoef)).astype(i32)
+        c = np.empty(2 * (ncoef - 1), dtype=i32)
+        c[0::2] = j
+        c[1::2] = j + 1
+        x = np.empty(2 * (ncoef - 1))
+        x[0::2] = -f
+        x[1::2] = f
+        return p, c, x
+
+    D1 = diff(N + 2, 3, 0)
+    D2 = diff(N + 1, 2, 1)
+    D3 = diff(N, 1, 2)
+    P32 = _pk.csr_matmat(n, N + 1, *D3, *D2)
+    P321 = _pk.csr_matmat(n, N + 2, *P32, *D1)
+    Gp, Gj, Gx = _pk.csr_matmat(n, N, *P321, Ep, Ej, Ex)
+    G = sp.csr_matrix((Gx, Gj, Gp), shape=(n, N))  # (n, N): S''' on span k
+    Jp, Jj, Jx = _pk.csr_matmat(n - 1, N, *diff(n, 0, 0), Gp, Gj, Gx)
+    Jm = sp.csr_matrix((Jx, Jj, Jp), shape=(n - 1, N))
+    A.eliminate_zeros()
+    return NaturalOperators(u, t, A, G, Jm, E)
+
+
+def _natural_operators_sparse(u: ArrayLike) -> NaturalOperators:
+    """:func:`natural_operators` built with scipy.sparse products (the reference its compiled
+    products are tested against)."""
     u = np.asarray(u, dtype=float)
     N = u.shape[0]
     n = N - 1
