@@ -65,40 +65,43 @@ def is_chord_interpolant(curve: PiecewiseCurve) -> bool:
     return bool(np.max(np.abs(d - dr)) <= 1e-7 * scale)
 
 
-#: :func:`rebuilt_curve` by curve object (a cubic Hermite curve's data are read-only): the
-#: method (points-l1) and fair()'s guard ask for the same result's rebuilt curve; points-l1
-#: also files the one it made itself (:func:`remember_rebuilt`)
-_REBUILT_MEMO: weakref.WeakKeyDictionary[Any, Any] = weakref.WeakKeyDictionary()
-_NONE = object()
-
-
 def rebuilt_curve(curve: CubicHermite) -> CubicHermite | None:
     """The curve a reader rebuilds from ``curve``'s points: the chord-length natural (closed:
-    periodic) cubic through them; None if they do not make one (coincident points). Made once
-    per curve object."""
+    periodic) cubic through them; None if they do not make one (coincident points)."""
     from ..curves.interpolate import interpolate_cubic
     from ..errors import InputError
 
+    try:
+        return interpolate_cubic(np.array(curve.points), "chord",
+                                 "periodic" if curve.closed else "natural")
+    except InputError:
+        return None
+
+
+#: the analysis blocks of the curves rebuilt from cubic Hermite curves' points, by the curve
+#: (its data are read-only; small dicts, no curve kept): points-l1 judges its result's rebuilt
+#: curve and fair()'s guard judges it again
+_REBUILT_ANALYSIS: weakref.WeakKeyDictionary[Any, Any] = weakref.WeakKeyDictionary()
+_NONE = object()
+
+
+def rebuilt_analysis(curve: PiecewiseCurve,
+                     analysis: Callable[[PiecewiseCurve], dict[str, Any]],
+                     rebuilt: CubicHermite | None = None) -> dict[str, Any] | None:
+    """``analysis(rebuilt_curve(curve))`` (None if the points make no curve), made once per
+    cubic Hermite curve object (a fresh dict each time). ``rebuilt``: that curve when the
+    caller already made it (``interpolate_cubic`` of the same points, ``"chord"``, natural or
+    periodic)."""
     memo = type(curve) is CubicHermite
     if memo:
-        got = _REBUILT_MEMO.get(curve)
+        got = _REBUILT_ANALYSIS.get(curve)
         if got is not None:
-            return None if got is _NONE else cast(CubicHermite, got)
-    try:
-        out: CubicHermite | None = interpolate_cubic(np.array(curve.points), "chord",
-                                                     "periodic" if curve.closed else "natural")
-    except InputError:
-        out = None
+            return None if got is _NONE else dict(got)
+    rc = rebuilt if rebuilt is not None else rebuilt_curve(cast(CubicHermite, curve))
+    out = None if rc is None else analysis(rc)
     if memo:
-        _REBUILT_MEMO[curve] = _NONE if out is None else out
+        _REBUILT_ANALYSIS[curve] = _NONE if out is None else dict(out)
     return out
-
-
-def remember_rebuilt(curve: CubicHermite, rebuilt: CubicHermite) -> None:
-    """File ``rebuilt`` as :func:`rebuilt_curve` of ``curve``: the caller made it the same way
-    (``interpolate_cubic`` of the same points, ``"chord"``, natural or periodic)."""
-    if type(curve) is CubicHermite:
-        _REBUILT_MEMO[curve] = rebuilt
 
 
 def _counts(a: dict[str, Any]) -> dict[str, int]:

@@ -660,7 +660,7 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
     primed = prime_power_forms(curve, new)
     after = analysis_block(new)
     guard_info: dict[str, Any] = {"kept": "output"}
-    from ._guard import _adds, is_chord_interpolant, rebuilt_curve
+    from ._guard import _adds, is_chord_interpolant, rebuilt_analysis
 
     worse = bool(_adds(after, before))
     rebuilt = rb_after = None
@@ -671,8 +671,7 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
                 and is_chord_interpolant(curve)):
             # point data: also judge the curve a reader rebuilds from the written points
             def rebuilt(c: PiecewiseCurve) -> dict[str, Any] | None:
-                r = rebuilt_curve(cast(CubicHermite, c))
-                return None if r is None else analysis_block(r)
+                return rebuilt_analysis(c, analysis_block)
 
             rb_after = rebuilt(new)
             worse = worse or rb_after is None or bool(_adds(rb_after, before))

@@ -108,7 +108,7 @@ from ..curves.interpolate import interpolate_cubic
 from ..curves.parameterize import parameterize
 from ..errors import InputError
 from ._guard import is_chord_interpolant as _is_natural_chord_interpolant
-from ._guard import rebuilt_curve, remember_rebuilt
+from ._guard import rebuilt_analysis
 from .problem import FairingHistory, FairingProblem, Outcome
 from .stop import StopReason
 
@@ -140,6 +140,8 @@ class PointsL1Result:
     points: np.ndarray
     curve: CubicHermite
     report: dict[str, Any] = field(default_factory=dict)
+    #: internal: the curve rebuilt from ``points`` when points_l1 made it (else None)
+    _rebuilt: CubicHermite | None = field(default=None, repr=False, compare=False)
 
 
 # ------------------------------------------------------------------------------------------
@@ -908,10 +910,8 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
             # factor (strictly inside every shrunk ball)
             shrink = min(shrink, float(pf.min()))
     # equal parameter: certified on the difference curve, every move scaled if needed
+    curve_in = curve
     curve_e, cert = enforce_tolerance(ref_in, curve, tol_out, curve_bound=True)
-    if curve_e is curve and ref is not None:
-        # the last attempt's rebuilt curve is that of the points returned
-        remember_rebuilt(curve, rebuilt)
     curve = cast(CubicHermite, curve_e)
     q_out = np.array(curve.points)[:N]
     x1 = _solve(ops.A, (q_out - centre) / size, closed, ops.cache)
@@ -926,7 +926,11 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
     if capped:
         report["tube_radius"] = SHRINK_CAP * size
     q_out.setflags(write=False)
-    return PointsL1Result(q_out, curve, report)
+    out = PointsL1Result(q_out, curve, report)
+    if curve_e is curve_in and ref is not None:
+        # the last attempt's rebuilt curve is that of the points returned (for :func:`solve`)
+        object.__setattr__(out, "_rebuilt", rebuilt)
+    return out
 
 
 #: the largest tube radius of :func:`points_l1`, as a fraction of the input's largest
@@ -1253,12 +1257,12 @@ def solve(problem: FairingProblem, *, rounds: int | None = None, delta: float = 
         natural or periodic cubic), made once per result (the curve's points are the result's:
         :func:`rebuilt_curve` of it, which fair()'s guard asks for again)."""
         if id(r) not in seen:
-            rc = rebuilt_curve(r.curve)
-            if rc is None:  # coincident points: the error of the interpolation itself
-                rc = interpolate_cubic(
+            a = rebuilt_analysis(r.curve, _analysis_block, r._rebuilt)
+            if a is None:  # coincident points: the error of the interpolation itself
+                a = _analysis_block(interpolate_cubic(
                     np.vstack([r.points, r.points[:1]]) if closed else np.array(r.points),
-                    "chord", "periodic" if closed else "natural")
-            seen[id(r)] = (r, _analysis_block(rc))
+                    "chord", "periodic" if closed else "natural"))
+            seen[id(r)] = (r, a)
         return seen[id(r)][1]
 
     if len(variants) > 1:
