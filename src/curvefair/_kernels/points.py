@@ -432,3 +432,205 @@ def tube_ipm(Kb, start, W, Y, rad, x, lam, max_steps, gap, stall):
         rd[:, :] = rd1
         steps += 1
     return steps, code
+
+
+@njit(cache=True)
+def polyline_distance(x, poly, idx, seg_ok, use_ok, best):
+    """``best[r]``: the distance of ``x[r]`` to the nearest of the polyline segments
+    ``poly[i] -> poly[i + 1]`` next to the vertices ``idx[r, :]`` (``i = idx - 1`` and ``idx``,
+    clipped to the segments; with ``use_ok``, segments whose ``seg_ok[i]`` is False count as
+    infinitely far). The arithmetic, operation for operation, of the numpy loop it replaces in
+    :func:`curvefair.fairing.points_l1._polyline_distance` (sums over the coordinates as
+    numpy's reductions add them, in order; NaN propagating as in ``np.minimum``)."""
+    m, dim = x.shape
+    hi = poly.shape[0] - 2
+    d = np.empty(dim)
+    for r in range(m):
+        b = np.inf
+        for col in range(idx.shape[1]):
+            for off in (-1, 0):
+                i0 = idx[r, col] + off
+                if i0 < 0:
+                    i0 = 0
+                elif i0 > hi:
+                    i0 = hi
+                for k in range(dim):
+                    d[k] = poly[i0 + 1, k] - poly[i0, k]
+                # numpy's reduction over a short axis adds the coordinates in order
+                dd = d[0] * d[0]
+                for k in range(1, dim):
+                    dd += d[k] * d[k]
+                if dd < 1e-300:
+                    dd = 1e-300
+                num = (x[r, 0] - poly[i0, 0]) * d[0]
+                for k in range(1, dim):
+                    num += (x[r, k] - poly[i0, k]) * d[k]
+                s = num / dd
+                if s < 0.0:
+                    s = 0.0
+                elif s > 1.0:
+                    s = 1.0
+                ss = 0.0
+                for k in range(dim):
+                    e = (x[r, k] - poly[i0, k]) - s * d[k]
+                    if k == 0:
+                        ss = e * e
+                    else:
+                        ss += e * e
+                dist = np.sqrt(ss)
+                if use_ok and not seg_ok[i0]:
+                    dist = np.inf
+                if np.isnan(b) or np.isnan(dist):
+                    b = np.nan
+                elif dist < b:
+                    b = dist
+        best[r] = b
+
+
+# ------------------------------------------------------------------------------------------
+# the closed-curve interior point (:func:`curvefair.fairing.points_l1._tube_qp_cyclic`): its
+# sparse products, with scipy's summation orders (bit for bit the scipy.sparse results)
+# ------------------------------------------------------------------------------------------
+@njit(cache=True)
+def csr_matvecs(indptr, indices, data, X, out):
+    """``out = C @ X`` for ``C`` in CSR arrays: each row's stored entries added in their stored
+    order onto 0.0, as scipy's ``csr_matvecs`` (``X`` and ``out`` 2-D)."""
+    nv = X.shape[1]
+    for i in range(indptr.shape[0] - 1):
+        for k in range(nv):
+            out[i, k] = 0.0
+        for jj in range(indptr[i], indptr[i + 1]):
+            j = indices[jj]
+            a = data[jj]
+            for k in range(nv):
+                out[i, k] += a * X[j, k]
+
+
+@njit(cache=True)
+def csr_t_matvecs(indptr, indices, data, Z, out):
+    """``out = C.T @ Z`` for ``C`` in CSR arrays, as scipy computes it (``C.T`` is CSC on the
+    same arrays, ``csc_matvecs``): rows of ``C`` in order, each entry added onto 0.0."""
+    nv = Z.shape[1]
+    out[:, :] = 0.0
+    for j in range(indptr.shape[0] - 1):
+        for ii in range(indptr[j], indptr[j + 1]):
+            i = indices[ii]
+            a = data[ii]
+            for k in range(nv):
+                out[i, k] += a * Z[j, k]
+
+
+@njit(cache=True)
+def cyclic_newton_band(cp, ci, cx, B, kp, ki, kx, pos, dim):
+    """The lower band, in the order ``pos`` (``pos[j]``: position of unknown block ``j``), of
+    ``M = Ks + CI^T blockdiag(B) CI`` with ``CI = C (x) I_dim``: ``(band, kd)``, ``band[o, c] =
+    M[r, c]`` (permuted indices, ``o = r - c``), ``kd`` the largest ``o`` of a non-zero entry.
+
+    The values are those of ``(Pm @ (Ks + CI.T @ Bd @ CI) @ Pm.T)`` in scipy.sparse, bit for
+    bit: ``CI.T @ Bd`` has one product per entry, ``X[(p, a), (k, b)] = B[k, a, b] C[k, p]``
+    (entries that are exactly 0 dropped); ``X @ CI`` adds, onto 0.0 and over the constraint
+    rows ``k`` in ascending order, ``C[k, q] X[(p, a), (k, b)]``; then one addition of ``Ks``
+    (``C``: ``cp, ci, cx``; ``Ks``: ``kp, ki, kx``, CSR arrays)."""
+    N = pos.shape[0]
+    n = N * dim
+    m = cp.shape[0] - 1
+    kdmax = 0
+    for k in range(m):
+        for jj in range(cp[k], cp[k + 1]):
+            for ll in range(cp[k], cp[k + 1]):
+                d = abs(pos[ci[jj]] - pos[ci[ll]])
+                if d > kdmax:
+                    kdmax = d
+    kdmax = kdmax * dim + dim - 1
+    for r in range(n):
+        for jj in range(kp[r], kp[r + 1]):
+            c = ki[jj]
+            d = abs((pos[r // dim] * dim + r % dim) - (pos[c // dim] * dim + c % dim))
+            if d > kdmax:
+                kdmax = d
+    band = np.zeros((kdmax + 1, n))
+    for k in range(m):
+        for jj in range(cp[k], cp[k + 1]):
+            p = ci[jj]
+            cpv = cx[jj]
+            for ll in range(cp[k], cp[k + 1]):
+                q = ci[ll]
+                cqv = cx[ll]
+                for a in range(dim):
+                    rr = pos[p] * dim + a
+                    for b in range(dim):
+                        cc = pos[q] * dim + b
+                        if rr < cc:
+                            continue
+                        xv = B[k, a, b] * cpv
+                        if xv != 0.0:
+                            band[rr - cc, cc] += cqv * xv
+    for r in range(n):
+        rr = pos[r // dim] * dim + r % dim
+        for jj in range(kp[r], kp[r + 1]):
+            c = ki[jj]
+            cc = pos[c // dim] * dim + c % dim
+            if rr >= cc:
+                band[rr - cc, cc] = kx[jj] + band[rr - cc, cc]
+    kd = 0
+    for o in range(kdmax, 0, -1):
+        nz = False
+        for c in range(n - o):
+            if band[o, c] != 0.0:
+                nz = True
+                break
+        if nz:
+            kd = o
+            break
+    return band, kd
+
+
+@njit(cache=True)
+def csr_matmat(n_row, n_col, Ap, Aj, Ax, Bp, Bj, Bx):
+    """``C = A @ B`` in CSR arrays exactly as scipy.sparse computes it (``csr_matmat`` of its
+    sparsetools): row by row, products added onto 0.0 in the order of ``A``'s and then
+    ``B``'s stored entries; each row's columns stored in reverse order of first touch; exact
+    zeros dropped. Returns ``(indptr, indices, data)`` (int32 indices: the small operators of
+    :func:`curvefair.fairing.points_l1.natural_operators`)."""
+    nxt = np.full(n_col, -1, dtype=np.int64)
+    sums = np.zeros(n_col)
+    # an upper bound of the entries: the structural count (scipy's csr_matmat_maxnnz)
+    mask = np.full(n_col, -1, dtype=np.int64)
+    cap = 0
+    for i in range(n_row):
+        for jj in range(Ap[i], Ap[i + 1]):
+            j = Aj[jj]
+            for kk in range(Bp[j], Bp[j + 1]):
+                k = Bj[kk]
+                if mask[k] != i:
+                    mask[k] = i
+                    cap += 1
+    Cp = np.empty(n_row + 1, dtype=np.int32)
+    Cj = np.empty(cap, dtype=np.int32)
+    Cx = np.empty(cap)
+    nnz = 0
+    Cp[0] = 0
+    for i in range(n_row):
+        head = -2
+        length = 0
+        for jj in range(Ap[i], Ap[i + 1]):
+            j = Aj[jj]
+            v = Ax[jj]
+            for kk in range(Bp[j], Bp[j + 1]):
+                k = Bj[kk]
+                sums[k] += v * Bx[kk]
+                if nxt[k] == -1:
+                    nxt[k] = head
+                    head = k
+                    length += 1
+        for _ in range(length):
+            if sums[head] != 0:
+                Cj[nnz] = head
+                Cx[nnz] = sums[head]
+                nnz += 1
+            temp = head
+            head = nxt[head]
+            nxt[temp] = -1
+            sums[temp] = 0.0
+        Cp[i + 1] = nnz
+    return Cp, Cj[:nnz].copy(), Cx[:nnz].copy()

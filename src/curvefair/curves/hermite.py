@@ -5,7 +5,7 @@ Indices are 0-based here; the papers number points from 1 (paper's ``P_k`` is ou
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -40,12 +40,16 @@ class HermiteSpline(PiecewiseCurve):
     _deriv_names: tuple[str, ...] = ()
 
     def _init(self, points: ArrayLike, derivs: list[ArrayLike], params: ArrayLike,
-              closed: bool) -> None:
-        pts = as_points(points, "points", min_points=2)
+              closed: bool, _valid: tuple[bool, bool] = (False, False)) -> None:
+        # ``_valid`` (internal): ``points`` is already a float64 array that as_points(...,
+        # min_points=2) accepted, and ``params`` one that as_params accepted, both fresh
+        # copies nobody else writes (interpolate_cubic's own): not validated again
+        pts = (cast(FloatArray, points) if _valid[0]
+               else as_points(points, "points", min_points=2))
         n, dim = pts.shape
         ders = [as_vectors(d, (n, dim), name)
                 for d, name in zip(derivs, self._deriv_names, strict=True)]
-        t = as_params(params, n, "params")
+        t = cast(FloatArray, params) if _valid[1] else as_params(params, n, "params")
         closed = bool(closed)
         if closed:
             if n < 3:

@@ -18,7 +18,7 @@ from .._typing import ArrayLike, FloatArray
 from .._validate import as_points, as_vectors, choice, magnitude
 from ..errors import InputError
 from .hermite import CubicHermite, QuinticHermite
-from .parameterize import parameterize
+from .parameterize import _parameterize_valid
 
 __all__ = ["interpolate_cubic", "interpolate_quintic", "BC_NAMES"]
 
@@ -49,16 +49,16 @@ def _prepare(points: ArrayLike, param: Any, bc: Any, min_points: int
         if pts.shape[0] < 4:
             raise InputError("a periodic (closed) curve needs at least 3 distinct points")
         if isinstance(param, str):
-            t = parameterize(pts, param)
+            t = _parameterize_valid(pts, param)
         else:
             t = np.asarray(param, dtype=float)
             if t.shape == (pts.shape[0] - 1,):
                 raise InputError(
                     "param for a closed curve needs one value per point plus one for the closing "
                     f"point ({pts.shape[0]} values)")
-            t = parameterize(pts, t)
+            t = _parameterize_valid(pts, t)
     else:
-        t = parameterize(pts, param)
+        t = _parameterize_valid(pts, param)
     return pts, t, periodic
 
 
@@ -189,7 +189,10 @@ def interpolate_cubic(points: ArrayLike, param: str | ArrayLike = "chord", bc: A
             raise InputError("a not-a-knot end needs at least 4 points unless both ends are "
                              "not-a-knot")
         tangents = cubic_slopes(t, pts, scipy_bc)
-    out = CubicHermite(pts, tangents, t, closed=periodic)
+    # pts and t are _prepare's own validated arrays (given parameters were validated by
+    # parameterize; computed ones, e.g. chord lengths, are checked by the constructor)
+    out = CubicHermite.__new__(CubicHermite)
+    out._init(pts, [tangents], t, periodic, _valid=(True, not isinstance(param, str)))
     if isinstance(param, str) and param == "chord" and isinstance(bc, str) \
             and bc in ("natural", "periodic"):
         # what a point file is read as: fair()'s guard need not rebuild it to recognise it

@@ -34,7 +34,11 @@ def parameterize(points: ArrayLike, param: str | ArrayLike = "chord") -> FloatAr
     >>> parameterize([[0, 0], [3, 4], [3, 5]], "chord").tolist()
     [0.0, 5.0, 6.0]
     """
-    pts = as_points(points, "points", min_points=2)
+    return _parameterize_valid(as_points(points, "points", min_points=2), param)
+
+
+def _parameterize_valid(pts: FloatArray, param: str | ArrayLike) -> FloatArray:
+    """:func:`parameterize` of points that ``as_points(..., min_points=2)`` accepted."""
     n = pts.shape[0]
     if not isinstance(param, str):
         return as_params(param, n, "param")

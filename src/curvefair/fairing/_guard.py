@@ -22,8 +22,9 @@ worse, and a fraction of the move is kept only if neither curve adds any.
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Callable
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -75,6 +76,32 @@ def rebuilt_curve(curve: CubicHermite) -> CubicHermite | None:
                                  "periodic" if curve.closed else "natural")
     except InputError:
         return None
+
+
+#: the analysis blocks of the curves rebuilt from cubic Hermite curves' points, by the curve
+#: (its data are read-only; small dicts, no curve kept): points-l1 judges its result's rebuilt
+#: curve and fair()'s guard judges it again
+_REBUILT_ANALYSIS: weakref.WeakKeyDictionary[Any, Any] = weakref.WeakKeyDictionary()
+_NONE = object()
+
+
+def rebuilt_analysis(curve: PiecewiseCurve,
+                     analysis: Callable[[PiecewiseCurve], dict[str, Any]],
+                     rebuilt: CubicHermite | None = None) -> dict[str, Any] | None:
+    """``analysis(rebuilt_curve(curve))`` (None if the points make no curve), made once per
+    cubic Hermite curve object (a fresh dict each time). ``rebuilt``: that curve when the
+    caller already made it (``interpolate_cubic`` of the same points, ``"chord"``, natural or
+    periodic)."""
+    memo = type(curve) is CubicHermite
+    if memo:
+        got = _REBUILT_ANALYSIS.get(curve)
+        if got is not None:
+            return None if got is _NONE else dict(got)
+    rc = rebuilt if rebuilt is not None else rebuilt_curve(cast(CubicHermite, curve))
+    out = None if rc is None else analysis(rc)
+    if memo:
+        _REBUILT_ANALYSIS[curve] = _NONE if out is None else dict(out)
+    return out
 
 
 def _counts(a: dict[str, Any]) -> dict[str, int]:

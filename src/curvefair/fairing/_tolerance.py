@@ -29,6 +29,7 @@ spline interpolant only up to the pull-back (a few ulp of the coordinates).
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 from typing import Any
 
@@ -179,6 +180,13 @@ def _against_zero(pp: PiecewisePolynomial, closed: bool) -> Any:
     return deviation(_PowerForm(pp, closed), _PowerForm(zero, closed))
 
 
+#: :func:`difference_deviation` of two cubic Hermite curves (their data are read-only), by
+#: the second curve, with the first: points-l1 certifies each attempt's curve and then hands
+#: the last one to :func:`enforce_tolerance`, which certifies the same pair again
+_DEVIATION_MEMO: weakref.WeakKeyDictionary[Any, tuple[Any, tuple[float, float, float]]] = \
+    weakref.WeakKeyDictionary()
+
+
 def difference_deviation(a: PiecewiseCurve, b: PiecewiseCurve,
                          form: PiecewisePolynomial | None = None) -> tuple[float, float, float]:
     """``(max_distance, upper_bound, param)`` of ``max_t |a(t) - b(t)|``.
@@ -186,8 +194,35 @@ def difference_deviation(a: PiecewiseCurve, b: PiecewiseCurve,
     On the difference curve when ``a`` and ``b`` share type, knots / parameters and data
     shapes (exactly linear, no rounding of the coordinates' offset), else
     :func:`curvefair.deviation` of the two curves. ``form``: the difference curve's power
-    form when the caller has it (:func:`prime_power_forms`).
+    form when the caller has it (:func:`prime_power_forms`). The figures of a pair of
+    :class:`CubicHermite` curves are computed once per pair of objects.
     """
+    memo = form is None and type(a) is CubicHermite and type(b) is CubicHermite
+    if memo:
+        got = _DEVIATION_MEMO.get(b)
+        if got is not None and _same_data(got[0](), a):
+            return got[1]
+    out = _difference_deviation(a, b, form)
+    if memo:
+        _DEVIATION_MEMO[b] = (weakref.ref(a), out)
+    return out
+
+
+def _same_data(x: Any, y: Any) -> bool:
+    """Whether ``x`` is ``y`` or a cubic Hermite curve with bit for bit the same data (then
+    every figure of the two is the same: fair() certifies the method's result against the
+    input curve, points-l1 against its own equal copy of it)."""
+    if x is y:
+        return True
+    if type(x) is not CubicHermite or x.closed != y.closed:
+        return False
+    return all(p.shape == q.shape and p.tobytes() == q.tobytes()
+               for p, q in ((x.params, y.params), (x.points, y.points),
+                            (x.tangents, y.tangents)))
+
+
+def _difference_deviation(a: PiecewiseCurve, b: PiecewiseCurve,
+                          form: PiecewisePolynomial | None) -> tuple[float, float, float]:
     from ..analysis import deviation
 
     if form is not None:

@@ -13,6 +13,7 @@ import functools
 import inspect
 import math
 import time
+import weakref
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, cast
@@ -393,9 +394,29 @@ ANALYSIS_FIGURES = ("energy", "energy3", "max_jump", "max_top_jump", "sapidis_su
                     "dkds_energy", "inflections", "extrema")
 
 
+#: the analysis blocks of cubic Hermite curves already analysed, by curve (their data are
+#: read-only): one fair() call on point data asks for the same curve's figures several times
+#: (the input before and in the method's back-off; the result in the method, after it and in
+#: the guard; the rebuilt curves of the method's choice and of the guard)
+_ANALYSIS_MEMO: weakref.WeakKeyDictionary[Any, dict[str, Any]] = weakref.WeakKeyDictionary()
+
+
 def analysis_block(curve: PiecewiseCurve) -> dict[str, Any]:
     """The report's figures of one curve (:func:`curvefair.analyze`): energies, largest jumps,
-    Sapidis sum, ``int (dkappa/ds)^2 ds``, inflection and curvature-extremum counts."""
+    Sapidis sum, ``int (dkappa/ds)^2 ds``, inflection and curvature-extremum counts (a fresh
+    dict; a :class:`CubicHermite`'s are computed once per curve object)."""
+    memo = type(curve) is CubicHermite
+    if memo:
+        got = _ANALYSIS_MEMO.get(curve)
+        if got is not None:
+            return dict(got)
+    block = _analysis_block_of(curve)
+    if memo:
+        _ANALYSIS_MEMO[curve] = dict(block)
+    return block
+
+
+def _analysis_block_of(curve: PiecewiseCurve) -> dict[str, Any]:
     from ..analysis import analyze
 
     a = analyze(curve)
@@ -639,7 +660,7 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
     primed = prime_power_forms(curve, new)
     after = analysis_block(new)
     guard_info: dict[str, Any] = {"kept": "output"}
-    from ._guard import _adds, is_chord_interpolant, rebuilt_curve
+    from ._guard import _adds, is_chord_interpolant, rebuilt_analysis
 
     worse = bool(_adds(after, before))
     rebuilt = rb_after = None
@@ -650,8 +671,7 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
                 and is_chord_interpolant(curve)):
             # point data: also judge the curve a reader rebuilds from the written points
             def rebuilt(c: PiecewiseCurve) -> dict[str, Any] | None:
-                r = rebuilt_curve(cast(CubicHermite, c))
-                return None if r is None else analysis_block(r)
+                return rebuilt_analysis(c, analysis_block)
 
             rb_after = rebuilt(new)
             worse = worse or rb_after is None or bool(_adds(rb_after, before))

@@ -91,6 +91,7 @@ points of ``benchmarks/bench_points_l1.py``), far beyond any equal-parameter tol
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Iterable
 from dataclasses import dataclass, field, replace
 from typing import Any, cast
@@ -107,6 +108,7 @@ from ..curves.interpolate import interpolate_cubic
 from ..curves.parameterize import parameterize
 from ..errors import InputError
 from ._guard import is_chord_interpolant as _is_natural_chord_interpolant
+from ._guard import rebuilt_analysis
 from .problem import FairingHistory, FairingProblem, Outcome
 from .stop import StopReason
 
@@ -138,6 +140,8 @@ class PointsL1Result:
     points: np.ndarray
     curve: CubicHermite
     report: dict[str, Any] = field(default_factory=dict)
+    #: internal: the curve rebuilt from ``points`` when points_l1 made it (else None)
+    _rebuilt: CubicHermite | None = field(default=None, repr=False, compare=False)
 
 
 # ------------------------------------------------------------------------------------------
@@ -173,7 +177,62 @@ class NaturalOperators:
 
 
 def natural_operators(u: ArrayLike) -> NaturalOperators:
-    """The operators of :class:`NaturalOperators` for parameters ``u`` (N >= 3, increasing)."""
+    """The operators of :class:`NaturalOperators` for parameters ``u`` (N >= 3, increasing).
+
+    The factors (end conditions, derivative differences) are made as CSR arrays directly and
+    multiplied by :func:`curvefair._kernels.points.csr_matmat`, scipy's own product (the same
+    sums in the same order, the same stored order): bitwise the matrices of
+    :func:`_natural_operators_sparse`, without a dozen scipy.sparse constructions."""
+    from .._kernels import points as _pk
+
+    u = np.asarray(u, dtype=float)
+    N = u.shape[0]
+    n = N - 1
+    t = np.r_[[u[0]] * 4, u[1:-1], [u[-1]] * 4]
+    h = np.diff(u)
+    r0 = h[0] / (h[0] + h[1])
+    r1 = h[-1] / (h[-1] + h[-2])
+    i32 = np.int32
+    # E ((N + 2) x N), canonical CSR: row 0 (1 + r0, -r0), rows 1 .. N the identity, row N + 1
+    # (-r1 at N - 2, 1 + r1 at N - 1)
+    Ep = np.r_[0, 2 + np.arange(N + 1), N + 4].astype(i32)
+    Ej = np.r_[0, 1, np.arange(N), N - 2, N - 1].astype(i32)
+    Ex = np.r_[1.0 + r0, -r0, np.ones(N), -r1, 1.0 + r1]
+    E = sp.csr_matrix((Ex, Ej, Ep), shape=(N + 2, N))
+    Bd = BSpline.design_matrix(u, t, 3).tocsr()  # (N, N + 2)
+    Ap, Aj, Ax = _pk.csr_matmat(N, N, Bd.indptr, Bd.indices, Bd.data, Ep, Ej, Ex)
+    A = type(Bd)((Ax, Aj, Ap), shape=(N, N))  # Bd @ E is of Bd's class
+
+    def diff(ncoef: int, k: int, shift: int) -> tuple[np.ndarray, np.ndarray, FloatArray]:
+        # the matrix of _diff_op, canonical CSR: row j (-f_j at j, f_j at j + 1); k = 0: the
+        # plain first differences (-1, 1)
+        j = np.arange(ncoef - 1)
+        f = k / (t[j + k + 1 + shift] - t[j + 1 + shift]) if k else np.ones(ncoef - 1)
+        p = (2 * np.arange(ncoef)).astype(i32)
+        c = np.empty(2 * (ncoef - 1), dtype=i32)
+        c[0::2] = j
+        c[1::2] = j + 1
+        x = np.empty(2 * (ncoef - 1))
+        x[0::2] = -f
+        x[1::2] = f
+        return p, c, x
+
+    D1 = diff(N + 2, 3, 0)
+    D2 = diff(N + 1, 2, 1)
+    D3 = diff(N, 1, 2)
+    P32 = _pk.csr_matmat(n, N + 1, *D3, *D2)
+    P321 = _pk.csr_matmat(n, N + 2, *P32, *D1)
+    Gp, Gj, Gx = _pk.csr_matmat(n, N, *P321, Ep, Ej, Ex)
+    G = sp.csr_matrix((Gx, Gj, Gp), shape=(n, N))  # (n, N): S''' on span k
+    Jp, Jj, Jx = _pk.csr_matmat(n - 1, N, *diff(n, 0, 0), Gp, Gj, Gx)
+    Jm = sp.csr_matrix((Jx, Jj, Jp), shape=(n - 1, N))
+    A.eliminate_zeros()
+    return NaturalOperators(u, t, A, G, Jm, E)
+
+
+def _natural_operators_sparse(u: ArrayLike) -> NaturalOperators:
+    """:func:`natural_operators` built with scipy.sparse products (the reference its compiled
+    products are tested against)."""
     u = np.asarray(u, dtype=float)
     N = u.shape[0]
     n = N - 1
@@ -369,6 +428,8 @@ def _tube_qp_cyclic(K: sp.csr_matrix, C: sp.csr_matrix, x0: FloatArray, pts: Flo
     ``O(n)`` per step."""
     from scipy.linalg import cho_solve_banded, cholesky_banded
 
+    from .._kernels import points as _pk
+
     N, dim = x0.shape
     m = pts.shape[0]
     n = N * dim
@@ -379,18 +440,38 @@ def _tube_qp_cyclic(K: sp.csr_matrix, C: sp.csr_matrix, x0: FloatArray, pts: Flo
         return x, np.zeros(m), 0, "zero_energy"
     Ks = (K * (2.0 / E0)).tocsr()
     Cc = sp.csr_matrix(C)
-    CI = sp.kron(Cc, sp.identity(dim), format="csr")
-    pos = (_zigzag(N)[:, None] * dim + np.arange(dim)[None, :]).reshape(-1)
-    Pm = sp.csr_matrix((np.ones(n), (pos, np.arange(n))), shape=(n, n))
+    # the sparse products of each step run compiled on the CSR arrays, in scipy's summation
+    # orders (:func:`curvefair._kernels.points.cyclic_newton_band`, ``csr_matvecs``,
+    # ``csr_t_matvecs``): bitwise the scipy.sparse figures, without a matrix built per step
+    cp, ci, cx = (np.asarray(Cc.indptr, dtype=np.int64), np.asarray(Cc.indices, dtype=np.int64),
+                  np.asarray(Cc.data, dtype=np.float64))
+    kp, ki, kx = (np.asarray(Ks.indptr, dtype=np.int64), np.asarray(Ks.indices, dtype=np.int64),
+                  np.asarray(Ks.data, dtype=np.float64))
+    zpos = _zigzag(N)
+    # Pm @ y (Pm the permutation matrix of the zigzag order) is y[i] at pos_full[i], added
+    # onto 0.0 as scipy's matvec does
+    pos_full = (zpos[:, None] * dim + np.arange(dim)[None, :]).reshape(-1)
     t2 = rad * rad
     lam = np.ones(m) if lam0 is None else np.array(lam0, dtype=np.float64)
 
+    def c_mul(y: FloatArray) -> FloatArray:
+        out = np.empty((m, dim))
+        _pk.csr_matvecs(cp, ci, cx, np.ascontiguousarray(y), out)
+        return out
+
+    def ct_mul(z: FloatArray) -> FloatArray:
+        out = np.empty((N, dim))
+        _pk.csr_t_matvecs(cp, ci, cx, np.ascontiguousarray(z), out)
+        return out
+
     def resid(x: FloatArray, lam: FloatArray, tinv: float
               ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-        v = Cc @ x - pts
+        v = c_mul(x) - pts
         fi = 0.5 * (np.sum(v * v, axis=1) / t2 - 1.0)
         rc = -lam * fi - tinv
-        rd = (Ks @ x.reshape(-1)).reshape(N, dim) + Cc.T @ ((lam / t2)[:, None] * v)
+        kxv = np.empty((n, 1))
+        _pk.csr_matvecs(kp, ki, kx, np.ascontiguousarray(x).reshape(n, 1), kxv)
+        rd = kxv.reshape(N, dim) + ct_mul((lam / t2)[:, None] * v)
         return v, fi, rd, rc
 
     v, fi, rd, rc = resid(x, lam, 0.0)
@@ -408,24 +489,23 @@ def _tube_qp_cyclic(K: sp.csr_matrix, C: sp.csr_matrix, x0: FloatArray, pts: Flo
         a = v / t2[:, None]
         blocks = ww[:, None, None] * a[:, :, None] * a[:, None, :] \
             + (lam / t2)[:, None, None] * np.eye(dim)[None]
-        M = Ks + CI.T @ _block_diag(blocks) @ CI
-        Mp = (Pm @ M @ Pm.T).tocoo()
-        low = Mp.row >= Mp.col
-        kd = int(np.max(Mp.row[low] - Mp.col[low]))
-        ab = np.zeros((kd + 1, n))
-        np.add.at(ab, (Mp.row[low] - Mp.col[low], Mp.col[low]), Mp.data[low])
-        rhs = -rd - Cc.T @ ((rc / fi)[:, None] * a)
+        band, kd = _pk.cyclic_newton_band(cp, ci, cx, np.ascontiguousarray(blocks), kp, ki, kx,
+                                          zpos, dim)
+        ab = band[:kd + 1]
+        rhs = -rd - ct_mul((rc / fi)[:, None] * a)
         try:
             cb = cholesky_banded(ab, lower=True)
         except np.linalg.LinAlgError:
             code = 2
             break
-        dxp = cho_solve_banded((cb, True), Pm @ rhs.reshape(-1))
-        dx = (Pm.T @ dxp).reshape(N, dim)
+        yp = np.empty(n)
+        yp[pos_full] = rhs.reshape(-1)
+        dxp = cho_solve_banded((cb, True), yp + 0.0)
+        dx = (dxp[pos_full] + 0.0).reshape(N, dim)
         if not np.all(np.isfinite(dx)):
             code = 2
             break
-        Cdx = Cc @ dx
+        Cdx = c_mul(dx)
         adx = np.sum(a * Cdx, axis=1)
         dlam = (rc - lam * adx) / fi
         neg = dlam < 0
@@ -468,7 +548,16 @@ def _tube_qp_cyclic(K: sp.csr_matrix, C: sp.csr_matrix, x0: FloatArray, pts: Flo
 def _jump_norms(ops: NaturalOperators, x: FloatArray, P: FloatArray | None = None
                 ) -> FloatArray:
     """``|J_k|``, or ``|P_k J_k|`` with the per-jump projections ``P`` (shape (k, dim, dim))."""
-    J = ops.Jm @ x
+    # ``ops.Jm @ x`` compiled on its CSR arrays as they are now (scipy's summation order: the
+    # same values; the arrays are read at every call, since ``_rows4`` puts ``Jm`` in
+    # canonical order in place after the first one)
+    from .._kernels import points as _pk
+
+    Jm = ops.Jm
+    xa = np.ascontiguousarray(x, dtype=np.float64)
+    J = np.empty((Jm.shape[0], xa.shape[1]))
+    _pk.csr_matvecs(np.asarray(Jm.indptr, dtype=np.int64), np.asarray(Jm.indices, dtype=np.int64),
+                    np.asarray(Jm.data, dtype=np.float64), xa, J)
     if P is not None:
         J = np.einsum("kab,kb->ka", P, J)
     return np.sqrt(np.sum(J * J, axis=1))
@@ -554,7 +643,8 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
               tau: float = 1.0, max_steps: int = 80, curve_tol: bool = True,
               samples: int = 3, max_attempts: int = 4, warm: float = 0.9,
               round_gap: float = 1e-6, warm_lam: bool = True,
-              scale: str = "none", closed: bool = False) -> PointsL1Result:
+              scale: str = "none", closed: bool = False,
+              _shared: dict[str, Any] | None = None) -> PointsL1Result:
     """The natural cubic through moved points with the sparsest third-derivative jumps.
 
     Parameters
@@ -597,6 +687,14 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
         ``points`` are the ``N`` distinct points of a closed list (no repeated closing point;
         ``params`` then has ``N + 1`` values): the periodic cubic (:func:`periodic_operators`).
 
+    _shared : dict, optional
+        Internal: a dict kept by the caller across calls on the same ``points``, ``params``,
+        ``hold``, ``closed``, ``samples``, ``beta`` and ``curve_tol`` (only ``tol`` and the
+        reweighting options may differ), e.g. the formulations and tolerance back-offs of
+        :func:`solve`. The work that does not depend on ``tol`` (validation, parameters,
+        operators, constraint rows, the input's curves) is done by the first call and reused
+        by the others: the same arrays, so the same results bit for bit.
+
     Returns
     -------
     PointsL1Result
@@ -613,36 +711,43 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
     """
     from ._tolerance import _pull_back, difference_deviation, enforce_tolerance
 
-    pts = as_points(points, "points", min_points=4)
+    sh: dict[str, Any] = {} if _shared is None else _shared
+    first = "p_in" not in sh
+    if first:
+        sh["p_in"] = as_points(points, "points", min_points=4)
     tolv = as_positive(tol, "tol")
     assert tolv is not None
+    pts = sh["p_in"]
     N, dim = pts.shape
     bc = "periodic" if closed else "natural"
-    # a closed list: the N distinct points, parameters N + 1 (the closing point's last)
-    u_in = parameterize(np.vstack([pts, pts[:1]]) if closed else pts,
-                        "chord" if params is None else params)
 
     def spline(q: FloatArray, u: Any) -> CubicHermite:
         return interpolate_cubic(np.vstack([q, q[:1]]) if closed else q, u, bc)
 
-    held = np.zeros(N, dtype=bool)
-    for i in np.asarray(list(cast(Iterable[int], hold)), dtype=int).reshape(-1):
-        if not -N <= i < N:
-            raise InputError(f"hold index {i} out of range for {N} points")
-        held[i] = True
+    if first:
+        # a closed list: the N distinct points, parameters N + 1 (the closing point's last)
+        sh["u_in"] = parameterize(np.vstack([pts, pts[:1]]) if closed else pts,
+                                  "chord" if params is None else params)
+        held = np.zeros(N, dtype=bool)
+        for i in np.asarray(list(cast(Iterable[int], hold)), dtype=int).reshape(-1):
+            if not -N <= i < N:
+                raise InputError(f"hold index {i} out of range for {N} points")
+            held[i] = True
+        sh["held"] = held
+        sh["ref_in"] = spline(pts, sh["u_in"])
+        # solved on centred, unit-size data (conditioning; a tol of 1e300 or 1e-300 must not
+        # overflow): a radius beyond 1e6 sizes binds nothing, one below 1e-12 moves nothing
+        sh["centre"] = 0.5 * (pts.max(axis=0) + pts.min(axis=0))
+        sh["size"] = float(np.ptp(pts, axis=0).max())
+    u_in, held, ref_in = sh["u_in"], sh["held"], sh["ref_in"]
+    centre, size = sh["centre"], sh["size"]
     p_in = pts
-    ref_in = spline(p_in, u_in)
-    # solved on centred, unit-size data (conditioning; a tol of 1e300 or 1e-300 must not
-    # overflow): a radius beyond 1e6 sizes binds nothing, one below 1e-12 moves nothing
-    centre = 0.5 * (pts.max(axis=0) + pts.min(axis=0))
-    size = float(np.ptp(pts, axis=0).max())
     if not size > 0 or tolv < 1e-12 * size:
         q0 = np.array(p_in)
         q0.setflags(write=False)
         return PointsL1Result(q0, ref_in, {"rounds": 0, "newton_steps": 0,
                                            "stop_reason": "tolerance", "n_active": 0,
                                            "attempts": 0, "pulled_back": 0, "scale": 1.0})
-    pts = (pts - centre) / size
     tol_out = tolv
     # the objective falls with the curve's scale: a curve that fits in the tube would shrink
     # towards a point (an 8-point circle 3.5 across at tol 5 came out 4e-12 across); the
@@ -650,11 +755,6 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
     # 2 SHRINK_CAP of the largest (the largest keeps 3/4 of itself)
     capped = tolv / size > SHRINK_CAP
     tolv = min(tolv / size, SHRINK_CAP)
-    margin = min(0.25 * tolv, 1e-9 * tolv + 64.0 * np.finfo(float).eps * float(np.abs(pts).max()))
-    # the parameters, affinely onto the chord length of the unit-size data (conditioning)
-    chord = float(np.sum(np.sqrt(np.sum(np.diff(np.vstack([pts, pts[:1]]) if closed else pts,
-                                                axis=0) ** 2, axis=1))))
-    u = (u_in - u_in[0]) * (chord / (u_in[-1] - u_in[0]))
     ns = max(0, int(samples))
 
     def setup(u: FloatArray) -> tuple[NaturalOperators, FloatArray, Any, FloatArray, float]:
@@ -662,7 +762,7 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
         constraint rows ``C`` (data points, then ``ns`` samples per span) with their
         centres ``Y``, and the E3 weight ``b``."""
         ops = periodic_operators(u) if closed else natural_operators(u)
-        xp = _solve(ops.A, pts, closed)  # the input's cubic at these parameters
+        xp = _solve(ops.A, pts, closed, ops.cache)  # the input's cubic at these parameters
         if ns:
             fr = np.arange(1, ns + 1) / (ns + 1.0)
             us = (u[:-1, None] + np.diff(u)[:, None] * fr[None, :]).reshape(-1)
@@ -679,25 +779,49 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
         b = beta * jj / e3 if e3 > 0 and jj > 0 else beta
         return ops, xp, C, Y, b
 
-    ops, xp, C, Y, b = setup(u)
-    # open curves: the compiled solver needs the rows of C only (four B-spline values each)
-    # and the energy's band (no sparse matrix kept); closed ones wrap around (numpy solver)
-    rows = None if closed else _rows4(C)
-    rad_s = np.full(C.shape[0] - N, tolv - margin)
+    if "ops" not in sh:
+        pts = (pts - centre) / size
+        sh["pts"] = pts
+        # the parameters, affinely onto the chord length of the unit-size data (conditioning)
+        chord = float(np.sum(np.sqrt(np.sum(np.diff(np.vstack([pts, pts[:1]]) if closed
+                                                    else pts, axis=0) ** 2, axis=1))))
+        u = (u_in - u_in[0]) * (chord / (u_in[-1] - u_in[0]))
+        sh["u"] = u
+        ops, xp, C, Y, b = setup(u)
+        sh["ops"], sh["xp"], sh["Y"], sh["b"] = ops, xp, Y, b
+        sh["n_samples"] = C.shape[0] - N
+        # open curves: the compiled solver needs the rows of C only (four B-spline values
+        # each) and the energy's band (no sparse matrix kept); closed ones wrap around (numpy
+        # solver)
+        if closed:
+            sh["C"] = C
+        else:
+            sh["rows"] = _rows4(C)
+            sh["jrows"], sh["grows"] = _rows4(ops.Jm, 5), _rows4(ops.G)
+        sh["j_before"] = float(_jump_norms(ops, xp).sum())
+        sh["Pn"] = _normal_projections(pts, closed)
+        sh["ref"] = spline(p_in, "chord") if curve_tol else None
+        sh["cost"] = {}
+    pts, u, ops, xp, Y, b = sh["pts"], sh["u"], sh["ops"], sh["xp"], sh["Y"], sh["b"]
+    C = sh.get("C")
+    rows = sh.get("rows")
     if not closed:
-        C = None  # freed: the rows are all the solver needs
-        jrows, grows = _rows4(ops.Jm, 5), _rows4(ops.G)
+        jrows, grows = sh["jrows"], sh["grows"]
+    margin = min(0.25 * tolv, 1e-9 * tolv + 64.0 * np.finfo(float).eps * float(np.abs(pts).max()))
+    rad_s = np.full(sh["n_samples"], tolv - margin)
     rad_p = np.where(held, 1e-4 * tolv, tolv - margin)
-    j_before = float(_jump_norms(ops, xp).sum())
-    Pn = _normal_projections(pts, closed)
+    j_before = sh["j_before"]
+    Pn = sh["Pn"]
     newton = 0
     rounds_done = 0
     attempts = 0
     curve_dev = None
-    ref = spline(p_in, "chord") if curve_tol else None
+    ref = sh["ref"]
     reason = "converged"
     # per-jump cost c_k of the L1 norm sum_k c_k |J_k| (see ``scale``)
-    cost = _jump_costs(scale, u, ops, xp, Pn)
+    if scale not in sh["cost"]:
+        sh["cost"][scale] = _jump_costs(scale, u, ops, xp, Pn)
+    cost = sh["cost"][scale]
     nj = cost.shape[0]
     w = cost * cost
     w *= nj / float(w.sum())
@@ -786,10 +910,11 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
             # factor (strictly inside every shrunk ball)
             shrink = min(shrink, float(pf.min()))
     # equal parameter: certified on the difference curve, every move scaled if needed
+    curve_in = curve
     curve_e, cert = enforce_tolerance(ref_in, curve, tol_out, curve_bound=True)
     curve = cast(CubicHermite, curve_e)
     q_out = np.array(curve.points)[:N]
-    x1 = _solve(ops.A, (q_out - centre) / size, closed)
+    x1 = _solve(ops.A, (q_out - centre) / size, closed, ops.cache)
     dev = np.sqrt(np.sum((q_out - p_in) ** 2, axis=1))
     report = {"rounds": rounds_done, "newton_steps": newton, "stop_reason": reason,
               "n_active": int(np.sum(dev > (1.0 - 1e-6) * tol_out)),
@@ -801,7 +926,11 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
     if capped:
         report["tube_radius"] = SHRINK_CAP * size
     q_out.setflags(write=False)
-    return PointsL1Result(q_out, curve, report)
+    out = PointsL1Result(q_out, curve, report)
+    if curve_e is curve_in and ref is not None:
+        # the last attempt's rebuilt curve is that of the points returned (for :func:`solve`)
+        object.__setattr__(out, "_rebuilt", rebuilt)
+    return out
 
 
 #: the largest tube radius of :func:`points_l1`, as a fraction of the input's largest
@@ -861,6 +990,23 @@ def _polyline_distance(x: FloatArray, poly: FloatArray,
     out (a polyline of several pieces: every vertex is still on a segment of its own piece)."""
     from scipy.spatial import cKDTree
 
+    from .._kernels import points as _pk
+
+    _, idx = cKDTree(poly).query(x, k=2)
+    x = np.ascontiguousarray(x, dtype=np.float64)
+    best = np.empty(x.shape[0])
+    ok = np.ones(1, dtype=bool) if seg_ok is None else np.ascontiguousarray(seg_ok, dtype=bool)
+    _pk.polyline_distance(x, np.ascontiguousarray(poly, dtype=np.float64),
+                          np.ascontiguousarray(idx, dtype=np.int64), ok, seg_ok is not None,
+                          best)
+    return best
+
+
+def _polyline_distance_numpy(x: FloatArray, poly: FloatArray,
+                             seg_ok: np.ndarray | None = None) -> FloatArray:
+    """:func:`_polyline_distance` in numpy (the reference its kernel is tested against)."""
+    from scipy.spatial import cKDTree
+
     _, idx = cKDTree(poly).query(x, k=2)
     best = np.full(x.shape[0], np.inf)
     for col in range(idx.shape[1]):
@@ -875,6 +1021,11 @@ def _polyline_distance(x: FloatArray, poly: FloatArray,
                 dist = np.where(seg_ok[i0], dist, np.inf)
             best = np.minimum(best, dist)
     return best
+
+
+#: :func:`_rebuilt_distance`'s samples of its first curve on every span, by curve (read-only)
+_SAMPLES_MEMO: weakref.WeakKeyDictionary[Any, tuple[int, FloatArray]] = \
+    weakref.WeakKeyDictionary()
 
 
 def _rebuilt_distance(a: CubicHermite, b: CubicHermite, tol: float, dense: int = 32,
@@ -907,23 +1058,34 @@ def _rebuilt_distance(a: CubicHermite, b: CubicHermite, tol: float, dense: int =
         t = (u[spans, None] + np.diff(u)[spans, None] * fr[None, :]).reshape(-1)
         return np.asarray(c(np.clip(t, u[0], u[-1])))
 
+    def samples_a(spans: np.ndarray) -> FloatArray:
+        # ``a`` (points-l1's reference, the input's rebuilt curve) is measured against every
+        # attempt of every solve: its samples of all spans are made once (each sample is
+        # evaluated on its own, so the rows taken are those of ``samples(a, spans)``)
+        got = _SAMPLES_MEMO.get(a)
+        if got is None or got[0] != dense:
+            got = (dense, samples(a, np.arange(ns)).reshape(ns, dense + 1, -1))
+            _SAMPLES_MEMO[a] = got
+        return cast(FloatArray, got[1][spans].reshape(-1, got[1].shape[2]))
+
     # segments of the sampled polyline: inside a span, or between the samples of two
     # consecutive spans (the same point); never across a gap between sampled spans
     inner = np.ones((near.size, dense + 1), dtype=bool)
     inner[:, -1] = np.r_[near[1:] == near[:-1] + 1, False]
     seg_ok = inner.reshape(-1)
-    pa, pb = samples(a, near), samples(b, near)
+    pa, pb = samples_a(near), samples(b, near)
     worst = float(np.max(per[per <= tol])) if np.any(per <= tol) else 0.0
     worst = max(worst, float(_polyline_distance(samples(b, bad), pa, seg_ok).max()),
-                float(_polyline_distance(samples(a, bad), pb, seg_ok).max()))
+                float(_polyline_distance(samples_a(bad), pb, seg_ok).max()))
     return worst
 
 
-def _solve(A: sp.csr_matrix, rhs: FloatArray, closed: bool) -> FloatArray:
+def _solve(A: sp.csr_matrix, rhs: FloatArray, closed: bool,
+           cache: dict[Any, Any] | None = None) -> FloatArray:
     """``A^{-1} rhs``: :func:`_solve_tri`, or for the cyclic tridiagonal ``A`` of a closed
     curve the same banded solve in the order of :func:`_zigzag` (half-bandwidth 4)."""
     if not closed:
-        return _solve_tri(A, rhs)
+        return _solve_tri(A, rhs, cache)
     from scipy.linalg import solve_banded
 
     N = A.shape[0]
@@ -939,16 +1101,23 @@ def _solve(A: sp.csr_matrix, rhs: FloatArray, closed: bool) -> FloatArray:
     return np.asarray(z[pos])
 
 
-def _solve_tri(A: sp.csr_matrix, rhs: FloatArray) -> FloatArray:
-    """``A^{-1} rhs`` for the tridiagonal collocation (LAPACK banded solve)."""
+def _solve_tri(A: sp.csr_matrix, rhs: FloatArray, cache: dict[Any, Any] | None = None
+               ) -> FloatArray:
+    """``A^{-1} rhs`` for the tridiagonal collocation (LAPACK banded solve); ``cache``: a
+    dict kept with ``A`` (:attr:`NaturalOperators.cache`) that holds its band."""
     from scipy.linalg import solve_banded
 
-    Aw = _tridiag(A)
-    N = Aw.shape[0]
-    ab = np.zeros((3, N))
-    ab[0, 1:] = Aw[:-1, 2]
-    ab[1] = Aw[:, 1]
-    ab[2, :-1] = Aw[1:, 0]
+    ab = None if cache is None else cache.get("A_band")
+    if ab is None:
+        Aw = _tridiag(A)
+        N = Aw.shape[0]
+        ab = np.zeros((3, N))
+        ab[0, 1:] = Aw[:-1, 2]
+        ab[1] = Aw[:, 1]
+        ab[2, :-1] = Aw[1:, 0]
+        if cache is not None:  # the operators' cache: made once per matrix
+            ab.setflags(write=False)
+            cache["A_band"] = ab
     return solve_banded((1, 1), ab, rhs)
 
 
@@ -1066,13 +1235,16 @@ def solve(problem: FairingProblem, *, rounds: int | None = None, delta: float = 
         if len(variants) < max(1, int(select)) and sc != scale:
             variants.append({"scale": sc, "rounds": 5})
     chosen = variants[0]
+    # every solve below is on the same points, parameters and held points: the work that does
+    # not depend on the tube's radius is done once (points_l1's ``_shared``)
+    shared: dict[str, Any] = {}
 
     def solve_at(t: float, v: dict[str, Any] | None = None) -> PointsL1Result:
         v = chosen if v is None else v
         return points_l1(p0, t, params=np.asarray(curve.params), hold=sorted(hold),
                          rounds=int(v["rounds"]), delta=delta, max_steps=steps,
                          curve_tol=curve_tol, samples=samples, scale=str(v["scale"]),
-                         closed=closed)
+                         closed=closed, _shared=shared)
 
     res = solve_at(tol)
     total = int(res.report["newton_steps"])
@@ -1082,11 +1254,15 @@ def solve(problem: FairingProblem, *, rounds: int | None = None, delta: float = 
 
     def rebuilt(r: PointsL1Result) -> dict[str, Any]:
         """Analysis of the curve a reader rebuilds from the result's points (chord-length
-        natural or periodic cubic), made once per result."""
+        natural or periodic cubic), made once per result (the curve's points are the result's:
+        :func:`rebuilt_curve` of it, which fair()'s guard asks for again)."""
         if id(r) not in seen:
-            seen[id(r)] = (r, _analysis_block(interpolate_cubic(
-                np.vstack([r.points, r.points[:1]]) if closed else np.array(r.points),
-                "chord", "periodic" if closed else "natural")))
+            a = rebuilt_analysis(r.curve, _analysis_block, r._rebuilt)
+            if a is None:  # coincident points: the error of the interpolation itself
+                a = _analysis_block(interpolate_cubic(
+                    np.vstack([r.points, r.points[:1]]) if closed else np.array(r.points),
+                    "chord", "periodic" if closed else "natural"))
+            seen[id(r)] = (r, a)
         return seen[id(r)][1]
 
     if len(variants) > 1:
