@@ -397,7 +397,8 @@ def _bitwise_same(a, b):
         assert np.array_equal(np.asarray(da[k]), np.asarray(db[k])), k
 
 
-@pytest.mark.parametrize("kind", ["open", "closed", "quintic", "twisted", "gaps"])
+@pytest.mark.parametrize("kind", ["open", "closed", "quintic", "twisted", "gaps",
+                                  "closed_few"])
 def test_sampling_pass_in_ranges_is_bitwise_the_same(monkeypatch, kind):
     """The sampling pass split into ranges on two threads (curvefair._threads) gives bitwise
     the analysis of one pass on one thread: every range boundary is a breakpoint whose jumps
@@ -424,12 +425,16 @@ def test_sampling_pass_in_ranges_is_bitwise_the_same(monkeypatch, kind):
     elif kind == "twisted":
         c = cf.interpolate_cubic(np.c_[np.cos(x), np.sin(x), 0.2 * x]
                                  + 0.01 * rng.normal(size=(n, 3)))
+    elif kind == "closed_few":  # fewer segments than ranges: some ranges are empty
+        a = np.linspace(0, 2 * np.pi, 9, endpoint=False)
+        c = cf.interpolate_cubic(np.vstack([np.c_[np.cos(a), 0.5 * np.sin(a) + 0.1 * a],
+                                            [[1.0, 0.0]]]), "chord", "periodic")
     else:  # near-straight noisy data: many gaps to refine in the sign certificates
         c = cf.interpolate_cubic(np.c_[x, 1e-3 * rng.normal(size=n)])
     monkeypatch.setattr(_threads, "THREADS", 1)
     ref = cf.analyze(c)
     monkeypatch.setattr(_threads, "THREADS", 2)
-    monkeypatch.setattr(_sampling, "PAR_MIN", 8)
+    monkeypatch.setattr(_sampling, "PAR_MIN", 4)
     calls = []
     ranges = _threads.ranges
     monkeypatch.setattr(_threads, "ranges",

@@ -312,7 +312,7 @@ def sample_curve(cw: FloatArray, h: FloatArray, planar: bool, closed: bool,
             if ngap <= gaps.shape[0]:
                 break
             gaps = np.empty((ngap, 3), dtype=np.int64)  # rare: the buffer was too small; redo
-        if a == 0:
+        if a == 0 and b > 0:  # (an empty range 0 .. 0 when there are fewer segments than ranges)
             ksfl[0] = fl[0]
         return nsing, maxk, maxks, box, gaps[:ngap], endv, fl
 
