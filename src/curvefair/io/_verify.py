@@ -553,16 +553,10 @@ def on_disk_report(report: dict[str, Any], original: Any, faired: Any, written: 
             return report
         # the file's numbers are the faired ones rounded to its precision: what is on disk
         # is analysed (a rounding ripple is a curvature extremum like any other)
-        out = dict(report)
-        after = analysis_block(written)
-        out["fair_after"] = {k: report.get(f"{k}_after") for k in after}
-        for k, v in after.items():
-            out[f"{k}_after"] = v
-        out["after_figures"] = ("counted on the curve read back from the written file, whose "
-                                "numbers are the faired ones rounded to the file's precision "
-                                "(fair_after: the faired curve)")
-        return out
-    out = dict(report)
+        return _with_after(report, analysis_block(written),
+                           "counted on the curve read back from the written file, whose "
+                           "numbers are the faired ones rounded to the file's precision "
+                           "(fair_after: the faired curve)")
     rb = (report.get("guard") or {}).get("rebuilt")
     if (isinstance(rb, dict) and all(k in rb for k in ANALYSIS_FIGURES)
             and written.closed == faired.closed
@@ -572,13 +566,20 @@ def on_disk_report(report: dict[str, Any], original: Any, faired: Any, written: 
         after = {k: rb[k] for k in ANALYSIS_FIGURES}
     else:
         after = analysis_block(written)
+    return _with_after(report, after,
+                       "counted on the curve read back from the written file: point data are "
+                       "rebuilt through the written points at their own chord lengths, as a "
+                       "reader does (fair_after: the faired curve on the input's parameters)")
+
+
+def _with_after(report: dict[str, Any], after: dict[str, Any], why: str) -> dict[str, Any]:
+    """A copy of ``report`` whose ``<figure>_after`` are ``after``'s, the faired curve's kept
+    under ``fair_after``, ``why`` under ``after_figures``."""
+    out = dict(report)
     out["fair_after"] = {k: report.get(f"{k}_after") for k in after}
     for k, v in after.items():
         out[f"{k}_after"] = v
-    out["after_figures"] = ("counted on the curve read back from the written file: point data "
-                            "are rebuilt through the written points at their own chord "
-                            "lengths, as a reader does (fair_after: the faired curve on the "
-                            "input's parameters)")
+    out["after_figures"] = why
     return out
 
 
