@@ -391,14 +391,16 @@ class BSplineCurve(PiecewiseCurve):
         if p > POWER_FORM_MAX_DEGREE or 64 * u.size >= s.shape[0]:
             return None
         t = self._knots
-        breaks = np.append(t[s], t[s[-1] + 1])
-        seg = np.clip(np.searchsorted(breaks, u, side="right") - 1, 0, s.shape[0] - 1)
-        rows = np.empty((seg.shape[0], p + 1, self._ctrl.shape[1]))
-        power_form(np.ascontiguousarray(t), p, np.ascontiguousarray(s[seg], dtype=np.int64),
+        # the non-empty span [t_k, t_k+1) holding each u (right-continuous, the last one closed:
+        # the whole form's segment_of on its breaks t[spans]), found in the knots themselves
+        k = np.clip(np.searchsorted(t, u, side="right") - 1, s[0], s[-1])
+        span = s[np.searchsorted(s, k)]
+        rows = np.empty((span.shape[0], p + 1, self._ctrl.shape[1]))
+        power_form(np.ascontiguousarray(t), p, np.ascontiguousarray(span, dtype=np.int64),
                    np.ascontiguousarray(self._ctrl), self._closed, rows)
         if not np.isfinite(rows).all():
             return None
-        return rows, u - breaks[seg]
+        return rows, u - t[span]
 
     def _span_values(self, seg: np.ndarray, s: FloatArray, nu: int) -> FloatArray:
         """``r^(nu)`` on power-form segments ``seg`` at local offsets ``s`` from the basis:

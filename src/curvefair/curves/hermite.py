@@ -86,6 +86,9 @@ class HermiteSpline(PiecewiseCurve):
         """The power form's coefficients of the segments between points ``lo .. hi-1``."""
         raise NotImplementedError
 
+    def _make_piecewise(self) -> PiecewisePolynomial:
+        return PiecewisePolynomial(np.array(self._params), self._rows(0, len(self._params)))
+
     def _partial_form(self, u: FloatArray) -> tuple[FloatArray, FloatArray] | None:
         """The coefficients of the segments holding ``u``, each from its own two points (as
         the whole form computes them), and the local offsets; None for a short curve."""
@@ -180,9 +183,6 @@ class CubicHermite(HermiteSpline):
         """First derivatives ``r'_i``, shape ``(n, dim)`` (read-only)."""
         return self._derivs[0]
 
-    def _make_piecewise(self) -> PiecewisePolynomial:
-        return PiecewisePolynomial(np.array(self._params), self._rows(0, len(self._params)))
-
     def _rows(self, lo: int, hi: int) -> FloatArray:
         return cubic_hermite_coefficients(self._points[lo:hi], self.tangents[lo:hi],
                                           self._params[lo:hi])
@@ -237,9 +237,6 @@ class QuinticHermite(HermiteSpline):
     def tangents(self) -> FloatArray:
         """Alias of :attr:`d1`."""
         return self._derivs[0]
-
-    def _make_piecewise(self) -> PiecewisePolynomial:
-        return PiecewisePolynomial(np.array(self._params), self._rows(0, len(self._params)))
 
     def _rows(self, lo: int, hi: int) -> FloatArray:
         return quintic_hermite_coefficients(self._points[lo:hi], self.d1[lo:hi], self.d2[lo:hi],
