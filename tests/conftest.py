@@ -32,7 +32,9 @@ if _hyp_settings is not None:
     if os.environ.get("CI", "").lower() in ("1", "true", "yes"):
         _hyp_settings.load_profile("ci")
 
-#: test files whose tests exercise the compiled loops (marked ``compiled``)
+#: test files whose tests exercise the compiled loops (marked ``compiled``). Not
+#: ``test_jit_cache.py``: its kernels run in subprocesses whose environment drops every
+#: ``NUMBA_*`` setting, so the second run repeated the first one's tests exactly (56 s of CI)
 COMPILED_FILES = frozenset({
     "test_knot_removal_compiled.py",
     "test_knot_removal.py",
@@ -49,7 +51,6 @@ COMPILED_FILES = frozenset({
     "test_hermite_measures.py",
     "test_analysis_deviation.py",
     "test_bspline_fairing_properties.py",
-    "test_jit_cache.py",
     "test_reproducible.py",
     "test_recorded_cases.py",
 })

@@ -172,3 +172,69 @@ def test_notice_can_be_silenced(tmp_path, name):
     root = _copy_package(tmp_path)
     _, err = _run(root, {"CURVEFAIR_CACHE_DIR": str(tmp_path / "cache"), name: "1"})
     assert "compiling" not in err
+
+
+# ------------------------------------------------------------------------------------------
+# njit(readonly=..., any_layout=...): one machine code whatever the arrays' flags
+# ------------------------------------------------------------------------------------------
+def _kernels():
+    """Two copies of one kernel, with and without the canonical argument types (no cache:
+    each test compiles its own)."""
+    import numpy as np  # noqa: F401  (the kernels' globals)
+
+    from curvefair._jit import njit
+
+    def total(x, w, out):
+        s = 0.0
+        for i in range(x.shape[0]):
+            for j in range(x.shape[1]):
+                s += x[i, j] * w[i]
+        out[0] = s
+        return s
+
+    plain = njit(cache=False)(total)
+    canon = njit(cache=False, readonly=("x", "w"), any_layout=("x",))(total)
+    return plain, canon
+
+
+def test_readonly_and_any_layout_compile_one_signature_for_every_variant():
+    """A kernel fed writable, read-only and strided arrays: compiled three times without the
+    option, once with it, and the same value every time (computed in numpy here)."""
+    import numpy as np
+
+    plain, canon = _kernels()
+    rng = np.random.default_rng(3)
+    x = rng.standard_normal((6, 4))
+    w = rng.standard_normal(6)
+    frozen = x.copy()
+    frozen.flags.writeable = False
+    strided = np.asfortranarray(x)[:, ::2]
+    variants = [(x, w), (frozen, w), (strided, w), (x, w.copy())]
+    for k in (plain, canon):
+        for a, b in variants:
+            out = np.zeros(1)
+            v = k(a, b, out)
+            assert v == out[0]
+            np.testing.assert_allclose(v, float(np.sum(a * b[:, None])), rtol=1e-13)
+    assert len(plain.signatures) == 3
+    assert len(canon.signatures) == 1
+    (sig,) = canon.signatures
+    assert not sig[0].mutable and sig[0].layout == "A" and not sig[1].mutable
+    assert sig[2].mutable  # the output keeps its type
+
+
+def test_readonly_names_must_be_parameters_and_stay_unwritten():
+    import numpy as np
+    from numba.core.errors import TypingError
+
+    from curvefair._jit import njit
+
+    def write(x):
+        x[0] = 1.0
+        return x[0]
+
+    with pytest.raises(TypeError, match="no parameter named"):
+        njit(cache=False, readonly=("y",))(write)
+    k = njit(cache=False, readonly=("x",))(write)
+    with pytest.raises(TypingError):
+        k(np.zeros(3))

@@ -40,6 +40,7 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
+import inspect
 import os
 import shutil
 import sys
@@ -56,6 +57,7 @@ from numba import njit as _numba_njit
 from numba import types as _types
 from numba.core import caching as _caching
 from numba.core import cgutils as _cgutils
+from numba.core.dispatcher import OmittedArg as _OmittedArg
 from numba.extending import intrinsic as _intrinsic
 
 __all__ = ["njit", "prefetch", "cache_dir", "cache_key"]
@@ -228,12 +230,67 @@ if _CurvefairCacheLocator not in _IMPL._locator_classes:
     _IMPL._locator_classes.insert(0, _CurvefairCacheLocator)
 
 
-def njit(*args: Any, **kwargs: Any) -> Any:
+def njit(*args: Any, readonly: tuple[str, ...] = (), any_layout: tuple[str, ...] = (),
+         **kwargs: Any) -> Any:
     """``numba.njit`` for curvefair kernels: ``cache=True`` goes to the keyed cache above, or is
-    dropped when no cache directory is writable (the kernel is then compiled per process)."""
+    dropped when no cache directory is writable (the kernel is then compiled per process).
+
+    ``readonly`` names array parameters that the kernel only reads, ``any_layout`` array
+    parameters that some callers pass as strided views: a call from Python compiles the kernel
+    for them typed as read-only arrays, or arrays of any layout, whatever the flags of the
+    arrays passed. numba
+    compiles one machine code per distinct argument type, and an array's writeable flag and
+    contiguity are part of its type: a kernel fed a curve's frozen coefficients by one caller
+    and fresh ones by another was compiled twice (2 to 5 times for 36 kernels, a third of the
+    compile time of a fresh install). numba converts a writable (or contiguous) array to the
+    read-only (any-layout) type of an existing machine code by itself, so after the first call
+    every variant of the arguments runs the same code. Calls from other kernels are typed by
+    the caller as usual."""
     if kwargs.get("cache") and _CACHE_DIR is None:
         kwargs["cache"] = False
-    return _numba_njit(*args, **kwargs)
+    if not readonly and not any_layout:
+        return _numba_njit(*args, **kwargs)
+
+    def decorate(fn: Callable[..., Any]) -> Any:
+        disp = _numba_njit(**kwargs)(fn)
+        names = list(inspect.signature(fn).parameters)
+        unknown = [x for x in (*readonly, *any_layout) if x not in names]
+        if unknown:
+            raise TypeError(f"njit({fn.__qualname__}): no parameter named {unknown}")
+        _canonical_types(disp, [names.index(x) for x in readonly],
+                         [names.index(x) for x in any_layout])
+        return disp
+
+    return decorate(args[0]) if args and callable(args[0]) else decorate
+
+
+def _canonical_types(disp: Any, ro: list[int], anyl: list[int]) -> None:
+    """Make ``disp`` compile a call's signature with the arrays at positions ``ro`` read-only
+    and those at ``anyl`` of layout ``A`` (see :func:`njit`). numba's C dispatcher
+    asks the instance's ``_compile_for_args`` for machine code when no compiled signature
+    accepts the arguments, then calls what it returns with the arguments as they are."""
+    plain = disp._compile_for_args
+
+    def _compile_for_args(*args: Any, **kws: Any) -> Any:
+        if kws:
+            return plain(*args, **kws)
+        tys = [_types.Omitted(a.value) if isinstance(a, _OmittedArg) else disp.typeof_pyval(a)
+               for a in args]
+        canon = list(tys)
+        for i in ro:
+            t = canon[i] if i < len(canon) else None
+            if isinstance(t, _types.Array) and t.mutable:
+                canon[i] = t.copy(readonly=True)
+        for i in anyl:
+            t = canon[i] if i < len(canon) else None
+            if isinstance(t, _types.Array) and t.layout != "A":
+                canon[i] = t.copy(layout="A")
+        if canon == tys:
+            return plain(*args)
+        disp._compilation_chain_init_hook()
+        return disp.compile(tuple(canon))
+
+    disp._compile_for_args = _compile_for_args
 
 
 @_intrinsic

@@ -75,7 +75,7 @@ def _ders_one(knots, p, s, u, base, nder, ndu, left, right, a, out, q):
         fac *= p - k
 
 
-@njit(cache=True)
+@njit(cache=True, readonly=('knots',))
 def ders_kernel(knots, p, span, x, nder, local, out):
     ndu = np.empty((p + 1, p + 1))
     left = np.empty(p + 1)
@@ -180,7 +180,7 @@ def _power_form_body(knots, p, spans, ctrl, base, closed, out, out_diff, pair):
                     out_diff[m, k, e] = acc2 / fact[k]
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, readonly=('knots', 'spans', 'ctrl'))
 def power_form_kernel(knots, p, spans, ctrl, closed, out):
     """``out[m, k, :] = sum_a N_{s-p+a}^(k)(t_s) d_{s-p+a} / k!`` for ``s = spans[m]`` (control
     indices mod ``n`` for a closed curve): the piecewise power form of the B-spline. A span
@@ -194,7 +194,7 @@ def power_form_kernel(knots, p, spans, ctrl, closed, out):
         _power_form_body(knots, p, spans, ctrl, ctrl, closed, out, out, False)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, readonly=('knots', 'spans', 'ctrl', 'base'))
 def power_form_pair_kernel(knots, p, spans, ctrl, base, closed, out, out_diff):
     """:func:`power_form_kernel` of ``ctrl`` into ``out`` and of ``ctrl - base`` into
     ``out_diff`` in one pass: the basis derivatives of each span (most of the work) are
@@ -283,7 +283,7 @@ def residual_row(W, ks, p, closed, x, i, a, interior):
     return acc
 
 
-@njit(cache=True)
+@njit(cache=True, readonly=('W', 'x'))
 def band_residual(W, p, closed, x, out):
     """``out = G x`` (per coordinate) for the Gram band ``W`` of
     :meth:`curvefair.BSplineCurve.gram_band`, in difference form
@@ -322,7 +322,7 @@ def energy_row(W, p, closed, x, i, e):
     return e
 
 
-@njit(cache=True)
+@njit(cache=True, readonly=('W', 'x'))
 def band_energy(W, p, closed, x):
     """``x^T G x`` summed over the coordinates, in difference form
     ``-sum_i sum_{o=1..p} W[i, p + o] |x_{i+o} - x_i|^2`` (see :func:`band_residual`): exact

@@ -156,7 +156,7 @@ def _step_factor(Q, Q0, m0, m1, r0, r1, a, b, pair, e, tmp0, tmp1):
     return lo
 
 
-@njit(cache=True)
+@njit(cache=True, readonly=('Q0', 'W'))
 def plan(Q, Q0, W, n, closed, m0, pair, e, dfix, new0, new1):
     """New positions of ``Q[m0]`` (and ``Q[m0+1]`` if ``pair``); returns the factor ``d`` used.
 

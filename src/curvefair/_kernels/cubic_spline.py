@@ -22,7 +22,7 @@ from __future__ import annotations
 from .._jit import njit
 
 
-@njit(cache=True)
+@njit(cache=True, readonly=('t', 'y', 'lo_val', 'hi_val'))
 def cubic_slopes_kernel(t, y, lo_order, lo_val, hi_order, hi_val, cp, pv, out):  # pragma: no cover
     """Slopes ``out`` (n, dim) of the C2 cubic through ``y`` (n, dim) at increasing ``t``
     (n >= 2) with the end conditions (``*_order`` 1 or 2, ``*_val`` (dim,)). ``cp``, ``pv``
@@ -60,7 +60,7 @@ def cubic_slopes_kernel(t, y, lo_order, lo_val, hi_order, hi_val, cp, pv, out): 
             out[i, a] = out[i, a] - cp[i] * out[i + 1, a]
 
 
-@njit(cache=True)
+@njit(cache=True, readonly=('t', 'y'))
 def periodic_slopes_kernel(t, y, cp, pv, z, out):  # pragma: no cover - compiled
     """Slopes ``out`` (n, dim) of the periodic C2 cubic through ``y`` (n, dim; ``y[-1]`` repeats
     ``y[0]``) at increasing ``t`` (n >= 4: at least 3 distinct points); ``out[-1] = out[0]``.

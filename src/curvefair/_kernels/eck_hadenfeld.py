@@ -577,7 +577,7 @@ def largest_free_z(W, p, closed, d, mask):
     return best
 
 
-@njit(cache=True)
+@njit(cache=True, readonly=('W', 'd', 'mask'))
 def setup_state(W, p, closed, d, mask, X, z):
     """One pass over the control points ``d``: the loop state ``X = [d | G d | d]`` (the
     residual of :func:`curvefair._kernels.bspline.band_residual`), the ranking-number slots

@@ -103,7 +103,7 @@ def _assemble_range2(K, ks, p, closed, B, Q, rot, fix, L, i0, i1):
         L[C1, 2 * p + 1] = 0.0
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, readonly=('K',), any_layout=('B', 'Q'))
 def assemble_range(K, ks, p, closed, B, Q, rot, fix, L, i0, i1):
     """Write the lower-band entries of the columns of points ``i0 .. i1 - 1`` into ``L``."""
     if B.shape[1] == 2:
@@ -273,7 +273,7 @@ def assemble_range(K, ks, p, closed, B, Q, rot, fix, L, i0, i1):
                         L[C, k] = blk[b, a]
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, readonly=('K',), any_layout=('B', 'Q'))
 def assemble(K, ks, p, closed, B, Q, rot, fix, L):
     """Fill ``L`` (shape (n dim, kd + 1)) with the lower band of ``M`` (see module docstring)."""
     assemble_range(K, ks, p, closed, B, Q, rot, fix, L, np.intp(0), K.shape[0])
@@ -407,7 +407,7 @@ def _ldl7(K, ks, p, B, Q, rot, fix, L, j, jstop, nxt, nmax):
     return 0, j, nxt
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, readonly=('K',), any_layout=('B', 'Q'))
 def assemble_ldl(K, ks, p, B, Q, rot, fix, L):
     """Assemble (open curves) and factorise ``M = U D U^T`` (``U`` unit lower band) in one pass:
     the columns of a batch of points are written just before the first elimination step that
@@ -442,7 +442,7 @@ def assemble_ldl(K, ks, p, B, Q, rot, fix, L):
     return 0
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, readonly=('K',), any_layout=('B', 'Q'))
 def assemble_ldl_head(K, ks, p, B, Q, rot, fix, L, nmax):
     """First part of :func:`assemble_ldl` (``kd = 7``, ``N > 16``) while the columns of the
     points ``nmax .. n - 1`` are assembled elsewhere (:func:`assemble_range`, e.g. on another
@@ -457,7 +457,7 @@ def assemble_ldl_head(K, ks, p, B, Q, rot, fix, L, nmax):
     return info, j
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, readonly=('K',), any_layout=('B', 'Q'))
 def assemble_ldl_tail(K, ks, p, B, Q, rot, fix, L, j):
     """The rest of :func:`assemble_ldl` after :func:`assemble_ldl_head` (every column
     assembled)."""
@@ -595,7 +595,7 @@ def band_residual_scaled(W, ks, p, closed, x, out):
             out[i, a] = residual_row(W, ks, p, closed, x, i, a, interior)
 
 
-@njit(cache=True)
+@njit(cache=True, readonly=('K',))
 def band_matvec(K, ks, p, closed, x, out):
     """``out = kron(K ks, I) x`` for points ``x`` (n, dim); ``K ks`` given by its band rows
     ``K[i, p + o] * ks = (K ks)_{i, i+o}`` (symmetric; closed: indices mod n)."""
@@ -932,7 +932,7 @@ def prep_rhs(K, ks, p, closed, B, Q, rot, fix, fix0, rhs, c, out, sgn=1.0):
                 out[i, a] = c[i] if (rot[i] and a == 0 and not fix0[i, a]) else 0.0
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, any_layout=('B', 'Q'))
 def prep_rhs2_range(K, ks, p, closed, B, Q, rot, fix, fix0, rhs, c, out, sgn, i0, i1):
     """:func:`prep_rhs` for planar curves in one pass (selects instead of branches on the
     frame flags of the neighbours), on the points ``i0 .. i1 - 1`` (each point is independent:
@@ -983,7 +983,7 @@ def post_solve(y, Q, rot, fix0):
     post_solve_range(y, Q, rot, fix0, 0, y.shape[0])
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, any_layout=('Q',))
 def post_solve_range(y, Q, rot, fix0, i0, i1):
     """:func:`post_solve` on the points ``i0 .. i1 - 1``; returns ``max |y_i|^2`` over the
     ``rot`` points and over the others (the norm before the rotation, which keeps it)."""
@@ -1195,7 +1195,7 @@ def second_order(dv, free, t2, out):
 # ------------------------------------------------------------------------------------------
 
 
-@njit(cache=True)
+@njit(cache=True, readonly=('K',))
 def shift_cholesky(K, ks, p, rho, L):
     """Band Cholesky of ``K + rho I`` (open curve, ``L`` shape (n, p + 1), ``L[r, k] =
     M[r + k, r]``), with the RECIPROCAL pivots stored in ``L[:, 0]`` (for
@@ -1211,7 +1211,7 @@ def shift_cholesky(K, ks, p, rho, L):
     return info
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, readonly=('K',))
 def admm_factor(K, ks, p, rho, L):
     """Factor of ``K + rho I`` (open curve) for the ADMM sweeps. ``p = 3`` (for
     :func:`admm_sweep_t`): ``K + rho I = U D U^T`` (``U`` unit lower) computed with the active
@@ -1526,7 +1526,7 @@ def set_frames(nrm, rot, Q, fix, fix0):
             _frame3(Q, i, nrm[i, 0], nrm[i, 1], nrm[i, 2])
 
 
-@njit(cache=True)
+@njit(cache=True, any_layout=('u',))
 def admm_active_norms(u, free, out):
     """``|u_i|`` of the free points with ``u_i != 0`` (the projected ones) packed into ``out``;
     returns their number."""
@@ -1553,7 +1553,7 @@ def admm_rescale(z, u, g0, f, rho, y):
             y[i, a] = rho * (z[i, a] - u[i, a]) - g0[i, a]
 
 
-@njit(cache=True)
+@njit(cache=True, any_layout=('z', 'u'))
 def admm_multipliers(z, u, free, rho, t2, lam):
     """``lam_i = max(rho t2 (u_i . z_i) / |z_i|^2, 0)`` at the free points with ``z_i != 0``
     (from ``g0 + K z + rho u = 0`` and ``g0 + K z + lam z / t2 = 0``), 0 elsewhere; returns the
@@ -1600,7 +1600,7 @@ def ssn_eval_prep(g0, K, ks, p, closed, v, lam, free, t2, kappa, delta, S, rd,
                           nrm, c, Q, fix, fix0, 0, v.shape[0])
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, any_layout=('B', 'Q'))
 def ssn_eval_range(g0, K, ks, p, closed, v, lam, free, t2, kappa, delta, S, rd,
                    B, nrm, c, Q, fix, fix0, i0, i1):
     """:func:`ssn_eval_prep` on the points ``i0 .. i1 - 1`` (reads ``v`` of their neighbours,

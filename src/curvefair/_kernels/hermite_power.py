@@ -31,7 +31,7 @@ def _widths(t, i):  # pragma: no cover - compiled
     return D, D * D, math.pow(D, 3.0)
 
 
-@njit(cache=True)
+@njit(cache=True, readonly=('p', 'm', 't'))
 def cubic_power_kernel(p, m, t, out):  # pragma: no cover - compiled
     """``out[i, j, d]`` (shape ``(n - 1, 4, dim)``) from points ``p``, tangents ``m`` and
     parameters ``t`` (``n`` of each)."""
@@ -45,7 +45,7 @@ def cubic_power_kernel(p, m, t, out):  # pragma: no cover - compiled
             out[i, 3, d] = -2.0 * dp / D3 + (m[i, d] + m[i + 1, d]) / D2
 
 
-@njit(cache=True)
+@njit(cache=True, readonly=('p', 'm', 's', 't'))
 def quintic_power_kernel(p, m, s, t, out):  # pragma: no cover - compiled
     """``out[i, j, d]`` (shape ``(n - 1, 6, dim)``) from points ``p``, first and second
     derivatives ``m``, ``s`` and parameters ``t``."""

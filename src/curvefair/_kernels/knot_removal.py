@@ -149,7 +149,7 @@ def _measure_parts(d, k, p, ctrl, C, right, left2):
     return v, speed
 
 
-@njit(cache=True)
+@njit(cache=True, readonly=('d',))
 def measure_all(d, ks, p, ctrl, C, right, left2, out):
     for u in range(ks.shape[0]):
         out[u] = knot_measure(d, ks[u], p, ctrl, C, right, left2)

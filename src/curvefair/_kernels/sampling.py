@@ -111,7 +111,7 @@ def _frenet_node(r1, r2, r3, sc1, sc2, speed_rtol, cross_rtol):
     return k_, ks, sp, num, enum, singular
 
 
-@njit(cache=True, nogil=True, fastmath=_FM, error_model="numpy")
+@njit(cache=True, nogil=True, fastmath=_FM, error_model="numpy", readonly=('cw', 'h'))
 def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cross_rtol,
                 kap, dks, knots, energies, quad, box, ell, pos, gaps, unit,
                 i_lo, i_hi, scratch, first, endv, ksfl):
@@ -471,7 +471,7 @@ def allowances(quad, h, rtol, tot, hist):
     return n
 
 
-@njit(cache=True, fastmath=_FM, error_model="numpy")
+@njit(cache=True, fastmath=_FM, error_model="numpy", readonly=('cw', 'h'))
 def refine_kernel(cw, h, quad, rtol, tot, thresh, P, xk, w7, fall, speed_rtol,
                   cross_rtol, max_levels, budget):
     """Adaptive re-integration, in place, of the segments whose worst ratio (:func:`allowance`

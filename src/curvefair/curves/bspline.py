@@ -20,10 +20,9 @@ order ``k = p + 1``).
 from __future__ import annotations
 
 from functools import cached_property
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from scipy.interpolate import BSpline, make_interp_spline, make_lsq_spline
 from scipy.sparse import csr_matrix
 
 from .. import _threads
@@ -49,6 +48,9 @@ from .._validate import (
 from ..errors import InputError
 from .parameterize import closed_point_data, parameterize
 from .piecewise import PiecewiseCurve, PiecewisePolynomial, readonly
+
+if TYPE_CHECKING:  # scipy.interpolate is imported where used (1 s of `import curvefair`)
+    from scipy.interpolate import BSpline
 
 __all__ = ["BSplineCurve", "interpolate_bspline", "fit_bspline", "basis_derivatives"]
 
@@ -483,6 +485,7 @@ class BSplineCurve(PiecewiseCurve):
     def to_scipy(self) -> BSpline:
         """The same curve as a :class:`scipy.interpolate.BSpline` (periodic extrapolation for
         closed curves; coefficients shape ``(n + p, dim)`` there)."""
+        from scipy.interpolate import BSpline
         c = np.array(self.extended_control_points)
         return BSpline(np.array(self._knots), c, self.degree,
                        extrapolate="periodic" if self._closed else True)
@@ -498,6 +501,7 @@ class BSplineCurve(PiecewiseCurve):
         End knots repeated more than ``k + 1`` times are reduced to ``k + 1`` (the dropped basis
         functions vanish on the domain), so scipy splines with them convert exactly.
         """
+        from scipy.interpolate import BSpline, make_interp_spline
         if not isinstance(spl, BSpline):
             raise InputError(f"spl must be a scipy.interpolate.BSpline, got "
                              f"{type(spl).__name__}")
@@ -574,6 +578,7 @@ def interpolate_bspline(points: ArrayLike, degree: int = 3, param: str | ArrayLi
     >>> bool(np.allclose(c(c.knots[3]), pts[0]))
     True
     """
+    from scipy.interpolate import make_interp_spline
     p = as_degree(degree)
     if closed:
         pts, t = closed_point_data(points, param)
@@ -697,6 +702,7 @@ def fit_bspline(points: ArrayLike, n_ctrl: int, degree: int = 3,
     >>> c.n_ctrl, c(1.5).round(12).tolist()
     (8, [1.5, 2.25])
     """
+    from scipy.interpolate import BSpline, make_lsq_spline
     p = as_degree(degree)
     if isinstance(n_ctrl, bool) or not isinstance(n_ctrl, (int, np.integer)):
         raise InputError(f"n_ctrl must be an integer, got {n_ctrl!r}")

@@ -10,7 +10,6 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 from scipy.linalg.lapack import dgbsv
 
 from .._kernels.cubic_spline import cubic_slopes_kernel, periodic_slopes_kernel
@@ -120,6 +119,7 @@ def cubic_slopes(t: FloatArray, pts: FloatArray, bc: Any) -> FloatArray:
     second derivative; zero: natural) or ``"not-a-knot"``. Given slopes and second derivatives
     go through the compiled tridiagonal solve of :mod:`curvefair._kernels.cubic_spline` (its
     docstring has the equations); a not-a-knot end through scipy's ``CubicSpline``."""
+    from scipy.interpolate import CubicSpline
     t = np.ascontiguousarray(t, dtype=np.float64)
     y = np.ascontiguousarray(pts, dtype=np.float64)
     n, dim = y.shape

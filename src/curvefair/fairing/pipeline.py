@@ -27,7 +27,6 @@ from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.interpolate import BSpline, make_interp_spline
 from scipy.sparse.linalg import splu
 
 from .._typing import ArrayLike, FloatArray
@@ -107,6 +106,7 @@ def _gram(curve: BSplineCurve, w: dict[int, float]) -> sp.csr_matrix:
 
 def _collocation(curve: BSplineCurve, u: FloatArray) -> sp.csr_matrix:
     """``A[i, j] = N_j(u_i)`` with the columns of a closed curve folded mod ``n``."""
+    from scipy.interpolate import BSpline
     A = BSpline.design_matrix(u, np.asarray(curve.knots), curve.degree).tocoo()
     return sp.csr_matrix((A.data, (A.row, curve.control_index(A.col))),
                          shape=(u.shape[0], curve.n_ctrl))
@@ -258,6 +258,7 @@ def _start_curve(pts: FloatArray, u: FloatArray, degree: int, closed: bool,
     """The interpolating spline of ``degree`` written on the knot vector with a knot at EVERY
     data parameter (open: clamped, ``m + degree - 1`` control points; closed: periodic, knots
     at the ``m`` data parameters)."""
+    from scipy.interpolate import make_interp_spline
     if closed:
         loop = np.vstack([pts, pts[:1]])
         spl = make_interp_spline(u, loop, k=degree, bc_type="periodic", axis=0)

@@ -98,7 +98,6 @@ from typing import Any, cast
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.interpolate import BSpline
 
 from .._typing import ArrayLike, FloatArray
 from .._validate import as_points, as_positive
@@ -183,6 +182,8 @@ def natural_operators(u: ArrayLike) -> NaturalOperators:
     multiplied by :func:`curvefair._kernels.points.csr_matmat`, scipy's own product (the same
     sums in the same order, the same stored order): bitwise the matrices of
     :func:`_natural_operators_sparse`, without a dozen scipy.sparse constructions."""
+    from scipy.interpolate import BSpline
+
     from .._kernels import points as _pk
 
     u = np.asarray(u, dtype=float)
@@ -233,6 +234,7 @@ def natural_operators(u: ArrayLike) -> NaturalOperators:
 def _natural_operators_sparse(u: ArrayLike) -> NaturalOperators:
     """:func:`natural_operators` built with scipy.sparse products (the reference its compiled
     products are tested against)."""
+    from scipy.interpolate import BSpline
     u = np.asarray(u, dtype=float)
     N = u.shape[0]
     n = N - 1
@@ -271,6 +273,7 @@ def periodic_operators(u: ArrayLike) -> NaturalOperators:
     ``Jm`` (N x N): the jump ``S'''(u_k+) - S'''(u_k-)`` at every point, cyclic (``k = 0``:
     span 0 minus span ``N - 1``). The matrices are banded with corner terms (the wrap).
     """
+    from scipy.interpolate import BSpline
     u = np.asarray(u, dtype=float)
     N = u.shape[0] - 1
     P = u[-1] - u[0]
@@ -761,6 +764,7 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
         """Operators at parameters ``u``, the input's natural cubic ``xp`` there, the
         constraint rows ``C`` (data points, then ``ns`` samples per span) with their
         centres ``Y``, and the E3 weight ``b``."""
+        from scipy.interpolate import BSpline
         ops = periodic_operators(u) if closed else natural_operators(u)
         xp = _solve(ops.A, pts, closed, ops.cache)  # the input's cubic at these parameters
         if ns:
