@@ -602,8 +602,12 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
             pts = _apply(ctm, pts)
             name = ident or f"{tag}{k}"
             base.update(subpath=0, n_subpaths=1, svg_closed=closed)
+            # a rectangle's four vertices are corners whatever their angle (skewed or drawn
+            # through a shear, or a --corner-angle above 90): it is written back only
+            # unchanged, so nothing of it may move
             try:
-                records.extend(_polyline_records(pts, closed, base, name, corner_angle, path,
+                records.extend(_polyline_records(pts, closed, base, name,
+                                                 0.0 if tag == "rect" else corner_angle, path,
                                                  len(records)))
             except Unsupported as exc:
                 skip(f"{what}: unsupported {exc}")
