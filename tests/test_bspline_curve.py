@@ -385,10 +385,17 @@ def test_power_form_in_ranges_is_bitwise_one_pass(monkeypatch, closed, degree):
         monkeypatch.setattr(_threads, "THREADS", th)
         monkeypatch.setattr(B, "POWER_FORM_PAR_MIN", pm)
         own = c.replace(control_points=np.asarray(c.control_points)).piecewise.coeffs
-        new, diff = prime_power_forms(c, c.replace(control_points=moved))
-        out[th] = [np.asarray(own), np.asarray(new.piecewise.coeffs), np.asarray(diff.coeffs)]
+        new, figs = prime_power_forms(c, c.replace(control_points=moved))
+        s = np.ascontiguousarray(c.spans, dtype=np.int64)
+        pair = np.empty((s.size, degree + 1, 2))
+        diff = np.empty_like(pair)
+        B.power_form(np.ascontiguousarray(c.knots), degree, s, np.ascontiguousarray(moved),
+                     closed, pair, np.ascontiguousarray(c.control_points), diff)
+        out[th] = [np.asarray(own), np.asarray(new.piecewise.coeffs), pair, diff,
+                   np.array(figs)]
     for a, b in zip(out[1], out[2], strict=True):
-        assert np.array_equal(a, b)
+        assert np.array_equal(a, b, equal_nan=True)
+    assert np.array_equal(out[1][1], out[1][2])  # the pair pass's own form is the curve's
     # and the form is the curve's: against scipy's BSpline at the span midpoints
     br = np.asarray(c.piecewise.breaks)
     mid, h = 0.5 * (br[:-1] + br[1:]), 0.5 * np.diff(br)
@@ -397,3 +404,33 @@ def test_power_form_in_ranges_is_bitwise_one_pass(monkeypatch, closed, degree):
     ctrl = np.asarray(c.control_points)[c.control_index(np.arange(t.size - degree - 1))]
     ref = BSpline(t, ctrl, degree)(mid)
     assert np.allclose(val, ref, rtol=1e-9, atol=1e-9 * np.abs(ref).max())
+
+
+@pytest.mark.parametrize("p", [2, 3, 4, 5])
+@pytest.mark.parametrize("closed", [False, True])
+def test_few_parameters_without_the_power_form_are_bitwise_the_same(p, closed):
+    """A few parameters of a long curve whose power form is not built are evaluated from their
+    spans' forms only (fair() evaluates its input at the certificate's parameter after dropping
+    the form): bitwise what the whole form gives, the form still not built; and scipy's
+    BSpline agrees (independent de Boor evaluation)."""
+    rng = np.random.default_rng(7 * p + closed)
+    c = _random_closed(rng, 800, p) if closed else _random_open(rng, 800, p)
+    ctrl, t = np.array(c.control_points), np.array(c.knots)
+    br = np.unique(t[p:t.size - p])
+    lo, hi = c.domain
+    u = np.r_[rng.uniform(lo, hi, 3), br[5], br[-6], lo, hi]  # breaks: the segment chosen
+    full = BSplineCurve(ctrl, t, p, closed=closed)
+    _ = full.piecewise
+    spl = full.to_scipy()
+    w = lo + np.mod(u - lo, hi - lo) if closed else u  # a closed curve wraps its end to its start
+    for nu in range(p + 1):
+        bare = BSplineCurve(ctrl, t, p, closed=closed)
+        got = bare(u, nu)
+        assert "piecewise" not in bare.__dict__
+        assert np.array_equal(got, full(u, nu))
+        ref = spl(w, nu)
+        assert np.allclose(got, ref, rtol=1e-9, atol=1e-9 * np.abs(ref).max())
+    # many parameters (or a cached form): the whole form, built once
+    many = BSplineCurve(ctrl, t, p, closed=closed)
+    v = np.linspace(lo, hi, 50)
+    assert np.array_equal(many(v), full(v)) and "piecewise" in many.__dict__

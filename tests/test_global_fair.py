@@ -167,6 +167,32 @@ def test_errors_and_trivial_cases():
     assert res.stop_reason == "no_movable_point"
 
 
+def test_closed_without_tol_is_refused_not_collapsed():
+    """Without a tolerance, a closed curve with fewer than 2 held control points has one energy
+    minimum, a single point (every figure of which is rounding noise): refused, naming tol.
+    With a tolerance, or 2 held points, the result keeps its size."""
+    from curvefair import fair
+
+    a = np.linspace(0.0, 2 * np.pi, 13)[:-1]
+    rng = np.random.default_rng(2)
+    ring = np.c_[np.cos(a), 0.7 * np.sin(a)] * (1 + 0.05 * rng.standard_normal(12))[:, None]
+    c = BSplineCurve(ring, np.arange(13.0), 3, closed=True)
+    for kw in ({}, {"protect": [4]}, {"l": 3}):
+        with pytest.raises(InputError, match="tol.*single point"):
+            global_fair(c, tol=None, **kw)
+    with pytest.raises(InputError, match="tol.*single point"):
+        fair(c, "global")
+    size = np.ptp(ring, axis=0).max()
+    # a tolerance, or two held points, keep the ring its size
+    r1 = global_fair(c, tol=0.05)
+    r2 = global_fair(c, tol=None, protect=[0, 6])
+    for r in (r1, r2):
+        assert np.ptp(np.asarray(r.curve.control_points), axis=0).max() > 0.5 * size
+    assert np.abs(np.asarray(r1.curve.control_points) - ring).max() <= 0.05
+    # an open curve (its ends held by the clamp) is still solved without tol
+    assert global_fair(noisy(n=12), tol=None).stop_reason == "unconstrained"
+
+
 # -- the compiled Newton systems against dense linear algebra ------------------------------
 @pytest.mark.parametrize("closed", [False, True])
 @pytest.mark.parametrize("dim,p,n", [(2, 3, 30), (3, 3, 25), (2, 2, 7), (3, 4, 9), (2, 5, 40)])

@@ -257,19 +257,28 @@ def deviation(curve_a: object, curve_b: object,
     starts, ends = br[:-1], br[1:]
     q = max(a.piecewise.degree, b.piecewise.degree) + 1
     ca, cb = np.asarray(a.piecewise.coeffs), np.asarray(b.piecewise.coeffs)
+    # b the zero curve (one 0.0 broadcast: a difference curve's certificate)
+    zero = cb.ndim > 0 and not any(cb.strides) and cb.size > 0 and cb.flat[0] == 0.0
     if br is ba and ca.shape == cb.shape:
-        d = ca - cb  # same breakpoints and degree: no re-expansion
+        # same breakpoints and degree: no re-expansion; x - 0.0 is x bit for bit (no copy)
+        d = ca if zero else ca - cb
     else:
         mids = 0.5 * (starts + ends)
         d = _on_breaks(a, starts, mids, q) - _on_breaks(b, starts, mids, q)
     w = ends - starts
-    scale = max(float(np.max(np.abs(ca[:, 0, :]))), float(np.max(np.abs(cb[:, 0, :]))),
-                np.finfo(float).tiny)
+    scale = max(float(np.max(np.abs(ca[:, 0, :]))),
+                0.0 if zero else float(np.max(np.abs(cb[:, 0, :]))), np.finfo(float).tiny)
     atol = 1e-13 * scale
 
     # every piece: Bernstein bound U and samples at the ends (exact) and quarter points
     U = np.empty(d.shape[0])
-    best, i, f = _k.first_pass(np.ascontiguousarray(d), np.ascontiguousarray(w),
+    # the kernel only reads d: always as a read-only array (d is the caller's read-only form
+    # against the zero curve), so that numba compiles it for one argument type
+    d = np.ascontiguousarray(d)
+    if d.flags.writeable:
+        d = d.view()
+        d.flags.writeable = False
+    best, i, f = _k.first_pass(d, np.ascontiguousarray(w),
                              bernstein_matrix(q - 1), U)
     best_t = float(starts[i] + f * w[i])
 

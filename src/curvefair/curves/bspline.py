@@ -381,6 +381,27 @@ class BSplineCurve(PiecewiseCurve):
             return PiecewisePolynomial(breaks, coeffs, evaluator=self._span_values)
         return PiecewisePolynomial(breaks, coeffs)
 
+    def _partial_form(self, u: FloatArray) -> tuple[FloatArray, FloatArray] | None:
+        """The power form of the spans holding ``u`` (see
+        :meth:`PiecewiseCurve._evaluate <curvefair.PiecewiseCurve>`), or None for a short curve,
+        a degree above :data:`POWER_FORM_MAX_DEGREE` or a non-finite form (whose whole form
+        raises its own message)."""
+        p = self.degree
+        s = np.asarray(self.spans)
+        if p > POWER_FORM_MAX_DEGREE or 64 * u.size >= s.shape[0]:
+            return None
+        t = self._knots
+        # the non-empty span [t_k, t_k+1) holding each u (right-continuous, the last one closed:
+        # the whole form's segment_of on its breaks t[spans]), found in the knots themselves
+        k = np.clip(np.searchsorted(t, u, side="right") - 1, s[0], s[-1])
+        span = s[np.searchsorted(s, k)]
+        rows = np.empty((span.shape[0], p + 1, self._ctrl.shape[1]))
+        power_form(np.ascontiguousarray(t), p, np.ascontiguousarray(span, dtype=np.int64),
+                   np.ascontiguousarray(self._ctrl), self._closed, rows)
+        if not np.isfinite(rows).all():
+            return None
+        return rows, u - t[span]
+
     def _span_values(self, seg: np.ndarray, s: FloatArray, nu: int) -> FloatArray:
         """``r^(nu)`` on power-form segments ``seg`` at local offsets ``s`` from the basis:
         ``sum_a N_{k-p+a}^(nu)(t_k + s) d_{k-p+a}`` with ``k = spans[seg]`` (control indices

@@ -82,6 +82,24 @@ class HermiteSpline(PiecewiseCurve):
     def dim(self) -> int:
         return int(self._points.shape[1])
 
+    def _rows(self, lo: int, hi: int) -> FloatArray:
+        """The power form's coefficients of the segments between points ``lo .. hi-1``."""
+        raise NotImplementedError
+
+    def _make_piecewise(self) -> PiecewisePolynomial:
+        return PiecewisePolynomial(np.array(self._params), self._rows(0, len(self._params)))
+
+    def _partial_form(self, u: FloatArray) -> tuple[FloatArray, FloatArray] | None:
+        """The coefficients of the segments holding ``u``, each from its own two points (as
+        the whole form computes them), and the local offsets; None for a short curve."""
+        t = self._params
+        m = t.shape[0] - 1
+        if 64 * u.size >= m:
+            return None
+        seg = np.clip(np.searchsorted(t, u, side="right") - 1, 0, m - 1)
+        rows = np.concatenate([self._rows(int(k), int(k) + 2) for k in seg])
+        return rows, u - t[seg]
+
     @property
     def closed(self) -> bool:
         return self._closed
@@ -165,10 +183,9 @@ class CubicHermite(HermiteSpline):
         """First derivatives ``r'_i``, shape ``(n, dim)`` (read-only)."""
         return self._derivs[0]
 
-    def _make_piecewise(self) -> PiecewisePolynomial:
-        return PiecewisePolynomial(np.array(self._params),
-                                   cubic_hermite_coefficients(self._points, self.tangents,
-                                                              self._params))
+    def _rows(self, lo: int, hi: int) -> FloatArray:
+        return cubic_hermite_coefficients(self._points[lo:hi], self.tangents[lo:hi],
+                                          self._params[lo:hi])
 
 
 class QuinticHermite(HermiteSpline):
@@ -221,11 +238,9 @@ class QuinticHermite(HermiteSpline):
         """Alias of :attr:`d1`."""
         return self._derivs[0]
 
-    def _make_piecewise(self) -> PiecewisePolynomial:
-        return PiecewisePolynomial(
-            np.array(self._params),
-            quintic_hermite_coefficients(self._points, self.d1, self.d2, self._params),
-        )
+    def _rows(self, lo: int, hi: int) -> FloatArray:
+        return quintic_hermite_coefficients(self._points[lo:hi], self.d1[lo:hi], self.d2[lo:hi],
+                                            self._params[lo:hi])
 
 
 def _c64(a: ArrayLike) -> FloatArray:

@@ -23,7 +23,7 @@ from .._typing import ArrayLike, FloatArray
 from .._validate import as_count, as_eval_params, check_fits
 from ..errors import InputError
 
-__all__ = ["PiecewisePolynomial", "PiecewiseCurve", "readonly"]
+__all__ = ["PiecewisePolynomial", "PiecewiseCurve", "horner_rows", "readonly"]
 
 
 def _frozen(arr: np.ndarray) -> bool:
@@ -50,6 +50,17 @@ def readonly(arr: np.ndarray) -> np.ndarray:
     a = arr if isinstance(arr, np.ndarray) else np.asarray(arr)
     # tobytes() copies any layout into C order: one copy, also for a strided view
     return np.frombuffer(a.tobytes(), dtype=a.dtype).reshape(a.shape)
+
+
+def horner_rows(rows: FloatArray, s: FloatArray, nu: int) -> FloatArray:
+    """``nu``-th derivative of the power-form rows ``rows`` (shape ``(k, p+1, dim)``) at local
+    offsets ``s`` (shape ``(k, 1)``), one row each: Horner's rule, shape ``(k, dim)``."""
+    c = derivative_coefficients(rows, nu)
+    out = c[:, -1, :].copy()
+    for j in range(c.shape[1] - 2, -1, -1):
+        out *= s
+        out += c[:, j, :]
+    return out
 
 
 def derivative_coefficients(coeffs: FloatArray, nu: int) -> FloatArray:
@@ -156,12 +167,7 @@ class PiecewisePolynomial:
         if seg.shape[0] < self.n_segments:
             # fewer parameters than segments (a few knots of a long curve): the derivative
             # coefficients of the segments asked for only (the same products, O(k) not O(m))
-            c = derivative_coefficients(self.coeffs[seg], nu)
-            out = c[:, -1, :].copy()
-            for j in range(c.shape[1] - 2, -1, -1):
-                out *= s
-                out += c[:, j, :]
-            return out.reshape(shape + (self.dim,))
+            return horner_rows(self.coeffs[seg], s, nu).reshape(shape + (self.dim,))
         c = derivative_coefficients(self.coeffs, nu)
         out = c[seg, -1, :].copy()
         for j in range(c.shape[1] - 2, -1, -1):
@@ -316,7 +322,28 @@ class PiecewiseCurve(abc.ABC):
                 v = u.reshape(-1)[np.flatnonzero(bad.reshape(-1))[0]]
                 raise InputError(f"u = {v!r} is outside the curve's domain [{t0!r}, {t1!r}]")
             u = np.clip(u, t0, t1)
-        return self.piecewise.evaluate(u, int(nu))
+        return self._evaluate(u, int(nu))
+
+    def _evaluate(self, u: FloatArray, nu: int) -> FloatArray:
+        """:meth:`__call__` on parameters already in the domain. A few parameters of a long
+        curve whose power form is not built yet are evaluated from their segments' forms only
+        (:meth:`_partial_form`): each segment's coefficients depend on its own data, so the
+        values are bitwise those of the whole form, without its 72 bytes per segment of a
+        planar cubic for one point (:func:`curvefair.fair` evaluates its input at the
+        certificate's parameter after dropping the form it built)."""
+        if "piecewise" not in self.__dict__ and u.size <= 64:
+            uf = u.reshape(-1)
+            part = self._partial_form(uf)
+            if part is not None:
+                rows, local = part
+                return horner_rows(rows, local[:, None], nu).reshape(u.shape + (self.dim,))
+        return self.piecewise.evaluate(u, nu)
+
+    def _partial_form(self, u: FloatArray) -> tuple[FloatArray, FloatArray] | None:
+        """The power-form rows of the segments holding ``u`` (as the whole form's
+        :meth:`PiecewisePolynomial.segment_of` chooses them) and the local offsets, or None
+        (build the whole form)."""
+        return None
 
     def sample(self, n: int = 200) -> FloatArray:
         """``n`` points at equally spaced parameters over the domain, shape ``(n, dim)``

@@ -135,14 +135,16 @@ def _difference_form(a: PiecewiseCurve, delta: dict[str, FloatArray]) -> Piecewi
 
 
 def prime_power_forms(original: PiecewiseCurve, new: PiecewiseCurve
-                      ) -> tuple[PiecewiseCurve, PiecewisePolynomial] | None:
+                      ) -> tuple[PiecewiseCurve, tuple[float, float, float]] | None:
     """For two comparable B-splines (same knots, degree, closedness, shapes): ``new``'s power
     form (cached on it, as its :attr:`~curvefair.PiecewiseCurve.piecewise` would be) and
     the power form of the difference curve ``new - original`` in one pass
     (:func:`curvefair._kernels.bspline.power_form_pair_kernel`: the basis derivatives once
-    for both, bitwise the two separate results). Returns ``(new, difference form)`` for
-    :func:`enforce_tolerance`'s ``primed``, or None (other curves, high degree, ``new``'s form
-    already built, a non-finite form: the usual paths then)."""
+    for both, bitwise the two separate results), and the difference curve's
+    :func:`difference_deviation` figures at once, so that its power form is freed before the
+    result's analysis (the call's peak memory). Returns ``(new, (max_distance, upper_bound,
+    param))`` for :func:`enforce_tolerance`'s ``primed``, or None (other curves, high degree,
+    ``new``'s form already built, a non-finite form: the usual paths then)."""
     if (not isinstance(new, BSplineCurve) or "piecewise" in new.__dict__
             or new.degree > POWER_FORM_MAX_DEGREE or not _comparable(original, new)):
         return None
@@ -158,7 +160,9 @@ def prime_power_forms(original: PiecewiseCurve, new: PiecewiseCurve
         return None  # new.piecewise raises its own message when asked
     breaks = np.append(t[s], t[s[-1] + 1])
     own = new.__dict__["piecewise"] = PiecewisePolynomial(breaks, coeffs)  # the cached_property
-    return new, PiecewisePolynomial._borrowed(own.breaks, diff)
+    del coeffs  # the frozen copy is the form now: not both through the certificate
+    return new, difference_deviation(original, new, PiecewisePolynomial._borrowed(own.breaks,
+                                                                                  diff))
 
 
 def delta_deviation(a: PiecewiseCurve, delta: dict[str, FloatArray]) -> Any:
@@ -268,7 +272,7 @@ def _pull_back(orig: FloatArray, moved: FloatArray, tol: float) -> tuple[FloatAr
 
 def enforce_tolerance(original: PiecewiseCurve, new: PiecewiseCurve, tol: float | None,
                       curve_bound: bool = True,
-                      primed: tuple[PiecewiseCurve, PiecewisePolynomial] | None = None
+                      primed: tuple[PiecewiseCurve, tuple[float, float, float]] | None = None
                       ) -> tuple[PiecewiseCurve, Certificate]:
     """``new`` made to satisfy the tolerance exactly in float64 (see the module docstring).
 
@@ -280,22 +284,25 @@ def enforce_tolerance(original: PiecewiseCurve, new: PiecewiseCurve, tol: float 
         ``None``: nothing is enforced, only the deviation is measured.
     curve_bound : bool
         The method promises the curve within ``tol`` too (certify and scale if needed).
-    primed : (curve, PiecewisePolynomial) or None
-        :func:`prime_power_forms` of ``(original, new)``: the difference form is used while
-        the curve checked is that very ``curve`` object (not after a pull-back or scaling).
+    primed : (curve, (max_distance, upper_bound, param)) or None
+        :func:`prime_power_forms` of ``(original, new)``: its deviation figures stand for
+        :func:`difference_deviation` while the curve checked is that very ``curve`` object
+        (not after a pull-back or scaling).
 
     Returns
     -------
     (curve, Certificate)
     """
-    def form_of(cur: PiecewiseCurve) -> PiecewisePolynomial | None:
-        return primed[1] if primed is not None and primed[0] is cur else None
+    def measure(cur: PiecewiseCurve) -> tuple[float, float, float]:
+        if primed is not None and primed[0] is cur:
+            return primed[1]
+        return difference_deviation(original, cur)
 
     fo = curve_fields(original)
     fn = curve_fields(new)
     if (tol is None or fo is None or fn is None or type(original) is not type(new)
             or fo[next(iter(fo))].shape != fn[next(iter(fn))].shape):
-        dmax, ub, t = difference_deviation(original, new, form_of(new))
+        dmax, ub, t = measure(new)
         return new, Certificate(dmax, ub, t, 0, 1.0)
     pos = next(iter(fo))
     if not _comparable(original, new):
@@ -309,7 +316,7 @@ def enforce_tolerance(original: PiecewiseCurve, new: PiecewiseCurve, tol: float 
             cur = _rebuild(new, cf)
         dmax, ub, t = difference_deviation(original, cur)
         return cur, Certificate(dmax, ub, t, pulled, 1.0)
-    delta = {k: fn[k] - fo[k] for k in fo}
+    delta: dict[str, FloatArray] = {}  # the data's differences, when a scaling needs them
     pulled_total = 0
     scale = 1.0
     cur = new
@@ -322,13 +329,14 @@ def enforce_tolerance(original: PiecewiseCurve, new: PiecewiseCurve, tol: float 
             cf = dict(curve_fields(cur))  # type: ignore[arg-type]
             cf[pos] = fixed
             cur = _rebuild(new, cf)
-        dmax, ub, t = difference_deviation(original, cur, form_of(cur))
+        dmax, ub, t = measure(cur)
         if not curve_bound or ub <= tol:
             return cur, Certificate(dmax, ub, t, pulled_total, scale)
         if attempt == _MAX_SCALINGS:
             break
         # the curve strays past tol between points: scale every data difference by one factor
         scale *= (tol / ub) * (1.0 - 2.0 ** (-40 + 4 * attempt))
+        delta = delta or {k: fn[k] - fo[k] for k in fo}
         cf = {k: fo[k] + scale * delta[k] for k in fo}
         cur = _rebuild(new, cf)
     # could not certify by scaling (cannot happen unless the bound is dominated by rounding):

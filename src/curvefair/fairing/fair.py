@@ -394,6 +394,38 @@ ANALYSIS_FIGURES = ("energy", "energy3", "max_jump", "max_top_jump", "sapidis_su
                     "dkds_energy", "inflections", "extrema")
 
 
+class _CacheState:
+    """Which lazily built figures a curve held when :func:`fair` was called with it: its
+    power form (:attr:`~curvefair.PiecewiseCurve.piecewise`) and, for a B-spline, the keys of
+    its Gram bands (shared by every curve on the same knots). :func:`fair` drops what it
+    built itself once it is done with it, so that the caller's curve leaves the call as it
+    came in and the call's peak memory does not hold them (a power form is 72 bytes per span
+    of a planar cubic, a Gram band 56 bytes per control point)."""
+
+    def __init__(self, curve: PiecewiseCurve) -> None:
+        self.had_form = "piecewise" in curve.__dict__
+        cache = getattr(curve, "_gram_cache", None)
+        self.gram_keys = frozenset(cache) if isinstance(cache, dict) else frozenset()
+
+    def drop_power_form(self, curve: PiecewiseCurve, *, method_done: bool) -> None:
+        """The input's power form, once nothing reads it: a B-spline's after its analysis and
+        join plan (the B-spline methods work on the control points), any curve's after the
+        method (the Hermite loops take end derivatives from it); the rest of the call reads
+        the input's data (the certificate works on the difference curve)."""
+        if not self.had_form and (method_done or hasattr(curve, "control_points")):
+            curve.__dict__.pop("piecewise", None)
+
+    def drop_gram_bands(self, curve: PiecewiseCurve, new: PiecewiseCurve) -> None:
+        """After the method: the Gram bands it built, on the input and on the result (the
+        two share one cache when their knots are the same)."""
+        for c in (curve, new):
+            cache = getattr(c, "_gram_cache", None)
+            if isinstance(cache, dict):
+                keep = self.gram_keys if cache is getattr(curve, "_gram_cache", None) else ()
+                for k in [k for k in cache if k not in keep]:
+                    del cache[k]
+
+
 #: the analysis blocks of cubic Hermite curves already analysed, by curve (their data are
 #: read-only): one fair() call on point data asks for the same curve's figures several times
 #: (the input before and in the method's back-off; the result in the method, after it and in
@@ -625,11 +657,16 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
         raise InputError(f"unknown joins {joins!r}; valid values are: 'keep', 'free'")
     g1_deg = _joins.DEFAULT_G1_ANGLE if g1_angle is None else as_nonnegative(g1_angle,
                                                                             "g1_angle")
+    # what the call adds to the input's caches (its power form, Gram bands) is dropped as soon
+    # as the call no longer needs it: at a million points they are 72 and 56 bytes per span,
+    # held by the caller's curve after the call, and at the call's peak (the result's analysis)
+    cached_at_entry = _CacheState(curve)
     before = analysis_block(curve)
     if progress is not None:
         progress(1, PHASES)
     jp = (_joins.plan(curve, clamp_pair, prot, g1_deg, tol_v) if joins == "keep"
           else _joins.JoinPlan(curve, prot, clamp_pair))
+    cached_at_entry.drop_power_form(curve, method_done=False)
 
     def solve(plan: Any, tol_w: float | None) -> Outcome:
         # the method solves the problem on the join plan's curve (joins held, tol shared)
@@ -647,6 +684,8 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
         jp = _joins.plan(curve, clamp_pair, prot, g1_deg, tol_v, allow_reduce=False)
         out = solve(jp, tol_v)
     new = jp.restore(out.curve)
+    cached_at_entry.drop_power_form(curve, method_done=True)
+    cached_at_entry.drop_gram_bands(curve, new)
     if progress is not None:
         progress(2, PHASES)
     if jp.reduced and out.history is not None and len(out.history):

@@ -434,7 +434,9 @@ def global_fair(curve: BSplineCurve, *, tol: float | None = None, l: Any = 2,  #
     curve : BSplineCurve
     tol : float or None
         Ball radius around every ORIGINAL control point; ``None``: unconstrained (the result is
-        the limit of the Eck-Hadenfeld iteration with the fixed points held).
+        the limit of the Eck-Hadenfeld iteration with the fixed points held). Refused
+        (:class:`~curvefair.errors.InputError`) for a closed curve with fewer than 2 held
+        control points, whose limit is a single point.
     l : 2, 3, (w2, w3) or {2: w2, 3: w3}
         The energy ``sum_l w_l E_l``.
     clamp, protect
@@ -577,6 +579,14 @@ def _global_fair(problem: FairingProblem, l: Any, gap: float) -> GlobalResult:  
     eye = np.broadcast_to(np.eye(dim), (n, dim, dim))
 
     if tol is None:
+        if closed and n - free.size < 2:
+            # every closed curve's energy falls to 0 as it shrinks: the limit is one point
+            # (at most one control point held), and every figure of it is rounding noise
+            raise InputError(
+                "tol: method 'global' without a tolerance on a closed curve with fewer than 2 "
+                "held control points has one answer, a single point (the energy of a closed "
+                "curve falls to 0 as it shrinks); give tol, or protect at least 2 control "
+                "points")
         # (K + delta I) (d - o) = -K o on the free points
         delta = 1e-15 * float((W[mask, p] * ks).max())
         if not system.factor(delta * eye):
