@@ -195,8 +195,12 @@ def test_circle_ellipse_rect_line(tmp_path):
     msgs = " ".join(str(w.message) for w in caught)
     assert "unsupported <circle>" in msgs and "unsupported <ellipse>" in msgs
     tags = [r.source["tag"] for r in recs]
-    assert tags == ["rect", "line", "polyline"]
-    np.testing.assert_array_equal(recs[0].points, [[1, 2], [11, 2], [11, 6], [1, 6], [1, 2]])
+    # a rectangle's four vertices are corners even with corner_angle=None (it is written back
+    # only unchanged, so nothing of it may move): four two-point sides
+    assert tags == ["rect"] * 4 + ["line", "polyline"]
+    corners = [[1, 2], [11, 2], [11, 6], [1, 6], [1, 2]]
+    for k in range(4):
+        np.testing.assert_array_equal(recs[k].points, corners[k:k + 2])
     # a drawing with a rectangle and a straight line: nothing to fair there, exit 0
     res = _run("fair", p, "-o", tmp_path / "o.svg", "--tol", "0.1", "--report",
                tmp_path / "r.json", "--corner-angle", "80")

@@ -298,6 +298,43 @@ def _measure(reference: Sequence[CurveRecord], curves: Sequence[Any], tol: float
     return devs, kinds, mpd
 
 
+#: The rounding allowance of :func:`_svg_point_displacement`, in units of ``eps`` times the
+#: largest coordinate: the Bezier points are computed from the B-spline (power form to
+#: Bernstein) and mapped through the element's transformation and back, each a few roundings.
+_SVG_POINT_ULPS = 64
+
+
+def _svg_point_displacement(ref: CurveRecord, back: CurveRecord) -> tuple[float, float] | None:
+    """SVG: how far the points the file holds moved -- the nodes and handles of a Bezier chain
+    (against the Bezier points of the reference curve), the vertices of a polyline -- and the
+    rounding allowance of that figure; None when they cannot be paired one to one.
+
+    The read-back deviation of a Bezier chain is a geometric (Hausdorff) distance, since its
+    knots follow the control polygon's lengths; a node or handle rounded to the element's
+    decimals can move farther than ``tol`` while the curve stays within it (a handle of a
+    one-decimal icon moved by 0.1 + rounding 0.05 in x and y: 0.14 at tol 0.1). ``--tol``
+    bounds every point, so it is measured here too."""
+    if ref.kind == "bspline" and back.kind == "bspline":
+        bb = back.source.get("beziers")
+        if bb is None:
+            return None
+        from ._common import bezier_pieces
+        try:
+            b0 = bezier_pieces(ref.curve, "write_checked", max_degree=3)
+        except CurvefairError:
+            return None
+        b1 = np.asarray(bb, dtype=np.float64)
+    elif ref.kind in POINT_KINDS and ref.points is not None and back.points is not None:
+        b0, b1 = np.asarray(ref.points, dtype=np.float64), np.asarray(back.points)
+    else:
+        return None
+    if b0.shape != b1.shape or b0.size == 0:
+        return None
+    d = float(np.sqrt(((b1 - b0) ** 2).sum(axis=-1)).max())
+    slack = _SVG_POINT_ULPS * float(np.finfo(np.float64).eps) * float(np.abs(b0).max())
+    return d, slack
+
+
 def _scaled(rec: CurveRecord, ref: CurveRecord, s: float) -> CurveRecord:
     """``rec`` with its data points moved ``s`` times as far from ``ref``'s as faired."""
     p0 = np.asarray(cast("CubicHermite", ref.curve).points, dtype=np.float64)
@@ -439,6 +476,12 @@ def write_checked(path: str | os.PathLike[str], records: Sequence[CurveRecord],
             except (ValueError, ArithmeticError, MemoryError) as exc:
                 raise WriteCheckError(f"{where}: not written: the curves read back could not "
                                       f"be measured against the input ({exc})") from None
+            if fmt == "svg" and tol is not None and _shapes_agree(reference, back):
+                # every node, handle and vertex within tol too, not only the curve
+                for i, (r, b) in enumerate(zip(reference, back, strict=True)):
+                    pd = _svg_point_displacement(r, b)
+                    if pd is not None and pd[0] > tol + pd[1]:
+                        devs[i] = max(devs[i], pd[0])
             over = [i for i, d in enumerate(devs) if tol is not None and not d <= tol]
             undone = ([i for i, d in enumerate(devs) if d == 0.0
                        and not _same_curve(records[i].curve, reference[i].curve)]

@@ -602,8 +602,12 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
             pts = _apply(ctm, pts)
             name = ident or f"{tag}{k}"
             base.update(subpath=0, n_subpaths=1, svg_closed=closed)
+            # a rectangle's four vertices are corners whatever their angle (skewed or drawn
+            # through a shear, or a --corner-angle above 90): it is written back only
+            # unchanged, so nothing of it may move
             try:
-                records.extend(_polyline_records(pts, closed, base, name, corner_angle, path,
+                records.extend(_polyline_records(pts, closed, base, name,
+                                                 0.0 if tag == "rect" else corner_angle, path,
                                                  len(records)))
             except Unsupported as exc:
                 skip(f"{what}: unsupported {exc}")
@@ -910,10 +914,31 @@ def _ctm(src: Any) -> np.ndarray | None:
     return None if m is None else np.asarray(m, dtype=float).reshape(2, 3)
 
 
-def _record_geometry(recs: list[CurveRecord]) -> tuple[str, FloatArray | None]:
+def _toward(geo: FloatArray, orig: FloatArray, decimals: int | None) -> FloatArray | None:
+    """``geo`` with every coordinate rounded to ``decimals`` TOWARD its value in ``orig`` (the
+    element's numbers as read, on that grid): no coordinate moves farther from the input than
+    faired, so a node, handle or vertex rounded for the file stays within the tolerance the
+    fairing held it to (rounded to nearest, a point moved by nearly ``tol`` ended up to half a
+    unit of the last decimal farther, e.g. 0.14 at tol 0.1 on a one-decimal icon). None when
+    that rounding undoes every move: the element's own text is kept (not rewritten with lines
+    as cubics whose rounded handles kink the joins), and the read-back check, finding the
+    curve as it was, tries more decimals."""
+    if decimals is None or orig.shape != geo.shape:
+        return geo
+    q = 10.0 ** decimals
+    o = np.round(orig * q) / q
+    step = np.trunc(np.round((geo - o) * q, 6))
+    if not step.any():
+        return None          # every move undone: the subpath is written back as it was
+    return o + step / q
+
+
+def _record_geometry(recs: list[CurveRecord], decimals: int | None = None
+                     ) -> tuple[str, FloatArray | None]:
     """``("bspline", Bezier points (m, 4, 2))`` or ``("points", vertices (n, 2))`` of one
     subpath / shape, in the ELEMENT's own coordinates (the inverse of its transformation
-    matrix applied), or ``(kind, None)`` when the record(s) hold the geometry read."""
+    matrix applied), or ``(kind, None)`` when the record(s) hold the geometry read. With
+    ``decimals``, rounded to them toward the input's values (:func:`_toward`)."""
     r0 = recs[0]
     ctm = _ctm(r0.source)
     if r0.kind == "bspline":
@@ -923,7 +948,7 @@ def _record_geometry(recs: list[CurveRecord]) -> tuple[str, FloatArray | None]:
         scale = max(float(np.abs(orig).max()) if orig.size else 1.0, 1.0)
         if orig.shape == B.shape and np.abs(orig - B).max() <= 1e-12 * scale:
             return "bspline", None
-        return "bspline", _unapply(ctm, B)
+        return "bspline", _toward(_unapply(ctm, B), _unapply(ctm, orig), decimals)
     n = int(r0.source["n_points"])
     dim = data_points(r0.curve, "write_curves (SVG)").shape[1]
     pts = piece_values(n, dim, recs, "write_curves (SVG)")
@@ -932,13 +957,13 @@ def _record_geometry(recs: list[CurveRecord]) -> tuple[str, FloatArray | None]:
         orig[np.asarray(r.source["indices"])] = np.asarray(r.points)
     if np.array_equal(orig, pts):
         return "points", None
-    full = pts[np.asarray(r0.source.get("row_map", range(n)), dtype=int)]
-    return "points", _unapply(ctm, full)
+    rows = np.asarray(r0.source.get("row_map", range(n)), dtype=int)
+    return "points", _toward(_unapply(ctm, pts[rows]), _unapply(ctm, orig[rows]), decimals)
 
 
 def _record_d(recs: list[CurveRecord], decimals: int | None) -> tuple[str, bool]:
     """The d of one subpath from its record(s), and whether it changed."""
-    kind, geo = _record_geometry(recs)
+    kind, geo = _record_geometry(recs, decimals)
     if geo is None:
         return "", False
     r0 = recs[0]
@@ -1095,7 +1120,10 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
         el = nodes[node]
         tag = _local(el.tag)
         if tag != "path":
-            kind, geo = _record_geometry(subs[0])
+            dec = decimals if decimals is not None else _element_decimals(
+                el.get("points") or "", precision)
+            kind, geo = _record_geometry(subs[0], dec if tag in ("polygon", "polyline")
+                                         else None)
             if geo is None:
                 continue
             if tag == "rect":
@@ -1107,8 +1135,6 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
                         el.get(name) or "", precision)
                     edit(node, name, _num(v, dec))
                 continue
-            dec = decimals if decimals is not None else _element_decimals(
-                el.get("points") or "", precision)
             edit(node, "points", " ".join(_pt(p, dec) for p in geo))
             continue
         parsed = spt.parse_path(el.get("d"))
