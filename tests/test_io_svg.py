@@ -498,3 +498,71 @@ def test_open_path_ending_at_its_start_stays_open(tmp_path):
     write_curves(tmp_path / "pl2.svg", moved, template=q)
     d2 = spt.svg2paths(str(tmp_path / "pl2.svg"))[1][0]["d"]
     assert "z" not in d2.lower() and d2.count("L") == 4, d2
+
+
+# a command after a closepath starts a new subpath at the closed one's initial point
+# (SVG 1.1 sec. 8.3.3); svgpathtools joins the two into one continuous subpath
+LOOP_THEN_TAIL = ("M10,10 C 60,0 110,20 160,10 C 170,60 150,110 160,160 "
+                  "C 110,170 60,150 10,160 Z C 40,60 60,90 100,100 C 140,110 150,140 160,160")
+
+
+def _loop_svg(tmp_path, d=LOOP_THEN_TAIL):
+    src = tmp_path / "loop.svg"
+    src.write_text('<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 200 200">\n'
+                   f'<path id="p" d="{d}" fill="none" stroke="black"/>\n</svg>\n')
+    return src
+
+
+@pytest.mark.parametrize("d", [LOOP_THEN_TAIL, LOOP_THEN_TAIL.replace("Z C", "z m 0,0 C")])
+def test_closepath_then_a_drawing_command_is_two_subpaths(tmp_path, d):
+    """Read: the loop (closed by its Z, 4 segments with the closing line) and the tail from
+    its initial point are two curves. Before, they were one open curve of 6 segments, and
+    the write-back dropped the Z (the closing line became a cubic in an open subpath)."""
+    recs = read_curves(_loop_svg(tmp_path, d), corner_angle=None)
+    assert [r.source["subpath"] for r in recs] == [0, 1]
+    loop, tail = recs
+    assert loop.source["svg_closed"]        # (a corner at its start: read as an open chain)
+    for u in loop.curve.domain:
+        np.testing.assert_allclose(loop.curve(u), [10.0, 10.0], rtol=0, atol=1e-12)
+    assert not tail.source["svg_closed"] and not tail.curve.closed
+    np.testing.assert_allclose(tail.curve(tail.curve.domain[0]), [10.0, 10.0], atol=1e-12)
+    np.testing.assert_allclose(tail.curve(tail.curve.domain[1]), [160.0, 160.0], atol=1e-12)
+
+
+def test_closepath_then_a_drawing_command_is_written_back_with_both_subpaths(tmp_path):
+    """Only the loop changed, its start point moved: the tail keeps its text and starts
+    where it did (an ``M`` with its old start written before it), the loop keeps its Z.
+    svgpathtools reads the tail's segments exactly as in the input."""
+    src = _loop_svg(tmp_path)
+    loop, tail = read_curves(src, corner_angle=None)
+    q = np.array(loop.curve.control_points) + [0.4, -0.3]
+    out = tmp_path / "out.svg"
+    write_curves(out, [loop.with_curve(loop.curve.replace(control_points=q)), tail],
+                 template=src)
+    d1 = re.search(r' d="([^"]*)"', out.read_text()).group(1)
+    assert d1.endswith("Z M 10,10 C 40,60 60,90 100,100 C 140,110 150,140 160,160")
+    p0, p1 = spt.parse_path(LOOP_THEN_TAIL), spt.parse_path(d1)
+    assert list(p1)[-2:] == list(p0)[-2:]                  # the tail exactly as it was
+    assert list(p1)[3].end == list(p1)[0].start            # the loop closed on itself
+    assert abs(list(p1)[0].start - (10.4 + 9.7j)) < 1e-9
+    back = read_curves(out, corner_angle=None)
+    assert [r.source["svg_closed"] for r in back] == [True, False]
+
+
+def test_closepath_then_a_drawing_command_through_the_cli(tmp_path):
+    """Faired by the command: both subpaths kept (the loop closed by its Z), every node and
+    handle within tol of the input, read back with svgpathtools."""
+    from test_cli import assert_user_error, cli
+    src = _loop_svg(tmp_path)
+    res = cli(["fair", src.name, "--tol", "2", "-o", "out.svg", "-q"], tmp_path)
+    assert_user_error(res, 0)
+    d1 = re.search(r' d="([^"]*)"', (tmp_path / "out.svg").read_text()).group(1)
+    pieces = [x for x in re.split(r"(?=[Mm])", d1.strip()) if x]
+    assert len(pieces) == 2 and pieces[0].rstrip().endswith("Z")
+    a, b = list(spt.parse_path(LOOP_THEN_TAIL)), list(spt.parse_path(d1))
+    assert len(a) == len(b)
+    for ga, gb in zip(a, b, strict=True):
+        pa, pb = list(ga.bpoints()), list(gb.bpoints())
+        if len(pa) != len(pb):                 # the closing line written as a cubic
+            pa, pb = [pa[0], pa[-1]], [pb[0], pb[-1]]
+        assert max(abs(x - y) for x, y in zip(pa, pb, strict=True)) <= 2.0

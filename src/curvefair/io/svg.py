@@ -620,7 +620,7 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
         except Exception as exc:  # svgpathtools raises ValueError/IndexError on bad data
             raise FileFormatError(f"<path> element {k} (id={ident!r}): bad path data "
                                   f"({type(exc).__name__}: {exc})", path) from None
-        subs = parsed.continuous_subpaths() if len(parsed) else []
+        subs = _subpaths(d, parsed, spt)
         zs = _closed_by_z(d, parsed, subs, spt)
         for j, sub in enumerate(subs):
             name = f"{ident or 'path' + str(k)}" + (f"/{j}" if len(subs) > 1 else "")
@@ -812,24 +812,31 @@ def _d_original(sub: Any, spt: Any, decimals: int | None) -> str:
 
 
 _MOVETO_RE = re.compile(r"[Mm]")
+_CLOSE_RE = re.compile(r"[Zz]")
 _NUM_RE = re.compile(r"[-+]?[0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?")
 
 
-def _subpath_spans(d: str, parsed: Any, spt: Any
-                   ) -> list[tuple[int, int, complex, complex]] | None:
-    """The text of each continuous subpath of ``d`` (svgpathtools' ``continuous_subpaths``
-    of ``parsed``): ``(start, end, current point before, current point after)`` with
-    ``d[start:end]`` its commands (trailing blanks excluded), or None when the text does not
-    split so (then the caller re-renders).
+def _split_subpaths(d: str, parsed: Any, spt: Any
+                    ) -> list[tuple[int, int, complex, complex, list[Any]]] | None:
+    """The subpaths of ``d`` as curvefair reads them: ``(start, end, current point before,
+    current point after, segments)`` with ``d[start:end]`` a subpath's commands (trailing
+    blanks excluded), or None when the text does not split so (then the callers fall back on
+    svgpathtools' ``continuous_subpaths`` of ``parsed``, and the writer re-renders).
 
-    The text is cut before every moveto (``M``/``m``: SVG 1.1 sec. 8.3.3; only a moveto starts
-    a new subpath, so a discontinuity is always at a cut) and each piece parsed by
-    svgpathtools from the current point the previous pieces leave (a relative ``m`` is
-    relative to it); the pieces must give exactly the segments of the whole path. Pieces
-    whose segments join continuously (an ``m 0,0``) belong to one subpath."""
+    The text is cut before every moveto (``M``/``m``: SVG 1.1 sec. 8.3.3) and after every
+    closepath (``z``/``Z``) that another command follows: that command starts a new subpath at
+    the closed one's initial point (sec. 8.3.3), which svgpathtools joins to the closed one as
+    one continuous subpath (a loop then lost its ``Z`` and the closing line became a cubic on
+    write-back). Each piece is parsed by svgpathtools from the current point the previous
+    pieces leave (a relative ``m`` is relative to it); the pieces must give exactly the
+    segments of the whole path. A piece whose segments join the previous piece's continuously
+    (an ``m 0,0``) belongs to the same subpath, unless the previous one was closed."""
     cuts = [m.start() for m in _MOVETO_RE.finditer(d)]
     if not cuts or d[:cuts[0]].strip():
         return None
+    after_z = {m.end() for m in _CLOSE_RE.finditer(d)
+               if d[m.end():].lstrip(" \t\r\n,")[:1] not in ("", "M", "m")}
+    cuts = sorted(set(cuts) | after_z)
     cuts.append(len(d))
     groups: list[tuple[int, int, complex, complex, list[Any]]] = []
     cp = 0j
@@ -846,15 +853,33 @@ def _subpath_spans(d: str, parsed: Any, spt: Any
     flat = [g for grp in groups for g in grp[4]]
     if len(flat) != len(parsed) or any(x != y for x, y in zip(flat, parsed, strict=True)):
         return None
-    out: list[tuple[int, int, complex, complex]] = []
+    out: list[tuple[int, int, complex, complex, list[Any]]] = []
     for a, b, before, after, segs in groups:
-        if out and segs[0].start == out[-1][3]:        # continuous: same subpath
-            out[-1] = (out[-1][0], b, out[-1][2], after)
+        if (out and segs[0].start == out[-1][3]       # continuous: same subpath,
+                and d[out[-1][0]:out[-1][1]][-1:] not in ("z", "Z")):  # unless closed
+            out[-1] = (out[-1][0], b, out[-1][2], after, out[-1][4] + segs)
         else:
-            out.append((a, b, before, after))
-    if len(out) != len(parsed.continuous_subpaths()):
-        return None
+            out.append((a, b, before, after, segs))
     return out
+
+
+def _subpath_spans(d: str, parsed: Any, spt: Any
+                   ) -> list[tuple[int, int, complex, complex]] | None:
+    """``(start, end, current point before, current point after)`` of each subpath of
+    :func:`_split_subpaths`, or None."""
+    split = _split_subpaths(d, parsed, spt)
+    return None if split is None else [g[:4] for g in split]
+
+
+def _subpaths(d: str, parsed: Any, spt: Any) -> list[Any]:
+    """The subpaths of a ``<path>`` as svgpathtools ``Path`` objects, cut as in
+    :func:`_split_subpaths` (svgpathtools' continuous subpaths when the text does not split)."""
+    if not len(parsed):
+        return []
+    split = _split_subpaths(d, parsed, spt)
+    if split is None:
+        return list(parsed.continuous_subpaths())
+    return [spt.Path(*g[4]) for g in split]
 
 
 def _splice_subpaths(d: str, parsed: Any, new: dict[int, str], spt: Any) -> str | None:
@@ -864,7 +889,9 @@ def _splice_subpaths(d: str, parsed: Any, new: dict[int, str], spt: Any) -> str 
     A subpath that follows a replaced one and starts with a relative ``m`` is relative to
     the current point the replaced one leaves; when that point changed, its moveto is
     written absolute (``M x,y``, then ``l`` for implicit coordinate pairs after it, SVG 1.1
-    sec. 8.3.2), the rest of its text unchanged."""
+    sec. 8.3.2), the rest of its text unchanged. One that starts with a drawing command
+    after a closepath starts at the closed subpath's initial point: when the replaced text
+    moved that point, ``M x,y`` with the point as it was is written before it."""
     spans = _subpath_spans(d, parsed, spt)
     if spans is None:
         return None
@@ -874,7 +901,8 @@ def _splice_subpaths(d: str, parsed: Any, new: dict[int, str], spt: Any) -> str 
     for j, (a, b, before, after) in enumerate(spans):
         out.append(d[pos:a])
         if j in new:
-            out.append(new[j])
+            kept = d[a:b]
+            out.append(kept[:len(kept) - len(kept.lstrip())] + new[j])  # its leading blanks
             try:
                 segs = list(spt.parse_path(new[j]))
             except Exception:  # noqa: BLE001
@@ -882,7 +910,13 @@ def _splice_subpaths(d: str, parsed: Any, new: dict[int, str], spt: Any) -> str 
             moved = not segs or segs[-1].end != after
         else:
             text = d[a:b]
-            if moved and text[0] == "m":
+            if moved and text[0] not in "Mm":
+                # drawn from the initial point of the closed subpath before it (a command
+                # after a closepath), which the replaced text moved: start it where it was
+                body = text.lstrip()
+                text = (text[:len(text) - len(body)] or " ") + \
+                    f"M {_num(before.real, None)},{_num(before.imag, None)} {body}"
+            elif moved and text[0] == "m":
                 start = _subpath_start(text, before, spt)
                 if start is None:
                     return None
@@ -1138,8 +1172,8 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
             edit(node, "points", " ".join(_pt(p, dec) for p in geo))
             continue
         parsed = spt.parse_path(el.get("d"))
-        originals = parsed.continuous_subpaths()
         d_text = el.get("d") or ""
+        originals = _subpaths(d_text, parsed, spt)
         changed = any(_record_d(subs[j], None)[1] for j in subs)
         if not changed:
             continue
