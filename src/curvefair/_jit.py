@@ -238,11 +238,10 @@ def njit(*args: Any, readonly: tuple[str, ...] = (), any_layout: tuple[str, ...]
     ``readonly`` names array parameters that the kernel only reads, ``any_layout`` array
     parameters that some callers pass as strided views: a call from Python compiles the kernel
     for them typed as read-only arrays, or arrays of any layout, whatever the flags of the
-    arrays passed. numba
-    compiles one machine code per distinct argument type, and an array's writeable flag and
-    contiguity are part of its type: a kernel fed a curve's frozen coefficients by one caller
-    and fresh ones by another was compiled twice (2 to 5 times for 36 kernels, a third of the
-    compile time of a fresh install). numba converts a writable (or contiguous) array to the
+    arrays passed. numba compiles one machine code per distinct argument type, and an array's
+    writeable flag and contiguity are part of its type: a kernel fed a curve's frozen
+    coefficients by one caller and fresh ones by another was compiled twice (36 kernels 2 to 5
+    times). numba converts a writable (or contiguous) array to the
     read-only (any-layout) type of an existing machine code by itself, so after the first call
     every variant of the arguments runs the same code. Calls from other kernels are typed by
     the caller as usual."""

@@ -620,8 +620,7 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
         except Exception as exc:  # svgpathtools raises ValueError/IndexError on bad data
             raise FileFormatError(f"<path> element {k} (id={ident!r}): bad path data "
                                   f"({type(exc).__name__}: {exc})", path) from None
-        subs = _subpaths(d, parsed, spt)
-        zs = _closed_by_z(d, parsed, subs, spt)
+        subs, zs = _subpaths(d, parsed, spt)
         for j, sub in enumerate(subs):
             name = f"{ident or 'path' + str(k)}" + (f"/{j}" if len(subs) > 1 else "")
             sbase = dict(base, subpath=j, n_subpaths=len(subs), svg_closed=zs[j])
@@ -707,21 +706,6 @@ def _degenerate(g: Any, spt: Any, tiny: float = 0.0) -> bool:
         return True
     return bool(all(max(abs(z.real - g.start.real), abs(z.imag - g.start.imag)) <= tiny
                     for z in pts))
-
-
-def _closed_by_z(d: str, parsed: Any, subs: list[Any], spt: Any) -> list[bool]:
-    """For every continuous subpath: closed by a ``z``/``Z`` command (it ends where it
-    starts and its text ends with the closepath). An open subpath that merely ends at its
-    start point is drawn with two caps, not a join, and is written back without ``Z``.
-    When the text does not split into the subpaths, where it ends at its start."""
-    geo = [bool(sub.isclosed()) for sub in subs]
-    if not any(geo):
-        return geo
-    spans = _subpath_spans(d, parsed, spt)
-    if spans is None or len(spans) != len(subs):
-        return geo
-    return [c and d[a:b].rstrip()[-1:] in ("z", "Z")
-            for c, (a, b, _, _) in zip(geo, spans, strict=True)]
 
 
 def _subpath_records(sub: Any, spt: Any, base: dict[str, Any], name: str,
@@ -871,15 +855,22 @@ def _subpath_spans(d: str, parsed: Any, spt: Any
     return None if split is None else [g[:4] for g in split]
 
 
-def _subpaths(d: str, parsed: Any, spt: Any) -> list[Any]:
+def _subpaths(d: str, parsed: Any, spt: Any) -> tuple[list[Any], list[bool]]:
     """The subpaths of a ``<path>`` as svgpathtools ``Path`` objects, cut as in
-    :func:`_split_subpaths` (svgpathtools' continuous subpaths when the text does not split)."""
+    :func:`_split_subpaths` (svgpathtools' continuous subpaths when the text does not split),
+    and for each whether a closepath closed it: it ends where it starts and its text ends
+    with ``z``/``Z``. An open subpath that merely ends at its start point is drawn with two
+    caps, not a join, and is written back without ``Z``; when the text does not split, a
+    subpath ending at its start counts as closed."""
     if not len(parsed):
-        return []
+        return [], []
     split = _split_subpaths(d, parsed, spt)
     if split is None:
-        return list(parsed.continuous_subpaths())
-    return [spt.Path(*g[4]) for g in split]
+        subs = list(parsed.continuous_subpaths())
+        return subs, [bool(sub.isclosed()) for sub in subs]
+    subs = [spt.Path(*g[4]) for g in split]
+    return subs, [bool(sub.isclosed()) and d[a:b][-1:] in ("z", "Z")
+                  for sub, (a, b, _, _, _) in zip(subs, split, strict=True)]
 
 
 def _splice_subpaths(d: str, parsed: Any, new: dict[int, str], spt: Any) -> str | None:
@@ -1154,10 +1145,10 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
         el = nodes[node]
         tag = _local(el.tag)
         if tag != "path":
-            dec = decimals if decimals is not None else _element_decimals(
-                el.get("points") or "", precision)
-            kind, geo = _record_geometry(subs[0], dec if tag in ("polygon", "polyline")
-                                         else None)
+            dec = None if tag not in ("polygon", "polyline") else (
+                decimals if decimals is not None
+                else _element_decimals(el.get("points") or "", precision))
+            kind, geo = _record_geometry(subs[0], dec)
             if geo is None:
                 continue
             if tag == "rect":
@@ -1173,7 +1164,6 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
             continue
         parsed = spt.parse_path(el.get("d"))
         d_text = el.get("d") or ""
-        originals = _subpaths(d_text, parsed, spt)
         changed = any(_record_d(subs[j], None)[1] for j in subs)
         if not changed:
             continue
@@ -1194,7 +1184,7 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
         spliced = _splice_subpaths(d_text, parsed, new_d, spt)
         if spliced is None:        # text not split into subpaths: every subpath re-rendered
             spliced = " ".join(new_d[j] if j in new_d else _d_original(sub, spt, None)
-                               for j, sub in enumerate(originals))
+                               for j, sub in enumerate(_subpaths(d_text, parsed, spt)[0]))
         edit(node, "d", spliced)
     for a, b, new in sorted(edits, reverse=True):
         raw = raw[:a] + new.encode("utf-8") + raw[b:]
