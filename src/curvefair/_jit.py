@@ -267,7 +267,9 @@ def _canonical_types(disp: Any, ro: list[int], anyl: list[int]) -> None:
     """Make ``disp`` compile a call's signature with the arrays at positions ``ro`` read-only
     and those at ``anyl`` of layout ``A`` (see :func:`njit`). numba's C dispatcher
     asks the instance's ``_compile_for_args`` for machine code when no compiled signature
-    accepts the arguments, then calls what it returns with the arguments as they are."""
+    accepts the arguments, then calls what it returns with the arguments as they are; the
+    arguments' own types are then registered as another key of that machine code, so the next
+    such call is dispatched in C."""
     plain = disp._compile_for_args
 
     def _compile_for_args(*args: Any, **kws: Any) -> Any:
@@ -287,7 +289,15 @@ def _canonical_types(disp: Any, ro: list[int], anyl: list[int]) -> None:
         if canon == tys:
             return plain(*args)
         disp._compilation_chain_init_hook()
-        return disp.compile(tuple(canon))
+        entry = disp.compile(tuple(canon))
+        # While compiling is allowed, the C dispatcher takes only an exact match of the argument
+        # types and would come back here on every call (typing every argument in Python: 0.1-2
+        # ms a call). Register these exact types as another key of the same machine code: its
+        # wrapper unboxes the arguments with the canonical types, which accept these arrays
+        # (the same array structure; only the flags differ). ``disp.overloads`` (and so the
+        # disk cache) keeps the canonical signature only.
+        disp._insert([t._code for t in tys], entry, False)
+        return entry
 
     disp._compile_for_args = _compile_for_args
 
