@@ -68,9 +68,26 @@ def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line("markers", "slow: takes more than ~20 s")
 
 
+#: test files whose tests run curvefair in fresh interpreters (CLI subprocesses, process pools,
+#: the recorded cases of test_reproducible.py): collected last, so that on a cold kernel cache
+#: those interpreters load the kernels the in-process tests compiled and saved before them
+#: instead of each compiling its own (test_reproducible's fresh interpreter compiled every
+#: method's kernels while the workers compiled them too: 150-180 s, the longest test of
+#: CI's second run). pytest-xdist's worksteal keeps this order within each worker's queue.
+LATE_FILES = frozenset({
+    "test_reproducible.py",
+    "test_batch.py",
+    "test_batch_chunked.py",
+    "test_batch_progress_tty.py",
+    "test_cli.py",
+    "test_cli_write.py",
+})
+
+
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     for item in items:
         if item.path.name in COMPILED_FILES:
             item.add_marker(pytest.mark.compiled)
         if item.path.name in SLOW_FILES:
             item.add_marker(pytest.mark.slow)
+    items.sort(key=lambda it: it.path.name in LATE_FILES)  # stable: the order within is kept
