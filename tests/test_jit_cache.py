@@ -258,6 +258,40 @@ def test_canonical_kernel_calls_are_dispatched_in_c_after_the_first():
     assert len(canon.signatures) == 1
 
 
+def test_canonical_kernel_first_called_from_many_threads_at_once():
+    """Threads that make a kernel's first call together (curvefair's ranges run kernels in
+    threads) all get its value, and later calls still resolve (each thread may register the
+    arguments' types as a key of the machine code: the same key twice is harmless)."""
+    import threading
+
+    import numpy as np
+
+    _, canon = _kernels()
+    rng = np.random.default_rng(5)
+    x = rng.standard_normal((7, 2))
+    w = rng.standard_normal(7)
+    want = float(np.sum(x * w[:, None]))
+    barrier = threading.Barrier(8)
+    got: list[float] = []
+    errors: list[BaseException] = []
+
+    def call() -> None:
+        try:
+            barrier.wait()
+            got.append(canon(x, w, np.zeros(1)))
+        except BaseException as exc:  # reported below
+            errors.append(exc)
+
+    threads = [threading.Thread(target=call) for _ in range(8)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert not errors, errors
+    np.testing.assert_allclose(got, [want] * 8, rtol=1e-13)
+    np.testing.assert_allclose(canon(x, w, np.zeros(1)), want, rtol=1e-13)
+
+
 def test_readonly_names_must_be_parameters_and_stay_unwritten():
     import numpy as np
     from numba.core.errors import TypingError
