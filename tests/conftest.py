@@ -71,9 +71,9 @@ def pytest_configure(config: pytest.Config) -> None:
 #: test files whose tests run curvefair in fresh interpreters (CLI subprocesses, process pools,
 #: the recorded cases of test_reproducible.py): collected last, so that on a cold kernel cache
 #: those interpreters load the kernels the in-process tests compiled and saved before them
-#: instead of each compiling its own (test_reproducible's fresh interpreter compiled every
-#: method's kernels while the workers compiled them too: 150-180 s, the longest test of
-#: CI's second run). pytest-xdist's worksteal keeps this order within each worker's queue.
+#: instead of each compiling its own (test_reproducible's fresh interpreter compiles every
+#: method's kernels: 180 s in one second-run measurement, under 8 s when collected last).
+#: pytest-xdist's worksteal keeps this order within each worker's queue.
 LATE_FILES = frozenset({
     "test_reproducible.py",
     "test_batch.py",
