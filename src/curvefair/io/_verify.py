@@ -35,6 +35,7 @@ from ..errors import CurvefairError, InputError
 from ._common import CurveRecord, atomic_path, points_curve
 
 if TYPE_CHECKING:
+    from ..curves.bspline import BSplineCurve
     from ..curves.hermite import CubicHermite
 
 __all__ = ["WriteCheck", "WriteCheckError", "write_checked", "rescaled_report"]
@@ -343,13 +344,21 @@ def _svg_point_displacement(ref: CurveRecord, back: CurveRecord) -> tuple[float,
     return d, slack
 
 
+def _moved_by(p0: FloatArray, p1: FloatArray, s: float) -> FloatArray:
+    """``p0 + s (p1 - p0)``, with the points that did not move (corners, clamped ends,
+    protected points) kept bit for bit."""
+    p0 = np.asarray(p0, dtype=np.float64)
+    p1 = np.asarray(p1, dtype=np.float64)
+    pts = p0 + s * (p1 - p0)
+    same = np.all(p1 == p0, axis=1)
+    pts[same] = p0[same]
+    return pts
+
+
 def _scaled(rec: CurveRecord, ref: CurveRecord, s: float) -> CurveRecord:
     """``rec`` with its data points moved ``s`` times as far from ``ref``'s as faired."""
-    p0 = np.asarray(cast("CubicHermite", ref.curve).points, dtype=np.float64)
-    p1 = np.asarray(cast("CubicHermite", rec.curve).points, dtype=np.float64)
-    pts = p0 + s * (p1 - p0)
-    # keep exactly the points that did not move (corners, clamped ends, protected points)
-    pts[np.all(p1 == p0, axis=1)] = p0[np.all(p1 == p0, axis=1)]
+    pts = _moved_by(cast("CubicHermite", ref.curve).points,
+                    cast("CubicHermite", rec.curve).points, s)
     return rec.with_curve(points_curve(pts, bool(rec.curve.closed)))
 
 
@@ -365,13 +374,9 @@ def _bspline_shrinkable(rec: CurveRecord, ref: CurveRecord) -> bool:
 
 def _scaled_bspline(rec: CurveRecord, ref: CurveRecord, s: float) -> CurveRecord:
     """``rec`` (a B-spline record) with its control points moved ``s`` times as far from
-    ``ref``'s as faired, on its own knots; points that did not move are kept bit for bit."""
-    c0 = np.asarray(cast("Any", ref.curve).control_points, dtype=np.float64)
-    curve = cast("Any", rec.curve)
-    c1 = np.asarray(curve.control_points, dtype=np.float64)
-    pts = c0 + s * (c1 - c0)
-    same = np.all(c1 == c0, axis=1)
-    pts[same] = c0[same]
+    ``ref``'s as faired, on its own knots (see :func:`_bspline_shrinkable`)."""
+    curve = cast("BSplineCurve", rec.curve)
+    pts = _moved_by(cast("BSplineCurve", ref.curve).control_points, curve.control_points, s)
     return rec.with_curve(curve.replace(control_points=pts))
 
 
@@ -508,28 +513,27 @@ def write_checked(path: str | os.PathLike[str], records: Sequence[CurveRecord],
                                       f"be measured against the input ({exc})") from None
             if fmt == "svg" and tol is not None and _shapes_agree(reference, back):
                 # every node, handle and vertex within tol too, not only the curve
-                nudge: list[tuple[int, float]] = []
+                nudge: dict[int, float] = {}  # curve -> the scale-down of its moves
                 for i, (r, b) in enumerate(zip(reference, back, strict=True)):
                     pd = _svg_point_displacement(r, b)
                     if pd is None or not pd[0] > tol:
                         continue
-                    if pd[0] <= tol + pd[1] and _bspline_shrinkable(records[i], reference[i]):
-                        nudge.append((i, pd[1]))  # rounding of the Bezier points: see below
+                    if (pd[0] <= tol + pd[1] and _attempt < _MAX_SHRINK
+                            and _bspline_shrinkable(records[i], reference[i])):
+                        nudge[i] = 8.0 * pd[1] / float(tol)
                     else:
                         devs[i] = max(devs[i], pd[0])
-                if nudge and _attempt < _MAX_SHRINK:
+                if nudge:
                     # a node or handle over tol by rounding only (the control points are
                     # within tol, the Bezier points are convex combinations of them, computed
                     # in float): scale the curve's moves down by 8 allowances and write again
-                    for i, slack in nudge:
-                        scale[i] *= 1.0 - 8.0 * slack / float(tol)
+                    for i, down in nudge.items():
+                        scale[i] *= 1.0 - down
                         recs[i] = _scaled_bspline(records[i], reference[i], scale[i])
                     notes.append(f"{len(nudge)} curve(s) had a node or handle over tol by "
                                  "rounding only; their moves were scaled down by at most "
-                                 f"{max(8.0 * sl / float(tol) for _, sl in nudge):.1e}")
+                                 f"{max(nudge.values()):.1e}")
                     continue
-                for i, _slack in nudge:
-                    devs[i] = max(devs[i], tol + _slack)
             over = [i for i, d in enumerate(devs) if tol is not None and not d <= tol]
             undone = ([i for i, d in enumerate(devs) if d == 0.0
                        and not _same_curve(records[i].curve, reference[i].curve)]
