@@ -387,6 +387,78 @@ def _shrinkable(rec: CurveRecord, ref: CurveRecord) -> bool:
             and a.shape == b.shape)
 
 
+#: The largest turn, in degrees, that rounding a rewritten SVG element's numbers may open at
+#: a join of a Bezier chain that is smooth in the input (handles parallel: the reader makes
+#: the B-spline C1 there, and fairing keeps it so). Rounded independently, the two handles of
+#: such a join point apart: a handle 2.3 units long rounded to one decimal turns by up to
+#: 1.8 degrees (Font Awesome 3.svg at tol 0.3), a visible kink in a curve the user had smooth.
+SMOOTH_JOIN_TURN = 0.01
+
+
+def _join_turns(B: FloatArray, closed: bool | None = None) -> tuple[FloatArray, FloatArray]:
+    """The turn (radians) at each join of the Bezier chain ``B`` (m, 4, dim), the closing
+    join included when ``closed`` (None: when the chain ends exactly at its start), and
+    whether the join is smooth by the reader's test
+    (:func:`curvefair.io.svg.bezier_chain_to_bspline`: both handles longer than 1e-12 of the
+    chain's size, parallel to 1e-9, same direction). A handle of zero length is replaced by
+    the next point of its segment (the tangent direction there)."""
+    B = np.asarray(B, dtype=np.float64)
+    m = B.shape[0]
+    if closed is None:
+        closed = bool(np.array_equal(B[-1, 3], B[0, 0]))
+    i = np.arange(m if closed and m > 1 else m - 1)
+    j = (i + 1) % m
+    scale = max(float(np.abs(B).max()), 1.0)
+
+    def direction(pts: FloatArray) -> tuple[FloatArray, FloatArray]:
+        # pts[:, k]: the node, then the handles outward; the first one off the node
+        v = pts[:, 1] - pts[:, 0]
+        first = np.linalg.norm(v, axis=1)
+        for k in (2, 3):
+            short = np.linalg.norm(v, axis=1) <= 1e-12 * scale
+            v[short] = pts[short, k] - pts[short, 0]
+        return v, first
+
+    a, na0 = direction(B[i][:, ::-1])      # incoming: P3 - P2 (sign reversed below)
+    a = -a
+    b, nb0 = direction(B[j])              # outgoing: Q1 - Q0
+    na, nb = np.linalg.norm(a, axis=1), np.linalg.norm(b, axis=1)
+    if B.shape[2] == 2:
+        cross = np.abs(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])
+    else:
+        cross = np.linalg.norm(np.cross(a, b), axis=1)
+    dot = np.einsum("ij,ij->i", a, b)
+    turn = np.arctan2(cross, dot)
+    smooth = ((na0 > 1e-12 * scale) & (nb0 > 1e-12 * scale)
+              & (cross <= 1e-9 * na * nb) & (dot > 0))
+    return turn, smooth
+
+
+def _opened_joins(ref: CurveRecord, faired: CurveRecord, back: CurveRecord) -> float:
+    """SVG: the largest turn (degrees) the file read back has at a join that is smooth in
+    the input and in the faired curve (turn at most :data:`SMOOTH_JOIN_TURN` / 100), 0.0
+    when there is none or the segments cannot be paired one to one."""
+    if not (ref.kind == "bspline" and back.kind == "bspline"):
+        return 0.0
+    b0 = np.asarray(ref.source.get("beziers", []), dtype=np.float64)
+    b1 = np.asarray(back.source.get("beziers", []), dtype=np.float64)
+    if b0.ndim != 3 or b0.shape != b1.shape or b0.shape[0] < 1:
+        return 0.0
+    from ._common import bezier_pieces
+    try:
+        bf = bezier_pieces(faired.curve, "write_checked", max_degree=3)
+    except CurvefairError:
+        return 0.0
+    if bf.shape != b0.shape:
+        return 0.0
+    closed = bool(np.array_equal(b0[-1, 3], b0[0, 0]))
+    t0, smooth = _join_turns(b0, closed)
+    tf, _ = _join_turns(bf, closed)
+    t1, _ = _join_turns(b1, closed)
+    keep = smooth & (np.degrees(tf) <= SMOOTH_JOIN_TURN / 100)
+    return float(np.degrees(t1[keep]).max()) if keep.any() else 0.0
+
+
 #: SVG write-backs round a rewritten element's numbers to its own decimals first, then to
 #: :data:`curvefair.io.svg.MORE_DECIMALS` more, then write them exactly (what the notes say).
 _SVG_PRECISION = {"file": "the elements' own decimals",
@@ -548,6 +620,24 @@ def write_checked(path: str | os.PathLike[str], records: Sequence[CurveRecord],
                              + f" were undone; {_SVG_NEXT[precision]}")
                 precision = _svg_next(precision)
                 continue
+            if (not over and fmt == "svg" and precision in ("file", "file+", "decimals")
+                    and _shapes_agree(reference, back)):
+                # rounding must not kink a join the user had smooth (handles rounded apart)
+                turns = [_opened_joins(r, f, b)
+                         for r, f, b in zip(reference, recs, back, strict=True)]
+                kinked = [i for i, t in enumerate(turns) if t > SMOOTH_JOIN_TURN]
+                if kinked:
+                    worst = max(kinked, key=lambda i: turns[i])
+                    what = (f"{_label(reference[worst], worst)} turned {turns[worst]:.3g} "
+                            "degrees at a join smooth in the input"
+                            + (f" ({len(kinked)} curves)" if len(kinked) > 1 else ""))
+                    if precision == "decimals":
+                        notes.append(f"rounded to --decimals {decimals}, {what}")
+                    else:
+                        notes.append(f"rounded to {_SVG_PRECISION[precision]}, {what}; "
+                                     f"{_SVG_NEXT[precision]}")
+                        precision = _svg_next(precision)
+                        continue
             if not over:
                 return WriteCheck(max(devs, default=0.0), tuple(devs), tuple(kinds), mpd,
                                   precision, tuple(scale), tuple(notes), tuple(curves))
