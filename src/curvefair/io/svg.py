@@ -761,10 +761,31 @@ def _pt(p: Any, decimals: int | None) -> str:
     return f"{_num(p[0], decimals)},{_num(p[1], decimals)}"
 
 
-def _d_cubics(B: FloatArray, closed: bool, decimals: int | None) -> str:
+def _straight(B: FloatArray) -> np.ndarray:
+    """Which segments of the Bezier chain ``B`` (m, 4, dim) are straight lines drawn evenly:
+    handles at the thirds of the chord to 1e-9 of the chain's size -- what the reader makes
+    of an ``L``, ``H`` or ``V`` (degree elevation), and what a faired curve keeps of such a
+    segment that it did not bend. They are written back as ``L``: exactly straight in the
+    file, where two handles rounded to the element's decimals would bend the line (by a
+    rounding-level amount, but with curvature of alternating sign: inflections a curvature
+    plot shows)."""
+    B = np.asarray(B, dtype=np.float64)
+    if B.size == 0:
+        return np.zeros(0, dtype=bool)
+    scale = max(float(np.abs(B).max()), 1.0)
+    h1 = (2.0 * B[:, 0] + B[:, 3]) / 3.0
+    h2 = (B[:, 0] + 2.0 * B[:, 3]) / 3.0
+    err = np.maximum(np.abs(B[:, 1] - h1).max(axis=1), np.abs(B[:, 2] - h2).max(axis=1))
+    return np.asarray(err <= 1e-9 * scale)
+
+
+def _d_cubics(B: FloatArray, closed: bool, decimals: int | None,
+              lines: np.ndarray | None = None) -> str:
+    """A subpath of cubic segments, ``lines[i]`` (:func:`_straight`) written as ``L``."""
     parts = [f"M {_pt(B[0, 0], decimals)}"]
-    parts += [f"C {_pt(b[1], decimals)} {_pt(b[2], decimals)} {_pt(b[3], decimals)}"
-              for b in B]
+    parts += [f"L {_pt(b[3], decimals)}" if lines is not None and lines[i] else
+              f"C {_pt(b[1], decimals)} {_pt(b[2], decimals)} {_pt(b[3], decimals)}"
+              for i, b in enumerate(B)]
     if closed:
         parts.append("Z")
     return " ".join(parts)
@@ -959,11 +980,13 @@ def _toward(geo: FloatArray, orig: FloatArray, decimals: int | None) -> FloatArr
 
 
 def _record_geometry(recs: list[CurveRecord], decimals: int | None = None
-                     ) -> tuple[str, FloatArray | None]:
-    """``("bspline", Bezier points (m, 4, 2))`` or ``("points", vertices (n, 2))`` of one
-    subpath / shape, in the ELEMENT's own coordinates (the inverse of its transformation
-    matrix applied), or ``(kind, None)`` when the record(s) hold the geometry read. With
-    ``decimals``, rounded to them toward the input's values (:func:`_toward`)."""
+                     ) -> tuple[str, FloatArray | None, np.ndarray | None]:
+    """``("bspline", Bezier points (m, 4, 2), straight)`` or ``("points", vertices (n, 2),
+    None)`` of one subpath / shape, in the ELEMENT's own coordinates (the inverse of its
+    transformation matrix applied), or ``(kind, None, None)`` when the record(s) hold the
+    geometry read. With ``decimals``, rounded to them toward the input's values
+    (:func:`_toward`); ``straight``: the segments that are lines before rounding
+    (:func:`_straight`)."""
     r0 = recs[0]
     ctm = _ctm(r0.source)
     if r0.kind == "bspline":
@@ -972,8 +995,9 @@ def _record_geometry(recs: list[CurveRecord], decimals: int | None = None
         orig = np.asarray(r0.source.get("beziers", []), dtype=float)
         scale = max(float(np.abs(orig).max()) if orig.size else 1.0, 1.0)
         if orig.shape == B.shape and np.abs(orig - B).max() <= 1e-12 * scale:
-            return "bspline", None
-        return "bspline", _toward(_unapply(ctm, B), _unapply(ctm, orig), decimals)
+            return "bspline", None, None
+        own = _unapply(ctm, B)
+        return "bspline", _toward(own, _unapply(ctm, orig), decimals), _straight(own)
     n = int(r0.source["n_points"])
     dim = data_points(r0.curve, "write_curves (SVG)").shape[1]
     pts = piece_values(n, dim, recs, "write_curves (SVG)")
@@ -981,19 +1005,21 @@ def _record_geometry(recs: list[CurveRecord], decimals: int | None = None
     for r in recs:
         orig[np.asarray(r.source["indices"])] = np.asarray(r.points)
     if np.array_equal(orig, pts):
-        return "points", None
+        return "points", None, None
     rows = np.asarray(r0.source.get("row_map", range(n)), dtype=int)
-    return "points", _toward(_unapply(ctm, pts[rows]), _unapply(ctm, orig[rows]), decimals)
+    return ("points", _toward(_unapply(ctm, pts[rows]), _unapply(ctm, orig[rows]), decimals),
+            None)
 
 
 def _record_d(recs: list[CurveRecord], decimals: int | None) -> tuple[str, bool]:
     """The d of one subpath from its record(s), and whether it changed."""
-    kind, geo = _record_geometry(recs, decimals)
+    kind, geo, lines = _record_geometry(recs, decimals)
     if geo is None:
         return "", False
     r0 = recs[0]
     if kind == "bspline":
-        return _d_cubics(geo, bool(r0.source.get("svg_closed", r0.curve.closed)), decimals), True
+        return _d_cubics(geo, bool(r0.source.get("svg_closed", r0.curve.closed)), decimals,
+                         lines), True
     closed = bool(r0.source.get("closed"))
     if closed and not r0.source.get("svg_closed", True):
         # read as a loop, but the subpath had no Z (it ends at its start): it stays open
@@ -1148,7 +1174,7 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
             dec = None if tag not in ("polygon", "polyline") else (
                 decimals if decimals is not None
                 else _element_decimals(el.get("points") or "", precision))
-            kind, geo = _record_geometry(subs[0], dec)
+            kind, geo, _ = _record_geometry(subs[0], dec)
             if geo is None:
                 continue
             if tag == "rect":
@@ -1227,7 +1253,8 @@ def _record_path_d(r: CurveRecord, decimals: int | None) -> str:
         return _d_points(pts[:-1] if c.closed else pts, c.closed, decimals)
     if c.dim != 2:
         raise InputError(f"write_curves (SVG): SVG holds 2-D curves, got dimension {c.dim}")
-    return _d_cubics(bezier_pieces(c, "write_curves (SVG)", max_degree=3), c.closed, decimals)
+    B = bezier_pieces(c, "write_curves (SVG)", max_degree=3)
+    return _d_cubics(B, c.closed, decimals, _straight(B))
 
 
 def _fresh_svg(records: Sequence[CurveRecord], decimals: int | None) -> str:
