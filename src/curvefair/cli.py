@@ -822,6 +822,15 @@ def _where(r: dict[str, Any]) -> str:
     return "" if where is None else " at (" + ", ".join(f"{v:.4g}" for v in where) + ")"
 
 
+def _deviation_cell(r: dict[str, Any]) -> str:
+    """The max deviation of a curve's row: the fair's, or 0 when the file holds the input
+    (a font contour the write-side never-worse guard kept: its other after-figures are
+    those of the file already)."""
+    if r.get("written") == "input":
+        return "0 (written unchanged)"
+    return _fmt(r["max_deviation"]) + _where(r)
+
+
 def _summary_card(row: dict[str, Any]) -> Any:
     """One curve's before/after summary as a narrow table."""
     from rich.table import Table
@@ -842,7 +851,7 @@ def _summary_card(row: dict[str, Any]) -> Any:
     for label, key in (("energy", "energy"), ("max |Δr" + "'" * 3 + "|", "max_jump"),
                        ("inflections", "inflections"), ("κ extrema", "extrema")):
         t.add_row(label, _fmt(r[f"{key}_before"]), _fmt(r[f"{key}_after"]))
-    t.add_row("max deviation", "", _fmt(r["max_deviation"]) + _where(r))
+    t.add_row("max deviation", "", _deviation_cell(r))
     return Group(head, t)
 
 
@@ -871,7 +880,7 @@ def _summary_table(rows: list[dict[str, Any]]) -> Any:
                   _arrow(r["max_jump_before"], r["max_jump_after"]),
                   _arrow(r["inflections_before"], r["inflections_after"]),
                   _arrow(r["extrema_before"], r["extrema_after"]),
-                  _fmt(r["max_deviation"]) + _where(r), f"{r['time_s']:.3g} s")
+                  _deviation_cell(r), f"{r['time_s']:.3g} s")
     return t
 
 
