@@ -1,8 +1,9 @@
-"""A UFO written by other software (MutatorSans Bold Condensed, a UFO 3 written by norad (Rust), made in RoboFont, from
-ufoLib2's test data; tests/data/README.md), faired by the command and checked with ufoLib2,
-not curvefair's reader: every file but the faired glyphs' .glif byte for byte, the glyph sets
-of both layers, metrics, components, anchors, guidelines and every point's type, smooth flag
-and name as they were, every point within --tol, every smooth node no less smooth."""
+"""A UFO written by other software (MutatorSans Bold Condensed: a UFO 3 written by norad,
+the Rust UFO library, made in RoboFont; from ufoLib2's test data, tests/data/README.md),
+faired by the command and checked with ufoLib2, not curvefair's reader: every file but the
+faired glyphs' .glif byte for byte, the glyph sets of both layers, metrics, components,
+anchors, guidelines and every point's type, smooth flag and name as they were, every point
+within --tol, every smooth node no less smooth."""
 
 from __future__ import annotations
 
