@@ -471,23 +471,62 @@ def allowances(quad, h, rtol, tot, hist):
     return n
 
 
+@njit(cache=True, fastmath=_FM, inline="always", error_model="numpy")
+def _piece7(e, a, b, hi, ih, xk, w7, fall, sc1, sc2, speed_rtol, cross_rtol, r1, r2, r3):
+    """The 7-point rule on the piece ``[a, b]`` (fractions of the segment, width ``hi``) of
+    the arc length and the dkds energy: ``(hi (b - a) sum w7 |r'|, hi (b - a) sum w7
+    (dkappa/ds)^2 |r'|)``."""
+    p1, dim = e.shape
+    w = b - a
+    qa = 0.0
+    qd = 0.0
+    for j in range(7):
+        u = a + w * xk[j]
+        for d in range(dim):
+            a1 = 0.0
+            a2 = 0.0
+            a3 = 0.0
+            for jj in range(p1 - 1, 0, -1):
+                a1 = a1 * u + fall[jj, 1] * e[jj, d]
+                if jj >= 2:
+                    a2 = a2 * u + fall[jj, 2] * e[jj, d]
+                if jj >= 3:
+                    a3 = a3 * u + fall[jj, 3] * e[jj, d]
+            r1[d] = a1 * ih
+            r2[d] = a2 * ih * ih
+            r3[d] = a3 * ih * ih * ih
+        k_, ks, sp, num, enum, sing = _frenet_node(r1, r2, r3, sc1, sc2, speed_rtol,
+                                                   cross_rtol)
+        qa += w7[j] * sp
+        qd += w7[j] * ks * ks * sp
+    return qa * hi * w, qd * hi * w
+
+
 @njit(cache=True, fastmath=_FM, error_model="numpy", readonly=('cw', 'h'))
 def refine_kernel(cw, h, quad, rtol, tot, thresh, P, xk, w7, fall, speed_rtol,
                   cross_rtol, max_levels, budget):
     """Adaptive re-integration, in place, of the segments whose worst ratio (:func:`allowance`
     with the totals ``tot`` of :func:`allowances`) exceeds ``thresh``.
 
-    Level ``L`` integrates segment ``i`` with the 7-point rule on ``P 2^L`` equal pieces; it
-    stops when both integrals changed by at most their allowances from the previous level
-    (level 0: the pass's values in ``quad[i]``), at ``max_levels``, or when the work budget
-    (pieces) is spent. ``quad`` rows: (arc length, its error estimate, dkds energy, its error
-    estimate). Returns the pieces used.
+    Locally adaptive bisection: segment ``i`` starts as ``P`` equal pieces; a piece is
+    accepted when the 7-point rule on its two halves differs from the rule on the whole
+    piece by at most the piece's share of the segment's allowances (its width times them),
+    else its halves are refined in turn, down to ``max_levels`` bisections or until the
+    work budget (pieces) is spent; a piece left unrefined then keeps its own value and half
+    its parent's differences as its error estimates (its whole value for a starting piece).
+    Only the pieces around a narrow feature are refined (a space curve whose curvature dips
+    nearly to zero, where dkappa/ds turns within a tiny parameter range), where refining
+    every piece of the segment uniformly spends thousands of pieces.
+    ``quad`` rows: (arc length, its error estimate, dkds energy, its error estimate).
+    Returns the pieces used.
     """
     m, p1, dim = cw.shape
     e = np.empty((p1, dim))
     r1 = np.empty(dim)
     r2 = np.empty(dim)
     r3 = np.empty(dim)
+    cap = P + 2 * max_levels + 4
+    st = np.empty((cap, 6))      # pieces to refine: a, b, Q_arc, Q_dkds, inherited errors
     used = 0
     ta = tot[0]
     td = tot[1]
@@ -495,54 +534,76 @@ def refine_kernel(cw, h, quad, rtol, tot, thresh, P, xk, w7, fall, speed_rtol,
         aa, ad, w = allowance(quad, h, i, rtol, ta, td)
         if not w > thresh:
             continue
-        if used + (P << 1) > budget:
+        if used + 3 * P > budget:
             break
         hi = h[i]
         ih = 1.0 / hi
         sc1, sc2 = _setup(cw, i, hi, fall, e)
-        prev_a = quad[i, 0]
-        err_a = quad[i, 1]
-        prev_d = quad[i, 2]
-        err_d = quad[i, 3]
-        for lev in range(1, max_levels + 1):
-            npc = P << lev
-            if used + npc > budget:
-                break
-            used += npc
-            qa = 0.0
-            qd = 0.0
-            inv_n = 1.0 / npc
-            for k in range(npc):
-                for j in range(7):
-                    u = (k + xk[j]) * inv_n
-                    for d in range(dim):
-                        a1 = 0.0
-                        a2 = 0.0
-                        a3 = 0.0
-                        for jj in range(p1 - 1, 0, -1):
-                            a1 = a1 * u + fall[jj, 1] * e[jj, d]
-                            if jj >= 2:
-                                a2 = a2 * u + fall[jj, 2] * e[jj, d]
-                            if jj >= 3:
-                                a3 = a3 * u + fall[jj, 3] * e[jj, d]
-                        r1[d] = a1 * ih
-                        r2[d] = a2 * ih * ih
-                        r3[d] = a3 * ih * ih * ih
-                    k_, ks, sp, num, enum, sing = _frenet_node(r1, r2, r3, sc1, sc2,
-                                                               speed_rtol, cross_rtol)
-                    qa += w7[j] * sp
-                    qd += w7[j] * ks * ks * sp
-            qa *= hi * inv_n
-            qd *= hi * inv_n
-            err_a = abs(qa - prev_a)
-            err_d = abs(qd - prev_d)
-            prev_a = qa
-            prev_d = qd
-            if err_a <= aa and err_d <= ad:
-                break
-        quad[i, 0] = prev_a
+        top = 0
+        for k in range(P - 1, -1, -1):   # pushed last first: popped in curve order
+            a = k / P
+            b = (k + 1) / P
+            qa, qd = _piece7(e, a, b, hi, ih, xk, w7, fall, sc1, sc2, speed_rtol,
+                             cross_rtol, r1, r2, r3)
+            st[top, 0] = a
+            st[top, 1] = b
+            st[top, 2] = qa
+            st[top, 3] = qd
+            st[top, 4] = np.inf
+            st[top, 5] = np.inf
+            top += 1
+        used += P
+        sum_a = 0.0
+        sum_d = 0.0
+        err_a = 0.0
+        err_d = 0.0
+        while top > 0:
+            top -= 1
+            a = st[top, 0]
+            b = st[top, 1]
+            qa = st[top, 2]
+            qd = st[top, 3]
+            ea = st[top, 4]
+            ed = st[top, 5]
+            mid = 0.5 * (a + b)
+            if used + 2 > budget or not (a < mid < b) or b - a < 0.5 ** max_levels \
+                    or top + 2 > cap:
+                # cannot refine further: the piece's own value, its parent's difference
+                sum_a += qa
+                sum_d += qd
+                err_a += abs(qa) if ea == np.inf else ea
+                err_d += abs(qd) if ed == np.inf else ed
+                continue
+            la, ld = _piece7(e, a, mid, hi, ih, xk, w7, fall, sc1, sc2, speed_rtol,
+                             cross_rtol, r1, r2, r3)
+            ra, rd = _piece7(e, mid, b, hi, ih, xk, w7, fall, sc1, sc2, speed_rtol,
+                             cross_rtol, r1, r2, r3)
+            used += 2
+            da = abs(la + ra - qa)
+            dd = abs(ld + rd - qd)
+            frac = b - a
+            if da <= aa * frac and dd <= ad * frac:
+                sum_a += la + ra
+                sum_d += ld + rd
+                err_a += da
+                err_d += dd
+                continue
+            st[top, 0] = mid
+            st[top, 1] = b
+            st[top, 2] = ra
+            st[top, 3] = rd
+            st[top, 4] = 0.5 * da
+            st[top, 5] = 0.5 * dd
+            st[top + 1, 0] = a
+            st[top + 1, 1] = mid
+            st[top + 1, 2] = la
+            st[top + 1, 3] = ld
+            st[top + 1, 4] = 0.5 * da
+            st[top + 1, 5] = 0.5 * dd
+            top += 2
+        quad[i, 0] = sum_a
         quad[i, 1] = err_a
-        quad[i, 2] = prev_d
+        quad[i, 2] = sum_d
         quad[i, 3] = err_d
     return used
 

@@ -44,7 +44,8 @@ ROUNDING_FLOOR = 1e3 * float(np.finfo(float).eps)
 #: Default relative accuracy requested from the adaptive quadratures.
 QUAD_RTOL = 1e-9
 _MAX_SPLITS = 48
-_MAX_LEVELS = 10
+#: Bisections of a piece at most in the adaptive re-integration (``refine_kernel``).
+_MAX_LEVELS = 40
 #: Segments: from this many on, the sampling pass runs in ranges on two threads
 #: (:mod:`curvefair._threads`; bitwise the same results as on one).
 PAR_MIN = 50_000
@@ -338,7 +339,7 @@ def sample_curve(cw: FloatArray, h: FloatArray, planar: bool, closed: bool,
     nbad = _k.allowances(quad, hc, float(rtol), tot, hist)
     if nbad:
         budget = max(200_000, m // 8)
-        top = budget // (2 * plan.P)  # at most this many segments get even one level
+        top = budget // (3 * plan.P)  # at most this many segments get even one bisection
         above = np.cumsum(hist[::-1])[::-1]  # above[k]: segments with worst > 2^k
         k = int(np.argmax(above <= top)) if above[0] > top else 0
         thresh = 1.0 if k == 0 else float(2.0**k)

@@ -395,7 +395,7 @@ def _shrinkable(rec: CurveRecord, ref: CurveRecord) -> bool:
 SMOOTH_JOIN_TURN = 0.01
 
 
-def _join_turns(B: FloatArray, closed: bool | None = None) -> tuple[FloatArray, FloatArray]:
+def _join_turns(B: FloatArray, closed: bool | None = None) -> tuple[FloatArray, np.ndarray]:
     """The turn (radians) at each join of the Bezier chain ``B`` (m, 4, dim), the closing
     join included when ``closed`` (None: when the chain ends exactly at its start), and
     whether the join is smooth by the reader's test
@@ -452,7 +452,7 @@ def _opened_joins(ref: CurveRecord, faired: CurveRecord, back: CurveRecord) -> f
     if bf.shape != b0.shape:
         return 0.0
     closed = bool(np.array_equal(b0[-1, 3], b0[0, 0]))
-    t0, smooth = _join_turns(b0, closed)
+    _, smooth = _join_turns(b0, closed)
     tf, _ = _join_turns(bf, closed)
     t1, _ = _join_turns(b1, closed)
     keep = smooth & (np.degrees(tf) <= SMOOTH_JOIN_TURN / 100)

@@ -1174,7 +1174,7 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
             dec = None if tag not in ("polygon", "polyline") else (
                 decimals if decimals is not None
                 else _element_decimals(el.get("points") or "", precision))
-            kind, geo, _ = _record_geometry(subs[0], dec)
+            kind, geo, _straight_segs = _record_geometry(subs[0], dec)
             if geo is None:
                 continue
             if tag == "rect":
