@@ -508,7 +508,8 @@ def refine_kernel(cw, h, quad, rtol, tot, thresh, P, xk, w7, fall, speed_rtol,
     """Adaptive re-integration, in place, of the segments whose worst ratio (:func:`allowance`
     with the totals ``tot`` of :func:`allowances`) exceeds ``thresh``.
 
-    Locally adaptive bisection: segment ``i`` starts as ``P`` equal pieces; a piece is
+    Locally adaptive bisection: segment ``i`` starts as ``P`` equal pieces (for ``P = 1``
+    the whole segment with the value the pass computed, ``quad[i]``); a piece is
     accepted when the 7-point rule on its two halves differs from the rule on the whole
     piece by at most the piece's share of the segment's allowances (its width times them),
     else its halves are refined in turn, down to ``max_levels`` bisections or until the
@@ -534,13 +535,22 @@ def refine_kernel(cw, h, quad, rtol, tot, thresh, P, xk, w7, fall, speed_rtol,
         aa, ad, w = allowance(quad, h, i, rtol, ta, td)
         if not w > thresh:
             continue
-        if used + 3 * P > budget:
+        if used + (2 if P == 1 else 3 * P) > budget:
             break
         hi = h[i]
         ih = 1.0 / hi
         sc1, sc2 = _setup(cw, i, hi, fall, e)
         top = 0
-        for k in range(P - 1, -1, -1):   # pushed last first: popped in curve order
+        if P == 1:
+            # one starting piece: the whole segment, whose 7-point value the pass computed
+            st[0, 0] = 0.0
+            st[0, 1] = 1.0
+            st[0, 2] = quad[i, 0]
+            st[0, 3] = quad[i, 2]
+            st[0, 4] = np.inf
+            st[0, 5] = np.inf
+            top = 1
+        for k in range(P - 1 if P > 1 else -1, -1, -1):  # pushed last first: popped in order
             a = k / P
             b = (k + 1) / P
             qa, qd = _piece7(e, a, b, hi, ih, xk, w7, fall, sc1, sc2, speed_rtol,
@@ -552,7 +562,7 @@ def refine_kernel(cw, h, quad, rtol, tot, thresh, P, xk, w7, fall, speed_rtol,
             st[top, 4] = np.inf
             st[top, 5] = np.inf
             top += 1
-        used += P
+        used += P if P > 1 else 0
         sum_a = 0.0
         sum_d = 0.0
         err_a = 0.0

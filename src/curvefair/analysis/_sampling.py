@@ -339,7 +339,9 @@ def sample_curve(cw: FloatArray, h: FloatArray, planar: bool, closed: bool,
     nbad = _k.allowances(quad, hc, float(rtol), tot, hist)
     if nbad:
         budget = max(200_000, m // 8)
-        top = budget // (3 * plan.P)  # at most this many segments get even one bisection
+        # at most this many segments get even one bisection (2 pieces for one starting
+        # piece, whose value the pass has; P more to start from P pieces)
+        top = budget // (2 if plan.P == 1 else 3 * plan.P)
         above = np.cumsum(hist[::-1])[::-1]  # above[k]: segments with worst > 2^k
         k = int(np.argmax(above <= top)) if above[0] > top else 0
         thresh = 1.0 if k == 0 else float(2.0**k)
