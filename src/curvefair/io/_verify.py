@@ -395,45 +395,6 @@ def _shrinkable(rec: CurveRecord, ref: CurveRecord) -> bool:
 SMOOTH_JOIN_TURN = 0.01
 
 
-def _join_turns(B: FloatArray, closed: bool | None = None) -> tuple[FloatArray, np.ndarray]:
-    """The turn (radians) at each join of the Bezier chain ``B`` (m, 4, dim), the closing
-    join included when ``closed`` (None: when the chain ends exactly at its start), and
-    whether the join is smooth by the reader's test
-    (:func:`curvefair.io.svg.bezier_chain_to_bspline`: both handles longer than 1e-12 of the
-    chain's size, parallel to 1e-9, same direction). A handle of zero length is replaced by
-    the next point of its segment (the tangent direction there)."""
-    B = np.asarray(B, dtype=np.float64)
-    m = B.shape[0]
-    if closed is None:
-        closed = bool(np.array_equal(B[-1, 3], B[0, 0]))
-    i = np.arange(m if closed and m > 1 else m - 1)
-    j = (i + 1) % m
-    scale = max(float(np.abs(B).max()), 1.0)
-
-    def direction(pts: FloatArray) -> tuple[FloatArray, FloatArray]:
-        # pts[:, k]: the node, then the handles outward; the first one off the node
-        v = pts[:, 1] - pts[:, 0]
-        first = np.linalg.norm(v, axis=1)
-        for k in (2, 3):
-            short = np.linalg.norm(v, axis=1) <= 1e-12 * scale
-            v[short] = pts[short, k] - pts[short, 0]
-        return v, first
-
-    a, na0 = direction(B[i][:, ::-1])      # incoming: P3 - P2 (sign reversed below)
-    a = -a
-    b, nb0 = direction(B[j])              # outgoing: Q1 - Q0
-    na, nb = np.linalg.norm(a, axis=1), np.linalg.norm(b, axis=1)
-    if B.shape[2] == 2:
-        cross = np.abs(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])
-    else:
-        cross = np.linalg.norm(np.cross(a, b), axis=1)
-    dot = np.einsum("ij,ij->i", a, b)
-    turn = np.arctan2(cross, dot)
-    smooth = ((na0 > 1e-12 * scale) & (nb0 > 1e-12 * scale)
-              & (cross <= 1e-9 * na * nb) & (dot > 0))
-    return turn, smooth
-
-
 def _opened_joins(ref: CurveRecord, faired: CurveRecord, back: CurveRecord) -> float:
     """SVG: the largest turn (degrees) the file read back has at a join that is smooth in
     the input and in the faired curve (turn at most :data:`SMOOTH_JOIN_TURN` / 100), 0.0
@@ -451,10 +412,11 @@ def _opened_joins(ref: CurveRecord, faired: CurveRecord, back: CurveRecord) -> f
         return 0.0
     if bf.shape != b0.shape:
         return 0.0
+    from .svg import join_turns
     closed = bool(np.array_equal(b0[-1, 3], b0[0, 0]))
-    _, smooth = _join_turns(b0, closed)
-    tf, _ = _join_turns(bf, closed)
-    t1, _ = _join_turns(b1, closed)
+    _, smooth = join_turns(b0, closed)
+    tf, _ = join_turns(bf, closed)
+    t1, _ = join_turns(b1, closed)
     keep = smooth & (np.degrees(tf) <= SMOOTH_JOIN_TURN / 100)
     return float(np.degrees(t1[keep]).max()) if keep.any() else 0.0
 

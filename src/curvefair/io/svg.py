@@ -110,6 +110,45 @@ def _bezier_eval(P: FloatArray, s: FloatArray) -> FloatArray:
     return np.einsum("kj,mjd->mkd", b, P)
 
 
+def join_turns(B: FloatArray, closed: bool | None = None) -> tuple[FloatArray, np.ndarray]:
+    """The turn (radians) at each join of the Bezier chain ``B`` (m, 4, dim), the closing
+    join included when ``closed`` (None: when the chain ends exactly at its start), and
+    whether the join is smooth: both handles longer than 1e-12 of the chain's size, parallel
+    to 1e-9, same direction -- where :func:`bezier_chain_to_bspline` makes the B-spline C1,
+    and what the write-back check keeps smooth in the file. A handle of zero length is
+    replaced by the next point of its segment (the tangent direction there) for the turn."""
+    B = np.asarray(B, dtype=np.float64)
+    m = B.shape[0]
+    if closed is None:
+        closed = bool(np.array_equal(B[-1, 3], B[0, 0]))
+    i = np.arange(m if closed else m - 1)
+    j = (i + 1) % m
+    scale = max(float(np.abs(B).max()), 1.0)
+
+    def direction(pts: FloatArray) -> tuple[FloatArray, FloatArray]:
+        # pts[:, k]: the node, then the handles outward; the first one off the node
+        v = pts[:, 1] - pts[:, 0]
+        first = np.linalg.norm(v, axis=1)
+        for k in (2, 3):
+            short = np.linalg.norm(v, axis=1) <= 1e-12 * scale
+            v[short] = pts[short, k] - pts[short, 0]
+        return v, first
+
+    a, na0 = direction(B[i][:, ::-1])      # incoming: P3 - P2 (sign reversed below)
+    a = -a
+    b, nb0 = direction(B[j])              # outgoing: Q1 - Q0
+    na, nb = np.linalg.norm(a, axis=1), np.linalg.norm(b, axis=1)
+    if B.shape[2] == 2:
+        cross = np.abs(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])
+    else:
+        cross = np.linalg.norm(np.cross(a, b), axis=1)
+    dot = np.einsum("ij,ij->i", a, b)
+    turn = np.arctan2(cross, dot)
+    smooth = ((na0 > 1e-12 * scale) & (nb0 > 1e-12 * scale)
+              & (cross <= 1e-9 * na * nb) & (dot > 0))
+    return turn, smooth
+
+
 def bezier_chain_to_bspline(P: FloatArray, closed: bool) -> BSplineCurve:
     """The cubic B-spline equal to a chain of cubic Bezier segments.
 
@@ -144,15 +183,12 @@ def bezier_chain_to_bspline(P: FloatArray, closed: bool) -> BSplineCurve:
     h[0] = poly[0]
     mult = np.full(m, 3)          # mult[i]: join between segment i and i+1 (m-1: closing)
     n_joins = m if closed else m - 1
+    _, smooth = join_turns(P, closed)
     for i in range(n_joins):
         j = (i + 1) % m
-        a = P[i, 3] - P[i, 2]
-        b = P[j, 1] - P[j, 0]
-        na, nb = np.linalg.norm(a), np.linalg.norm(b)
-        g1 = False
-        if na > 1e-12 * scale and nb > 1e-12 * scale:
-            cross = np.linalg.norm(np.cross(a, b)) if dim == 3 else abs(a[0] * b[1] - a[1] * b[0])
-            g1 = cross <= 1e-9 * na * nb and float(np.dot(a, b)) > 0
+        g1 = bool(smooth[i])
+        na = np.linalg.norm(P[i, 3] - P[i, 2])
+        nb = np.linalg.norm(P[j, 1] - P[j, 0])
         if j == 0:
             # closing join: C1 only if the widths come round consistently
             if g1 and abs(h[0] - h[i] * nb / na) <= 1e-9 * h[0]:
