@@ -64,6 +64,9 @@ __all__ = ["plan", "JoinPlan", "join_angles", "DEFAULT_G1_ANGLE"]
 DEFAULT_G1_ANGLE = 0.5
 _G2_REL = 1e-6
 _STRAIGHT_REL = 1e-9  # straight: off the line by at most this times the piece's length
+#: a derivative of order k vanishes at a join when |r^(k)| w^k is at most this times the
+#: curve's size (w the piece's width): a handle of zero length, up to rounding
+_VANISH = 1e-10
 _ROUND = 8 * np.finfo(float).eps  # plus this times the curve's size (rounding)
 _CLAMP_RANK = {"none": -1, "g0": 0, "g1": 1, "g2": 2}
 
@@ -203,6 +206,49 @@ def _side_support(curve: BSplineCurve, span: int, u: float, nder: int) -> list[i
     return [int(i) for i in curve.control_index(span - p + nz)]
 
 
+def _side_tangent(pp: Any, v: float, seg: int, left: bool, size: float
+                  ) -> tuple[FloatArray | None, int]:
+    """The direction in which the curve arrives at (``left``) or leaves the break ``v`` of
+    polynomial piece ``seg``, and the derivative order it comes from: the first derivative
+    ``r^(k)`` that does not vanish (``|r^(k)| w^k > _VANISH size``, ``w`` the piece's width),
+    ``(-1)^(k+1) r^(k)`` on the arriving side (``r(v - h) - r(v) ~ (-h)^k r^(k) / k!``);
+    ``(None, 0)`` when every derivative vanishes (a piece of zero length). A Bezier whose last
+    handle lies on its node (``P_2 = P_3``) arrives along ``P_3 - P_1``."""
+    w = float(np.asarray(pp.widths)[seg])
+    x, s = np.array([v]), np.array([seg])
+    for k in range(1, int(np.asarray(pp.coeffs).shape[1])):
+        d = np.asarray(pp.evaluate(x, k, segment=s), dtype=float).reshape(-1)
+        if float(np.linalg.norm(d)) * w ** k > _VANISH * size:
+            return (-d if left and k % 2 == 0 else d), k
+    return None, 0
+
+
+def _degenerate_join(curve: BSplineCurve, pp: Any, v: float, k: int, j: int, g1: float,
+                     size: float, hold: set[int], rep: dict[str, Any],
+                     seam: tuple[float, int] | None = None) -> None:
+    """A C0 join (knot ``v``, break ``k`` of ``pp``, join point ``P_j``) with a handle of zero
+    length on a side: it cannot be made C1 (one first derivative is zero), so it is held.
+    A corner (tangents apart by more than ``g1``, or a side of zero length) holds its point;
+    a G1 join holds every control point its two tangents depend on -- the point, and on each
+    side those of the derivatives up to the order that gives the tangent there -- so both
+    directions, the handles of zero length and the join stay exactly as they are.
+    ``seam``: the seam of a closed curve, where the curve arrives at ``seam = (v_end, last
+    piece)`` and leaves at ``(v, k)`` = (the domain's start, piece 0)."""
+    vl, kl_seg = seam if seam is not None else (v, k - 1)
+    tl, kl = _side_tangent(pp, vl, kl_seg, True, size)
+    tr, kr = _side_tangent(pp, v, k, False, size)
+    if tl is None or tr is None or _angle(tl, tr) > g1:
+        hold.add(int(curve.control_index(j)))
+        rep["corners_held"] += 1
+        return
+    t = np.asarray(curve.knots)
+    sl = int(np.searchsorted(t, vl, side="left")) - 1  # the span ending at vl
+    sr = int(np.searchsorted(t, v, side="right")) - 1  # the span starting at v
+    hold.update(_side_support(curve, sl, vl, kl))
+    hold.update(_side_support(curve, sr, v, kr))
+    rep["g1_joins"] += 1
+
+
 def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozenset[int],
                   g1: float, tol: float | None, allow_reduce: bool = True,
                   no_g2: frozenset[int] = frozenset()) -> JoinPlan:
@@ -236,6 +282,7 @@ def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozense
     okk = (ck > 0) & (ck < br.shape[0] - 1)
     okk[okk] &= br[ck[okk]] == cv[okk]
     cv, ca, cm, ck = cv[okk], ca[okk], cm[okk], ck[okk]
+    wid = np.asarray(pp.widths, dtype=float)
     D1L = pp.evaluate(cv, 1, segment=ck - 1).reshape(-1, P.shape[1])
     D1R = pp.evaluate(cv, 1, segment=ck).reshape(-1, P.shape[1])
     D2L = pp.evaluate(cv, 2, segment=ck - 1).reshape(-1, P.shape[1])
@@ -244,10 +291,15 @@ def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozense
         v, a, m = float(cv[q]), int(ca[q]), int(cm[q])
         d1l, d1r, d2l, d2r = D1L[q], D1R[q], D2L[q], D2R[q]
         nl, nr = float(np.linalg.norm(d1l)), float(np.linalg.norm(d1r))
-        if not (nl > 0 and nr > 0):
+        c0 = m == p
+        if (nl * float(wid[ck[q] - 1]) <= _VANISH * size
+                or nr * float(wid[ck[q]]) <= _VANISH * size):
+            # a handle of zero length on one side (a Bezier control point on its node): the
+            # tangent there is that of the first derivative that does not vanish
+            if c0:
+                _degenerate_join(curve, pp, v, int(ck[q]), int(a - 1), g1, size, hold, rep)
             continue
         ang = _angle(d1l, d1r)
-        c0 = m == p
         if c0 and ang > g1:
             if curve.closed:
                 hold.add(int(curve.control_index(a - 1)))
@@ -298,8 +350,12 @@ def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozense
             d0 = pp.evaluate(np.array([lo]), 1, segment=np.array([0])).reshape(-1)
             d1 = pp.evaluate(np.array([hi]), 1,
                              segment=np.array([br.shape[0] - 2])).reshape(-1)
-            if np.linalg.norm(d0) > 0 and np.linalg.norm(d1) > 0:
-                j = a0 - 1
+            j = a0 - 1
+            last = br.shape[0] - 2
+            if (float(np.linalg.norm(d0)) * float(wid[0]) <= _VANISH * size
+                    or float(np.linalg.norm(d1)) * float(wid[last]) <= _VANISH * size):
+                _degenerate_join(curve, pp, lo, 0, j, g1, size, hold, rep, seam=(hi, last))
+            else:
                 if _angle(d1, d0) > g1:
                     hold.add(int(curve.control_index(j)))
                     rep["corners_held"] += 1
@@ -313,7 +369,18 @@ def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozense
         if np.abs(e0 - e1).max() <= _STRAIGHT_REL * size:
             d0 = curve(np.array([lo]), 1)[0]
             d1 = curve(np.array([hi]), 1)[0]
-            if min(np.linalg.norm(d0), np.linalg.norm(d1)) > 0 and _angle(d1, d0) <= g1:
+            last = br.shape[0] - 2
+            if (float(np.linalg.norm(d0)) * float(wid[0]) <= _VANISH * size
+                    or float(np.linalg.norm(d1)) * float(wid[last]) <= _VANISH * size):
+                # an end handle of zero length: no clamp keeps the end's tangent (it is not the
+                # first derivative's), so a G1 seam holds what both end tangents depend on
+                tl, kl = _side_tangent(pp, hi, last, True, size)
+                tr, kr = _side_tangent(pp, lo, 0, False, size)
+                if tl is not None and tr is not None and _angle(tl, tr) <= g1:
+                    hold.update(_side_support(curve, n - 1, hi, kl))
+                    hold.update(_side_support(curve, p, lo, kr))
+                    rep["seam_clamp"] = "held"
+            elif min(np.linalg.norm(d0), np.linalg.norm(d1)) > 0 and _angle(d1, d0) <= g1:
                 k0 = _curvature(d0, curve(np.array([lo]), 2)[0])
                 k1 = _curvature(d1, curve(np.array([hi]), 2)[0])
                 want = "g2" if abs(k0 - k1) <= _G2_REL * max(abs(k0), abs(k1), 1e-300) else "g1"

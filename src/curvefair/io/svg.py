@@ -398,8 +398,10 @@ def _shape_elements(root: ET.Element, spt: Any, path: object
     sizes: dict[int, tuple[float, float] | None] = {}
     below: dict[int, list[int]] = {}        # id(element): positions in out of its shapes
 
-    def walk(el: ET.Element, ctm: np.ndarray, size: tuple[float, float] | None,
-             why: str | None, chain: tuple[int, ...] = ()) -> None:
+    def visit(el: ET.Element, ctm: np.ndarray, size: tuple[float, float] | None,
+              why: str | None, chain: tuple[int, ...]
+              ) -> tuple[np.ndarray, tuple[float, float] | None, str | None, tuple[int, ...]]:
+        """One element; what its children inherit."""
         nonlocal count
         k = count
         count += 1
@@ -435,10 +437,16 @@ def _shape_elements(root: ET.Element, spt: Any, path: object
             for a in chain:
                 below.setdefault(a, []).append(len(out))
             out.append((k, el, None if ident else ctm[:2].copy(), why))
-        for child in el:
-            walk(child, ctm, size, why, chain)
+        return ctm, size, why, chain
 
-    walk(root, np.eye(3), _root_viewport(root), _sheet_transform(root))
+    # depth first in document order, with a stack of its own: a file may nest its groups
+    # deeper than Python's recursion limit (librsvg's fuzz file: 2,000 nested <g>)
+    stack: list[tuple[ET.Element, Any]] = [(root, (np.eye(3), _root_viewport(root),
+                                                   _sheet_transform(root), ()))]
+    while stack:
+        el, inherited = stack.pop()
+        mine = visit(el, *inherited)
+        stack.extend((child, mine) for child in reversed(list(el)))
     _drawn_by_use(root, out, before, after, sizes, below)
     return out
 
