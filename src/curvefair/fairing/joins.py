@@ -32,6 +32,13 @@ geometry the curve's author drew on purpose. :func:`plan` looks at the curve fir
   and curvature of both sides exactly.
 * **corners** (a C0 knot whose tangents differ by more than ``g1_angle``): the join point
   ``P_j`` is held; the corner stays where it is and stays a corner.
+* **a handle on its node** (a C0 join whose first derivative vanishes on a side, to
+  ``_VANISH`` of the curve's size: ``C 240,60 240,90 240,90`` in SVG, Inkscape's rounded
+  corners): the tangent of that side is that of its first derivative that does not vanish
+  (``P_3 - P_1`` for a Bezier whose last handle is on its node). Such a join cannot be made
+  C1; a G1 one is held -- its point and every control point the two tangents depend on --
+  so its tangents and the handle on the node stay exactly; a corner holds its point. The
+  seam of an open chain that ends on its start is treated the same way.
 * **straight pieces**: the control points of a knot span whose control points are collinear
   (to 1e-9 of the curve's size: a line segment drawn as a B-spline or Bezier, a glyph stem)
   are held, so the line stays that line. (Point lists are cut at their corners when read, so
