@@ -81,6 +81,7 @@ LATE_FILES = frozenset({
     "test_batch_progress_tty.py",
     "test_cli.py",
     "test_cli_write.py",
+    "test_files_hunt4.py",
 })
 
 

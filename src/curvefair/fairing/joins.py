@@ -37,8 +37,9 @@ geometry the curve's author drew on purpose. :func:`plan` looks at the curve fir
   corners): the tangent of that side is that of its first derivative that does not vanish
   (``P_3 - P_1`` for a Bezier whose last handle is on its node). Such a join cannot be made
   C1; a G1 one is held -- its point and every control point the two tangents depend on --
-  so its tangents and the handle on the node stay exactly; a corner holds its point. The
-  seam of an open chain that ends on its start is treated the same way.
+  so its tangents and the handle on the node stay exactly; a corner holds its point and
+  the handle on it. The seam of an open chain that ends on its start is treated the same
+  way.
 * **straight pieces**: the control points of a knot span whose control points are collinear
   (to 1e-9 of the curve's size: a line segment drawn as a B-spline or Bezier, a glyph stem)
   are held, so the line stays that line. (Point lists are cut at their corners when read, so
@@ -235,8 +236,8 @@ def _degenerate_join(curve: BSplineCurve, pp: Any, v: float, k: int, j: int, g1:
                      seam: tuple[float, int] | None = None) -> None:
     """A C0 join (knot ``v``, break ``k`` of ``pp``, join point ``P_j``) with a handle of zero
     length on a side: it cannot be made C1 (one first derivative is zero), so it is held.
-    A corner (tangents apart by more than ``g1``, or a side of zero length) holds its point;
-    a G1 join holds every control point its two tangents depend on -- the point, and on each
+    A corner (tangents apart by more than ``g1``, or a side of zero length) holds its point
+    and a handle that lies on it (the first derivative of that side stays zero); a G1 join holds every control point its two tangents depend on -- the point, and on each
     side those of the derivatives up to the order that gives the tangent there -- so both
     directions, the handles of zero length and the join stay exactly as they are.
     ``seam``: the seam of a closed curve, where the curve arrives at ``seam = (v_end, last
@@ -244,13 +245,19 @@ def _degenerate_join(curve: BSplineCurve, pp: Any, v: float, k: int, j: int, g1:
     vl, kl_seg = seam if seam is not None else (v, k - 1)
     tl, kl = _side_tangent(pp, vl, kl_seg, True, size)
     tr, kr = _side_tangent(pp, v, k, False, size)
-    if tl is None or tr is None or _angle(tl, tr) > g1:
-        hold.add(int(curve.control_index(j)))
-        rep["corners_held"] += 1
-        return
     t = np.asarray(curve.knots)
     sl = int(np.searchsorted(t, vl, side="left")) - 1  # the span ending at vl
     sr = int(np.searchsorted(t, v, side="right")) - 1  # the span starting at v
+    if tl is None or tr is None or _angle(tl, tr) > g1:
+        hold.add(int(curve.control_index(j)))
+        # a handle on the node stays there (a cusp or a corner drawn with the handle
+        # retracted keeps that: its first derivative stays zero)
+        if kl >= 2:
+            hold.update(_side_support(curve, sl, vl, 1))
+        if kr >= 2:
+            hold.update(_side_support(curve, sr, v, 1))
+        rep["corners_held"] += 1
+        return
     hold.update(_side_support(curve, sl, vl, kl))
     hold.update(_side_support(curve, sr, v, kr))
     rep["g1_joins"] += 1
