@@ -237,8 +237,9 @@ def _degenerate_join(curve: BSplineCurve, pp: Any, v: float, k: int, j: int, g1:
     """A C0 join (knot ``v``, break ``k`` of ``pp``, join point ``P_j``) with a handle of zero
     length on a side: it cannot be made C1 (one first derivative is zero), so it is held.
     A corner (tangents apart by more than ``g1``, or a side of zero length) holds its point
-    and a handle that lies on it (the first derivative of that side stays zero); a G1 join holds every control point its two tangents depend on -- the point, and on each
-    side those of the derivatives up to the order that gives the tangent there -- so both
+    and a handle that lies on it (the first derivative of that side stays zero); a G1 join
+    holds every control point its two tangents depend on -- the point, and on each side
+    those of the derivatives up to the order that gives the tangent there -- so both
     directions, the handles of zero length and the join stay exactly as they are.
     ``seam``: the seam of a closed curve, where the curve arrives at ``seam = (v_end, last
     piece)`` and leaves at ``(v, k)`` = (the domain's start, piece 0)."""
