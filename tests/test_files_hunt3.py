@@ -114,19 +114,24 @@ def test_every_node_and_handle_of_a_real_svg_within_tol_exactly(tmp_path):
     assert worst > 0.5 * tol  # it did fair
 
 
-def _join_turns_deg(path):
-    """The turn in degrees at every join between two segments of every subpath of an SVG,
-    from svgpathtools' unit tangents (segments shorter than 1e-9 skipped)."""
+def _join_pairs(path):
+    """The two segments ``(a, b)`` of every join of every continuous subpath of an SVG as
+    svgpathtools reads it (segments shorter than 1e-9 skipped; a closed subpath's last one
+    joins its first)."""
     spt = pytest.importorskip("svgpathtools")
-    import numpy as np
-    out = []
     for p in spt.Document(str(path)).paths():
         for sub in p.continuous_subpaths():
             segs = [g for g in sub if g.length() > 1e-9]
             for i in range(len(segs) if sub.isclosed() else len(segs) - 1):
-                a, b = segs[i], segs[(i + 1) % len(segs)]
-                out.append(abs(np.degrees(np.angle(b.unit_tangent(0.0) / a.unit_tangent(1.0)))))
-    return np.array(out)
+                yield segs[i], segs[(i + 1) % len(segs)]
+
+
+def _join_turns_deg(path):
+    """The turn in degrees at every join of an SVG (:func:`_join_pairs`), from svgpathtools'
+    unit tangents."""
+    import numpy as np
+    return np.array([abs(np.degrees(np.angle(b.unit_tangent(0.0) / a.unit_tangent(1.0))))
+                     for a, b in _join_pairs(path)])
 
 
 def _cli(src, out, tol, *extra):

@@ -52,19 +52,17 @@ def _tangents(seg, spt):
 
 
 def _joins(path):
-    """``(turn in degrees, a handle on its node)`` of every join of every continuous subpath
-    of the file as svgpathtools reads it (segments shorter than 1e-9 skipped)."""
+    """``(turn in degrees, a handle on its node)`` of every join of the file
+    (``test_files_hunt3._join_pairs``)."""
+    from test_files_hunt3 import _join_pairs
+
     spt = pytest.importorskip("svgpathtools")
     out = []
-    for p in spt.Document(str(path)).paths():
-        for sub in p.continuous_subpaths():
-            segs = [g for g in sub if g.length() > 1e-9]
-            for i in range(len(segs) if sub.isclosed() else len(segs) - 1):
-                a, b = segs[i], segs[(i + 1) % len(segs)]
-                turn = abs(math.degrees(np.angle(_tangents(b, spt)[0] / _tangents(a, spt)[1])))
-                on_node = (isinstance(a, spt.CubicBezier) and a.control2 == a.end) or (
-                    isinstance(b, spt.CubicBezier) and b.control1 == b.start)
-                out.append((turn, on_node))
+    for a, b in _join_pairs(path):
+        turn = abs(math.degrees(np.angle(_tangents(b, spt)[0] / _tangents(a, spt)[1])))
+        on_node = (isinstance(a, spt.CubicBezier) and a.control2 == a.end) or (
+            isinstance(b, spt.CubicBezier) and b.control1 == b.start)
+        out.append((turn, on_node))
     return out
 
 
