@@ -26,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from test_files_hunt3 import _join_pairs, _worst_node_or_handle
 
 import curvefair as cf
 
@@ -54,8 +55,6 @@ def _tangents(seg, spt):
 def _joins(path):
     """``(turn in degrees, a handle on its node)`` of every join of the file
     (``test_files_hunt3._join_pairs``)."""
-    from test_files_hunt3 import _join_pairs
-
     spt = pytest.importorskip("svgpathtools")
     out = []
     for a, b in _join_pairs(path):
@@ -64,23 +63,6 @@ def _joins(path):
             isinstance(b, spt.CubicBezier) and b.control1 == b.start)
         out.append((turn, on_node))
     return out
-
-
-def _worst_node_or_handle(src, out):
-    """The largest distance of a node or handle of ``out`` from its place in ``src`` (a
-    segment written as another kind, an arc: its ends), svgpathtools reading both."""
-    spt = pytest.importorskip("svgpathtools")
-    a, b = spt.Document(str(src)).paths(), spt.Document(str(out)).paths()
-    assert len(a) == len(b)
-    worst = 0.0
-    for pa, pb in zip(a, b, strict=True):
-        assert len(pa) == len(pb)
-        for ga, gb in zip(pa, pb, strict=True):
-            qa, qb = [ga.start, ga.end], [gb.start, gb.end]
-            if type(ga) is type(gb) and not isinstance(ga, spt.Arc):
-                qa, qb = list(ga.bpoints()), list(gb.bpoints())
-            worst = max(worst, max(abs(x - y) for x, y in zip(qa, qb, strict=True)))
-    return worst
 
 
 @pytest.mark.parametrize("src, tol, faired", [(W3C, 0.6, True), (W3C, 3.0, True),

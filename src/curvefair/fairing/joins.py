@@ -214,6 +214,12 @@ def _side_support(curve: BSplineCurve, span: int, u: float, nder: int) -> list[i
     return [int(i) for i in curve.control_index(span - p + nz)]
 
 
+def _vanishes(d: FloatArray, w: float, k: int, size: float) -> bool:
+    """Whether the derivative ``d`` of order ``k`` of a piece of width ``w`` is zero up to
+    rounding: ``|d| w^k <= _VANISH size`` (a handle of zero length for ``k = 1``)."""
+    return float(np.linalg.norm(d)) * float(w) ** k <= _VANISH * size
+
+
 def _side_tangent(pp: Any, v: float, seg: int, left: bool, size: float
                   ) -> tuple[FloatArray | None, int]:
     """The direction in which the curve arrives at (``left``) or leaves the break ``v`` of
@@ -226,7 +232,7 @@ def _side_tangent(pp: Any, v: float, seg: int, left: bool, size: float
     x, s = np.array([v]), np.array([seg])
     for k in range(1, int(np.asarray(pp.coeffs).shape[1])):
         d = np.asarray(pp.evaluate(x, k, segment=s), dtype=float).reshape(-1)
-        if float(np.linalg.norm(d)) * w ** k > _VANISH * size:
+        if not _vanishes(d, w, k, size):
             return (-d if left and k % 2 == 0 else d), k
     return None, 0
 
@@ -305,10 +311,8 @@ def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozense
     for q in range(cv.shape[0]):
         v, a, m = float(cv[q]), int(ca[q]), int(cm[q])
         d1l, d1r, d2l, d2r = D1L[q], D1R[q], D2L[q], D2R[q]
-        nl, nr = float(np.linalg.norm(d1l)), float(np.linalg.norm(d1r))
         c0 = m == p
-        if (nl * float(wid[ck[q] - 1]) <= _VANISH * size
-                or nr * float(wid[ck[q]]) <= _VANISH * size):
+        if _vanishes(d1l, wid[ck[q] - 1], 1, size) or _vanishes(d1r, wid[ck[q]], 1, size):
             # a handle of zero length on one side (a Bezier control point on its node): the
             # tangent there is that of the first derivative that does not vanish
             if c0:
@@ -367,8 +371,7 @@ def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozense
                              segment=np.array([br.shape[0] - 2])).reshape(-1)
             j = a0 - 1
             last = br.shape[0] - 2
-            if (float(np.linalg.norm(d0)) * float(wid[0]) <= _VANISH * size
-                    or float(np.linalg.norm(d1)) * float(wid[last]) <= _VANISH * size):
+            if _vanishes(d0, wid[0], 1, size) or _vanishes(d1, wid[last], 1, size):
                 _degenerate_join(curve, pp, lo, 0, j, g1, size, hold, rep, seam=(hi, last))
             else:
                 if _angle(d1, d0) > g1:
@@ -385,8 +388,7 @@ def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozense
             d0 = curve(np.array([lo]), 1)[0]
             d1 = curve(np.array([hi]), 1)[0]
             last = br.shape[0] - 2
-            if (float(np.linalg.norm(d0)) * float(wid[0]) <= _VANISH * size
-                    or float(np.linalg.norm(d1)) * float(wid[last]) <= _VANISH * size):
+            if _vanishes(d0, wid[0], 1, size) or _vanishes(d1, wid[last], 1, size):
                 # an end handle of zero length: no clamp keeps the end's tangent (it is not the
                 # first derivative's), so a G1 seam holds what both end tangents depend on
                 tl, kl = _side_tangent(pp, hi, last, True, size)
