@@ -338,6 +338,28 @@ def test_option_noequals_is_a_usage_error_naming_option(tmp_path: Path, ex1: Pat
     assert not (tmp_path / "o.csv").exists()
 
 
+def test_fair_arguments_given_as_method_options_name_a_real_flag(tmp_path: Path, ex1: Path,
+                                                                monkeypatch):
+    """``-O tol=...`` points to ``--tol``; a fair() argument the command has no flag for
+    (``corner_turn``, ``g1_angle``) says the default is kept (it named ``--corner-turn``,
+    which does not exist)."""
+    import click
+
+    from curvefair.cli import _FAIR_FLAGS, _fair_arguments, fair_cmd
+
+    flags = {o for p in fair_cmd.params if isinstance(p, click.Option) for o in p.opts}
+    for flag in _FAIR_FLAGS.values():
+        assert flag == "the IN argument" or set(flag.split("/")) <= flags, flag
+    assert set(_FAIR_FLAGS) <= _fair_arguments()
+    monkeypatch.chdir(tmp_path)
+    for key, want in (("tol", "use --tol"), ("corner_turn", "keeps fair()'s default"),
+                      ("g1_angle", "keeps fair()'s default")):
+        r = CliRunner().invoke(main, ["fair", "ex1.csv", "-o", "o.csv", "-O", f"{key}=1"])
+        assert r.exit_code == 2 and want in r.output, r.output
+        assert "--corner-turn" not in r.output and "--g1-angle" not in r.output
+    assert not (tmp_path / "o.csv").exists()
+
+
 def test_option_values_are_typed():
     from curvefair.cli import _parse_method_options
 

@@ -214,6 +214,12 @@ def _parse_value(text: str) -> Any:
     return text
 
 
+#: fair()'s own arguments the command sets, and how (the others keep fair()'s defaults)
+_FAIR_FLAGS = {"curve": "the IN argument", "method": "-m/--method", "tol": "--tol",
+               "eps": "--eps", "max_steps": "--max-steps", "clamp": "--clamp",
+               "protect": "--protect", "mode": "--mode"}
+
+
 def _parse_method_options(items: Sequence[str]) -> dict[str, Any]:
     """``("schedule=sweep", "l=3")`` -> ``{"schedule": "sweep", "l": 3}`` (the last wins)."""
     out: dict[str, Any] = {}
@@ -224,9 +230,11 @@ def _parse_method_options(items: Sequence[str]) -> dict[str, Any]:
             raise click.BadParameter(f"{item!r} is not KEY=VALUE (e.g. -O schedule=sweep)",
                                      param_hint="'-O' / '--option'")
         if key in _fair_arguments():
-            flag = "the IN argument" if key == "curve" else "--" + key.replace("_", "-")
-            raise click.BadParameter(f"{key!r} is not a method option; use {flag}",
-                                     param_hint="'-O' / '--option'")
+            flag = _FAIR_FLAGS.get(key)
+            raise click.BadParameter(
+                f"{key!r} is not a method option; " + (f"use {flag}" if flag else
+                                                      "the command keeps fair()'s default"),
+                param_hint="'-O' / '--option'")
         out[key] = _parse_value(value)
     return out
 

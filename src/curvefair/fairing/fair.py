@@ -475,7 +475,8 @@ _analysis_block = analysis_block  # the former name (used inside the fairing pac
 def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None = None,
          eps: float | None = None, max_steps: int | None = None, clamp: Any = "g0",
          protect: Iterable[int] = (), mode: str = "spline", joins: str = "keep",
-         g1_angle: float | None = None, guard: bool = True, structure: str = "keep",
+         g1_angle: float | None = None, corner_turn: float | None = None,
+         guard: bool = True, structure: str = "keep",
          progress: Callable[[int, int], None] | None = None,
          **options: Any) -> FairingResult:
     """Fair a curve automatically: repeatedly apply a local step at the worst point.
@@ -531,6 +532,12 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
     g1_angle : float, optional
         Degrees; a C0 knot whose two tangents differ by at most this is a G1 join (default
         :data:`curvefair.fairing.joins.DEFAULT_G1_ANGLE`, 0.5).
+    corner_turn : float, optional
+        Degrees; the most the angle of a corner of a B-spline (a C0 knot that is not G1) may
+        change (default :data:`curvefair.fairing.joins.DEFAULT_CORNER_TURN`, 1). Where the
+        method turns one more, the curve is faired again with the control points that fix
+        that corner's angle held (``report["joins"]["corner_points_held"]``); ``math.inf``:
+        no limit (only the corner's point is held).
     guard : bool
         Default True: if the faired curve has more inflections or curvature extrema than the
         input (curvefair's own counts, :func:`curvefair.analyze`), the largest fraction of the
@@ -614,7 +621,7 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
             cast("BSplineCurve", curve), method,
             _pos(tol, "tol", allow_none=True, window=True), fair, eps=eps,
             max_steps=max_steps, clamp=clamp, protect=protect, mode=mode, joins=joins,
-            g1_angle=g1_angle, guard=guard, **options)
+            g1_angle=g1_angle, corner_turn=corner_turn, guard=guard, **options)
         if progress is not None:
             progress(PHASES, PHASES)
         return res
@@ -657,6 +664,9 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
         raise InputError(f"unknown joins {joins!r}; valid values are: 'keep', 'free'")
     g1_deg = _joins.DEFAULT_G1_ANGLE if g1_angle is None else as_nonnegative(g1_angle,
                                                                             "g1_angle")
+    turn_deg = (_joins.DEFAULT_CORNER_TURN if corner_turn is None
+                else math.inf if isinstance(corner_turn, (int, float)) and corner_turn == math.inf
+                else as_nonnegative(corner_turn, "corner_turn"))
     # what the call adds to the input's caches (its power form, Gram bands) is dropped as soon
     # as the call no longer needs it: at a million points they are 72 and 56 bytes per span,
     # held by the caller's curve after the call, and at the call's peak (the result's analysis)
@@ -679,11 +689,29 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
                             "expected DriverOutput")
         return res
 
-    out = solve(jp, None if tol_v is None else tol_v - jp.margin)
-    if not jp.restorable(out.curve):  # the method changed the knots: hold the joins instead
-        jp = _joins.plan(curve, clamp_pair, prot, g1_deg, tol_v, allow_reduce=False)
-        out = solve(jp, tol_v)
-    new = jp.restore(out.curve)
+    def run(jp: Any, held: frozenset[int]) -> tuple[Any, Outcome, PiecewiseCurve]:
+        out = solve(jp, None if tol_v is None else tol_v - jp.margin)
+        if not jp.restorable(out.curve):  # the method changed the knots: hold the joins
+            jp = _joins.plan(curve, clamp_pair, frozenset(prot) | held, g1_deg, tol_v,
+                             allow_reduce=False)
+            out = solve(jp, tol_v)
+        return jp, out, jp.restore(out.curve)
+
+    jp, out, new = run(jp, frozenset())
+    if jp.corners and isinstance(curve, BSplineCurve) and math.isfinite(turn_deg):
+        # a corner keeps its angle to DEFAULT_CORNER_TURN: where one turned more, fair again
+        # with what fixes it held; if another turns then, with every corner's held
+        corners = list(jp.corners)
+        held: frozenset[int] = frozenset()
+        for attempt in range(2):
+            turned = _joins.corner_turns(curve, new, corners, turn_deg)
+            if not turned:
+                break
+            held |= turned if attempt == 0 else frozenset().union(*(c[4] for c in corners))
+            jp, out, new = run(_joins.plan(curve, clamp_pair, frozenset(prot) | held, g1_deg,
+                                           tol_v), held)
+        if held:
+            jp.report["corner_points_held"] = len(held)
     cached_at_entry.drop_power_form(curve, method_done=True)
     cached_at_entry.drop_gram_bands(curve, new)
     if progress is not None:

@@ -31,7 +31,13 @@ geometry the curve's author drew on purpose. :func:`plan` looks at the curve fir
   value, tangent and second derivative on either side depend, which keeps position, tangent
   and curvature of both sides exactly.
 * **corners** (a C0 knot whose tangents differ by more than ``g1_angle``): the join point
-  ``P_j`` is held; the corner stays where it is and stays a corner.
+  ``P_j`` is held; the corner stays where it is and stays a corner. Its angle may change
+  by at most :data:`DEFAULT_CORNER_TURN` (1 degree): :func:`curvefair.fair` measures every
+  corner after the method (:func:`corner_turns`) and, where one turned more, fairs again
+  with the control points that fix its angle held (``P_{j-1}``, ``P_j``, ``P_{j+1}``, or
+  the supports of the tangents below), then with those of every corner held if another
+  turned. Holding the point alone let a method swing the tangents where ``tol`` is longer
+  than the handles: a 0.9-degree join of a Rhino PolyCurve came out a 93-degree kink.
 * **a handle on its node** (a C0 join whose first derivative vanishes on a side, to
   ``_VANISH`` of the curve's size: ``C 240,60 240,90 240,90`` in SVG, Inkscape's rounded
   corners): the tangent of that side is that of its first derivative that does not vanish
@@ -66,10 +72,14 @@ from .._typing import FloatArray
 from ..curves.bspline import BSplineCurve, basis_derivatives
 from ..curves.piecewise import PiecewiseCurve
 
-__all__ = ["plan", "JoinPlan", "join_angles", "DEFAULT_G1_ANGLE"]
+__all__ = ["plan", "JoinPlan", "join_angles", "corner_turns", "DEFAULT_G1_ANGLE",
+           "DEFAULT_CORNER_TURN"]
 
 #: Default largest angle (degrees) between the two tangents of a join that is treated as G1.
 DEFAULT_G1_ANGLE = 0.5
+#: The most (degrees) a corner's angle may change in :func:`curvefair.fair` before the control
+#: points that fix it are held (:func:`corner_turns`); Rhino's default angle tolerance.
+DEFAULT_CORNER_TURN = 1.0
 _G2_REL = 1e-6
 _STRAIGHT_REL = 1e-9  # straight: off the line by at most this times the piece's length
 #: a derivative of order k vanishes at a join when |r^(k)| w^k is at most this times the
@@ -139,6 +149,9 @@ class JoinPlan:
     clamp: tuple[str, str]
     margin: float = 0.0
     report: dict[str, Any] = field(default_factory=dict)
+    #: the corners of the input whose angle :func:`corner_turns` checks: (knot arriving,
+    #: piece arriving, knot leaving, piece leaving, the control points that fix the angle)
+    corners: list[tuple[float, int, float, int, frozenset[int]]] = field(default_factory=list)
     # reduction data (B-splines with reduced G1 joins)
     _orig: BSplineCurve | None = None
     _keep: np.ndarray | None = None  # original index of each reduced control point
@@ -239,7 +252,8 @@ def _side_tangent(pp: Any, v: float, seg: int, left: bool, size: float
 
 def _degenerate_join(curve: BSplineCurve, pp: Any, v: float, k: int, j: int, g1: float,
                      size: float, hold: set[int], rep: dict[str, Any],
-                     seam: tuple[float, int] | None = None) -> None:
+                     seam: tuple[float, int] | None = None,
+                     corners: list[Any] | None = None) -> None:
     """A C0 join (knot ``v``, break ``k`` of ``pp``, join point ``P_j``) with a handle of zero
     length on a side: it cannot be made C1 (one first derivative is zero), so it is held.
     A corner (tangents apart by more than ``g1``, or a side of zero length) holds its point
@@ -264,6 +278,9 @@ def _degenerate_join(curve: BSplineCurve, pp: Any, v: float, k: int, j: int, g1:
         if kr >= 2:
             hold.update(_side_support(curve, sr, v, 1))
         rep["corners_held"] += 1
+        if corners is not None and tl is not None and tr is not None:
+            corners.append((vl, kl_seg, v, k, frozenset(_side_support(curve, sl, vl, kl))
+                            | frozenset(_side_support(curve, sr, v, kr))))
         return
     hold.update(_side_support(curve, sl, vl, kl))
     hold.update(_side_support(curve, sr, v, kr))
@@ -280,6 +297,7 @@ def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozense
     size = _size(P)
     eps = _ROUND * size
     hold: set[int] = set()
+    corners: list[tuple[float, int, float, int, frozenset[int]]] = []
     rep: dict[str, Any] = {"g1_joins": 0, "g1_joins_reparametrised": 0, "g2_joins_held": 0,
                            "g2_joins_faired": 0, "corners_held": 0, "straight_spans_held": 0}
 
@@ -316,14 +334,14 @@ def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozense
             # a handle of zero length on one side (a Bezier control point on its node): the
             # tangent there is that of the first derivative that does not vanish
             if c0:
-                _degenerate_join(curve, pp, v, int(ck[q]), int(a - 1), g1, size, hold, rep)
+                _degenerate_join(curve, pp, v, int(ck[q]), int(a - 1), g1, size, hold, rep,
+                                 corners=corners)
             continue
         ang = _angle(d1l, d1r)
         if c0 and ang > g1:
-            if curve.closed:
-                hold.add(int(curve.control_index(a - 1)))
-            else:
-                hold.add(int(a - 1))
+            hold.add(int(curve.control_index(a - 1)))
+            corners.append((v, int(ck[q]) - 1, v, int(ck[q]), frozenset(
+                int(i) for i in curve.control_index(np.arange(a - 2, a + 1)))))
             rep["corners_held"] += 1
             continue
         if ang > g1:
@@ -372,10 +390,13 @@ def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozense
             j = a0 - 1
             last = br.shape[0] - 2
             if _vanishes(d0, wid[0], 1, size) or _vanishes(d1, wid[last], 1, size):
-                _degenerate_join(curve, pp, lo, 0, j, g1, size, hold, rep, seam=(hi, last))
+                _degenerate_join(curve, pp, lo, 0, j, g1, size, hold, rep, seam=(hi, last),
+                                 corners=corners)
             else:
                 if _angle(d1, d0) > g1:
                     hold.add(int(curve.control_index(j)))
+                    corners.append((hi, last, lo, 0, frozenset(
+                        int(i) for i in curve.control_index(np.arange(j - 1, j + 2)))))
                     rep["corners_held"] += 1
                 else:
                     hold.update(int(i) for i in curve.control_index(np.arange(j - 1, j + 2)))
@@ -393,11 +414,18 @@ def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozense
                 # first derivative's), so a G1 seam holds what both end tangents depend on
                 tl, kl = _side_tangent(pp, hi, last, True, size)
                 tr, kr = _side_tangent(pp, lo, 0, False, size)
-                if tl is not None and tr is not None and _angle(tl, tr) <= g1:
-                    hold.update(_side_support(curve, n - 1, hi, kl))
-                    hold.update(_side_support(curve, p, lo, kr))
-                    rep["seam_clamp"] = "held"
-            elif min(np.linalg.norm(d0), np.linalg.norm(d1)) > 0 and _angle(d1, d0) <= g1:
+                if tl is not None and tr is not None:
+                    sup = set(_side_support(curve, n - 1, hi, kl)) | set(
+                        _side_support(curve, p, lo, kr))
+                    if _angle(tl, tr) <= g1:
+                        hold.update(sup)
+                        rep["seam_clamp"] = "held"
+                    else:
+                        corners.append((hi, last, lo, 0, frozenset(sup)))
+            elif min(np.linalg.norm(d0), np.linalg.norm(d1)) > 0 and _angle(d1, d0) > g1:
+                # a corner where the chain meets its start (its ends are clamped)
+                corners.append((hi, last, lo, 0, frozenset((0, 1, n - 2, n - 1))))
+            elif min(np.linalg.norm(d0), np.linalg.norm(d1)) > 0:
                 k0 = _curvature(d0, curve(np.array([lo]), 2)[0])
                 k1 = _curvature(d1, curve(np.array([hi]), 2)[0])
                 want = "g2" if abs(k0 - k1) <= _G2_REL * max(abs(k0), abs(k1), 1e-300) else "g1"
@@ -406,7 +434,8 @@ def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozense
                         out_clamp[s] = want
                 rep["seam_clamp"] = want
 
-    jplan = JoinPlan(curve, frozenset(), (out_clamp[0], out_clamp[1]), 0.0, rep)
+    jplan = JoinPlan(curve, frozenset(), (out_clamp[0], out_clamp[1]), 0.0, rep,
+                     corners=corners)
     # a join is reduced only if its point is free and the reduction moves it little: the
     # re-inserted point is (R P_{j-1} + L P_{j+1}) / (L + R), L and R the handle lengths
     errs: dict[int, float] = {}
@@ -625,6 +654,33 @@ def _g2_through(jplan: JoinPlan, R0: BSplineCurve, knot: dict[int, float], left:
     rep["g2_joins_held"] += len(refused)
     rep["_g2_refused"] = refused
     return fixed
+
+
+def corner_turns(before: BSplineCurve, after: PiecewiseCurve,
+                 corners: list[tuple[float, int, float, int, frozenset[int]]],
+                 limit: float = DEFAULT_CORNER_TURN) -> frozenset[int]:
+    """The control points that fix each corner of ``before`` (:attr:`JoinPlan.corners`) whose
+    angle ``after`` the fairing differs by more than ``limit`` degrees (empty: none).
+
+    The angle is that between the tangents arriving and leaving (:func:`_side_tangent`: the
+    first derivative that does not vanish), on both curves, which share their breaks (the
+    result is on the input's knots). A corner whose tangent vanishes after counts as turned."""
+    if not corners:
+        return frozenset()
+    ppa, ppb = before.piecewise, after.piecewise
+    size = _size(np.asarray(before.control_points, dtype=np.float64))
+    lim = float(np.radians(limit))
+    out: set[int] = set()
+    for vl, sl, vr, sr, sup in corners:
+        angles = []
+        for pp in (ppa, ppb):
+            tl, _ = _side_tangent(pp, vl, sl, True, size)
+            tr, _ = _side_tangent(pp, vr, sr, False, size)
+            angles.append(None if tl is None or tr is None else _angle(tl, tr))
+        a, b = angles
+        if a is not None and (b is None or abs(b - a) > lim):
+            out.update(sup)
+    return frozenset(out)
 
 
 def plan(curve: PiecewiseCurve, clamp: tuple[str, str], protect: frozenset[int],

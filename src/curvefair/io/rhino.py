@@ -11,13 +11,18 @@ are not read; lines, arcs and other geometry are left alone):
   are added back (``Knots.SuperfluousKnot``), so the knot vector is the usual full one;
 - degree-1 ``NurbsCurve`` and ``PolylineCurve`` -> ``kind="polyline"`` (vertices, split at
   corners like every point list);
-- rational curves, unclamped non-periodic knots, ``PolyCurve``: unsupported
-  (``on_unsupported``).
+- ``PolyCurve`` (joined curves; Rhino 2 saved every curve as one): one segment -> read as
+  that ``NurbsCurve``; several -> one ``kind="bspline"`` record per run of segments
+  (:func:`_polycurve`: clamped non-rational ``NurbsCurve`` segments of degree >= 2 and one
+  degree, meeting exactly), the other segments kept, the ends of a run next to them held;
+  written back into the segments in place. Nested PolyCurves are unsupported;
+- rational curves, unclamped non-periodic knots: unsupported (``on_unsupported``).
 
 A curve whose control points all have the same z is 2-D (``source["z"]`` keeps that z).
 ``source`` keys: ``id`` (the object's GUID as a string), ``object`` (index in the object
 table), ``layer`` (layer name), ``geometry`` (class name), ``z``, ``nurbs_layout``
-(``"clamped"``/``"periodic"``), plus the point-list keys for polylines.
+(``"clamped"``/``"periodic"``), ``polycurve`` and ``segments`` (a PolyCurve's run: its segment
+indices), plus the point-list keys for polylines.
 
 Write
 -----
@@ -156,10 +161,15 @@ def _records_of(obj: Any, i: int, base: dict[str, Any], path: object, rh: Any,
     if isinstance(g, rh.PolylineCurve):
         xyz = np.array([tuple(_p3(g.Point(k))) for k in range(g.PointCount)], dtype=float)
         return _polyline(xyz, base, path, corner_angle, index)
+    if isinstance(g, rh.PolyCurve):
+        return _polycurve(g, base, path, rh, corner_angle, index)
     if not isinstance(g, rh.NurbsCurve):
-        if isinstance(g, rh.PolyCurve):
-            raise Unsupported("PolyCurve")
         return []
+    return _nurbs_records(g, base, path, corner_angle, index)
+
+
+def _nurbs_records(g: Any, base: dict[str, Any], path: object, corner_angle: float | None,
+                   index: int) -> list[CurveRecord]:
     if g.IsRational:
         xyz, w, _, _ = _nurbs(g)
         if not np.all(w == 1.0):
@@ -195,6 +205,117 @@ def _records_of(obj: Any, i: int, base: dict[str, Any], path: object, rh: Any,
         raise Unsupported(f"NurbsCurve: {exc}") from None
     src = dict(base, z=z, nurbs_layout=layout, index=index)
     return [CurveRecord(curve, base["name"], "bspline", src)]
+
+
+def _segment(s: Any, rh: Any) -> tuple[FloatArray, FloatArray, int] | None:
+    """Control points (x, y, z), full knots and degree of a PolyCurve segment curvefair fairs:
+    a clamped non-rational ``NurbsCurve`` of degree >= 2 with finite numbers and some length;
+    None for every other segment (lines, arcs, rational or unclamped curves), which is kept."""
+    if not isinstance(s, rh.NurbsCurve) or int(s.Degree) < 2:
+        return None
+    xyz, w, full, p = _nurbs(s)
+    if not (np.all(w == 1.0) and np.isfinite(xyz).all() and np.isfinite(full).all()
+            and is_clamped(full, p) and full[-1] > full[0]
+            and np.any(xyz[1:] != xyz[:-1])):
+        return None
+    return xyz, full, p
+
+
+def _join_held(left: Any, right: Any, size: float) -> int:
+    """How many control points each side of a join between a faired run and a kept segment
+    (or another run) holds: 2 (the point and its neighbour: the tangent, so a G1 join stays
+    G1 and a corner keeps its angle), 3 where the two sides' curvature vectors agree (a G2
+    join: the curvature at an end depends on the first three control points)."""
+    ka = np.array(_p3(left.CurvatureAt(left.Domain.T1)))
+    kb = np.array(_p3(right.CurvatureAt(right.Domain.T0)))
+    ta = np.array(_p3(left.TangentAtEnd))
+    tb = np.array(_p3(right.TangentAtStart))
+    g1 = float(np.dot(ta, tb)) > np.cos(np.radians(0.01))
+    g2 = g1 and float(np.linalg.norm(ka - kb)) <= 1e-6 * (max(np.linalg.norm(ka),
+                                                              np.linalg.norm(kb)) + 1.0 / size)
+    return 3 if g2 else 2
+
+
+def _polycurve(g: Any, base: dict[str, Any], path: object, rh: Any,
+               corner_angle: float | None, index: int) -> list[CurveRecord]:
+    """The records of a ``PolyCurve``: one per run of consecutive segments curvefair fairs
+    (:func:`_segment`) that have one degree and meet exactly (the end control point of one is
+    the start of the next, float for float).
+
+    A run is one clamped B-spline: its segments' control points in order, the shared ones
+    once, and each segment's knots mapped linearly onto an interval as long as its control
+    polygon, with a knot of multiplicity ``degree`` between segments (a C0 join, which the
+    fairing keeps G1 where it was; :mod:`curvefair.fairing.joins`). A linear map of a
+    segment's knots does not change its shape, and only control points are written back,
+    into each segment with its own knots. Where a run meets a kept segment or another run,
+    its end point and one or two neighbours are held (:func:`_join_held`); a closed
+    PolyCurve that is one run ending on its start has its seam planned like an open chain's.
+    """
+    n_seg = int(g.SegmentCount)
+    segs = [g.SegmentCurve(i) for i in range(n_seg)]
+    if any(isinstance(s, rh.PolyCurve) for s in segs):
+        raise Unsupported("nested PolyCurve")
+    if n_seg == 1 and isinstance(segs[0], rh.NurbsCurve):
+        # one segment (how Rhino 2 saved every curve): read as the NurbsCurve it holds,
+        # periodic ones included
+        return [CurveRecord(r.curve, r.name, r.kind, dict(r.source, polycurve=True,
+                                                          segments=(0,)), r.points, r.corners)
+                for r in _nurbs_records(segs[0], base, path, corner_angle, index)]
+    found = [_segment(s, rh) for s in segs]
+    info = {i: f for i, f in enumerate(found) if f is not None}
+    runs: list[list[int]] = []
+    for i, inf in info.items():
+        prev = info.get(i - 1)
+        if runs and runs[-1][-1] == i - 1 and prev is not None and prev[2] == inf[2] \
+                and np.array_equal(prev[0][-1], inf[0][0]):
+            runs[-1].append(i)
+        else:
+            runs.append([i])
+    if not runs:
+        raise Unsupported("PolyCurve: no segment is a non-rational NurbsCurve of degree >= 2")
+    closed = bool(g.IsClosed)
+    box = g.GetBoundingBox()
+    size = float(np.linalg.norm(np.subtract(_p3(box.Max), _p3(box.Min)))) or 1.0
+    out = []
+    for run in runs:
+        p = info[run[0]][2]
+        pts = [info[run[0]][0][:1]]
+        knots = [np.zeros(p + 1)]
+        off = 0.0
+        for j, i in enumerate(run):
+            xyz, full, _ = info[i]
+            length = float(np.linalg.norm(np.diff(xyz, axis=0), axis=1).sum())
+            a, b = full[p], full[-p - 1]
+            if j:
+                knots.append(np.full(p, off))
+            knots.append(off + (full[p + 1: -p - 1] - a) / (b - a) * length)
+            pts.append(xyz[1:])
+            off += length
+        knots.append(np.full(p + 1, off))
+        xyz = np.vstack(pts)
+        held: list[int] = []
+        # a closed PolyCurve that is one run ending exactly on its start: the fairing plans
+        # its seam; else the closing join is held like any other
+        whole = closed and len(runs) == 1 and run[0] == 0 and run[-1] == n_seg - 1 \
+            and np.array_equal(xyz[0], xyz[-1])
+        if not whole:
+            if run[0] > 0 or closed:
+                k = _join_held(segs[run[0] - 1], segs[run[0]], size)
+                held += list(range(min(k, xyz.shape[0])))
+            if run[-1] < n_seg - 1 or closed:
+                k = _join_held(segs[run[-1]], segs[(run[-1] + 1) % n_seg], size)
+                held += list(range(max(xyz.shape[0] - k, 0), xyz.shape[0]))
+        pts2, z = planar(xyz)
+        try:
+            curve = BSplineCurve(pts2, np.concatenate(knots), p, closed=False)
+        except CurvefairError as exc:
+            raise Unsupported(f"PolyCurve segments {run[0]}-{run[-1]}: {exc}") from None
+        name = base["name"] if len(runs) == 1 else f"{base['name']}[{run[0]}:{run[-1] + 1}]"
+        src = dict(base, z=z, nurbs_layout="clamped", polycurve=True, segments=tuple(run),
+                   index=index)
+        out.append(CurveRecord(curve, name, "bspline", src, corners=tuple(sorted(set(held)))))
+        index += 1
+    return out
 
 
 def _p3(p: Any) -> tuple[float, float, float]:
@@ -310,6 +431,29 @@ def _edit_nurbs(rh: Any, model: Any, obj: Any, rec: CurveRecord) -> None:
     _replace_geometry(model, obj, _nurbs_of(rh, curve, rec.source.get("z")))
 
 
+def _edit_polycurve(rh: Any, obj: Any, recs: list[CurveRecord]) -> None:
+    """Write each run's control points into its PolyCurve segments (in place: the segments'
+    knots, the PolyCurve's parametrisation and every other segment stay as they were)."""
+    g = obj.Geometry
+    for rec in recs:
+        curve = bspline_of(rec.curve, "write_curves (3dm)")
+        cps = _xyz(curve.extended_control_points, rec.source.get("z"))
+        k = 0
+        segs = [g.SegmentCurve(int(i)) for i in rec.source["segments"]]
+        if sum(len(s.Points) - 1 for s in segs) + 1 != cps.shape[0] or \
+                any(int(s.Degree) != curve.degree for s in segs):
+            raise InputError(f"write_curves: object {rec.source['id']} segments "
+                             f"{list(rec.source['segments'])}: the faired curve has "
+                             f"{cps.shape[0]} control points of degree {curve.degree}; a "
+                             "PolyCurve's segments keep theirs (use a method that keeps the "
+                             "B-spline's structure)")
+        for s in segs:
+            for q in range(len(s.Points)):
+                x, y, zz = cps[k + q]
+                s.Points[q] = rh.Point4d(float(x), float(y), float(zz), 1.0)
+            k += len(s.Points) - 1
+
+
 def _replace_geometry(model: Any, obj: Any, geometry: Any) -> None:
     attr = obj.Attributes
     ident = attr.Id
@@ -317,13 +461,12 @@ def _replace_geometry(model: Any, obj: Any, geometry: Any) -> None:
     model.Objects.Add(geometry, attr)
 
 
-def _edit_points(rh: Any, obj: Any, recs: list[CurveRecord]) -> None:
+def _edit_points(rh: Any, g: Any, recs: list[CurveRecord]) -> None:
     src = recs[0].source
     n = int(src["n_points"])
     dim = data_points(recs[0].curve, "write_curves (3dm)").shape[1]
     distinct = piece_values(n, dim, recs, "write_curves (3dm)")
     pts = _xyz(distinct[np.asarray(src["row_map"], dtype=int)], src.get("z"))
-    g = obj.Geometry
     if isinstance(g, rh.PolylineCurve):
         if g.PointCount != pts.shape[0]:
             raise InputError(f"write_curves: object {src['id']} has {g.PointCount} vertices, "
@@ -359,12 +502,16 @@ def _geometry_key(g: Any) -> tuple[Any, ...]:
                                          for i in range(len(pts))]), np.array(list(g.Knots)))
     if hasattr(g, "PointCount"):
         return (np.array([_p3(g.Point(k)) for k in range(g.PointCount)]),)
+    if hasattr(g, "SegmentCount"):
+        return tuple(_geometry_key(g.SegmentCurve(i)) if hasattr(g.SegmentCurve(i), "Knots")
+                     else type(g.SegmentCurve(i)).__name__ for i in range(g.SegmentCount))
     return (id(g),)
 
 
 def _same_key(a: tuple[Any, ...], b: tuple[Any, ...]) -> bool:
     return len(a) == len(b) and all(
-        np.array_equal(x, y) if isinstance(x, np.ndarray) else x == y
+        np.array_equal(x, y) if isinstance(x, np.ndarray)
+        else _same_key(x, y) if isinstance(x, tuple) and isinstance(y, tuple) else x == y
         for x, y in zip(a, b, strict=True))
 
 
@@ -402,10 +549,14 @@ def write(path: str | os.PathLike[str], records: Sequence[CurveRecord], *,
         if obj is None:
             raise InputError(f"write_curves: the template has no object with id {ident}")
         before = _geometry_key(obj.Geometry)
-        if recs[0].kind == "bspline":
+        if recs[0].source.get("polycurve") and recs[0].kind == "bspline":
+            _edit_polycurve(rh, obj, recs)
+        elif recs[0].source.get("polycurve"):     # one degree-1 segment: its vertices
+            _edit_points(rh, obj.Geometry.SegmentCurve(0), recs)
+        elif recs[0].kind == "bspline":
             _edit_nurbs(rh, model, obj, recs[0])
         else:
-            _edit_points(rh, obj, recs)
+            _edit_points(rh, obj.Geometry, recs)
         obj = next((model.Objects[k] for k in range(len(model.Objects))
                     if str(model.Objects[k].Attributes.Id) == str(obj.Attributes.Id)), obj)
         changed = changed or not _same_key(before, _geometry_key(obj.Geometry))
