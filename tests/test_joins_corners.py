@@ -74,6 +74,10 @@ def test_a_corner_keeps_its_angle(method, corner):
     # the premise: with no limit the method swings the short handles
     assert abs(_turn(free, 7.0) - corner) > DEFAULT_CORNER_TURN
     assert abs(_turn(kept.curve, 7.0) - corner) <= DEFAULT_CORNER_TURN
+    # and neither tangent swings round (same angle, turned whole)
+    for side in (-1, 1):
+        d0, d1 = _direction(c, 7.0, side), _direction(kept.curve, 7.0, side)
+        assert math.degrees(math.acos(min(1.0, float(d0 @ d1)))) <= DEFAULT_CORNER_TURN
     assert kept.report["joins"]["corner_points_held"] >= 3
 
 

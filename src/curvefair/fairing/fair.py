@@ -533,8 +533,9 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
         Degrees; a C0 knot whose two tangents differ by at most this is a G1 join (default
         :data:`curvefair.fairing.joins.DEFAULT_G1_ANGLE`, 0.5).
     corner_turn : float, optional
-        Degrees; the most the angle of a corner of a B-spline (a C0 knot that is not G1) may
-        change (default :data:`curvefair.fairing.joins.DEFAULT_CORNER_TURN`, 1). Where the
+        Degrees; the most the angle of a corner of a B-spline (a C0 knot that is not G1), and
+        each of its two tangents, may turn (default
+        :data:`curvefair.fairing.joins.DEFAULT_CORNER_TURN`, 1). Where the
         method turns one more, the curve is faired again with the control points that fix
         that corner's angle held (``report["joins"]["corner_points_held"]``); ``math.inf``:
         no limit (only the corner's point is held).

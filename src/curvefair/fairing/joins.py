@@ -31,8 +31,9 @@ geometry the curve's author drew on purpose. :func:`plan` looks at the curve fir
   value, tangent and second derivative on either side depend, which keeps position, tangent
   and curvature of both sides exactly.
 * **corners** (a C0 knot whose tangents differ by more than ``g1_angle``): the join point
-  ``P_j`` is held; the corner stays where it is and stays a corner. Its angle may change
-  by at most :data:`DEFAULT_CORNER_TURN` (1 degree): :func:`curvefair.fair` measures every
+  ``P_j`` is held; the corner stays where it is and stays a corner. Its angle, and each of
+  its tangents, may turn by at most :data:`DEFAULT_CORNER_TURN` (1 degree):
+  :func:`curvefair.fair` measures every
   corner after the method (:func:`corner_turns`) and, where one turned more, fairs again
   with the control points that fix its angle held (``P_{j-1}``, ``P_j``, ``P_{j+1}``, or
   the supports of the tangents below), then with those of every corner held if another
@@ -660,11 +661,14 @@ def corner_turns(before: BSplineCurve, after: PiecewiseCurve,
                  corners: list[tuple[float, int, float, int, frozenset[int]]],
                  limit: float = DEFAULT_CORNER_TURN) -> frozenset[int]:
     """The control points that fix each corner of ``before`` (:attr:`JoinPlan.corners`) whose
-    angle ``after`` the fairing differs by more than ``limit`` degrees (empty: none).
+    angle ``after`` the fairing differs by more than ``limit`` degrees, or one of whose two
+    tangents turned by more than that (a corner swung round whole keeps its angle but not its
+    look: a Bezier leaving a line at 0.9 degrees to one side came back at 0.9 degrees to the
+    other); empty: none.
 
-    The angle is that between the tangents arriving and leaving (:func:`_side_tangent`: the
-    first derivative that does not vanish), on both curves, which share their breaks (the
-    result is on the input's knots). A corner whose tangent vanishes after counts as turned."""
+    Tangents are those arriving and leaving (:func:`_side_tangent`: the first derivative that
+    does not vanish), on both curves, which share their breaks (the result is on the input's
+    knots). A corner whose tangent vanishes after counts as turned."""
     if not corners:
         return frozenset()
     ppa, ppb = before.piecewise, after.piecewise
@@ -672,13 +676,14 @@ def corner_turns(before: BSplineCurve, after: PiecewiseCurve,
     lim = float(np.radians(limit))
     out: set[int] = set()
     for vl, sl, vr, sr, sup in corners:
-        angles = []
-        for pp in (ppa, ppb):
-            tl, _ = _side_tangent(pp, vl, sl, True, size)
-            tr, _ = _side_tangent(pp, vr, sr, False, size)
-            angles.append(None if tl is None or tr is None else _angle(tl, tr))
-        a, b = angles
-        if a is not None and (b is None or abs(b - a) > lim):
+        tla, _ = _side_tangent(ppa, vl, sl, True, size)
+        tra, _ = _side_tangent(ppa, vr, sr, False, size)
+        if tla is None or tra is None:
+            continue
+        tlb, _ = _side_tangent(ppb, vl, sl, True, size)
+        trb, _ = _side_tangent(ppb, vr, sr, False, size)
+        if (tlb is None or trb is None or abs(_angle(tlb, trb) - _angle(tla, tra)) > lim
+                or _angle(tla, tlb) > lim or _angle(tra, trb) > lim):
             out.update(sup)
     return frozenset(out)
 
