@@ -340,24 +340,45 @@ def test_option_noequals_is_a_usage_error_naming_option(tmp_path: Path, ex1: Pat
 
 def test_fair_arguments_given_as_method_options_name_a_real_flag(tmp_path: Path, ex1: Path,
                                                                 monkeypatch):
-    """``-O tol=...`` points to ``--tol``; a fair() argument the command has no flag for
-    (``corner_turn``, ``g1_angle``) says the default is kept (it named ``--corner-turn``,
-    which does not exist)."""
+    """``-O tol=...`` points to ``--tol``; a fair() argument the command has no flag for and
+    does not pass on (``joins``, ``guard``) says the default is kept (``-O g1_angle=1`` named
+    ``--g1-angle``, which does not exist)."""
     import click
 
-    from curvefair.cli import _FAIR_FLAGS, _fair_arguments, fair_cmd
+    from curvefair.cli import _FAIR_FLAGS, _FAIR_VIA_OPTION, _fair_arguments, fair_cmd
 
     flags = {o for p in fair_cmd.params if isinstance(p, click.Option) for o in p.opts}
     for flag in _FAIR_FLAGS.values():
         assert flag == "the IN argument" or set(flag.split("/")) <= flags, flag
-    assert set(_FAIR_FLAGS) <= _fair_arguments()
+    assert set(_FAIR_FLAGS) | set(_FAIR_VIA_OPTION) <= _fair_arguments()
     monkeypatch.chdir(tmp_path)
-    for key, want in (("tol", "use --tol"), ("corner_turn", "keeps fair()'s default"),
-                      ("g1_angle", "keeps fair()'s default")):
+    for key, want in (("tol", "use --tol"), ("joins", "keeps fair()'s default"),
+                      ("guard", "keeps fair()'s default")):
         r = CliRunner().invoke(main, ["fair", "ex1.csv", "-o", "o.csv", "-O", f"{key}=1"])
         assert r.exit_code == 2 and want in r.output, r.output
-        assert "--corner-turn" not in r.output and "--g1-angle" not in r.output
+        assert "--joins" not in r.output and "--guard" not in r.output
     assert not (tmp_path / "o.csv").exists()
+
+
+def test_corner_turn_reaches_fair_through_option(tmp_path: Path, monkeypatch):
+    """``-O corner_turn=inf`` reaches fair() (the corners of a B-spline may turn: nothing
+    held for them); by default a corner that turned is held (tests/test_joins_corners.py)."""
+    import json
+
+    from test_joins_corners import _chain, _wiggly_chain
+
+    from curvefair import CurveRecord, write_curves
+
+    monkeypatch.chdir(tmp_path)
+    write_curves("c.json", [CurveRecord(_chain(_wiggly_chain(35.0)), "chain")])
+    held = []
+    for extra in ([], ["-O", "corner_turn=inf"]):
+        r = CliRunner().invoke(main, ["fair", "c.json", "-o", "o.json", "--tol", "0.2", "-q",
+                                      "-m", "global", "--report", "r.json", *extra])
+        assert r.exit_code == 0, r.output
+        joins = json.loads(Path("r.json").read_text())["curves"][0]["report"]["joins"]
+        held.append(joins.get("corner_points_held", 0))
+    assert held[0] >= 3 and held[1] == 0
 
 
 def test_option_values_are_typed():

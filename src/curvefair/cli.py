@@ -218,6 +218,8 @@ def _parse_value(text: str) -> Any:
 _FAIR_FLAGS = {"curve": "the IN argument", "method": "-m/--method", "tol": "--tol",
                "eps": "--eps", "max_steps": "--max-steps", "clamp": "--clamp",
                "protect": "--protect", "mode": "--mode"}
+#: fair()'s own arguments ``-O`` passes on (they reach fair() with the method's options)
+_FAIR_VIA_OPTION = ("corner_turn", "g1_angle")
 
 
 def _parse_method_options(items: Sequence[str]) -> dict[str, Any]:
@@ -229,7 +231,7 @@ def _parse_method_options(items: Sequence[str]) -> dict[str, Any]:
         if not sep or not key:
             raise click.BadParameter(f"{item!r} is not KEY=VALUE (e.g. -O schedule=sweep)",
                                      param_hint="'-O' / '--option'")
-        if key in _fair_arguments():
+        if key in _fair_arguments() and key not in _FAIR_VIA_OPTION:
             flag = _FAIR_FLAGS.get(key)
             raise click.BadParameter(
                 f"{key!r} is not a method option; " + (f"use {flag}" if flag else
@@ -949,7 +951,8 @@ def _batch_fair_options(method: str | None, tol: float | None, eps: float | None
                    "-O l=3). VALUE is read as an integer, else a number, else true/false, "
                    "else text; a repeated KEY: the last wins. 'curvefair methods' lists each "
                    "method's options and defaults; a KEY the method does not take fails the "
-                   "curve.")
+                   "curve. fair()'s corner_turn and g1_angle (degrees) are taken too: "
+                   "-O corner_turn=inf lets B-spline corners turn more than 1 degree.")
 @click.option("--decimals", type=click.IntRange(min=0), metavar="N",
               help="Text formats: write every number with N decimals [default: the input "
                    "file's precision]. A rounding that puts a curve read back farther than "
