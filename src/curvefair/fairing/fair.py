@@ -705,10 +705,10 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
         corners = list(jp.corners)
         held: frozenset[int] = frozenset()
         for attempt in range(2):
-            turned = _joins.corner_turns(curve, new, corners, turn_deg)
+            turned = _joins.corner_turns(cast("BSplineCurve", new), corners, turn_deg)
             if not turned:
                 break
-            held |= turned if attempt == 0 else frozenset().union(*(c[4] for c in corners))
+            held |= turned if attempt == 0 else frozenset().union(*(c.support for c in corners))
             jp, out, new = run(_joins.plan(curve, clamp_pair, frozenset(prot) | held, g1_deg,
                                            tol_v), held)
         if held:

@@ -64,7 +64,7 @@ plain behaviour).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, cast
+from typing import Any, NamedTuple, cast
 
 import numpy as np
 
@@ -73,7 +73,7 @@ from .._typing import FloatArray
 from ..curves.bspline import BSplineCurve, basis_derivatives
 from ..curves.piecewise import PiecewiseCurve
 
-__all__ = ["plan", "JoinPlan", "join_angles", "corner_turns", "DEFAULT_G1_ANGLE",
+__all__ = ["plan", "JoinPlan", "Corner", "join_angles", "corner_turns", "DEFAULT_G1_ANGLE",
            "DEFAULT_CORNER_TURN"]
 
 #: Default largest angle (degrees) between the two tangents of a join that is treated as G1.
@@ -126,6 +126,20 @@ def join_angles(curve: PiecewiseCurve) -> FloatArray:
     return np.array([_angle(a, b) for a, b in pairs])
 
 
+class Corner(NamedTuple):
+    """A corner of the input that :func:`corner_turns` checks: where the curve arrives (knot
+    ``vl`` of piece ``sl``) and leaves (``vr`` of ``sr``; the same knot but at a seam), the
+    input's tangents there (directions; any length), and the control points that fix them."""
+
+    vl: float
+    sl: int
+    vr: float
+    sr: int
+    tl: FloatArray
+    tr: FloatArray
+    support: frozenset[int]
+
+
 @dataclass
 class JoinPlan:
     """What :func:`plan` decided; see the module docstring.
@@ -150,9 +164,8 @@ class JoinPlan:
     clamp: tuple[str, str]
     margin: float = 0.0
     report: dict[str, Any] = field(default_factory=dict)
-    #: the corners of the input whose angle :func:`corner_turns` checks: (knot arriving,
-    #: piece arriving, knot leaving, piece leaving, the control points that fix the angle)
-    corners: list[tuple[float, int, float, int, frozenset[int]]] = field(default_factory=list)
+    #: the corners of the input whose angle :func:`corner_turns` checks
+    corners: list[Corner] = field(default_factory=list)
     # reduction data (B-splines with reduced G1 joins)
     _orig: BSplineCurve | None = None
     _keep: np.ndarray | None = None  # original index of each reduced control point
@@ -254,7 +267,7 @@ def _side_tangent(pp: Any, v: float, seg: int, left: bool, size: float
 def _degenerate_join(curve: BSplineCurve, pp: Any, v: float, k: int, j: int, g1: float,
                      size: float, hold: set[int], rep: dict[str, Any],
                      seam: tuple[float, int] | None = None,
-                     corners: list[Any] | None = None) -> None:
+                     corners: list[Corner] | None = None) -> None:
     """A C0 join (knot ``v``, break ``k`` of ``pp``, join point ``P_j``) with a handle of zero
     length on a side: it cannot be made C1 (one first derivative is zero), so it is held.
     A corner (tangents apart by more than ``g1``, or a side of zero length) holds its point
@@ -280,8 +293,9 @@ def _degenerate_join(curve: BSplineCurve, pp: Any, v: float, k: int, j: int, g1:
             hold.update(_side_support(curve, sr, v, 1))
         rep["corners_held"] += 1
         if corners is not None and tl is not None and tr is not None:
-            corners.append((vl, kl_seg, v, k, frozenset(_side_support(curve, sl, vl, kl))
-                            | frozenset(_side_support(curve, sr, v, kr))))
+            corners.append(Corner(vl, kl_seg, v, k, tl, tr,
+                                  frozenset(_side_support(curve, sl, vl, kl))
+                                  | frozenset(_side_support(curve, sr, v, kr))))
         return
     hold.update(_side_support(curve, sl, vl, kl))
     hold.update(_side_support(curve, sr, v, kr))
@@ -298,7 +312,7 @@ def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozense
     size = _size(P)
     eps = _ROUND * size
     hold: set[int] = set()
-    corners: list[tuple[float, int, float, int, frozenset[int]]] = []
+    corners: list[Corner] = []
     rep: dict[str, Any] = {"g1_joins": 0, "g1_joins_reparametrised": 0, "g2_joins_held": 0,
                            "g2_joins_faired": 0, "corners_held": 0, "straight_spans_held": 0}
 
@@ -341,7 +355,7 @@ def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozense
         ang = _angle(d1l, d1r)
         if c0 and ang > g1:
             hold.add(int(curve.control_index(a - 1)))
-            corners.append((v, int(ck[q]) - 1, v, int(ck[q]), frozenset(
+            corners.append(Corner(v, int(ck[q]) - 1, v, int(ck[q]), d1l, d1r, frozenset(
                 int(i) for i in curve.control_index(np.arange(a - 2, a + 1)))))
             rep["corners_held"] += 1
             continue
@@ -396,7 +410,7 @@ def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozense
             else:
                 if _angle(d1, d0) > g1:
                     hold.add(int(curve.control_index(j)))
-                    corners.append((hi, last, lo, 0, frozenset(
+                    corners.append(Corner(hi, last, lo, 0, d1, d0, frozenset(
                         int(i) for i in curve.control_index(np.arange(j - 1, j + 2)))))
                     rep["corners_held"] += 1
                 else:
@@ -422,10 +436,10 @@ def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozense
                         hold.update(sup)
                         rep["seam_clamp"] = "held"
                     else:
-                        corners.append((hi, last, lo, 0, frozenset(sup)))
+                        corners.append(Corner(hi, last, lo, 0, tl, tr, frozenset(sup)))
             elif min(np.linalg.norm(d0), np.linalg.norm(d1)) > 0 and _angle(d1, d0) > g1:
                 # a corner where the chain meets its start (its ends are clamped)
-                corners.append((hi, last, lo, 0, frozenset((0, 1, n - 2, n - 1))))
+                corners.append(Corner(hi, last, lo, 0, d1, d0, frozenset((0, 1, n - 2, n - 1))))
             elif min(np.linalg.norm(d0), np.linalg.norm(d1)) > 0:
                 k0 = _curvature(d0, curve(np.array([lo]), 2)[0])
                 k1 = _curvature(d1, curve(np.array([hi]), 2)[0])
@@ -657,34 +671,30 @@ def _g2_through(jplan: JoinPlan, R0: BSplineCurve, knot: dict[int, float], left:
     return fixed
 
 
-def corner_turns(before: BSplineCurve, after: PiecewiseCurve,
-                 corners: list[tuple[float, int, float, int, frozenset[int]]],
+def corner_turns(after: BSplineCurve, corners: list[Corner],
                  limit: float = DEFAULT_CORNER_TURN) -> frozenset[int]:
-    """The control points that fix each corner of ``before`` (:attr:`JoinPlan.corners`) whose
+    """The control points that fix each corner of the input (:attr:`JoinPlan.corners`) whose
     angle ``after`` the fairing differs by more than ``limit`` degrees, or one of whose two
     tangents turned by more than that (a corner swung round whole keeps its angle but not its
     look: a Bezier leaving a line at 0.9 degrees to one side came back at 0.9 degrees to the
     other); empty: none.
 
     Tangents are those arriving and leaving (:func:`_side_tangent`: the first derivative that
-    does not vanish), on both curves, which share their breaks (the result is on the input's
-    knots). A corner whose tangent vanishes after counts as turned."""
+    does not vanish) of ``after``, which is on the input's knots (same breaks), against the
+    input's own, kept in each :class:`Corner` by :func:`plan`. A corner whose tangent
+    vanishes after counts as turned."""
     if not corners:
         return frozenset()
-    ppa, ppb = before.piecewise, after.piecewise
-    size = _size(np.asarray(before.control_points, dtype=np.float64))
+    pp = after.piecewise
+    size = _size(np.asarray(after.control_points, dtype=np.float64))
     lim = float(np.radians(limit))
     out: set[int] = set()
-    for vl, sl, vr, sr, sup in corners:
-        tla, _ = _side_tangent(ppa, vl, sl, True, size)
-        tra, _ = _side_tangent(ppa, vr, sr, False, size)
-        if tla is None or tra is None:
-            continue
-        tlb, _ = _side_tangent(ppb, vl, sl, True, size)
-        trb, _ = _side_tangent(ppb, vr, sr, False, size)
-        if (tlb is None or trb is None or abs(_angle(tlb, trb) - _angle(tla, tra)) > lim
-                or _angle(tla, tlb) > lim or _angle(tra, trb) > lim):
-            out.update(sup)
+    for c in corners:
+        tl, _ = _side_tangent(pp, c.vl, c.sl, True, size)
+        tr, _ = _side_tangent(pp, c.vr, c.sr, False, size)
+        if (tl is None or tr is None or abs(_angle(tl, tr) - _angle(c.tl, c.tr)) > lim
+                or _angle(c.tl, tl) > lim or _angle(c.tr, tr) > lim):
+            out.update(c.support)
     return frozenset(out)
 
 

@@ -265,9 +265,8 @@ def _polycurve(g: Any, base: dict[str, Any], path: object, rh: Any,
     info = {i: f for i, f in enumerate(found) if f is not None}
     runs: list[list[int]] = []
     for i, inf in info.items():
-        prev = info.get(i - 1)
-        if runs and runs[-1][-1] == i - 1 and prev is not None and prev[2] == inf[2] \
-                and np.array_equal(prev[0][-1], inf[0][0]):
+        prev = info.get(i - 1)  # when there, it ends the last run
+        if prev is not None and prev[2] == inf[2] and np.array_equal(prev[0][-1], inf[0][0]):
             runs[-1].append(i)
         else:
             runs.append([i])
@@ -503,8 +502,9 @@ def _geometry_key(g: Any) -> tuple[Any, ...]:
     if hasattr(g, "PointCount"):
         return (np.array([_p3(g.Point(k)) for k in range(g.PointCount)]),)
     if hasattr(g, "SegmentCount"):
-        return tuple(_geometry_key(g.SegmentCurve(i)) if hasattr(g.SegmentCurve(i), "Knots")
-                     else type(g.SegmentCurve(i)).__name__ for i in range(g.SegmentCount))
+        segs = [g.SegmentCurve(i) for i in range(g.SegmentCount)]
+        return tuple(_geometry_key(s) if hasattr(s, "Knots") else type(s).__name__
+                     for s in segs)
     return (id(g),)
 
 
