@@ -525,7 +525,8 @@ def test_id_pattern_selects_svg_elements_by_their_id(tmp_path: Path):
         '<svg xmlns="http://www.w3.org/2000/svg" width="120" height="80">'
         f'<path id="frame_7" d="{path_d(0)}" fill="none" stroke="black"/>'
         f'<path id="keel" d="{path_d(1)}" fill="none" stroke="black"/></svg>')
-    r = _run(["fair", "two.svg", "-o", "sel.svg", "--tol", "0.3", "--id", "frame_*"], tmp_path)
+    r = _run(["fair", "two.svg", "-o", "sel.svg", "--tol", "0.3", "--id", "frame_*",
+              "--polylines"], tmp_path)
     assert r.exit_code == 0, r.output
 
     def ds(p: Path) -> dict[str, str]:

@@ -111,7 +111,10 @@ def test_read_kinds_and_svgpathtools_evaluation(tmp_path):
         '<g transform="scale(2)"><path id="poly" d="M0,0 L10,0 L20,5 L30,0 L30,30 L0,30 Z"/>'
         '</g>\n<path id="quad" d="M 0 0 Q 5 10 10 0 T 20 0"/>\n'
         '<rect x="1" y="1" width="5" height="5"/>\n'))
-    recs = read_curves(p)
+    # by default the hexagon and the rectangle are drawn shapes, left as drawn
+    assert [r.source["id"] for r in read_curves(p)] == ["wave", "quad"]
+    recs = read_curves(p, polylines=True)
+    assert [r.source["polylines"] for r in recs] == [True] * len(recs)
     by = {}
     for r in recs:
         by.setdefault(r.source["id"], []).append(r)
@@ -139,7 +142,8 @@ def test_read_kinds_and_svgpathtools_evaluation(tmp_path):
 
 def test_real_matplotlib_svg_round_trip_and_element_write_back(tmp_path):
     src = DATA / "matplotlib_logo.svg"
-    recs = read_curves(src)
+    assert [r.kind for r in read_curves(src)] == ["bspline"] * 3  # the polygons as drawn
+    recs = read_curves(src, polylines=True)
     kinds = [r.kind for r in recs]
     assert kinds.count("bspline") == 3 and kinds.count("polyline") >= 30
     circle = next(r for r in recs if r.kind == "bspline")
@@ -167,7 +171,7 @@ def test_real_matplotlib_svg_round_trip_and_element_write_back(tmp_path):
     assert b[b.index(changed[0]) + 1] == '" style="fill:#ffffff;"/>'
     assert len(b) == len(a) - 9
     assert len(re.findall(r"\bC\b", changed[0])) == 8
-    back = read_curves(tmp_path / "f.svg")
+    back = read_curves(tmp_path / "f.svg", polylines=True)
     c2 = next(x for x in back if x.source["element"] == circle.source["element"])
     np.testing.assert_allclose(c2.curve(c2.curve.piecewise.breaks),
                                faired(faired.piecewise.breaks), atol=1e-6)  # 6 decimals
@@ -178,13 +182,13 @@ def test_real_matplotlib_svg_round_trip_and_element_write_back(tmp_path):
     write_curves(tmp_path / "g.svg", [x.with_curve(moved) if x is pl else x for x in recs],
                  template=src, decimals=4)
     # read the whole subpath back unsplit: the moved piece's vertices moved, the rest did not
-    whole = next(x for x in read_curves(src, corner_angle=None)
+    whole = next(x for x in read_curves(src, corner_angle=None, polylines=True)
                  if x.source["element"] == pl.source["element"])
     expect = np.array(whole.points)
     expect[list(pl.source["indices"])] = moved.points
     if whole.curve.closed:                     # the closing point repeats the first
         expect[-1] = expect[0]
-    bp = next(x for x in read_curves(tmp_path / "g.svg", corner_angle=None)
+    bp = next(x for x in read_curves(tmp_path / "g.svg", corner_angle=None, polylines=True)
               if x.source["element"] == pl.source["element"])
     assert len(bp.points) == len(expect)
     # 4 decimals, rounded toward the input's values (so no point moves farther than faired):
@@ -215,7 +219,7 @@ def test_arcs_are_unsupported(tmp_path):
     with pytest.raises(FileFormatError, match="Arc"):
         read_curves(p)
     with pytest.warns(UserWarning, match="Arc"):
-        recs = read_curves(p, on_unsupported="skip", corner_angle=None)
+        recs = read_curves(p, on_unsupported="skip", corner_angle=None, polylines=True)
     assert [r.source["id"] for r in recs] == ["b"]
     # the arc element stays untouched on write-back
     moved = recs[0].curve.replace(points=np.array(recs[0].curve.points) + [0, 1])
@@ -458,7 +462,7 @@ def test_vertices_equal_up_to_rounding_real(name, n_sub):
     """Closed subpaths of straight segments whose last vertex equals the first up to float
     noise (relative commands) used to be refused as coincident points: read, every subpath."""
     src = REAL / name
-    recs = read_curves(src, on_unsupported="skip", corner_angle=None)
+    recs = read_curves(src, on_unsupported="skip", corner_angle=None, polylines=True)
     subs = {(r.source["element"], r.source["subpath"]) for r in recs}
     if n_sub is not None:
         # every subpath read but the two with arcs (skipped, kept untouched)
@@ -474,7 +478,7 @@ def test_vertex_equal_up_to_rounding_dropped_with_warning(tmp_path):
     p = tmp_path / "n.svg"
     p.write_text(_svg('<polyline id="pl" points="0,0 10.1,0 10.100000000000001,0 10,5 0,7"/>'))
     with pytest.warns(UserWarning, match=r"<polyline> element 0 \(id='pl'\).*up to rounding"):
-        recs = read_curves(p, corner_angle=None)
+        recs = read_curves(p, corner_angle=None, polylines=True)
     assert len(recs) == 1 and np.asarray(recs[0].points).shape == (4, 2)
 
 
@@ -495,7 +499,7 @@ def test_open_path_ending_at_its_start_stays_open(tmp_path):
     # a polyline subpath ending at its start without z, changed: written without Z too
     q = tmp_path / "pl.svg"
     q.write_text(_svg('<path id="o" d="M 0 0 L 10 0 L 10 10 L 0 10 L 0 0"/>'))
-    recs = read_curves(q, corner_angle=None)
+    recs = read_curves(q, corner_angle=None, polylines=True)
     moved = [r.with_curve(r.curve.replace(points=np.asarray(r.curve.points) + [0, 1]))
              for r in recs]
     write_curves(tmp_path / "pl2.svg", moved, template=q)

@@ -81,7 +81,9 @@ def test_svg_prefixed_path_with_commented_copy(tmp_path):
 # ------------------------------------------------------------------------------------------
 def test_svgpathtools_polygons(tmp_path):
     p = SPT / "polygons.svg"
-    recs = read_curves(p)
+    with pytest.raises(FileFormatError, match="2 straight-line shapes are .* left as drawn"):
+        read_curves(p)                        # drawn shapes unless polylines=True
+    recs = read_curves(p, polylines=True)
     paths, _ = spt.svg2paths(str(p))          # svgpathtools converts polygons to paths
     by = _by_node(recs)
     assert len(by) == len(paths) == 2
@@ -95,7 +97,7 @@ def test_svgpathtools_polygons(tmp_path):
     moved = [r.with_curve(r.curve.replace(points=r.points + [0.5, 0.0])) for r in r0]
     write_curves(tmp_path / "o.svg", moved + [r for n, rs in by.items() if n != min(by)
                                                for r in rs], template=p)
-    back = _by_node(read_curves(tmp_path / "o.svg"))
+    back = _by_node(read_curves(tmp_path / "o.svg", polylines=True))
     np.testing.assert_allclose(_vertices(back[min(by)]), _vertices(r0) + [0.5, 0.0],
                                atol=1e-12)
     orig_lines = p.read_text().splitlines()
@@ -120,7 +122,7 @@ def _ends(paths) -> np.ndarray:
 
 def test_svgpathtools_groups_transforms_applied_and_undone(tmp_path):
     p = SPT / "groups.svg"
-    recs = read_curves(p)
+    recs = read_curves(p, polylines=True)
     ref = spt.Document(str(p)).paths()       # svgpathtools applies the transforms
     assert len(recs) == len(ref) == 12
     got = np.array([np.r_[r.points[0], r.points[-1]] for r in recs])
@@ -133,7 +135,7 @@ def test_svgpathtools_groups_transforms_applied_and_undone(tmp_path):
     # the written numbers keep each element's precision (integers here): within rounding
     # of the element's coordinates mapped by its transformation (scales up to 1.875)
     _match(_ends(out), got + [1.0, 2.0, 1.0, 2.0], 1.9)
-    back = read_curves(tmp_path / "o.svg", format="svg")
+    back = read_curves(tmp_path / "o.svg", format="svg", polylines=True)
     _match(np.array([np.r_[r.points[0], r.points[-1]] for r in back]), _ends(out), 1e-9)
     # the transform attributes themselves are untouched
     t_in = [e.get("transform") for e in ET.parse(p).getroot().iter()]
@@ -146,7 +148,7 @@ def test_transform_inverse_exact_at_full_precision(tmp_path):
     p.write_text('<svg xmlns="http://www.w3.org/2000/svg"><g transform="rotate(30) '
                  'scale(2 0.5)"><path d="M 0.125,0.25 L 1.5,2.25 L 3.75,2.5 L 5.125,1.75" '
                  'transform="translate(3 -1)"/></g></svg>')
-    (rec,) = read_curves(p, corner_angle=None)
+    (rec,) = read_curves(p, corner_angle=None, polylines=True)
     th = np.radians(30)
     M = np.array([[np.cos(th), -np.sin(th)], [np.sin(th), np.cos(th)]]) @ np.diag([2, 0.5])
     el = np.array([[0.125, 0.25], [1.5, 2.25], [3.75, 2.5], [5.125, 1.75]]) + [3, -1]
@@ -167,7 +169,7 @@ def test_arcs_skipped_with_warning_and_kept(tmp_path, name, n_skipped):
     with pytest.raises(FileFormatError, match="unsupported Arc segment"):
         read_curves(p)
     with pytest.warns(UserWarning, match="skipped .*Arc segment; kept untouched") as rec_w:
-        recs = read_curves(p, on_unsupported="skip")
+        recs = read_curves(p, on_unsupported="skip", polylines=True)
     assert len([w for w in rec_w if "Arc" in str(w.message)]) == n_skipped
     # CLI: skipped by default (exit 0, a Warning line), refused with --strict (exit 1)
     res = _run("fair", p, "-o", tmp_path / "o.svg", "--tol", "0.5")
@@ -191,7 +193,7 @@ def test_circle_ellipse_rect_line(tmp_path):
                  '<rect x="1" y="2" width="10" height="4"/>\n<line x1="0" y1="0" x2="3" y2="4"/>\n'
                  '<polyline points="0,0 1,2 2,3 4,3.5 6,3"/>\n</svg>\n')
     with pytest.warns(UserWarning) as caught:
-        recs = read_curves(p, on_unsupported="skip", corner_angle=None)
+        recs = read_curves(p, on_unsupported="skip", corner_angle=None, polylines=True)
     msgs = " ".join(str(w.message) for w in caught)
     assert "unsupported <circle>" in msgs and "unsupported <ellipse>" in msgs
     tags = [r.source["tag"] for r in recs]
@@ -203,7 +205,7 @@ def test_circle_ellipse_rect_line(tmp_path):
         np.testing.assert_array_equal(recs[k].points, corners[k:k + 2])
     # a drawing with a rectangle and a straight line: nothing to fair there, exit 0
     res = _run("fair", p, "-o", tmp_path / "o.svg", "--tol", "0.1", "--report",
-               tmp_path / "r.json", "--corner-angle", "80")
+               tmp_path / "r.json", "--corner-angle", "80", "--polylines")
     assert res.exit_code == 0, res.output
     rep = json.loads((tmp_path / "r.json").read_text())
     assert rep["n_failed"] == 0 and rep["n_nothing_to_fair"] >= 5   # 4 sides + the line

@@ -440,7 +440,7 @@ def test_svg_element_merged_by_its_own_decimals_is_written_exactly(tmp_path):
         f'<path style="fill:none;stroke:#00f" d="{d}" id="oct"/>\n'
         '<path style="fill:none;stroke:#000" d="M 0,0 L 100,0 L 100,100" id="other"/>\n'
         '</g>\n</svg>\n')
-    recs = read_curves(src)
+    recs = read_curves(src, polylines=True)
     assert [r.source["id"] for r in recs] == ["oct", "other", "other"]  # split at its corner
     p = np.asarray(recs[0].curve.points)[:-1]  # document coordinates, closing point dropped
     c = p.mean(axis=0)
@@ -454,7 +454,7 @@ def test_svg_element_merged_by_its_own_decimals_is_written_exactly(tmp_path):
     assert [x["id"] for x in attr_out] == ["oct", "other"]
     assert attr_out[1]["d"] == attr_in[1]["d"]  # the other element as it was
     # 4 decimals of the element (scaled by 0.4577 into the document): within one unit of them
-    whole = read_curves(out, corner_angle=None)[0]
+    whole = read_curves(out, corner_angle=None, polylines=True)[0]
     assert whole.source["id"] == "oct" and len(whole.points) == 9    # the first repeated
     np.testing.assert_allclose(np.asarray(whole.points)[:-1], q, rtol=0, atol=1e-4)
 

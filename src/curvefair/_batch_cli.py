@@ -487,13 +487,18 @@ def _threshold(value: str | None, name: str) -> float | None:
 @click.option("--read-corner-angle", type=click.FloatRange(0, 180, min_open=True),
               default=60.0, show_default=True, metavar="DEG",
               help="Point lists turning by DEG or more at a point are split there on reading.")
+@click.option("--polylines", is_flag=True,
+              help="SVG: read straight-line shapes (polygons, polylines, lines, rectangles, "
+                   "subpaths of lines only) as point lists and check them too [default: "
+                   "they are drawn shapes, not curves].")
 @click.option("--strict", is_flag=True, help="Refuse files with entities curvefair cannot "
               "represent (default: skip them).")
 @_selection_options
 def check_cmd(paths: tuple[str, ...], out_format: str, kink_angle: str | None,
               corner: str | None, g2_rel: str | None, wiggle: str | None,
               max_inflections: str | None, max_bad: str | None, out: str | None,
-              read_corner_angle: float, strict: bool, layer: tuple[str, ...],
+              read_corner_angle: float, polylines: bool, strict: bool,
+              layer: tuple[str, ...],
               name: tuple[str, ...], handle: tuple[str, ...]) -> None:
     """Report curves whose fairness measures exceed thresholds; write nothing.
 
@@ -524,7 +529,7 @@ def check_cmd(paths: tuple[str, ...], out_format: str, kink_angle: str | None,
     n_curves = 0
     for f in files:
         got, n = _check.check_file(f, th, corner_angle=read_corner_angle, strict=strict,
-                                   select=select)
+                                   select=select, polylines=polylines)
         findings += got
         n_curves += n
     if out_format == "json":

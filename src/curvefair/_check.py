@@ -51,6 +51,7 @@ import math
 import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -311,9 +312,11 @@ def _worst(findings: list[Finding], top: int) -> list[Finding]:
 
 def check_file(path: str, thresholds: Mapping[str, float | None] | None = None, *,
                corner_angle: float | None = 60.0, strict: bool = False,
-               select: Mapping[str, Any] | None = None) -> tuple[list[Finding], int]:
+               select: Mapping[str, Any] | None = None,
+               polylines: bool = False) -> tuple[list[Finding], int]:
     """``(findings, number of curves checked)`` for one file; an unreadable file is one
-    ``unreadable`` finding."""
+    ``unreadable`` finding. ``polylines``: an SVG's straight-line shapes are read as point
+    lists and checked too (other formats' polylines always are)."""
     import warnings
 
     from . import read_curves
@@ -322,8 +325,11 @@ def check_file(path: str, thresholds: Mapping[str, float | None] | None = None, 
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
+            extra: dict[str, Any] = {}
+            if polylines and Path(path).suffix.lower() == ".svg":
+                extra["polylines"] = True
             recs = read_curves(path, corner_angle=corner_angle,
-                               on_unsupported="raise" if strict else "skip")
+                               on_unsupported="raise" if strict else "skip", **extra)
     except (CurvefairError, OSError) as exc:
         if isinstance(exc, FileFormatError) and "no curves in the" in str(exc):
             return [], 0  # a drawing without curves has nothing unfair in it

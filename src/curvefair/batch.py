@@ -73,13 +73,13 @@ REPORT_DIR = ".curvefair"
 #: Options that change what is written (hashed for ``resume``).
 OUTPUT_OPTIONS = ("method", "tol", "eps", "max_steps", "clamp", "protect", "mode",
                   "method_options", "decimals", "corner_angle", "strict", "layer", "name",
-                  "handle", "hold_shared", "shared_distance", "format")
+                  "handle", "hold_shared", "shared_distance", "format", "polylines")
 _DEFAULTS: dict[str, Any] = {"method": None, "tol": None, "eps": None, "max_steps": None,
                              "clamp": "g0", "protect": (), "mode": "spline",
                              "method_options": {}, "decimals": None, "corner_angle": 60.0,
                              "strict": False, "layer": (), "name": (), "handle": (),
                              "hold_shared": False, "shared_distance": None, "history": False,
-                             "format": None}
+                             "format": None, "polylines": False}
 _GLOB_CHARS = re.compile(r"[*?\[]")
 
 
@@ -602,25 +602,51 @@ def _read(path: str, opts: Mapping[str, Any], notes: list[str] | None = None,
           fmt: str | None = None) -> list[Any]:
     from . import read_curves
 
+    extra: dict[str, Any] = {}
+    if opts.get("polylines"):  # SVG only: other formats' polylines are point lists always
+        from .io import detect_format
+
+        try:
+            kind: str | None = detect_format(path, cast("FormatName | None", fmt))
+        except CurvefairError:
+            kind = None  # read_curves says why
+        if kind == "svg":
+            extra["polylines"] = True
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
             recs = read_curves(path, corner_angle=opts["corner_angle"],
                                format=cast("FormatName | None", fmt),
-                               on_unsupported="raise" if opts["strict"] else "skip")
+                               on_unsupported="raise" if opts["strict"] else "skip", **extra)
         finally:  # the skip warnings also when the file then holds no curve at all
             if notes is not None:
                 notes.extend(dict.fromkeys(str(w.message) for w in caught))
     return recs
 
 
-def _all_skipped(exc: BaseException, notes: list[str], opts: Mapping[str, Any]) -> int:
-    """The number of skipped unsupported entities when ``exc`` says a file holds no curve
-    only because every curve entity in it was skipped (then it is written back unchanged, as
-    ``curvefair fair`` does for one file); 0 otherwise."""
-    if opts["strict"] or not isinstance(exc, CurvefairError) or "no curves in the" not in str(exc):
-        return 0
-    return sum(": skipped " in n for n in notes)
+def _all_skipped(exc: BaseException, notes: list[str], opts: Mapping[str, Any]
+                 ) -> tuple[int, int]:
+    """``(skipped, drawn)``: the numbers of skipped unsupported entities and of SVG shapes
+    left as drawn when ``exc`` says a file holds no curve only because of them (then it is
+    written back unchanged, as ``curvefair fair`` does for one file); ``(0, 0)`` otherwise."""
+    if not isinstance(exc, CurvefairError) or "no curves in the" not in str(exc):
+        return 0, 0
+    drawn = int(getattr(exc, "n_drawn", 0))
+    if opts["strict"]:
+        return 0, drawn
+    return sum(": skipped " in n for n in notes), drawn
+
+
+def _nothing_why(n_skipped: int, n_drawn: int) -> str:
+    """Why a file has nothing to fair, for a note."""
+    why = []
+    if n_skipped:
+        why.append(f"{n_skipped} unsupported entit{'y' if n_skipped == 1 else 'ies'} skipped, "
+                   "see the warnings")
+    if n_drawn:
+        why.append(f"{n_drawn} straight-line shape{'s' if n_drawn > 1 else ''} left as drawn: "
+                   "--polylines fairs them as point lists")
+    return "; ".join(why)
 
 
 def _test_delay() -> None:
@@ -689,13 +715,14 @@ def _fair_file(infile: str, outfile: str | None, options: Mapping[str, Any] | No
         if read_notes:
             rep["read_warnings"] = read_notes
     except (CurvefairError, OSError) as exc:
-        n_skipped = _all_skipped(exc, read_notes, opts)
-        if n_skipped and fmt_in and fmt_out == fmt_in:
+        n_skipped, n_drawn = _all_skipped(exc, read_notes, opts)
+        if (n_skipped or n_drawn) and fmt_in and fmt_out == fmt_in:
             # nothing curvefair can fair: the output is the input's bytes
             rep.update(status="ok" if not dry_run else "dry-run", n_curves=0,
-                       n_skipped_unsupported=n_skipped, read_warnings=read_notes,
-                       note=f"nothing to fair ({n_skipped} unsupported entit"
-                            f"{'y' if n_skipped == 1 else 'ies'} skipped); written unchanged")
+                       n_skipped_unsupported=n_skipped, n_drawn_shapes=n_drawn,
+                       read_warnings=read_notes,
+                       note=f"nothing to fair ({_nothing_why(n_skipped, n_drawn)}); "
+                            "written unchanged")
             if outfile is not None and not dry_run:
                 import shutil
 
@@ -806,14 +833,16 @@ def _err(exc: BaseException) -> str:
 
 def _write(outfile: str, faired: list[Any], records: list[Any], infile: str, fmt_in: str,
            fmt_out: str, opts: Mapping[str, Any], in_place: bool) -> Any:
-    from .io import write_checked
+    from .io import svg_reads_polylines, write_checked
 
     folder = os.path.dirname(os.path.abspath(outfile))
     os.makedirs(folder, exist_ok=True)
+    # point data written to an SVG are paths of lines: read back as point lists
+    back = dict(opts, polylines=opts.get("polylines") or bool(svg_reads_polylines(faired)))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         return write_checked(outfile, faired, records, tol=opts["tol"],
-                             reader=lambda p: _read(p, opts, None, fmt_out),
+                             reader=lambda p: _read(p, back, None, fmt_out),
                              template=infile if fmt_out == fmt_in else None, format=fmt_out,
                              overwrite=in_place, decimals=opts["decimals"])
 
@@ -1111,7 +1140,8 @@ def fair_files(paths: str | Sequence[str], out_dir: str | os.PathLike[str], clie
         ``method`` (a name or ``"kind=name,..."``), ``tol``, ``eps``, ``max_steps``, ``clamp``,
         ``protect``, ``mode``, ``method_options`` (dict), ``decimals``, ``corner_angle``,
         ``strict``, ``layer``, ``name``, ``handle``, ``hold_shared``, ``shared_distance``,
-        ``history``.
+        ``history``, ``polylines`` (SVG files: read straight-line shapes as point lists, as
+        :func:`curvefair.read_curves`; other formats ignore it).
 
     Returns
     -------

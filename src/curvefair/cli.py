@@ -397,34 +397,41 @@ def _warnings_to_stderr(quiet: bool, prefix: str = "",
 
 
 class _AllSkipped(Exception):
-    """Every curve entity of the file was skipped as unsupported (``n`` of them)."""
+    """Every curve entity of the file was skipped as unsupported (``n`` of them), or is a
+    straight-line SVG shape left as drawn (``drawn`` of them)."""
 
-    def __init__(self, n: int, message: str) -> None:
+    def __init__(self, n: int, message: str, drawn: int = 0) -> None:
         super().__init__(message)
         self.n = n
+        self.drawn = drawn
 
 
 def _read(path: str, corner_angle: float | None, strict: bool = False,
           quiet: bool = False, glyphs: str | None = None,
-          all_skipped_ok: bool = False, fmt: str | None = None) -> list[Any]:
+          all_skipped_ok: bool = False, fmt: str | None = None,
+          polylines: bool = False) -> list[Any]:
     """The records of a file; entities curvefair cannot represent are skipped with a warning
     (kept untouched on write-back) unless ``strict``, which refuses the file. With
     ``all_skipped_ok``, a file whose every curve entity was skipped raises
-    :class:`_AllSkipped` (the caller writes it back unchanged) instead of failing."""
+    :class:`_AllSkipped` (the caller writes it back unchanged) instead of failing.
+    ``polylines`` (``--polylines``) reads an SVG's straight-line shapes as point lists; it
+    means nothing for other formats (their polylines are point lists always)."""
     from . import read_curves
 
-    if fmt is None:
-        _format_of(path)  # a CLI message (the API's names format=, which the CLI lacks)
+    kind = fmt if fmt is not None else _format_of(path)  # a CLI message (not format=)
+    extra: dict[str, Any] = {} if glyphs is None else {"glyphs": glyphs}
+    if polylines and kind == "svg":
+        extra["polylines"] = True
     seen: list[str] = []
     try:
         with _warnings_to_stderr(quiet, into=seen):
             return read_curves(path, corner_angle=corner_angle, format=cast(Any, fmt),
-                               on_unsupported="raise" if strict else "skip",
-                               **cast(dict[str, Any], {} if glyphs is None else {"glyphs": glyphs}))
+                               on_unsupported="raise" if strict else "skip", **extra)
     except CurvefairError as exc:
         skipped = sum(": skipped " in w for w in seen)
-        if skipped and all_skipped_ok and "no curves in the" in str(exc):
-            raise _AllSkipped(skipped, str(exc)) from None
+        drawn = int(getattr(exc, "n_drawn", 0))
+        if (skipped or drawn) and all_skipped_ok and "no curves in the" in str(exc):
+            raise _AllSkipped(skipped, str(exc), drawn) from None
         if skipped:
             raise InputFailure(f"{exc} ({skipped} unsupported entit"
                                f"{'y' if skipped == 1 else 'ies'} skipped"
@@ -437,9 +444,10 @@ def _read(path: str, corner_angle: float | None, strict: bool = False,
 
 
 def _write_unchanged(infile: str, out: str, report: str | None, n_skipped: int,
-                     quiet: bool) -> None:
+                     quiet: bool, n_drawn: int = 0) -> None:
     """A file holding only entities curvefair cannot fair (each skipped with a warning, kept
-    untouched on write-back): nothing to fair; OUT is the input's bytes, exit 0."""
+    untouched on write-back) or SVG shapes left as drawn: nothing to fair; OUT is the
+    input's bytes, exit 0."""
     import shutil
 
     from .io import atomic_path
@@ -452,11 +460,12 @@ def _write_unchanged(infile: str, out: str, report: str | None, n_skipped: int,
             _write_json(report, {
                 "curvefair": __version__, "input": os.path.abspath(infile),
                 "output": os.path.abspath(out), "n_curves": 0, "n_failed": 0,
-                "n_skipped_unsupported": n_skipped, "output_written": True,
-                "output_check": None, "curves": []})
+                "n_skipped_unsupported": n_skipped, "n_drawn_shapes": n_drawn,
+                "output_written": True, "output_check": None, "curves": []})
     if not quiet:
-        click.echo(f"Note: {infile}: nothing to fair ({n_skipped} unsupported entit"
-                   f"{'y' if n_skipped == 1 else 'ies'} skipped, see the warnings); "
+        from .batch import _nothing_why
+
+        click.echo(f"Note: {infile}: nothing to fair ({_nothing_why(n_skipped, n_drawn)}); "
                    f"{out} written unchanged", err=True)
 
 
@@ -482,6 +491,10 @@ def _reading_options(f: Any) -> Any:
                           "there into separate curves (the corner is kept fixed).")(f)
     f = click.option("--no-corners", is_flag=True,
                      help="Never split point lists at corners.")(f)
+    f = click.option("--polylines", is_flag=True,
+                     help="SVG: read straight-line shapes (polygons, polylines, lines, "
+                          "rectangles, subpaths of lines only) as point lists to fair "
+                          "[default: leave them as drawn].")(f)
     f = click.option("--strict", is_flag=True,
                      help="Refuse a file holding an entity curvefair cannot represent exactly "
                           "(rational or degree-1 splines, arcs, ...) [default: skip it with a "
@@ -624,14 +637,15 @@ def methods_cmd(as_json: bool) -> None:
 @_reading_options
 @_quiet_option
 def analyze_cmd(infile: str, as_json: bool, top: int, corner_angle: float, no_corners: bool,
-                strict: bool, quiet: bool) -> None:
+                polylines: bool, strict: bool, quiet: bool) -> None:
     """Analyse every curve of IN: energies, inflections, curvature extrema, the worst jumps,
     and the ranked list of bad points (index, measure, kind)."""
     from . import analyze
     from .analysis import rank_bad_points
 
     with _user_errors():
-        records = _read(infile, _corner(corner_angle, no_corners), strict, quiet)
+        records = _read(infile, _corner(corner_angle, no_corners), strict, quiet,
+                        polylines=polylines)
         out = []
         for i, rec in enumerate(records):
             a = analyze(rec.curve)
@@ -708,7 +722,7 @@ def analyze_cmd(infile: str, as_json: bool, top: int, corner_angle: float, no_co
 def plot_cmd(infile: str, other: str | None, out: str, comb_scale: float | None,
              comb_density: int | None, no_comb: bool, no_markers: bool, tol: float | None,
              projection: str, title: str | None, corner_angle: float, no_corners: bool,
-             strict: bool, quiet: bool) -> None:
+             polylines: bool, strict: bool, quiet: bool) -> None:
     """Draw the curves of IN with their curvature combs and curvature plots into FIG."""
     _check_outputs([(infile, "IN")] + ([(other, "--compare")] if other else []),
                    [(out, "-o/--output")])
@@ -717,10 +731,10 @@ def plot_cmd(infile: str, other: str | None, out: str, comb_scale: float | None,
 
     corner = _corner(corner_angle, no_corners)
     with _user_errors():
-        recs = _read(infile, corner, strict, quiet)
+        recs = _read(infile, corner, strict, quiet, polylines=polylines)
         curves = [r.curve for r in recs]
-        others = None if other is None else [r.curve for r in _read(other, corner, strict,
-                                                                      quiet)]
+        others = None if other is None else [r.curve for r in _read(
+            other, corner, strict, quiet, polylines=polylines)]
     _check_comb(curves + (others or []), comb_scale, comb_density, no_comb)
     with _user_errors():
         labels = (Path(infile).name, Path(other).name if other else "")
@@ -757,7 +771,7 @@ def plot_cmd(infile: str, other: str | None, out: str, comb_scale: float | None,
 @_quiet_option
 def view_cmd(infile: str, other: str | None, out: str, tol: float | None,
              report_path: str | None, title: str | None, corner_angle: float,
-             no_corners: bool, strict: bool, quiet: bool) -> None:
+             no_corners: bool, polylines: bool, strict: bool, quiet: bool) -> None:
     """Write an interactive HTML page of the curves of IN: combs, curvature, deviation."""
     _check_outputs([(infile, "IN")] + ([(other, "--compare")] if other else [])
                    + ([(report_path, "--report")] if report_path else []),
@@ -782,9 +796,9 @@ def view_cmd(infile: str, other: str | None, out: str, tol: float | None,
             if isinstance(t, (int, float)) and not isinstance(t, bool) and t > 0:
                 tol = float(t)
     with _user_errors():
-        recs = _read(infile, corner, strict, quiet)
-        others = None if other is None else [r.curve for r in _read(other, corner, strict,
-                                                                      quiet)]
+        recs = _read(infile, corner, strict, quiet, polylines=polylines)
+        others = None if other is None else [r.curve for r in _read(
+            other, corner, strict, quiet, polylines=polylines)]
         if others is not None and len(others) != len(recs):
             raise InputFailure(f"--compare {other!r} has {len(others)} curves but {infile!r} "
                                f"has {len(recs)}; they are paired in order")
@@ -905,7 +919,7 @@ def _batch_fair_options(method: str | None, tol: float | None, eps: float | None
                         max_steps: int | None, clamp: str, protect: str | None, mode: str,
                         method_option: tuple[str, ...], decimals: int | None, history: bool,
                         corner_angle: float, no_corners: bool, strict: bool,
-                        batch: dict[str, Any]) -> dict[str, Any]:
+                        batch: dict[str, Any], polylines: bool = False) -> dict[str, Any]:
     """The options of :func:`curvefair.batch.fair_file`, checked as for one file."""
     options = _parse_method_options(method_option)
     _check_option_values(method if method and "=" not in method else None, options)
@@ -913,8 +927,9 @@ def _batch_fair_options(method: str | None, tol: float | None, eps: float | None
             "protect": tuple(_parse_protect(protect)), "mode": mode, "method_options": options,
             "decimals": decimals, "history": history,
             "corner_angle": _corner(corner_angle, no_corners), "strict": strict,
-            "layer": batch["layer"], "name": batch["name"], "handle": batch["handle"],
-            "hold_shared": batch["hold_shared"], "shared_distance": batch["shared_distance"]}
+            "polylines": bool(polylines), "layer": batch["layer"], "name": batch["name"],
+            "handle": batch["handle"], "hold_shared": batch["hold_shared"],
+            "shared_distance": batch["shared_distance"]}
 
 
 @main.command("fair", epilog="Default method per curve type: " + _default_methods_text()
@@ -972,7 +987,8 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
              decimals: int | None, report: str | None,
              history: bool,
              plot_path: str | None, corner_angle: float, no_corners: bool,
-             strict: bool, quiet: bool, glyphs: str | None = None, **batch: Any) -> None:
+             polylines: bool, strict: bool, quiet: bool, glyphs: str | None = None,
+             **batch: Any) -> None:
     """Fair every curve in IN and write them to OUT.
 
     Prints a before/after table: strain energy, largest third-derivative jump, inflections,
@@ -1003,7 +1019,7 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
     if wants_chunks(paths, chunk):
         fair_in_chunks(paths, out, in_place, _batch_fair_options(
             method, tol, eps, max_steps, clamp, protect, mode, method_option, decimals,
-            history, corner_angle, no_corners, strict, batch),
+            history, corner_angle, no_corners, strict, batch, polylines),
             {k: batch[k] for k in ("layer", "name", "handle", "hold_shared", "shared_distance",
                                    "resume", "dry_run", "diff", "in_format")},
             chunk=chunk, overlap=overlap, jobs=batch["jobs"], scheduler=batch["scheduler"],
@@ -1017,7 +1033,7 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
                                      param_hint="--glyphs")
         fair_many(paths, out, in_place, _batch_fair_options(
             method, tol, eps, max_steps, clamp, protect, mode, method_option, decimals,
-            history, corner_angle, no_corners, strict, batch), jobs=batch["jobs"],
+            history, corner_angle, no_corners, strict, batch, polylines), jobs=batch["jobs"],
             resume=batch["resume"], dry_run=batch["dry_run"], diff=batch["diff"],
             scheduler=batch["scheduler"], report=report, fmt=batch["in_format"], quiet=quiet,
             plot_path=plot_path)
@@ -1056,13 +1072,13 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
             out_fmt = in_fmt
         try:
             records = _read(infile, _corner(corner_angle, no_corners), strict, quiet, glyphs,
-                            all_skipped_ok=out_fmt == in_fmt)
+                            all_skipped_ok=out_fmt == in_fmt, polylines=polylines)
         except _AllSkipped as exc:
-            _write_unchanged(infile, out, report, exc.n, quiet)
+            _write_unchanged(infile, out, report, exc.n, quiet, exc.drawn)
             return
     _check_protect_range(records, user_protect)
     from . import fair
-    from .io import write_checked
+    from .io import svg_reads_polylines, write_checked
 
     rows: list[dict[str, Any]] = []
     faired = []
@@ -1126,8 +1142,10 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
             check = write_checked(out, faired, records, tol=tol,
                                   # the temporary file has OUT's extension, which need
                                   # not name a format (-o OUT without one: IN's format)
+                                  # point data written to an SVG are paths of lines
                                   reader=lambda p: _read(p, corner, strict, True, glyphs,
-                                                         fmt=out_fmt),
+                                                         fmt=out_fmt, polylines=polylines
+                                                         or bool(svg_reads_polylines(faired))),
                                   template=infile if out_fmt == in_fmt else None,
                                   format=out_fmt, overwrite=in_place, decimals=decimals)
             if prog is not None:
@@ -1176,7 +1194,7 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
                             "method_options": {k: _option_default(v)
                                                for k, v in options.items()},
                             "corner_angle": _corner(corner_angle, no_corners),
-                            "strict": strict},
+                            "polylines": polylines, "strict": strict},
                 "n_curves": len(rows), "n_failed": len(failures),
                 "n_nothing_to_fair": sum(r["status"] == "nothing to fair" for r in rows),
                 "output_written": wrote_out,

@@ -155,7 +155,8 @@ def _module(fmt: str) -> Any:
 def read_curves(path: str | os.PathLike[str], *, format: FormatName | None = None,
                 corner_angle: float | None = 60.0,
                 on_unsupported: Literal["raise", "skip"] = "raise",
-                glyphs: Sequence[str] | str | None = None) -> list[CurveRecord]:
+                glyphs: Sequence[str] | str | None = None,
+                polylines: bool | None = None) -> list[CurveRecord]:
     """Read every curve of a file.
 
     Parameters
@@ -174,6 +175,11 @@ def read_curves(path: str | os.PathLike[str], *, format: FormatName | None = Non
     glyphs : sequence of str or str, optional
         Fonts (``ufo``, ``opentype``, ``glyphs``): only these glyphs (names, or one comma-separated
         string); one record per contour with curves, named ``"<glyph>#<contour>"``.
+    polylines : bool, optional
+        SVG only: read straight-line shapes (polygons, polylines, lines, rectangles, subpaths
+        of lines only) as point lists (True), or leave them as drawn (the default for SVG: in
+        a drawing a polygon's vertices are its design; see :mod:`curvefair.io.svg`). Other
+        formats' polylines are point lists always.
 
     Returns
     -------
@@ -216,6 +222,13 @@ def read_curves(path: str | os.PathLike[str], *, format: FormatName | None = Non
     if glyphs is not None and fmt not in FONT_FORMATS:
         raise InputError(f"glyphs= is for fonts (ufo, opentype, glyphs), not {fmt} files")
     extra: dict[str, Any] = {} if glyphs is None else {"glyphs": glyphs}
+    if polylines is not None:
+        if not isinstance(polylines, (bool, np.bool_)):
+            raise InputError(f"polylines must be True, False or None, got {polylines!r}")
+        if fmt != "svg":
+            raise InputError(f"polylines= is for svg files, not {fmt} files (their polylines "
+                             "are always read as point lists)")
+        extra["polylines"] = bool(polylines)
     if fmt in ("iges", "step"):
         extra["format"] = fmt       # one module reads both; the path may have no extension
     records = _module(fmt).read(path, corner_angle=corner_angle, on_unsupported=on_unsupported,
@@ -371,17 +384,32 @@ def write_curves(path: str | os.PathLike[str], curves: CurveRecord | PiecewiseCu
 
     ref = _reference(records, reference, tol_f, corner_angle)
 
+    poly = svg_reads_polylines(records) if fmt == "svg" else None
+
     def reader(p: str) -> list[CurveRecord]:
         with warnings.catch_warnings():  # the input's skip warnings, again
             warnings.simplefilter("ignore")
             return read_curves(p, format=fmt, corner_angle=corner_angle,
-                               on_unsupported="skip")
+                               on_unsupported="skip", polylines=poly)
 
     check = write_checked(path, records, ref, tol=tol_f, reader=reader, template=tpath,
                           format=fmt, overwrite=True, decimals=decimals, precision=precision)
     for note in check.notes:
         warnings.warn(f"{os.fspath(path)}: {note}", UserWarning, stacklevel=2)
     return check
+
+
+def svg_reads_polylines(records: Sequence[CurveRecord]) -> bool | None:
+    """Whether an SVG written from ``records`` is read back with ``polylines=True``, so that
+    its curves pair up with them: records read from an SVG that way
+    (``source["polylines"]``), or point data (a point list is written as a path of lines).
+    None (the reader's default) otherwise."""
+    from ._verify import POINT_KINDS
+
+    for r in records:
+        if r.kind in POINT_KINDS or (r.format == "svg" and r.source.get("polylines")):
+            return True
+    return None
 
 
 def _write_plain(path: str | os.PathLike[str], records: Sequence[CurveRecord], fmt: str,
@@ -415,7 +443,10 @@ def _reference(records: list[CurveRecord], reference: object, tol: float | None,
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 cache[src] = read_curves(src, format=r.format,  # type: ignore[arg-type]
-                                         corner_angle=corner_angle, on_unsupported="skip")
+                                         corner_angle=corner_angle, on_unsupported="skip",
+                                         polylines=svg_reads_polylines([x for x in records
+                                                                   if x.path == src])
+                                         if r.format == "svg" else None)
         j = r.source.get("index")
         got = cache[src]
         o = got[j] if isinstance(j, int) and 0 <= j < len(got) else None
