@@ -28,7 +28,9 @@ of lines; ``index[k]`` gives the control point of the contour's point ``k``.
 contour points, then the outline's rules are enforced exactly:
 
 - points of straight segments and corner nodes (on-curve points that are not smooth) keep
-  their input position;
+  their input position, and so does a corner's handle where rounding would turn the tangent
+  along it by more than :data:`CORNER_TURN` (1 degree, as the fairing allows) from the
+  input's when the fair had kept it within that;
 - a smooth node stays smooth: its on-curve point is put on the segment between its two
   neighbours (the collinear handles of a cubic node, the two off-curve points of a TrueType
   node), or the handle next to a line on that line's extension;
@@ -61,6 +63,10 @@ __all__ = ["Contour", "contour_curve", "constrained_points", "smooth_angle"]
 #: a node flagged smooth is kept exactly smooth when its input turns by at most this (degrees,
 #: the G1 threshold of :mod:`curvefair.fairing.joins`)
 SMOOTH_ANGLE = 0.5
+#: a corner node's tangent turns by at most this on write (degrees; the fairing's own limit,
+#: :data:`curvefair.fairing.joins.DEFAULT_CORNER_TURN`): where rounding to the grid turns it
+#: more, that side's handle keeps its input position
+CORNER_TURN = 1.0
 
 
 @dataclass(frozen=True)
@@ -290,6 +296,46 @@ def _place(c: Contour, q: FloatArray, target: FloatArray, k: int, horizontal: bo
     q[ia], q[k], q[ib] = best[1], best[2], best[3]
 
 
+def _side_tangent(pts: FloatArray, k: int, idx: list[int]) -> FloatArray | None:
+    for i in idx:
+        if not np.array_equal(pts[i], pts[k]):
+            return pts[i] - pts[k]
+    return None
+
+
+def _corner_side_turned(c: Contour, q: FloatArray, target: FloatArray, P0: FloatArray,
+                        k: int, step: int) -> list[int]:
+    """The off-curve points on side ``step`` (-1: before, +1: after) of the corner node ``k``
+    up to the first one off the node in the input -- the points its tangent on that side
+    leaves along -- when that tangent in ``q`` (rounded) turned by more than
+    :data:`CORNER_TURN` from the input's (or is lost: every one of them on the node) while in
+    ``target`` (the fair's, unrounded) it did not; else an empty list. A corner the fair
+    itself turned more (``fair(..., corner_turn=math.inf)``) is the fair's choice, and a
+    straight side (an on-curve neighbour) is held anyway: empty."""
+    n = len(c.on)
+    idx: list[int] = []
+    j = k
+    for _ in range(n - 1):
+        j += step
+        if not c.closed and not 0 <= j < n:
+            return []
+        j %= n
+        if c.on[j]:
+            return []
+        idx.append(j)
+        if not np.array_equal(P0[j], P0[k]):
+            break
+    else:
+        return []
+    t0 = P0[j] - P0[k]
+    limit = np.radians(CORNER_TURN)
+    tt = _side_tangent(target, k, idx)
+    if tt is None or _angle(t0, tt) > limit:
+        return []
+    tq = _side_tangent(q, k, idx)
+    return idx if tq is None or _angle(t0, tq) > limit else []
+
+
 def constrained_points(c: Contour, new: FloatArray, tol: float | None,
                        ) -> tuple[FloatArray, float]:
     """The contour's points from faired ones with the outline's rules enforced (module
@@ -313,9 +359,17 @@ def constrained_points(c: Contour, new: FloatArray, tol: float | None,
         q[fixed] = P0[fixed]
         for k in smooth:
             _place(c, q, target, k, *ext[k], fixed)
+        # a corner whose tangent turned (a short handle rounded to the grid: Linux Libertine's
+        # 3-unit handles turned 4.4 degrees) gets that side's handle back
+        held = fixed.copy()
+        for k in corners:
+            for step in (-1, 1):
+                back = _corner_side_turned(c, q, target, P0, k, step)
+                if back:
+                    q[back] = P0[back]
+                    held[back] = True
         # a node spoilt by a neighbour's placement (TrueType: two nodes share an off-curve
         # point) gets its input points back, until every smooth node is exactly smooth
-        held = fixed.copy()
         for _ in range(n + 1):
             bad = [k for k in smooth if not _exact_smooth(c, q, k, *ext[k])
                    and not all(np.array_equal(q[j], P0[j]) for j in ((k - 1) % n, k, (k + 1) % n))]
