@@ -715,12 +715,18 @@ class DrawnShapesOnly(FileFormatError):
         self.n_drawn = n_drawn
 
 
+def _kept_segments(sub: Any, spt: Any) -> list[Any]:
+    """The segments of a subpath without the degenerate ones (length zero, or no longer than
+    rounding noise: relative commands closed by ``z`` leave closing segments ~1e-15 long)."""
+    tiny = _rounding_level([c for g in sub if not isinstance(g, spt.Arc)
+                            for z in (g.start, g.end) for c in (z.real, z.imag)])
+    return [g for g in sub if not _degenerate(g, spt, tiny)]
+
+
 def _lines_only(sub: Any, spt: Any) -> bool:
     """A subpath of straight segments only, once the degenerate ones are dropped (what
     :func:`_subpath_records` reads as a point list)."""
-    tiny = _rounding_level([c for g in sub if not isinstance(g, spt.Arc)
-                            for z in (g.start, g.end) for c in (z.real, z.imag)])
-    segs = [g for g in sub if not _degenerate(g, spt, tiny)]
+    segs = _kept_segments(sub, spt)
     return bool(segs) and all(isinstance(g, spt.Line) for g in segs)
 
 
@@ -802,9 +808,7 @@ def _subpath_records(sub: Any, spt: Any, base: dict[str, Any], name: str,
     # segments no longer than rounding noise are dropped like zero-length ones; the
     # segments kept are joined exactly (a dropped one's gap closed) and a closed subpath
     # ends exactly at its start
-    tiny = _rounding_level([c for g in sub if not isinstance(g, spt.Arc)
-                            for z in (g.start, g.end) for c in (z.real, z.imag)])
-    segs = [g for g in sub if not _degenerate(g, spt, tiny)]
+    segs = _kept_segments(sub, spt)
     if not segs:
         return []
     sub = spt.Path(*segs)
