@@ -59,7 +59,8 @@ def run_dxf(n: int, d: str, ezdxf: object) -> tuple[float, float, float]:
     doc.modelspace().add_lwpolyline([tuple(p) for p in data(n)])
     doc.saveas(src)
     recs: list = []
-    tr = best(lambda: recs.__setitem__(slice(None), read_curves(src, corner_angle=None)))
+    tr = best(lambda: recs.__setitem__(slice(None), read_curves(src, corner_angle=None,
+                                                                polylines=True)))
     tw = best(lambda: write_curves(os.path.join(d, f"o{n}.dxf"), recs, template=src))
 
     def peer() -> None:

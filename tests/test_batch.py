@@ -316,11 +316,12 @@ def _dxf_polylines(path: Path) -> list[np.ndarray]:
 
 def test_hold_shared_keeps_intersections_in_both_curves(tmp_path: Path):
     shared = _dxf_network(tmp_path / "net.dxf")
-    r = _run(["fair", "net.dxf", "-o", "free.dxf", "--tol", "0.2", "--no-corners"], tmp_path)
+    r = _run(["fair", "net.dxf", "-o", "free.dxf", "--tol", "0.2", "--no-corners",
+              "--polylines"], tmp_path)
     assert r.exit_code == 0, r.output
     free = _dxf_polylines(tmp_path / "free.dxf")
     assert not (np.array_equal(free[0][6], shared) and np.array_equal(free[1][6], shared))
-    r = _run(["fair", "net.dxf", "-o", "held.dxf", "--tol", "0.2", "--no-corners",
+    r = _run(["fair", "net.dxf", "-o", "held.dxf", "--tol", "0.2", "--no-corners", "--polylines",
               "--hold-shared"], tmp_path)
     assert r.exit_code == 0, r.output
     held = _dxf_polylines(tmp_path / "held.dxf")

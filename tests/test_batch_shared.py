@@ -173,13 +173,13 @@ def test_hold_shared_keeps_a_point_data_crossing_between_vertices(tmp_path: Path
     # between vertices of both, far from every vertex
     assert min(np.linalg.norm(np.r_[A, B] - X, axis=1)) > 0.02
     tol = 0.05
-    r = _run(["fair", "net.dxf", "-o", "free.dxf", "--tol", str(tol)], tmp_path)
+    r = _run(["fair", "net.dxf", "-o", "free.dxf", "--tol", str(tol), "--polylines"], tmp_path)
     assert r.exit_code == 0, r.output
     fa, fb = _vertices(tmp_path / "free.dxf")
     moved_free = float(np.linalg.norm(_spline_crossing(fa, fb) - X))
     assert moved_free > 0.05 * tol
-    r = _run(["fair", "net.dxf", "-o", "held.dxf", "--tol", str(tol), "--hold-shared"],
-             tmp_path)
+    r = _run(["fair", "net.dxf", "-o", "held.dxf", "--tol", str(tol), "--hold-shared",
+              "--polylines"], tmp_path)
     assert r.exit_code == 0, r.output
     ha, hb = _vertices(tmp_path / "held.dxf")
     moved_held = float(np.linalg.norm(_spline_crossing(ha, hb) - X))

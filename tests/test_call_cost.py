@@ -194,7 +194,7 @@ def test_point_data_read_back_bound_meets_a_dense_hausdorff_distance(tmp_path):
     src, dst = tmp_path / "in.dxf", tmp_path / "out.dxf"
     doc.saveas(src)
     tol = 0.01
-    recs = cf.read_curves(src)
+    recs = cf.read_curves(src, polylines=True)
     faired = [r.with_curve(cf.fair(r.curve, "poliakoff", tol=tol).curve) for r in recs]
     check = cf.write_curves(dst, faired, template=src, tol=tol)
 

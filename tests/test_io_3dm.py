@@ -69,10 +69,10 @@ def _model(path):
     return ids
 
 
-def _read(p):
+def _read(p, polylines=True):
     # the model's circle is stored by openNURBS as a rational NURBS curve: not faired, skipped
     with pytest.warns(UserWarning, match="'circle'.*rational"):
-        return read_curves(p, on_unsupported="skip")
+        return read_curves(p, on_unsupported="skip", polylines=polylines)
 
 
 def _pointat(g, u):
@@ -83,6 +83,9 @@ def _pointat(g, u):
 def test_read_matches_opennurbs_evaluation(tmp_path):
     p = tmp_path / "m.3dm"
     ids = _model(p)
+    # by default the polyline is a drawn shape, left as drawn
+    assert {r.source["id"] for r in _read(p, polylines=False)} == \
+        {ids[k] for k in ("open3d", "planar_deg4", "periodic")}
     recs = _read(p)
     by = {}
     for r in recs:

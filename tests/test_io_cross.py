@@ -35,8 +35,10 @@ def test_split_loop_goes_across_formats_as_one_polyline(tmp_path, ext, lib):
     assert len(recs) == 4
     out = tmp_path / f"o.{ext}"
     write_curves(out, recs)
-    # an SVG holds the list as a path of lines: a drawn shape unless polylines=True
-    back = read_curves(out, corner_angle=None, **({"polylines": True} if ext == "svg" else {}))
+    # a drawing holds the list as a polyline (an SVG path of lines): a drawn shape unless
+    # polylines=True
+    back = read_curves(out, corner_angle=None,
+                       polylines=True if ext in ("dxf", "3dm", "svg") else None)
     if ext == "json":
         # JSON keeps each piece as its own curve
         assert len(back) == 4
@@ -55,12 +57,11 @@ def test_airfoil_to_cad_and_back(tmp_path, ext, lib):
     pytest.importorskip(lib)
     (rec,) = read_curves(DATA / "e423.dat")
     write_curves(tmp_path / f"e.{ext}", [rec])
-    if ext == "svg":   # a path of lines: by default a drawn shape, and the error says so
-        with pytest.raises(FileFormatError, match=r"1 straight-line shape is .* "
-                                                  r"polylines=True"):
-            read_curves(tmp_path / "e.svg")
-    (back,) = read_curves(tmp_path / f"e.{ext}", corner_angle=None,
-                          **({"polylines": True} if ext == "svg" else {}))
+    # a polyline (an SVG path of lines): by default a drawn shape, and the error says so
+    noun = "straight-line shape" if ext == "svg" else "polyline"
+    with pytest.raises(FileFormatError, match=f"1 {noun} is .* polylines=True"):
+        read_curves(tmp_path / f"e.{ext}")
+    (back,) = read_curves(tmp_path / f"e.{ext}", corner_angle=None, polylines=True)
     assert back.kind == "polyline"
     np.testing.assert_allclose(back.points, rec.points, atol=1e-12)
     write_curves(tmp_path / "e2.dat", [back])

@@ -88,7 +88,10 @@ def _drawing(path):
 def test_read_geometry_matches_ezdxf_evaluation(tmp_path):
     p = tmp_path / "d.dxf"
     h = _drawing(p)
-    recs = read_curves(p)
+    # by default the polylines are drawn shapes, left as drawn: only the splines are read
+    assert [r.source["handle"] for r in read_curves(p)] == [h[k] for k in ("open3d", "open2d",
+                                                                         "periodic", "fit")]
+    recs = read_curves(p, polylines=True)
     by = {}
     for r in recs:
         by.setdefault(r.source["handle"], []).append(r)
@@ -145,7 +148,7 @@ def _entity_state(e):
 def test_write_back_replaces_only_the_faired_entities(tmp_path):
     p = tmp_path / "d.dxf"
     h = _drawing(p)
-    recs = read_curves(p)
+    recs = read_curves(p, polylines=True)
     faired = []
     changed = {h["open3d"], h["periodic"], h["lw"], h["fit"], h["poly3d"]}
     for r in recs:
@@ -180,7 +183,7 @@ def test_write_back_replaces_only_the_faired_entities(tmp_path):
     blk_b = [tuple(v) for v in b.blocks["B1"].query("SPLINE")[0].control_points]
     assert blk_a == blk_b
     # the faired geometry reads back exactly, widths kept on the polyline
-    back = read_curves(out)
+    back = read_curves(out, polylines=True)
     for r, f in zip(back, faired, strict=True):
         assert r.source["handle"] == f.source["handle"]
         if r.kind == "bspline":
@@ -217,10 +220,10 @@ def test_read_write_read_identical_and_untouched_file(tmp_path):
 def test_new_drawing_without_template(tmp_path):
     p = tmp_path / "d.dxf"
     _drawing(p)
-    recs = read_curves(p)
+    recs = read_curves(p, polylines=True)
     extra = interpolate_cubic(np.c_[np.arange(5.0), np.arange(5.0) ** 2 / 4])
     write_curves(tmp_path / "new.dxf", recs + [extra])
-    back = read_curves(tmp_path / "new.dxf")
+    back = read_curves(tmp_path / "new.dxf", polylines=True)
     kinds = [r.kind for r in back]
     assert kinds.count("bspline") == 4 and kinds.count("fit_points") == 1
     # pieces of the split polyline were joined into one polyline again
@@ -265,9 +268,15 @@ def test_unsupported_entities_raise_or_skip(tmp_path):
         read_curves(tmp_path / "u.dxf")
     assert exc.value.path == str(tmp_path / "u.dxf")
     with pytest.warns(UserWarning) as w:
-        recs = read_curves(tmp_path / "u.dxf", on_unsupported="skip")
+        recs = read_curves(tmp_path / "u.dxf", on_unsupported="skip", polylines=True)
     msgs = " ".join(str(x.message) for x in w)
     assert "rational" in msgs and "bulges" in msgs and "knot layout" in msgs
+    assert [r.source["handle"] for r in recs] == [good]
+    # by default the polyline with an arc is a drawn shape like any other: no warning for it
+    with pytest.warns(UserWarning) as w:
+        recs = read_curves(tmp_path / "u.dxf", on_unsupported="skip")
+    msgs = " ".join(str(x.message) for x in w)
+    assert "rational" in msgs and "bulges" not in msgs
     assert [r.source["handle"] for r in recs] == [good]
 
 
@@ -294,18 +303,24 @@ def test_no_curves_and_nan(tmp_path):
     doc.modelspace().add_lwpolyline([(0, 0), (1, float("nan")), (2, 0)])
     doc.saveas(tmp_path / "n.dxf")
     with pytest.raises(FileFormatError, match="non-finite"):
+        read_curves(tmp_path / "n.dxf", polylines=True)
+    # by default a polyline is left as drawn, and a file of nothing else says so
+    with pytest.raises(FileFormatError, match=r"no curves in the dxf file: its 1 polyline "
+                                              r"is \(LWPOLYLINE.*\) left as drawn.*"
+                                              r"polylines=True") as exc:
         read_curves(tmp_path / "n.dxf")
+    assert exc.value.n_drawn == 1
     doc = ezdxf.new("R2010")
     doc.modelspace().add_lwpolyline([(0, 0), (1, 1), (1, 1), (2, 0)])
     doc.saveas(tmp_path / "d.dxf")
     with pytest.warns(UserWarning, match="dropped 1 exactly repeated"):
-        recs = read_curves(tmp_path / "d.dxf", corner_angle=None)
+        recs = read_curves(tmp_path / "d.dxf", corner_angle=None, polylines=True)
     assert recs[0].points.shape == (3, 2)
     doc = ezdxf.new("R2010")
     doc.modelspace().add_lwpolyline([(0, 0), (1, 1), (1 + 2e-16, 1), (2, 0)])
     doc.saveas(tmp_path / "d2.dxf")
     with pytest.raises(FileFormatError, match="duplicate consecutive"):
-        read_curves(tmp_path / "d2.dxf")
+        read_curves(tmp_path / "d2.dxf", polylines=True)
 
 
 def test_real_libdxfrw_file(tmp_path):

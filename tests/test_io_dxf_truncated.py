@@ -110,9 +110,16 @@ def test_closed_two_vertex_polyline_is_skipped():
            and e.is_closed and len(e.vertices) == 2
            and not any(v.dxf.get("bulge", 0.0) for v in e.vertices)]
     assert two  # the file has such polylines (e.g. handle 39)
+    # by default every polyline (bulges or not, two vertices or more) is a drawn shape, left as
+    # drawn: the file has nothing else, and the error counts them
+    n_poly = sum(e.dxftype() == "POLYLINE" and (e.is_2d_polyline or e.is_3d_polyline)
+                 and not e.dxf.flags & 6 for e in doc.modelspace())
+    with pytest.raises(FileFormatError, match=f"its {n_poly} polylines are") as exc:
+        read_curves(path, on_unsupported="skip")
+    assert exc.value.n_drawn == n_poly >= 30
     with warnings.catch_warnings(record=True) as w:
         warnings.simplefilter("always")
-        recs = read_curves(path, on_unsupported="skip")
+        recs = read_curves(path, on_unsupported="skip", polylines=True)
     text = " ".join(str(x.message) for x in w)
     for h in two:
         assert f"POLYLINE {h} " in text and "2 distinct vertices" in text

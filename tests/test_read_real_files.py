@@ -257,14 +257,14 @@ def test_dxf_duplicate_vertex_dropped_and_written_back(tmp_path):
     p = tmp_path / "dup.dxf"
     doc.saveas(p)
     with pytest.warns(UserWarning, match="dropped 1 exactly repeated"):
-        (rec,) = read_curves(p)
+        (rec,) = read_curves(p, polylines=True)
     assert rec.points.shape == (5, 2)
     moved = rec.with_curve(rec.curve.replace(points=rec.points + [0, 0.1]))
     write_curves(tmp_path / "o.dxf", moved, template=p)
     (e,) = ezdxf.readfile(tmp_path / "o.dxf").modelspace().query("LWPOLYLINE")
     got = np.array([v[:2] for v in e.get_points("xy")])
     np.testing.assert_allclose(got, np.array(pts) + [0, 0.1], atol=1e-12)
-    res = _run("fair", p, "-o", tmp_path / "c.dxf", "--tol", "0.01")
+    res = _run("fair", p, "-o", tmp_path / "c.dxf", "--tol", "0.01", "--polylines")
     assert res.exit_code == 0 and "Warning:" in res.output
 
 
@@ -345,7 +345,7 @@ def test_dxf_rectangle_is_nothing_to_fair(tmp_path):
     p = tmp_path / "rect.dxf"
     doc.saveas(p)
     res = _run("fair", p, "-o", tmp_path / "o.dxf", "--tol", "0.01", "--report",
-               tmp_path / "r.json")
+               tmp_path / "r.json", "--polylines")
     assert res.exit_code == 0, res.output
     rep = json.loads((tmp_path / "r.json").read_text())
     assert [r["status"] for r in rep["curves"]] == ["nothing to fair"] * 4 + ["ok"]

@@ -107,7 +107,8 @@ def test_curves_faired_polygons_beside_them_kept_exactly(tmp_path):
 
 
 def test_polylines_argument_is_checked():
-    with pytest.raises(InputError, match="polylines= is for svg files, not airfoil"):
+    with pytest.raises(InputError, match=r"polylines= is for drawings \(svg, dxf, 3dm\), "
+                                         r"not airfoil"):
         read_curves(Path(__file__).parent / "data" / "e423.dat", polylines=True)
     with pytest.raises(InputError, match="polylines must be True, False or None"):
         read_curves(SI / "spdx.svg", polylines="yes")

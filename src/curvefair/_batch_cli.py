@@ -488,9 +488,9 @@ def _threshold(value: str | None, name: str) -> float | None:
               default=60.0, show_default=True, metavar="DEG",
               help="Point lists turning by DEG or more at a point are split there on reading.")
 @click.option("--polylines", is_flag=True,
-              help="SVG: read straight-line shapes (polygons, polylines, lines, rectangles, "
-                   "subpaths of lines only) as point lists and check them too [default: "
-                   "they are drawn shapes, not curves].")
+              help="SVG, DXF, 3dm: read straight-line shapes (polygons, polylines, lines, "
+                   "rectangles; DXF LWPOLYLINE and POLYLINE; 3dm PolylineCurve) as point "
+                   "lists and check them too [default: they are drawn shapes, not curves].")
 @click.option("--strict", is_flag=True, help="Refuse files with entities curvefair cannot "
               "represent (default: skip them).")
 @_selection_options

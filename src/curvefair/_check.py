@@ -51,7 +51,6 @@ import math
 import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -315,21 +314,20 @@ def check_file(path: str, thresholds: Mapping[str, float | None] | None = None, 
                select: Mapping[str, Any] | None = None,
                polylines: bool = False) -> tuple[list[Finding], int]:
     """``(findings, number of curves checked)`` for one file; an unreadable file is one
-    ``unreadable`` finding. ``polylines``: an SVG's straight-line shapes are read as point
-    lists and checked too (other formats' polylines always are)."""
+    ``unreadable`` finding. ``polylines``: a drawing's straight-line shapes (SVG, DXF, 3dm) are
+    read as point lists and checked too (point data always are)."""
     import warnings
 
     from . import read_curves
     from .batch import selected
+    from .io import detect_format, polylines_for
 
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            extra: dict[str, Any] = {}
-            if polylines and Path(path).suffix.lower() == ".svg":
-                extra["polylines"] = True
             recs = read_curves(path, corner_angle=corner_angle,
-                               on_unsupported="raise" if strict else "skip", **extra)
+                               on_unsupported="raise" if strict else "skip",
+                               polylines=polylines_for(detect_format(path), polylines))
     except (CurvefairError, OSError) as exc:
         if isinstance(exc, FileFormatError) and "no curves in the" in str(exc):
             return [], 0  # a drawing without curves has nothing unfair in it

@@ -602,22 +602,22 @@ def _read(path: str, opts: Mapping[str, Any], notes: list[str] | None = None,
           fmt: str | None = None) -> list[Any]:
     from . import read_curves
 
-    extra: dict[str, Any] = {}
-    if opts.get("polylines"):  # SVG only: other formats' polylines are point lists always
-        from .io import detect_format
+    poly: bool | None = None
+    if opts.get("polylines"):  # drawings only: point data are point lists always
+        from .io import detect_format, polylines_for
 
         try:
             kind: str | None = detect_format(path, cast("FormatName | None", fmt))
         except CurvefairError:
             kind = None  # read_curves says why
-        if kind == "svg":
-            extra["polylines"] = True
+        poly = polylines_for(kind, True)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
             recs = read_curves(path, corner_angle=opts["corner_angle"],
                                format=cast("FormatName | None", fmt),
-                               on_unsupported="raise" if opts["strict"] else "skip", **extra)
+                               on_unsupported="raise" if opts["strict"] else "skip",
+                               polylines=poly)
         finally:  # the skip warnings also when the file then holds no curve at all
             if notes is not None:
                 notes.extend(dict.fromkeys(str(w.message) for w in caught))
@@ -833,12 +833,13 @@ def _err(exc: BaseException) -> str:
 
 def _write(outfile: str, faired: list[Any], records: list[Any], infile: str, fmt_in: str,
            fmt_out: str, opts: Mapping[str, Any], in_place: bool) -> Any:
-    from .io import svg_reads_polylines, write_checked
+    from .io import reads_polylines, write_checked
 
     folder = os.path.dirname(os.path.abspath(outfile))
     os.makedirs(folder, exist_ok=True)
-    # point data written to an SVG are paths of lines: read back as point lists
-    back = dict(opts, polylines=opts.get("polylines") or bool(svg_reads_polylines(faired)))
+    # point data written to a drawing are polylines: read back as point lists
+    back = dict(opts, polylines=opts.get("polylines")
+                or bool(reads_polylines(faired, fmt_out)))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         return write_checked(outfile, faired, records, tol=opts["tol"],
@@ -1140,8 +1141,8 @@ def fair_files(paths: str | Sequence[str], out_dir: str | os.PathLike[str], clie
         ``method`` (a name or ``"kind=name,..."``), ``tol``, ``eps``, ``max_steps``, ``clamp``,
         ``protect``, ``mode``, ``method_options`` (dict), ``decimals``, ``corner_angle``,
         ``strict``, ``layer``, ``name``, ``handle``, ``hold_shared``, ``shared_distance``,
-        ``history``, ``polylines`` (SVG files: read straight-line shapes as point lists, as
-        :func:`curvefair.read_curves`; other formats ignore it).
+        ``history``, ``polylines`` (SVG, DXF and 3dm files: read straight-line shapes as point
+        lists, as :func:`curvefair.read_curves`; other formats ignore it).
 
     Returns
     -------

@@ -414,19 +414,19 @@ def _read(path: str, corner_angle: float | None, strict: bool = False,
     (kept untouched on write-back) unless ``strict``, which refuses the file. With
     ``all_skipped_ok``, a file whose every curve entity was skipped raises
     :class:`_AllSkipped` (the caller writes it back unchanged) instead of failing.
-    ``polylines`` (``--polylines``) reads an SVG's straight-line shapes as point lists; it
-    means nothing for other formats (their polylines are point lists always)."""
+    ``polylines`` (``--polylines``) reads a drawing's straight-line shapes (SVG, DXF, 3dm) as
+    point lists; it means nothing for other formats (point data are point lists always)."""
     from . import read_curves
+    from .io import polylines_for
 
     kind = fmt if fmt is not None else _format_of(path)  # a CLI message (not format=)
     extra: dict[str, Any] = {} if glyphs is None else {"glyphs": glyphs}
-    if polylines and kind == "svg":
-        extra["polylines"] = True
     seen: list[str] = []
     try:
         with _warnings_to_stderr(quiet, into=seen):
             return read_curves(path, corner_angle=corner_angle, format=cast(Any, fmt),
-                               on_unsupported="raise" if strict else "skip", **extra)
+                               on_unsupported="raise" if strict else "skip",
+                               polylines=polylines_for(kind, polylines), **extra)
     except CurvefairError as exc:
         skipped = sum(": skipped " in w for w in seen)
         drawn = int(getattr(exc, "n_drawn", 0))
@@ -492,9 +492,10 @@ def _reading_options(f: Any) -> Any:
     f = click.option("--no-corners", is_flag=True,
                      help="Never split point lists at corners.")(f)
     f = click.option("--polylines", is_flag=True,
-                     help="SVG: read straight-line shapes (polygons, polylines, lines, "
-                          "rectangles, subpaths of lines only) as point lists to fair "
-                          "[default: leave them as drawn].")(f)
+                     help="SVG, DXF, 3dm: read straight-line shapes (polygons, polylines, "
+                          "lines, rectangles; DXF LWPOLYLINE and POLYLINE; 3dm "
+                          "PolylineCurve) as point lists to fair [default: leave them as "
+                          "drawn].")(f)
     f = click.option("--strict", is_flag=True,
                      help="Refuse a file holding an entity curvefair cannot represent exactly "
                           "(rational or degree-1 splines, arcs, ...) [default: skip it with a "
@@ -1078,7 +1079,7 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
             return
     _check_protect_range(records, user_protect)
     from . import fair
-    from .io import svg_reads_polylines, write_checked
+    from .io import reads_polylines, write_checked
 
     rows: list[dict[str, Any]] = []
     faired = []
@@ -1142,10 +1143,11 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
             check = write_checked(out, faired, records, tol=tol,
                                   # the temporary file has OUT's extension, which need
                                   # not name a format (-o OUT without one: IN's format)
-                                  # point data written to an SVG are paths of lines
+                                  # point data written to a drawing are polylines
                                   reader=lambda p: _read(p, corner, strict, True, glyphs,
                                                          fmt=out_fmt, polylines=polylines
-                                                         or bool(svg_reads_polylines(faired))),
+                                                         or bool(reads_polylines(faired,
+                                                                                 out_fmt))),
                                   template=infile if out_fmt == in_fmt else None,
                                   format=out_fmt, overwrite=in_place, decimals=decimals)
             if prog is not None:

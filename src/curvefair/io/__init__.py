@@ -115,6 +115,10 @@ FORMATS: dict[str, tuple[str, ...]] = {
 #: formats stored as a folder, and the formats that take ``glyphs=``
 FOLDER_FORMATS = ("ufo",)
 FONT_FORMATS = ("ufo", "opentype", "glyphs", "designspace")
+#: Drawings whose straight-line shapes (polygons, polylines) are drawn shapes, left as drawn
+#: unless read with ``polylines=True`` (docs/formats.md, "Straight-line shapes are drawn
+#: shapes").
+DRAWN_SHAPE_FORMATS = ("svg", "dxf", "3dm")
 
 
 def detect_format(path: str | os.PathLike[str], format: str | None = None) -> FormatName:
@@ -176,10 +180,13 @@ def read_curves(path: str | os.PathLike[str], *, format: FormatName | None = Non
         Fonts (``ufo``, ``opentype``, ``glyphs``): only these glyphs (names, or one comma-separated
         string); one record per contour with curves, named ``"<glyph>#<contour>"``.
     polylines : bool, optional
-        SVG only: read straight-line shapes (polygons, polylines, lines, rectangles, subpaths
-        of lines only) as point lists (True), or leave them as drawn (the default for SVG: in
-        a drawing a polygon's vertices are its design; see :mod:`curvefair.io.svg`). Other
-        formats' polylines are point lists always.
+        Drawings (``svg``, ``dxf``, ``3dm``: :data:`DRAWN_SHAPE_FORMATS`): read straight-line
+        shapes -- SVG polygons, polylines, lines, rectangles and subpaths of lines only; DXF
+        ``LWPOLYLINE`` and 2-D / 3-D ``POLYLINE``; 3dm ``PolylineCurve`` and degree-1
+        ``NurbsCurve`` -- as point lists (True), or leave them as drawn (the default: in a
+        drawing a polygon's vertices are its design, not samples of a curve; see
+        docs/formats.md). A file of point data (``points``, ``airfoil``) is point lists
+        always.
 
     Returns
     -------
@@ -225,9 +232,9 @@ def read_curves(path: str | os.PathLike[str], *, format: FormatName | None = Non
     if polylines is not None:
         if not isinstance(polylines, (bool, np.bool_)):
             raise InputError(f"polylines must be True, False or None, got {polylines!r}")
-        if fmt != "svg":
-            raise InputError(f"polylines= is for svg files, not {fmt} files (their polylines "
-                             "are always read as point lists)")
+        if fmt not in DRAWN_SHAPE_FORMATS:
+            raise InputError(f"polylines= is for drawings ({', '.join(DRAWN_SHAPE_FORMATS)}), "
+                             f"not {fmt} files")
         extra["polylines"] = bool(polylines)
     if fmt in ("iges", "step"):
         extra["format"] = fmt       # one module reads both; the path may have no extension
@@ -384,7 +391,7 @@ def write_curves(path: str | os.PathLike[str], curves: CurveRecord | PiecewiseCu
 
     ref = _reference(records, reference, tol_f, corner_angle)
 
-    poly = svg_reads_polylines(records) if fmt == "svg" else None
+    poly = reads_polylines(records, fmt)
 
     def reader(p: str) -> list[CurveRecord]:
         with warnings.catch_warnings():  # the input's skip warnings, again
@@ -399,17 +406,29 @@ def write_curves(path: str | os.PathLike[str], curves: CurveRecord | PiecewiseCu
     return check
 
 
-def svg_reads_polylines(records: Sequence[CurveRecord]) -> bool | None:
-    """Whether an SVG written from ``records`` is read back with ``polylines=True``, so that
-    its curves pair up with them: records read from an SVG that way
-    (``source["polylines"]``), or point data (a point list is written as a path of lines).
-    None (the reader's default) otherwise."""
+def reads_polylines(records: Sequence[CurveRecord], fmt: str | None) -> bool | None:
+    """Whether a ``fmt`` file written from ``records`` is read back with ``polylines=True``, so
+    that its curves pair up with them: records read from a drawing that way
+    (``source["polylines"]``), or point data, which the writers write as polylines (in an SVG
+    every point kind is a path of lines; in DXF and 3dm fit points are a fit-point spline).
+    None (the reader's default) for other records, and for formats without the choice."""
     from ._verify import POINT_KINDS
 
+    if fmt not in DRAWN_SHAPE_FORMATS:
+        return None
+    kinds = POINT_KINDS if fmt == "svg" else ("points", "airfoil", "polyline")
     for r in records:
-        if r.kind in POINT_KINDS or (r.format == "svg" and r.source.get("polylines")):
+        if r.kind in kinds or (r.format in DRAWN_SHAPE_FORMATS and r.source.get("polylines")):
             return True
     return None
+
+
+def polylines_for(fmt: str | None, polylines: bool) -> bool | None:
+    """``read_curves``' ``polylines`` for a caller's choice (the CLI's ``--polylines``, a batch
+    option) applied to a file of format ``fmt``: True where the format has the choice
+    (:data:`DRAWN_SHAPE_FORMATS`), None (the reader's default) otherwise -- point data are
+    point lists always."""
+    return True if polylines and fmt in DRAWN_SHAPE_FORMATS else None
 
 
 def _write_plain(path: str | os.PathLike[str], records: Sequence[CurveRecord], fmt: str,
@@ -444,9 +463,8 @@ def _reference(records: list[CurveRecord], reference: object, tol: float | None,
                 warnings.simplefilter("ignore")
                 cache[src] = read_curves(src, format=r.format,  # type: ignore[arg-type]
                                          corner_angle=corner_angle, on_unsupported="skip",
-                                         polylines=svg_reads_polylines([x for x in records
-                                                                   if x.path == src])
-                                         if r.format == "svg" else None)
+                                         polylines=reads_polylines(
+                                             [x for x in records if x.path == src], r.format))
         j = r.source.get("index")
         got = cache[src]
         o = got[j] if isinstance(j, int) and 0 <= j < len(got) else None

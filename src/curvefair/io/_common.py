@@ -339,6 +339,29 @@ class Unsupported(Exception):
     """A curve entity curvefair cannot represent exactly (reported or skipped by the reader)."""
 
 
+#: What a format's straight-line shapes are called in :class:`DrawnShapesOnly`'s message.
+_DRAWN_WHAT = {
+    "svg": ("straight-line shape", "polygons, polylines, lines, rectangles, subpaths of lines "
+                                   "only"),
+    "dxf": ("polyline", "LWPOLYLINE, 2-D and 3-D POLYLINE"),
+    "3dm": ("polyline", "PolylineCurve, degree-1 NurbsCurve"),
+}
+
+
+class DrawnShapesOnly(FileFormatError):
+    """A drawing (SVG, DXF, 3dm) holding no curve but ``n_drawn`` straight-line shapes, which
+    are left as drawn unless ``polylines=True``; the command line writes such a file back
+    unchanged."""
+
+    def __init__(self, n_drawn: int, path: object, fmt: str) -> None:
+        noun, detail = _DRAWN_WHAT[fmt]
+        super().__init__(
+            f"no curves in the {fmt} file: its {n_drawn} {noun}"
+            f"{'s are' if n_drawn > 1 else ' is'} ({detail}) left as drawn; read_curves(..., "
+            "polylines=True) (CLI --polylines) reads them as point lists", path)
+        self.n_drawn = n_drawn
+
+
 def planar(xyz: FloatArray) -> tuple[FloatArray, float | None]:
     """2-D points and their common z when all z are equal, else the 3-D points and None."""
     if xyz.shape[0] and np.all(xyz[:, 2] == xyz[0, 2]):

@@ -149,6 +149,52 @@ def _ordered(reference: Sequence[CurveRecord], back: Sequence[CurveRecord]
     return out
 
 
+def _lifted(rec: CurveRecord) -> CurveRecord | None:
+    """A 2-D record read back with a common z (``source["z"]``) as the same curve in 3-D, or
+    None when its curve type cannot be lifted."""
+    from ..curves.bspline import BSplineCurve
+    from ..curves.hermite import HermiteSpline
+
+    z = float(rec.source["z"])
+    c = rec.curve
+
+    def up(a: Any, value: float) -> FloatArray:
+        a = np.asarray(a, dtype=float)
+        return np.c_[a, np.full(a.shape[0], value)]
+
+    if isinstance(c, BSplineCurve):
+        new: Any = c.replace(control_points=up(c.control_points, z))
+    elif isinstance(c, HermiteSpline):
+        new = c.replace(points=up(c.points, z),
+                        **{k: up(d, 0.0) for k, d in zip(c._deriv_names, c._derivs,
+                                                         strict=True)})
+    else:
+        return None
+    pts = None if rec.points is None else up(rec.points, z)
+    return CurveRecord(new, rec.name, rec.kind, rec.source, pts, rec.corners)
+
+
+def _as_reference_dims(reference: Sequence[CurveRecord], back: Sequence[CurveRecord]
+                       ) -> list[CurveRecord]:
+    """``back`` (in ``reference``'s order, :func:`_ordered`) with each 2-D record read back for
+    a 3-D reference entity lifted to 3-D at its common z: a 3-D curve the fair made exactly
+    planar at constant z (a straight polyline whose z had rounding noise) is read back 2-D,
+    the readers' form of a planar curve, and is the same curve. Paired by source entity as
+    :func:`_matched` pairs them (:func:`_groups`); unchanged when they cannot be paired."""
+    if all(r.curve.dim == 2 for r in reference):
+        return list(back)
+    rg, bg = _groups(reference), _groups(back)
+    if len(rg) != len(bg):
+        return list(back)
+    out = []
+    for rr, bb in zip(rg, bg, strict=True):
+        for b in bb:
+            if rr[0].curve.dim == 3 and b.curve.dim == 2 and b.source.get("z") is not None:
+                b = _lifted(b) or b
+            out.append(b)
+    return out
+
+
 def _groups(records: Sequence[CurveRecord]) -> list[list[CurveRecord]]:
     """Records grouped by source entity: the pieces ``0 .. n_pieces-1`` of a point list split
     at corners form one group, any other record a group of its own."""
@@ -523,7 +569,7 @@ def write_checked(path: str | os.PathLike[str], records: Sequence[CurveRecord],
                     else ""
                 raise WriteCheckError(f"{where}: not written: the file would not read back: "
                                       f"{msg}{hint}") from None
-            back = _ordered(reference, back)
+            back = _as_reference_dims(reference, _ordered(reference, back))
             lost = _lost_points(reference, back)
             if lost is not None:
                 hint = f" (--decimals {decimals} rounds too much?)" if decimals is not None \

@@ -18,12 +18,18 @@ the entity's degree, knots and control points:
 - weights other than 1 (rational), degree < 2 or any other knot layout: unsupported.
 
 ``SPLINE`` with fit points only -> ``kind="fit_points"``: the curve through the fit points
-(periodic if the spline is closed). Polylines -> ``kind="polyline"``, split at corners like
-every point list; polylines with arc segments (bulges) or spline/curve-fit vertices are
+(periodic if the spline is closed). Polylines (``LWPOLYLINE``, 2-D / 3-D ``POLYLINE``) are
+**drawn shapes, not read** by default: a polyline's vertices are its design, not samples of a
+curve (of 491 polylines in the DXF and 3dm files of ezdxf's, dxf-parser's, openNURBS' and
+rhino3dm's repositories 12 look like samples: docs/formats.md), so they are left exactly as
+drawn. ``polylines=True`` (CLI ``--polylines``) reads them as point lists,
+``kind="polyline"``, split at corners like every point list; polylines with arc segments
+(bulges) are then unsupported. Spline-fit or curve-fit ``POLYLINE`` entities are
 unsupported. Coordinates are the entity's own (OCS for 2-D polylines); a curve whose points
 all have the same z is 2-D and keeps that z (``source["z"]``).
 
-``source`` keys: ``handle``, ``dxftype``, ``layer``, ``layout``, ``z`` (None for 3-D), and
+``source`` keys: ``handle``, ``dxftype``, ``layer``, ``layout``, ``polylines`` (the reading's
+choice: the write-back's check reads the file again the same way), ``z`` (None for 3-D), and
 ``spline_layout`` (``"clamped"``, ``"clamped_closed"``, ``"periodic"``,
 ``"periodic_short"``) or the point-list keys.
 
@@ -57,6 +63,7 @@ from ..curves.bspline import BSplineCurve
 from ..errors import CurvefairError, FileFormatError, InputError
 from ._common import (
     CurveRecord,
+    DrawnShapesOnly,
     Unsupported,
     atomic_path,
     bspline_of,
@@ -263,15 +270,34 @@ def _truncated(path: str | os.PathLike[str]) -> str | None:
             "truncated")
 
 
+def _drawn(e: Any, t: str) -> bool:
+    """Whether entity ``e`` (of DXF type ``t``) is a polyline of straight segments and arcs: a
+    drawn shape, read only with ``polylines=True``. A spline-fit or curve-fit ``POLYLINE``
+    is a curve (reported as unsupported), a polyface or mesh no curve at all."""
+    if t == "LWPOLYLINE":
+        return True
+    return t == "POLYLINE" and bool(e.is_2d_polyline or e.is_3d_polyline) \
+        and not e.dxf.flags & 6
+
+
 def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
-         on_unsupported: str = "raise", **_: Any) -> list[CurveRecord]:
-    """Read the curves of a DXF drawing; see the module docstring."""
+         on_unsupported: str = "raise", polylines: bool = False,
+         **_: Any) -> list[CurveRecord]:
+    """Read the curves of a DXF drawing; see the module docstring.
+
+    ``polylines=False`` leaves polylines as drawn (no records); a drawing holding nothing
+    else raises :class:`~curvefair.io._common.DrawnShapesOnly` (a
+    :class:`~curvefair.FileFormatError`) saying how many there are and how to read them."""
     doc = _load(path, "reading DXF files")
     records: list[CurveRecord] = []
+    drawn = 0
     for layout in doc.layouts:
         for e in layout:
             t = e.dxftype()
             if t not in ("SPLINE", "LWPOLYLINE", "POLYLINE"):
+                continue
+            if not polylines and _drawn(e, t):
+                drawn += 1
                 continue
             handle = e.dxf.handle
             layer = e.dxf.get("layer", "0")
@@ -285,7 +311,7 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
                 continue
             base = {"format": FORMAT, "path": os.path.abspath(path), "handle": handle,
                     "dxftype": t, "layer": layer, "layout": layout.name,
-                    "name": f"{layer}:{t}:{handle}"}
+                    "polylines": bool(polylines), "name": f"{layer}:{t}:{handle}"}
             try:
                 if t == "SPLINE":
                     new = _spline_record(e, base, path, corner_angle, len(records))
@@ -303,6 +329,8 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
                 src.pop("name", None)
                 src["index"] = len(records)
                 records.append(CurveRecord(r.curve, r.name, r.kind, src, r.points, r.corners))
+    if not records and drawn:
+        raise DrawnShapesOnly(drawn, path, FORMAT)
     return records
 
 

@@ -9,8 +9,10 @@ are not read; lines, arcs and other geometry are left alone):
   curve, periodic ones (``IsPeriodic``: the first ``degree`` control points repeated at the
   end) a closed curve. openNURBS stores ``n + p - 1`` knots; the two "superfluous" end knots
   are added back (``Knots.SuperfluousKnot``), so the knot vector is the usual full one;
-- degree-1 ``NurbsCurve`` and ``PolylineCurve`` -> ``kind="polyline"`` (vertices, split at
-  corners like every point list);
+- degree-1 ``NurbsCurve`` and ``PolylineCurve`` (also as a ``PolyCurve``'s one segment):
+  **drawn shapes, not read** by default (a polyline's vertices are its design, as in DXF and
+  SVG: docs/formats.md); ``polylines=True`` (CLI ``--polylines``) reads them as
+  ``kind="polyline"`` (vertices, split at corners like every point list);
 - ``PolyCurve`` (joined curves; Rhino 2 saved every curve as one): one segment -> read as
   that ``NurbsCurve``; several -> one ``kind="bspline"`` record per run of segments
   (:func:`_polycurve`: clamped non-rational ``NurbsCurve`` segments of degree >= 2 and one
@@ -20,7 +22,8 @@ are not read; lines, arcs and other geometry are left alone):
 
 A curve whose control points all have the same z is 2-D (``source["z"]`` keeps that z).
 ``source`` keys: ``id`` (the object's GUID as a string), ``object`` (index in the object
-table), ``layer`` (layer name), ``geometry`` (class name), ``z``, ``nurbs_layout``
+table), ``layer`` (layer name), ``geometry`` (class name), ``polylines`` (the reading's
+choice), ``z``, ``nurbs_layout``
 (``"clamped"``/``"periodic"``), ``polycurve`` and ``segments`` (a PolyCurve's run: its segment
 indices), plus the point-list keys for polylines.
 
@@ -61,6 +64,7 @@ from ..curves.bspline import BSplineCurve
 from ..errors import CurvefairError, FileFormatError, InputError
 from ._common import (
     CurveRecord,
+    DrawnShapesOnly,
     Unsupported,
     atomic_path,
     bspline_of,
@@ -340,9 +344,24 @@ def _polyline(xyz: FloatArray, base: dict[str, Any], path: object,
                          name=base["name"], source=src, first_index=index)
 
 
+def _drawn(g: Any, rh: Any) -> bool:
+    """Whether geometry ``g`` is a polyline: a ``PolylineCurve``, a degree-1 ``NurbsCurve``
+    or a ``PolyCurve`` of one such segment -- a drawn shape, read only with
+    ``polylines=True``."""
+    if isinstance(g, rh.PolyCurve) and int(g.SegmentCount) == 1:
+        g = g.SegmentCurve(0)
+    return isinstance(g, rh.PolylineCurve) or (isinstance(g, rh.NurbsCurve)
+                                                and int(g.Degree) == 1)
+
+
 def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
-         on_unsupported: str = "raise", **_: Any) -> list[CurveRecord]:
-    """Read the curves of a Rhino model; see the module docstring."""
+         on_unsupported: str = "raise", polylines: bool = False,
+         **_: Any) -> list[CurveRecord]:
+    """Read the curves of a Rhino model; see the module docstring.
+
+    ``polylines=False`` leaves polylines as drawn (no records); a model holding nothing
+    else raises :class:`~curvefair.io._common.DrawnShapesOnly` (a
+    :class:`~curvefair.FileFormatError`) saying how many there are and how to read them."""
     rh = _rhino("reading 3dm files")
     model = _load(path, "reading 3dm files")
     layers = [model.Layers[k].Name for k in range(len(model.Layers))]
@@ -352,6 +371,7 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
                                              ("hidden", not model.Layers[j].Visible)) if on)
                    for j in range(len(model.Layers))]
     records: list[CurveRecord] = []
+    drawn = 0
     for i in range(len(model.Objects)):
         obj = model.Objects[i]
         attr = obj.Attributes
@@ -359,6 +379,9 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
             # the geometry of a block definition, drawn by its instances through their
             # transforms (a scaled instance would carry a fairing beyond --tol into the model;
             # every instance would change): not read, like DXF block definitions
+            continue
+        if not polylines and _drawn(obj.Geometry, rh):
+            drawn += 1
             continue
         ident = str(attr.Id)
         li = int(attr.LayerIndex)
@@ -373,7 +396,8 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
             continue
         name = attr.Name or f"{type(obj.Geometry).__name__}:{ident}"
         base = {"format": FORMAT, "path": os.path.abspath(path), "id": ident, "object": i,
-                "layer": layer, "geometry": type(obj.Geometry).__name__, "name": name}
+                "layer": layer, "geometry": type(obj.Geometry).__name__,
+                "polylines": bool(polylines), "name": name}
         try:
             new = _records_of(obj, i, base, path, rh, corner_angle, len(records))
         except Unsupported as exc:
@@ -388,6 +412,8 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
             src.pop("name", None)
             src["index"] = len(records)
             records.append(CurveRecord(r.curve, r.name, r.kind, src, r.points, r.corners))
+    if not records and drawn:
+        raise DrawnShapesOnly(drawn, path, FORMAT)
     return records
 
 

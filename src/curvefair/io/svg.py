@@ -86,6 +86,7 @@ from ..curves.bspline import BSplineCurve
 from ..errors import FileFormatError, InputError, MissingDependencyError
 from ._common import (
     CurveRecord,
+    DrawnShapesOnly,
     Unsupported,
     atomic_write,
     bezier_pieces,
@@ -698,21 +699,8 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
                 raise FileFormatError(f"<path> element {k} (id={ident!r}) subpath {j}: {exc}",
                                       path) from None
     if not records and drawn:
-        raise DrawnShapesOnly(drawn, path)
+        raise DrawnShapesOnly(drawn, path, FORMAT)
     return records
-
-
-class DrawnShapesOnly(FileFormatError):
-    """An SVG holding no curve but ``n_drawn`` straight-line shapes, which are left as drawn
-    unless ``polylines=True``; the command line writes such a file back unchanged."""
-
-    def __init__(self, n_drawn: int, path: object) -> None:
-        super().__init__(
-            f"no curves in the svg file: its {n_drawn} straight-line shape"
-            f"{'s are' if n_drawn > 1 else ' is'} (polygons, polylines, lines, rectangles, "
-            "subpaths of lines only) left as drawn; read_curves(..., polylines=True) "
-            "(CLI --polylines) reads them as point lists", path)
-        self.n_drawn = n_drawn
 
 
 def _kept_segments(sub: Any, spt: Any) -> list[Any]:
