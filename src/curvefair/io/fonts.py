@@ -60,7 +60,7 @@ A variable TrueType binary (``gvar``) is refused: its sources are faired instead
   rewritten as ``rmoveto``/``rlineto``/``rrcurveto`` (hints, hint masks and width kept).
 
 The font is saved with fontTools (head/hhea/maxp bounds recomputed) and read back by the
-caller's check.
+caller's check; a binary font in which no glyph changed is copied byte for byte instead.
 """
 
 from __future__ import annotations
@@ -863,9 +863,11 @@ def write_binary(path: str | os.PathLike[str], changes: dict[str, dict[int, Floa
                  template: str) -> None:
     """Replace the changed glyphs' outlines in a copy of the binary font ``template``.
 
-    A variable TrueType font (``gvar``) is refused: its instances are the default outline plus
-    the ``gvar`` deltas, so a faired default outline with the deltas kept would move every
-    instance by the default's moves, unchecked against ``tol`` and unfaired."""
+    Nothing changed: the template's bytes, exactly (fontTools' save would rebuild every table,
+    and a CFF font's charstrings come out desubroutinized, larger). A variable TrueType font
+    (``gvar``) is refused: its instances are the default outline plus the ``gvar`` deltas, so
+    a faired default outline with the deltas kept would move every instance by the default's
+    moves, unchecked against ``tol`` and unfaired."""
     font = _open_binary(template)
     if "gvar" in font:
         raise FileFormatError("a variable TrueType font (gvar table): fairing its default "
@@ -873,6 +875,9 @@ def write_binary(path: str | os.PathLike[str], changes: dict[str, dict[int, Floa
                               "deltas; fair the font's sources (a .designspace with "
                               "'curvefair fair X.designspace --tol T -o OUTDIR', or its UFO "
                               "masters) and build it again", template)
+    if not any(changes.values()):
+        shutil.copyfile(template, os.fspath(path))
+        return
     if "glyf" in font:
         glyf, hmtx = font["glyf"], font["hmtx"]
         for gname, conts in changes.items():
