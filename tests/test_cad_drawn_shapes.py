@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import shutil
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -21,6 +22,7 @@ from click.testing import CliRunner
 from curvefair import read_curves
 from curvefair.cli import main
 from curvefair.errors import FileFormatError
+from curvefair.io import DrawnShapesLeft
 
 ezdxf = pytest.importorskip("ezdxf")
 
@@ -61,6 +63,9 @@ def test_dxf_polylines_stay_as_drawn_and_the_spline_is_faired(tmp_path):
     out = tmp_path / "out.dxf"
     res = _run("fair", HATCHES, "-o", out, "--tol", tol, "--report", tmp_path / "r.json")
     assert res.exit_code == 0, res.output
+    # said, so that a user who wanted them faired is not left guessing
+    assert "Note: " in res.output and "4 polylines (LWPOLYLINE, 2-D and 3-D POLYLINE) left " \
+        "as drawn; read_curves(..., polylines=True) (CLI --polylines)" in res.output
     rep = json.loads((tmp_path / "r.json").read_text())
     assert [c["kind"] for c in rep["curves"]] == ["bspline"]
     before, after = _dxf_polylines(HATCHES), _dxf_polylines(out)
@@ -78,6 +83,21 @@ def test_dxf_polylines_stay_as_drawn_and_the_spline_is_faired(tmp_path):
     after = _dxf_polylines(out2)
     moved = np.linalg.norm(after["24A"][:, :2] - before["24A"][:, :2], axis=1)
     assert np.count_nonzero(moved) > 100 and moved.max() <= tol
+
+
+@pytest.mark.parametrize("path, n, lib", [
+    (HATCHES, 4, "ezdxf"),
+    (REAL / "simple-icons" / "spdx.svg", 2, "svgpathtools"),   # a polygon, a rectangle, curves
+    (TJOINT, 2, "rhino3dm"),
+])
+def test_reading_a_drawing_notes_the_shapes_left_as_drawn(path, n, lib):
+    pytest.importorskip(lib)
+    with pytest.warns(DrawnShapesLeft, match=f": {n} .* left as drawn; read_curves") as w:
+        recs = read_curves(path, on_unsupported="skip")
+    assert recs and [x.message.n_drawn for x in w if x.category is DrawnShapesLeft] == [n]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", DrawnShapesLeft)
+        read_curves(path, on_unsupported="skip", polylines=True)   # nothing left: no note
 
 
 def test_dxf_of_polylines_only_is_written_unchanged_and_said_so(tmp_path):

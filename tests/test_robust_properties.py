@@ -252,7 +252,12 @@ def test_fair_result_is_valid_within_tol_clamped_and_not_worse(case):
         np.testing.assert_array_equal(d1[i], d0[i])
     if c.closed and hasattr(c, "points"):
         np.testing.assert_array_equal(out.points[0], out.points[-1])
-    # clamped ends (open curves): position, tangent direction, curvature vector
+    # clamped ends (open curves): position, tangent direction, curvature vector. The held
+    # control points are kept bitwise, but the curve is evaluated at its right end through the
+    # last span's power form (Taylor coefficients at the span's left knot, Horner at its
+    # length): every control point of that span contributes there, the moved ones cancel
+    # only up to rounding (a degree-4 case of eck-hadenfeld: curvature 1.4e-12 relative
+    # apart). 1e-10 is far below any real break of the condition and far above that rounding.
     scale = size_of(c)
     if not c.closed:
         for end, cl in zip(c.domain, case.clamp, strict=True):
@@ -260,9 +265,9 @@ def test_fair_result_is_valid_within_tol_clamped_and_not_worse(case):
             p1, t1, k1 = end_geometry(out, end)
             assert np.abs(p1 - p0).max() <= 1e-12 * scale, ("g0", end)
             if cl in ("g1", "g2"):
-                assert np.abs(t1 - t0).max() <= 1e-12, ("g1", end, t0, t1)
+                assert np.abs(t1 - t0).max() <= 1e-10, ("g1", end, t0, t1)
             if cl == "g2":
-                assert np.abs(k1 - k0).max() <= 1e-12 * (np.abs(k0).max() + 1.0 / scale), \
+                assert np.abs(k1 - k0).max() <= 1e-10 * (np.abs(k0).max() + 1.0 / scale), \
                     ("g2", end, k0, k1)
     # report and result agree; no NaN anywhere in the report's numbers
     assert res.report["max_deviation"] <= case.tol * (1 + 1e-12)

@@ -385,6 +385,8 @@ def _warnings_to_stderr(quiet: bool, prefix: str = "",
         try:
             yield
         finally:
+            from .io import DrawnShapesLeft
+
             seen: set[str] = set()
             for w in caught:
                 msg = prefix + str(w.message)
@@ -393,6 +395,10 @@ def _warnings_to_stderr(quiet: bool, prefix: str = "",
                 seen.add(msg)
                 if into is not None:
                     into.append(str(w.message))
+                if isinstance(w.message, DrawnShapesLeft):  # a note, not a warning
+                    if not quiet:
+                        click.echo(f"Note: {msg}", err=True)
+                    continue
                 _warn(msg, quiet)
 
 

@@ -86,11 +86,20 @@ import numpy as np
 from .._validate import as_positive, choice
 from ..curves.piecewise import PiecewiseCurve
 from ..errors import FileFormatError, InputError
-from ._common import KINDS, CurveRecord, atomic_path, atomic_write, curve_kind, same_path
+from ._common import (
+    KINDS,
+    CurveRecord,
+    DrawnShapesLeft,
+    DrawnShapesOnly,
+    atomic_path,
+    atomic_write,
+    curve_kind,
+    same_path,
+)
 from ._verify import WriteCheck, WriteCheckError, on_disk_report, rescaled_report, write_checked
 
 __all__ = ["read_curves", "write_curves", "WriteCheck", "WriteCheckError", "CurveRecord", "KINDS",
-           "FORMATS", "detect_format",
+           "FORMATS", "detect_format", "DRAWN_SHAPE_FORMATS", "DrawnShapesLeft", "DrawnShapesOnly",
            "atomic_write", "atomic_path", "write_checked", "rescaled_report", "on_disk_report"]
 
 FormatName = Literal["points", "airfoil", "json", "dxf", "3dm", "svg", "iges", "step", "ufo",

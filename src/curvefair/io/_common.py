@@ -348,6 +348,30 @@ _DRAWN_WHAT = {
 }
 
 
+class DrawnShapesLeft(UserWarning):
+    """A drawing's reader left ``n_drawn`` straight-line shapes as drawn (not read, kept
+    byte for byte on write-back) beside the curves it read: a note, so that they are not
+    missed; ``polylines=True`` reads them. The command line prints it as a ``Note:``."""
+
+    def __init__(self, message: str, n_drawn: int = 0) -> None:
+        super().__init__(message)
+        self.n_drawn = n_drawn
+
+
+def warn_drawn(path: str | os.PathLike[str], n_drawn: int, fmt: str) -> None:
+    """The :class:`DrawnShapesLeft` note of a reader that read curves and left ``n_drawn``
+    straight-line shapes (nothing when there are none)."""
+    if not n_drawn:
+        return
+    import warnings
+
+    noun, detail = _DRAWN_WHAT[fmt]
+    warnings.warn(DrawnShapesLeft(
+        f"{os.fspath(path)}: {n_drawn} {noun}{'s' if n_drawn > 1 else ''} ({detail}) left as "
+        "drawn; read_curves(..., polylines=True) (CLI --polylines) reads them as point lists",
+        n_drawn), stacklevel=4)
+
+
 class DrawnShapesOnly(FileFormatError):
     """A drawing (SVG, DXF, 3dm) holding no curve but ``n_drawn`` straight-line shapes, which
     are left as drawn unless ``polylines=True``; the command line writes such a file back

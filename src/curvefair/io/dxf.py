@@ -76,6 +76,7 @@ from ._common import (
     planar,
     point_records,
     points_curve,
+    warn_drawn,
 )
 
 __all__ = ["read", "write"]
@@ -286,7 +287,7 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
     """Read the curves of a DXF drawing; see the module docstring.
 
     ``polylines=False`` leaves polylines as drawn (no records); a drawing holding nothing
-    else raises :class:`~curvefair.io._common.DrawnShapesOnly` (a
+    else raises :class:`~curvefair.io.DrawnShapesOnly` (a
     :class:`~curvefair.FileFormatError`) saying how many there are and how to read them."""
     doc = _load(path, "reading DXF files")
     records: list[CurveRecord] = []
@@ -331,6 +332,7 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
                 records.append(CurveRecord(r.curve, r.name, r.kind, src, r.points, r.corners))
     if not records and drawn:
         raise DrawnShapesOnly(drawn, path, FORMAT)
+    warn_drawn(path, drawn, FORMAT)
     return records
 
 

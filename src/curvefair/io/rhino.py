@@ -78,6 +78,7 @@ from ._common import (
     planar,
     point_records,
     points_curve,
+    warn_drawn,
 )
 
 __all__ = ["read", "write"]
@@ -360,7 +361,7 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
     """Read the curves of a Rhino model; see the module docstring.
 
     ``polylines=False`` leaves polylines as drawn (no records); a model holding nothing
-    else raises :class:`~curvefair.io._common.DrawnShapesOnly` (a
+    else raises :class:`~curvefair.io.DrawnShapesOnly` (a
     :class:`~curvefair.FileFormatError`) saying how many there are and how to read them."""
     rh = _rhino("reading 3dm files")
     model = _load(path, "reading 3dm files")
@@ -414,6 +415,7 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
             records.append(CurveRecord(r.curve, r.name, r.kind, src, r.points, r.corners))
     if not records and drawn:
         raise DrawnShapesOnly(drawn, path, FORMAT)
+    warn_drawn(path, drawn, FORMAT)
     return records
 
 

@@ -97,6 +97,7 @@ from ._common import (
     lazy_import,
     piece_values,
     point_records,
+    warn_drawn,
 )
 
 __all__ = ["read", "write", "bezier_chain_to_bspline"]
@@ -700,6 +701,7 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
                                       path) from None
     if not records and drawn:
         raise DrawnShapesOnly(drawn, path, FORMAT)
+    warn_drawn(path, drawn, FORMAT)
     return records
 
 
