@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from _helpers import assert_copied_with_note
 from click.testing import CliRunner
 
 from curvefair import read_curves
@@ -110,13 +111,7 @@ def test_dxf_of_polylines_only_is_written_unchanged_and_said_so(tmp_path):
     assert exc.value.n_drawn == 12
     src = tmp_path / "polylines.dxf"
     shutil.copyfile(POLYLINES, src)
-    res = _run("fair", src, "-o", tmp_path / "out.dxf", "--tol", "0.4",
-               "--report", tmp_path / "r.json")
-    assert res.exit_code == 0, res.output
-    assert "12 straight-line shapes left as drawn: --polylines fairs them" in res.output
-    assert (tmp_path / "out.dxf").read_bytes() == POLYLINES.read_bytes()
-    rep = json.loads((tmp_path / "r.json").read_text())
-    assert rep["n_curves"] == 0 and rep["n_drawn_shapes"] == 12
+    assert_copied_with_note(_run, src, tmp_path / "out.dxf", tmp_path / "r.json", 0.4, 12)
     res = _run("fair", src, "-o", tmp_path / "pl.dxf", "--tol", "0.4", "--polylines", "-q")
     assert res.exit_code == 0, res.output
     before, after = _dxf_polylines(src), _dxf_polylines(tmp_path / "pl.dxf")

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from _helpers import assert_copied_with_note
 from click.testing import CliRunner
 
 from curvefair import read_curves
@@ -54,13 +55,7 @@ def test_polygon_logo_is_written_unchanged_and_said_so(tmp_path):
     with pytest.raises(FileFormatError, match=r"1 straight-line shape is .* left as drawn; "
                                               r"read_curves\(\.\.\., polylines=True\)"):
         read_curves(src)
-    res = _run("fair", src, "-o", tmp_path / "out.svg", "--tol", "0.05",
-               "--report", tmp_path / "r.json")
-    assert res.exit_code == 0, res.output
-    assert "1 straight-line shape left as drawn: --polylines fairs them" in res.output
-    assert (tmp_path / "out.svg").read_bytes() == src.read_bytes()
-    rep = json.loads((tmp_path / "r.json").read_text())
-    assert rep["n_drawn_shapes"] == 1 and rep["n_curves"] == 0 and rep["output_written"]
+    assert_copied_with_note(_run, src, tmp_path / "out.svg", tmp_path / "r.json", 0.05, 1)
     # the opt-in: read as a point list and faired, every vertex within tol
     res = _run("fair", src, "-o", tmp_path / "pl.svg", "--tol", "0.05", "--polylines")
     assert res.exit_code == 0, res.output

@@ -29,8 +29,12 @@ contour points, then the outline's rules are enforced exactly:
 
 - points of straight segments and corner nodes (on-curve points that are not smooth) keep
   their input position, and so does a corner's handle where rounding would turn the tangent
-  along it by more than :data:`CORNER_TURN` (1 degree, as the fairing allows) from the
-  input's when the fair had kept it within that;
+  along it, or the corner's angle, by more than :data:`CORNER_TURN` (1 degree, as the
+  fairing allows) from the input's when the fair had kept it within that; a node flagged
+  smooth that is kinked in the input (on the integer grid, three points rarely line up
+  exactly: a corner to the fairing) is not made more kinked than its input plus
+  :data:`SMOOTH_KINK_GROWTH` (0.1 degree) by the rounding -- the side that turned more keeps
+  its handle;
 - a smooth node stays smooth: its on-curve point is put on the segment between its two
   neighbours (the collinear handles of a cubic node, the two off-curve points of a TrueType
   node), or the handle next to a line on that line's extension;
@@ -63,6 +67,10 @@ __all__ = ["Contour", "contour_curve", "constrained_points", "smooth_angle"]
 #: a node flagged smooth is kept exactly smooth when its input turns by at most this (degrees,
 #: the G1 threshold of :mod:`curvefair.fairing.joins`)
 SMOOTH_ANGLE = 0.5
+#: a node flagged smooth that the grid keeps from being exactly smooth (a corner to the
+#: fairing) is not written more kinked than this beyond its input's kink (degrees) by the
+#: rounding: where it would be, the side that turned more keeps its input handle
+SMOOTH_KINK_GROWTH = 0.1
 #: a corner node's tangent turns by at most this on write (degrees; the fairing's own limit,
 #: :data:`curvefair.fairing.joins.DEFAULT_CORNER_TURN`): where rounding to the grid turns it
 #: more, that side's handle keeps its input position
@@ -303,15 +311,11 @@ def _side_tangent(pts: FloatArray, k: int, idx: list[int]) -> FloatArray | None:
     return None
 
 
-def _corner_side_turned(c: Contour, q: FloatArray, target: FloatArray, P0: FloatArray,
-                        k: int, step: int) -> list[int]:
+def _corner_side(c: Contour, P0: FloatArray, k: int, step: int) -> list[int]:
     """The off-curve points on side ``step`` (-1: before, +1: after) of the corner node ``k``
     up to the first one off the node in the input -- the points its tangent on that side
-    leaves along -- when that tangent in ``q`` (rounded) turned by more than
-    :data:`CORNER_TURN` from the input's (or is lost: every one of them on the node) while in
-    ``target`` (the fair's, unrounded) it did not; else an empty list. A corner the fair
-    itself turned more (``fair(..., corner_turn=math.inf)``) is the fair's choice, and a
-    straight side (an on-curve neighbour) is held anyway: empty."""
+    leaves along; empty for a straight side (an on-curve neighbour, held anyway) and at the
+    end of an open contour."""
     n = len(c.on)
     idx: list[int] = []
     j = k
@@ -324,16 +328,107 @@ def _corner_side_turned(c: Contour, q: FloatArray, target: FloatArray, P0: Float
             return []
         idx.append(j)
         if not np.array_equal(P0[j], P0[k]):
-            break
-    else:
+            return idx
+    return []
+
+
+def _corner_side_turned(c: Contour, q: FloatArray, target: FloatArray, P0: FloatArray,
+                        k: int, step: int) -> list[int]:
+    """The points of side ``step`` of the corner node ``k`` (:func:`_corner_side`) when that
+    side's tangent in ``q`` (rounded) turned by more than :data:`CORNER_TURN` from the
+    input's (or is lost: every one of them on the node) while in ``target`` (the fair's,
+    unrounded) it did not; else an empty list. A corner the fair itself turned more
+    (``fair(..., corner_turn=math.inf)``) is the fair's choice."""
+    idx = _corner_side(c, P0, k, step)
+    if not idx:
         return []
-    t0 = P0[j] - P0[k]
+    t0 = P0[idx[-1]] - P0[k]
     limit = np.radians(CORNER_TURN)
     tt = _side_tangent(target, k, idx)
     if tt is None or _angle(t0, tt) > limit:
         return []
     tq = _side_tangent(q, k, idx)
     return idx if tq is None or _angle(t0, tq) > limit else []
+
+
+def _corner_opening(pts: FloatArray, k: int, sides: tuple[list[int], list[int]]
+                    ) -> float | None:
+    """The signed angle (radians) from the corner node ``k``'s tangent on one side to the
+    other's in ``pts``, or None when a side's points all sit on the node."""
+    ta = _side_tangent(pts, k, sides[0])
+    tb = _side_tangent(pts, k, sides[1])
+    if ta is None or tb is None:
+        return None
+    return float(np.arctan2(ta[0] * tb[1] - ta[1] * tb[0], ta @ tb))
+
+
+def _corner_angle_turned(c: Contour, q: FloatArray, target: FloatArray, P0: FloatArray,
+                         k: int) -> list[list[int]]:
+    """The two sides' points (:func:`_corner_side`) of the corner node ``k``, the side whose
+    tangent turned more first, when the corner's angle in ``q`` (rounded) differs from the
+    input's by more than :data:`CORNER_TURN` while in ``target`` (the fair's, unrounded) it
+    did not: each side within the limit (:func:`_corner_side_turned`) can still open or close
+    the angle by twice it (Bilbo's ``O``: two handles moved one unit each, 0.46 and 0.60
+    degrees, the corner 1.07). Empty otherwise, and for a corner with a straight side (its
+    angle then turns with the other side's tangent alone)."""
+    sides = (_corner_side(c, P0, k, -1), _corner_side(c, P0, k, 1))
+    if not sides[0] or not sides[1]:
+        return []
+    a0 = _corner_opening(P0, k, sides)
+    at = _corner_opening(target, k, sides)
+    aq = _corner_opening(q, k, sides)
+    limit = np.radians(CORNER_TURN)
+
+    def turn(a: float | None) -> float:
+        return np.inf if a is None or a0 is None else \
+            abs(float(np.angle(np.exp(1j * (a - a0)))))
+
+    if a0 is None or turn(at) > limit or turn(aq) <= limit:
+        return []
+
+    def side_turn(idx: list[int]) -> float:
+        t0, tq = _side_tangent(P0, k, idx), _side_tangent(q, k, idx)
+        return np.inf if t0 is None or tq is None else _angle(t0, tq)
+
+    return sorted(sides, key=side_turn, reverse=True)
+
+
+def _kink_grown(c: Contour, q: FloatArray, target: FloatArray, P0: FloatArray, k: int
+                ) -> list[list[int]]:
+    """The sides of the node ``k`` -- flagged smooth, kinked in the input (integer
+    coordinates rarely line up exactly), so a corner to the fairing -- the side whose tangent
+    turned more first, when its kink (180 degrees minus the angle between its two tangents)
+    grew by more than :data:`SMOOTH_KINK_GROWTH` in ``q`` (rounded) while in ``target`` (the
+    fair's, unrounded) it did not; empty otherwise. A side along a straight segment is its
+    on-curve neighbour (held anyway)."""
+    n = len(c.on)
+    sides = []
+    for step in (-1, 1):
+        idx = _corner_side(c, P0, k, step)
+        j = (k + step) % n
+        if not idx and (c.closed or 0 <= k + step < n) and c.on[j]:
+            idx = [j]
+        if not idx:
+            return []
+        sides.append(idx)
+    two = (sides[0], sides[1])
+    a0 = _corner_opening(P0, k, two)
+    if a0 is None:
+        return []
+    most = np.pi - abs(a0) + np.radians(SMOOTH_KINK_GROWTH)
+
+    def grown(pts: FloatArray) -> bool:
+        a = _corner_opening(pts, k, two)
+        return a is None or np.pi - abs(a) > most
+
+    if grown(target) or not grown(q):
+        return []
+
+    def side_turn(idx: list[int]) -> float:
+        t0, tq = _side_tangent(P0, k, idx), _side_tangent(q, k, idx)
+        return np.inf if t0 is None or tq is None else _angle(t0, tq)
+
+    return sorted(two, key=side_turn, reverse=True)
 
 
 def constrained_points(c: Contour, new: FloatArray, tol: float | None,
@@ -368,6 +463,20 @@ def constrained_points(c: Contour, new: FloatArray, tol: float | None,
                 if back:
                     q[back] = P0[back]
                     held[back] = True
+            # and so does the side that turned more where the two sides together turned the
+            # corner's angle by more (then the other side too, if that is not enough)
+            for back in _corner_angle_turned(c, q, target, P0, k):
+                q[back] = P0[back]
+                held[back] = True
+                if not _corner_angle_turned(c, q, target, P0, k):
+                    break
+            # a node the designer flagged smooth is never written more kinked than it was
+            if c.smooth[k]:
+                for back in _kink_grown(c, q, target, P0, k):
+                    q[back] = P0[back]
+                    held[back] = True
+                    if not _kink_grown(c, q, target, P0, k):
+                        break
         # a node spoilt by a neighbour's placement (TrueType: two nodes share an off-curve
         # point) gets its input points back, until every smooth node is exactly smooth
         for _ in range(n + 1):
