@@ -41,9 +41,11 @@ energy; else the input contour is written). The layers of a multi-master ``.glyp
 share that decision per contour, instances between them included (:func:`shared_points`).
 A variable TrueType binary (``gvar``) is refused: its sources are faired instead.
 
-- UFO: the template folder is copied and only the ``.glif`` files of changed glyphs are
-  rewritten (through fontTools' glifLib, in the glyph's own GLIF format version); kerning,
-  features, groups, lib, other layers, components, anchors, guidelines come back byte for byte.
+- UFO: the template folder is copied; in the ``.glif`` file of each changed glyph only the
+  ``x``/``y`` attributes of the moved points are replaced, in the file's own text
+  (:func:`_patch_glif`; read back with glifLib and compared, else the file is rewritten by
+  glifLib in the glyph's own GLIF format version); kerning, features, groups, lib, other
+  layers, components, anchors, guidelines, notes and every other byte come back unchanged.
   A contour whose coordinates are all integers keeps to the integer grid.
 - TrueType: the changed glyphs' coordinates are replaced (instructions, flags and point
   counts kept), bounds recomputed, the left side bearing follows ``xMin`` where it was equal.
@@ -733,8 +735,82 @@ def _write_layer(dest: str, template: str, layer_name: str | None,
         for ci, pts in conts.items():
             for p, (x, y) in zip(glyph.contours[ci].points, pts, strict=True):
                 p.x, p.y = _number(x), _number(y)
-        version = _glif_version(gs.getGLIF(gname))
-        gs.writeGlyph(gname, glyph, glyph.drawPoints, formatVersion=version)
+        raw = gs.getGLIF(gname)
+        patched = _patch_glif(raw, conts)
+        if patched is not None:
+            # the file's own text with only the moved numbers replaced, if it reads back as
+            # exactly the glyph with the new points
+            gs.fs.writebytes(gs.contents[gname], patched)
+            back = ufoLib2.objects.Glyph(gname)
+            gs.readGlyph(gname, back, back.getPointPen())
+            if back == glyph:
+                continue
+        gs.writeGlyph(gname, glyph, glyph.drawPoints, formatVersion=_glif_version(raw))
+
+
+_POINT_TAG = re.compile(rb"""<point\b(?:\s+[\w:.-]+\s*=\s*(?:"[^"]*"|'[^']*'))*\s*/?>""")
+
+
+def _patch_glif(raw: bytes, conts: dict[int, FloatArray]) -> bytes | None:
+    """The ``.glif`` text ``raw`` with the ``x``/``y`` attributes of the points of the changed
+    contours (``conts``: contour index -> new points, in file order) replaced, every other byte
+    kept -- the file's formatting, attribute order and quoting, notes, lib, comments -- so a
+    version-controlled UFO changes by exactly the moved numbers (fontTools' glifLib rewrites
+    the whole file in its own layout and drops an empty ``<note>``). GLIF 1 stores anchors as
+    contours of one named ``move`` point, which glifLib reads as anchors: those are not counted.
+    None when the file cannot be patched so (the contours and points found differ from
+    ``conts``). The caller reads the result back and compares."""
+    import xml.parsers.expat
+
+    version = _glif_version(raw)
+    if version is None or version[0] not in (1, 2):
+        return None
+    found: list[list[tuple[int, dict[str, str]]]] = []   # per contour: each child's offset
+    depth: list[str] = []
+    parser = xml.parsers.expat.ParserCreate()
+
+    def start(name: str, attrs: dict[str, str]) -> None:
+        if name == "contour" and depth[-1:] == ["outline"]:
+            found.append([])
+        elif depth[-2:] == ["outline", "contour"]:
+            found[-1].append((parser.CurrentByteIndex if name == "point" else -1, attrs))
+        depth.append(name)
+
+    def end(_name: str) -> None:
+        depth.pop()
+
+    parser.StartElementHandler = start
+    parser.EndElementHandler = end
+    try:
+        parser.Parse(raw, True)
+    except xml.parsers.expat.ExpatError:
+        return None
+    if version[0] == 1:
+        found = [c for c in found if not (len(c) == 1 and c[0][0] >= 0
+                                          and c[0][1].get("type") == "move"
+                                          and c[0][1].get("name") is not None)]
+    if any(off < 0 for c in found for off, _ in c):
+        return None
+    starts = [[off for off, _ in c] for c in found]
+    edits: list[tuple[int, int, bytes]] = []
+    for ci, pts in conts.items():
+        if not 0 <= ci < len(starts) or len(starts[ci]) != len(pts):
+            return None
+        for off, (x, y) in zip(starts[ci], pts, strict=True):
+            m = _POINT_TAG.match(raw, off)
+            if m is None:
+                return None
+            tag = m.group(0)
+            for name, v in ((b"x", x), (b"y", y)):
+                a = re.search(rb"(\s" + name + rb"\s*=\s*)([\"'])([^\"']*)\2", tag)
+                if a is None:
+                    return None
+                tag = tag[:a.start(3)] + repr(_number(v)).encode() + tag[a.end(3):]
+            edits.append((m.start(), m.end(), tag))
+    out = bytearray(raw)
+    for s, e, tag in sorted(edits, reverse=True):
+        out[s:e] = tag
+    return bytes(out)
 
 
 def write_glyphs(path: str | os.PathLike[str], changes: dict[str, dict[int, FloatArray]],
