@@ -188,3 +188,26 @@ def test_3dm_polylines_stay_as_drawn_and_a_3d_polyline_faired_flat_reads_back(tm
     for k, p in before.items():
         assert after[k].shape == p.shape
         assert np.linalg.norm(after[k] - p, axis=1).max() <= tol
+
+
+def test_a_3d_spline_faired_flat_is_measured_in_3d(tmp_path):
+    """The B-spline side of the lift: a 3-D SPLINE whose z differ by rounding noise, written
+    flat (every z equal), reads back as a 2-D curve at that z and is measured against the 3-D
+    input as the same curve (it raised "curve_a is 3-D but curve_b is 2-D")."""
+    from curvefair import BSplineCurve, write_curves
+
+    a = np.linspace(0.0, 3.0, 9)
+    noisy = np.c_[np.cos(a), np.sin(a), 2.5 + np.r_[0.0, 4e-16, -4e-16, 0.0, 2e-16, 0.0, 0.0,
+                                                        -2e-16, 0.0]]
+    knots = np.r_[[0.0] * 4, np.arange(1.0, 6.0), [6.0] * 4]
+    src = tmp_path / "in.dxf"
+    write_curves(src, [BSplineCurve(noisy, knots, 3)])
+    (rec,) = read_curves(src)
+    assert rec.curve.dim == 3
+    flat = np.array(rec.curve.control_points)
+    flat[:, 2] = 2.5
+    check = write_curves(tmp_path / "out.dxf", [rec.with_curve(rec.curve.replace(
+        control_points=flat))], template=src, tol=1e-12)
+    assert check.max_deviation <= 1e-12
+    (back,) = read_curves(tmp_path / "out.dxf")
+    assert back.curve.dim == 2 and back.source["z"] == 2.5

@@ -153,7 +153,7 @@ def _lifted(rec: CurveRecord) -> CurveRecord | None:
     """A 2-D record read back with a common z (``source["z"]``) as the same curve in 3-D, or
     None when its curve type cannot be lifted."""
     from ..curves.bspline import BSplineCurve
-    from ..curves.hermite import HermiteSpline
+    from ..curves.hermite import CubicHermite, QuinticHermite
 
     z = float(rec.source["z"])
     c = rec.curve
@@ -164,10 +164,10 @@ def _lifted(rec: CurveRecord) -> CurveRecord | None:
 
     if isinstance(c, BSplineCurve):
         new: Any = c.replace(control_points=up(c.control_points, z))
-    elif isinstance(c, HermiteSpline):
+    elif isinstance(c, (CubicHermite, QuinticHermite)):
+        names = ("tangents",) if isinstance(c, CubicHermite) else ("d1", "d2")
         new = c.replace(points=up(c.points, z),
-                        **{k: up(d, 0.0) for k, d in zip(c._deriv_names, c._derivs,
-                                                         strict=True)})
+                        **{k: up(getattr(c, k), 0.0) for k in names})
     else:
         return None
     pts = None if rec.points is None else up(rec.points, z)
