@@ -161,6 +161,19 @@ def options_digest(options: Mapping[str, Any], out_format: str | None = None) ->
 
 
 def file_sha256(path: str | os.PathLike[str]) -> str:
+    """SHA-256 of a file's bytes; of a folder (a UFO font), of every file in it: each relative
+    path (``/``-separated, sorted) and the SHA-256 of its bytes."""
+    if os.path.isdir(path):
+        h = hashlib.sha256(b"folder\0")
+        found = []
+        for root, dirs, files in os.walk(path):
+            dirs.sort()
+            for name in files:
+                full = os.path.join(root, name)
+                found.append((os.path.relpath(full, path).replace(os.sep, "/"), full))
+        for rel, full in sorted(found):
+            h.update(rel.encode("utf-8") + b"\0" + file_sha256(full).encode() + b"\n")
+        return h.hexdigest()
     h = hashlib.sha256()
     with open(path, "rb") as f:
         for chunk in iter(lambda: f.read(1 << 20), b""):
@@ -637,13 +650,16 @@ def _all_skipped(exc: BaseException, notes: list[str], opts: Mapping[str, Any]
     return sum(": skipped " in n for n in notes), drawn
 
 
-def _nothing_why(n_skipped: int, n_drawn: int) -> str:
-    """Why a file has nothing to fair, for a note."""
+def _nothing_why(n_skipped: int, n_drawn: int, font: bool = False) -> str:
+    """Why a file has nothing to fair, for a note (``font``: the drawn shapes are a font's
+    contours of straight lines)."""
     why = []
     if n_skipped:
         why.append(f"{n_skipped} unsupported entit{'y' if n_skipped == 1 else 'ies'} skipped, "
                    "see the warnings")
-    if n_drawn:
+    if n_drawn and font:
+        why.append(f"{n_drawn} contour{'s' if n_drawn > 1 else ''} of straight lines only")
+    elif n_drawn:
         why.append(f"{n_drawn} straight-line shape{'s' if n_drawn > 1 else ''} left as drawn: "
                    "--polylines fairs them as point lists")
     return "; ".join(why)
@@ -718,21 +734,20 @@ def _fair_file(infile: str, outfile: str | None, options: Mapping[str, Any] | No
         n_skipped, n_drawn = _all_skipped(exc, read_notes, opts)
         if (n_skipped or n_drawn) and fmt_in and fmt_out == fmt_in:
             # nothing curvefair can fair: the output is the input's bytes
+            font = not getattr(exc, "polylines_option", True)
             rep.update(status="ok" if not dry_run else "dry-run", n_curves=0,
                        n_skipped_unsupported=n_skipped, n_drawn_shapes=n_drawn,
                        read_warnings=read_notes,
-                       note=f"nothing to fair ({_nothing_why(n_skipped, n_drawn)}); "
+                       note=f"nothing to fair ({_nothing_why(n_skipped, n_drawn, font)}); "
                             "written unchanged")
             if outfile is not None and not dry_run:
-                import shutil
-
-                from .io import atomic_path
+                from .io import atomic_path, copy_input
 
                 same = os.path.exists(outfile) and os.path.samefile(infile, outfile)
                 if not same:
                     os.makedirs(os.path.dirname(os.path.abspath(outfile)), exist_ok=True)
                     with atomic_path(outfile) as tmp:
-                        shutil.copyfile(infile, tmp)
+                        copy_input(infile, tmp)
                 rep["output_sha256"] = file_sha256(outfile)
             rep["time_s"] = time.perf_counter() - t0
             return _finish(rep, report, dry_run)
@@ -866,7 +881,7 @@ def up_to_date(job: Job, options: Mapping[str, Any], out_format: str | None = No
                in_format: str | None = None) -> dict[str, Any] | None:
     """The recorded report when ``job``'s output exists and matches (see the module
     docstring), else None."""
-    if job.report is None or not os.path.isfile(job.report) or not os.path.isfile(job.output):
+    if job.report is None or not os.path.isfile(job.report) or not os.path.exists(job.output):
         return None
     try:
         with open(job.report, encoding="utf-8") as f:

@@ -404,12 +404,14 @@ def _warnings_to_stderr(quiet: bool, prefix: str = "",
 
 class _AllSkipped(Exception):
     """Every curve entity of the file was skipped as unsupported (``n`` of them), or is a
-    straight-line SVG shape left as drawn (``drawn`` of them)."""
+    straight-line shape left as drawn (``drawn`` of them: a drawing's polygons, or a font's
+    straight contours when ``font``)."""
 
-    def __init__(self, n: int, message: str, drawn: int = 0) -> None:
+    def __init__(self, n: int, message: str, drawn: int = 0, font: bool = False) -> None:
         super().__init__(message)
         self.n = n
         self.drawn = drawn
+        self.font = font
 
 
 def _read(path: str, corner_angle: float | None, strict: bool = False,
@@ -437,7 +439,8 @@ def _read(path: str, corner_angle: float | None, strict: bool = False,
         skipped = sum(": skipped " in w for w in seen)
         drawn = int(getattr(exc, "n_drawn", 0))
         if (skipped or drawn) and all_skipped_ok and "no curves in the" in str(exc):
-            raise _AllSkipped(skipped, str(exc), drawn) from None
+            raise _AllSkipped(skipped, str(exc), drawn,
+                              not getattr(exc, "polylines_option", True)) from None
         if skipped:
             raise InputFailure(f"{exc} ({skipped} unsupported entit"
                                f"{'y' if skipped == 1 else 'ies'} skipped"
@@ -450,18 +453,17 @@ def _read(path: str, corner_angle: float | None, strict: bool = False,
 
 
 def _write_unchanged(infile: str, out: str, report: str | None, n_skipped: int,
-                     quiet: bool, n_drawn: int = 0) -> None:
+                     quiet: bool, n_drawn: int = 0, font: bool = False) -> None:
     """A file holding only entities curvefair cannot fair (each skipped with a warning, kept
-    untouched on write-back) or SVG shapes left as drawn: nothing to fair; OUT is the
-    input's bytes, exit 0."""
-    import shutil
-
-    from .io import atomic_path
+    untouched on write-back), straight-line shapes of a drawing left as drawn, or a font's
+    straight contours (``font``): nothing to fair; OUT is the input's bytes (a UFO folder
+    copied), exit 0."""
+    from .io import atomic_path, copy_input
 
     with _user_errors():
         if not (os.path.exists(out) and os.path.samefile(infile, out)):   # not --in-place
             with atomic_path(out) as tmp:
-                shutil.copyfile(infile, tmp)
+                copy_input(infile, tmp)
         if report is not None:
             _write_json(report, {
                 "curvefair": __version__, "input": os.path.abspath(infile),
@@ -471,8 +473,9 @@ def _write_unchanged(infile: str, out: str, report: str | None, n_skipped: int,
     if not quiet:
         from .batch import _nothing_why
 
-        click.echo(f"Note: {infile}: nothing to fair ({_nothing_why(n_skipped, n_drawn)}); "
-                   f"{out} written unchanged", err=True)
+        click.echo(f"Note: {infile}: nothing to fair "
+                   f"({_nothing_why(n_skipped, n_drawn, font)}); {out} written unchanged",
+                   err=True)
 
 
 def _nothing_to_fair(rec: Any) -> bool:
@@ -1081,7 +1084,7 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
             records = _read(infile, _corner(corner_angle, no_corners), strict, quiet, glyphs,
                             all_skipped_ok=out_fmt == in_fmt, polylines=polylines)
         except _AllSkipped as exc:
-            _write_unchanged(infile, out, report, exc.n, quiet, exc.drawn)
+            _write_unchanged(infile, out, report, exc.n, quiet, exc.drawn, exc.font)
             return
     _check_protect_range(records, user_protect)
     from . import fair

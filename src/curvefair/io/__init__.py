@@ -93,6 +93,7 @@ from ._common import (
     DrawnShapesOnly,
     atomic_path,
     atomic_write,
+    copy_input,
     curve_kind,
     same_path,
 )
@@ -100,7 +101,8 @@ from ._verify import WriteCheck, WriteCheckError, on_disk_report, rescaled_repor
 
 __all__ = ["read_curves", "write_curves", "WriteCheck", "WriteCheckError", "CurveRecord", "KINDS",
            "FORMATS", "detect_format", "DRAWN_SHAPE_FORMATS", "DrawnShapesLeft", "DrawnShapesOnly",
-           "atomic_write", "atomic_path", "write_checked", "rescaled_report", "on_disk_report"]
+           "atomic_write", "atomic_path", "copy_input", "write_checked", "rescaled_report",
+           "on_disk_report"]
 
 FormatName = Literal["points", "airfoil", "json", "dxf", "3dm", "svg", "iges", "step", "ufo",
                      "opentype", "glyphs", "designspace"]

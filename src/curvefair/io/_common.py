@@ -241,6 +241,16 @@ def _user_os_error(exc: OSError, user: str, tmp: str | None, always: bool = Fals
     return exc
 
 
+def copy_input(src: str | os.PathLike[str], tmp: Path) -> None:
+    """Copy the input ``src`` as it is onto the temporary path ``tmp`` of :func:`atomic_path`:
+    a file byte for byte, a folder (a UFO font) as a tree, its symbolic links kept."""
+    if os.path.isdir(src):
+        _remove(tmp)
+        shutil.copytree(src, tmp, symlinks=True)
+    else:
+        shutil.copyfile(src, tmp)
+
+
 @contextlib.contextmanager
 def atomic_path(path: str | os.PathLike[str], suffix: str | None = None) -> Iterator[Path]:
     """Yield a temporary path in the destination folder; on success ``os.replace`` it onto
@@ -345,7 +355,14 @@ _DRAWN_WHAT = {
                                    "only"),
     "dxf": ("polyline", "LWPOLYLINE, 2-D and 3-D POLYLINE"),
     "3dm": ("polyline", "PolylineCurve, degree-1 NurbsCurve"),
+    "font": ("contour", "straight lines only"),
 }
+#: How to read them anyway (fonts: no way -- a straight contour has no curve to fair).
+_DRAWN_HINT = {
+    "font": "a contour of straight lines has no curve to fair",
+}
+_POLYLINES_HINT = ("read_curves(..., polylines=True) (CLI --polylines) reads them as point "
+                   "lists")
 
 
 class DrawnShapesLeft(UserWarning):
@@ -374,16 +391,19 @@ def warn_drawn(path: str | os.PathLike[str], n_drawn: int, fmt: str) -> None:
 
 class DrawnShapesOnly(FileFormatError):
     """A drawing (SVG, DXF, 3dm) holding no curve but ``n_drawn`` straight-line shapes, which
-    are left as drawn unless ``polylines=True``; the command line writes such a file back
-    unchanged."""
+    are left as drawn unless ``polylines=True``, or a font whose contours are all straight
+    lines (nothing to fair); the command line writes such a file back unchanged."""
 
     def __init__(self, n_drawn: int, path: object, fmt: str) -> None:
-        noun, detail = _DRAWN_WHAT[fmt]
+        kind = "font" if fmt in ("ufo", "glyphs", "opentype") else fmt
+        noun, detail = _DRAWN_WHAT[kind]
         super().__init__(
             f"no curves in the {fmt} file: its {n_drawn} {noun}"
-            f"{'s are' if n_drawn > 1 else ' is'} ({detail}) left as drawn; read_curves(..., "
-            "polylines=True) (CLI --polylines) reads them as point lists", path)
+            f"{'s are' if n_drawn > 1 else ' is'} ({detail}) left as drawn; "
+            f"{_DRAWN_HINT.get(kind, _POLYLINES_HINT)}", path)
         self.n_drawn = n_drawn
+        #: whether ``polylines=True`` would read the shapes (drawings; not fonts)
+        self.polylines_option = kind not in _DRAWN_HINT
 
 
 def planar(xyz: FloatArray) -> tuple[FloatArray, float | None]:

@@ -14,7 +14,9 @@ a ``.designspace`` document
 -o OUTDIR``, writes one, masters included; records
 named ``"<glyph>@<source name>#<contour>"``). Units are font units, ``y`` up. Contours made
 of straight lines only, components and empty glyphs carry no curve and are not records (they
-are written back untouched). The curve is the contour's B-spline of
+are written back untouched); a font whose contours are all straight raises
+:class:`~curvefair.io.DrawnShapesOnly` (nothing to fair: the command line writes it back
+unchanged). The curve is the contour's B-spline of
 :mod:`curvefair.io._outline` (cubic poly-Bezier with knots of multiplicity 3; quadratic
 B-spline with TrueType's implied on-curve points exact); ``corners`` holds the corner nodes
 and straight segments.
@@ -79,7 +81,7 @@ import numpy as np
 
 from .._typing import FloatArray
 from ..errors import CurvefairError, FileFormatError, InputError
-from ._common import CurveRecord, Unsupported, lazy_import
+from ._common import CurveRecord, DrawnShapesOnly, Unsupported, lazy_import
 from ._outline import Contour, constrained_points, contour_curve, fairness, smooth_angle
 from ._outline import harmonize as _harmonize
 
@@ -501,8 +503,14 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
     fmt, per_glyph = font_contours(path, glyphs)
     base = {"format": fmt, "path": where}
     recs: list[CurveRecord] = []
+    straight = 0
     for g, conts, extra in per_glyph:
         recs.extend(glyph_contours(g, conts, dict(base, **extra), skip, len(recs)))
+        straight += sum(isinstance(c, Contour) and all(c.on) for c in conts)
+    if not recs and straight:
+        # a font of straight contours only (a pixel or geometric design): nothing to fair, and
+        # the command line writes it back unchanged, as a drawing of polygons
+        raise DrawnShapesOnly(straight, path, fmt)
     return recs
 
 
