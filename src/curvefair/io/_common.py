@@ -385,8 +385,7 @@ def warn_drawn(path: str | os.PathLike[str], n_drawn: int, fmt: str) -> None:
     noun, detail = _DRAWN_WHAT[fmt]
     warnings.warn(DrawnShapesLeft(
         f"{os.fspath(path)}: {n_drawn} {noun}{'s' if n_drawn > 1 else ''} ({detail}) left as "
-        "drawn; read_curves(..., polylines=True) (CLI --polylines) reads them as point lists",
-        n_drawn), stacklevel=4)
+        f"drawn; {_POLYLINES_HINT}", n_drawn), stacklevel=4)
 
 
 class DrawnShapesOnly(FileFormatError):

@@ -53,6 +53,7 @@ contour points, then the outline's rules are enforced exactly:
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from math import gcd
 
@@ -362,6 +363,17 @@ def _corner_opening(pts: FloatArray, k: int, sides: tuple[list[int], list[int]]
     return float(np.arctan2(ta[0] * tb[1] - ta[1] * tb[0], ta @ tb))
 
 
+def _by_turn(sides: tuple[list[int], list[int]], P0: FloatArray, q: FloatArray, k: int
+             ) -> list[list[int]]:
+    """The two sides of node ``k``, the one whose tangent turned more from ``P0`` to ``q``
+    first (a side whose points all sit on the node counts as turned most)."""
+    def side_turn(idx: list[int]) -> float:
+        t0, tq = _side_tangent(P0, k, idx), _side_tangent(q, k, idx)
+        return np.inf if t0 is None or tq is None else _angle(t0, tq)
+
+    return sorted(sides, key=side_turn, reverse=True)
+
+
 def _corner_angle_turned(c: Contour, q: FloatArray, target: FloatArray, P0: FloatArray,
                          k: int) -> list[list[int]]:
     """The two sides' points (:func:`_corner_side`) of the corner node ``k``, the side whose
@@ -385,12 +397,7 @@ def _corner_angle_turned(c: Contour, q: FloatArray, target: FloatArray, P0: Floa
 
     if a0 is None or turn(at) > limit or turn(aq) <= limit:
         return []
-
-    def side_turn(idx: list[int]) -> float:
-        t0, tq = _side_tangent(P0, k, idx), _side_tangent(q, k, idx)
-        return np.inf if t0 is None or tq is None else _angle(t0, tq)
-
-    return sorted(sides, key=side_turn, reverse=True)
+    return _by_turn(sides, P0, q, k)
 
 
 def _kink_grown(c: Contour, q: FloatArray, target: FloatArray, P0: FloatArray, k: int
@@ -423,12 +430,18 @@ def _kink_grown(c: Contour, q: FloatArray, target: FloatArray, P0: FloatArray, k
 
     if grown(target) or not grown(q):
         return []
+    return _by_turn(two, P0, q, k)
 
-    def side_turn(idx: list[int]) -> float:
-        t0, tq = _side_tangent(P0, k, idx), _side_tangent(q, k, idx)
-        return np.inf if t0 is None or tq is None else _angle(t0, tq)
 
-    return sorted(two, key=side_turn, reverse=True)
+def _hold_until_kept(rule: Callable[..., list[list[int]]], c: Contour, q: FloatArray,
+                     target: FloatArray, P0: FloatArray, held: np.ndarray, k: int) -> None:
+    """Give the sides of node ``k`` that ``rule`` names their input points back in ``q``
+    (marked in ``held``), one side at a time, until it names none."""
+    for back in rule(c, q, target, P0, k):
+        q[back] = P0[back]
+        held[back] = True
+        if not rule(c, q, target, P0, k):
+            break
 
 
 def constrained_points(c: Contour, new: FloatArray, tol: float | None,
@@ -465,18 +478,10 @@ def constrained_points(c: Contour, new: FloatArray, tol: float | None,
                     held[back] = True
             # and so does the side that turned more where the two sides together turned the
             # corner's angle by more (then the other side too, if that is not enough)
-            for back in _corner_angle_turned(c, q, target, P0, k):
-                q[back] = P0[back]
-                held[back] = True
-                if not _corner_angle_turned(c, q, target, P0, k):
-                    break
-            # a node the designer flagged smooth is never written more kinked than it was
+            _hold_until_kept(_corner_angle_turned, c, q, target, P0, held, k)
+            # a node the designer flagged smooth is not made more kinked by the rounding
             if c.smooth[k]:
-                for back in _kink_grown(c, q, target, P0, k):
-                    q[back] = P0[back]
-                    held[back] = True
-                    if not _kink_grown(c, q, target, P0, k):
-                        break
+                _hold_until_kept(_kink_grown, c, q, target, P0, held, k)
         # a node spoilt by a neighbour's placement (TrueType: two nodes share an off-curve
         # point) gets its input points back, until every smooth node is exactly smooth
         for _ in range(n + 1):
