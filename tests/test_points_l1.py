@@ -573,3 +573,35 @@ def test_fair_guard_catches_a_poliakoff_result_that_rebuilds_worse() -> None:
     e1, i1 = _rebuilt_counts(res.curve.points)
     assert e1 <= e0 and i1 <= i0
     assert np.all(np.linalg.norm(np.asarray(res.curve.points) - pts, axis=1) <= tol)
+
+
+def test_the_tube_cap_does_not_depend_on_the_orientation() -> None:
+    """The cap on the tube radius (``SHRINK_CAP`` of the input's size) is measured by a size
+    a rotation does not change. It was the largest coordinate extent: this closed 7-point
+    loop (a case hypothesis found) spans 4.03 along x but 3.81 when turned by 17.3 degrees,
+    so at tol 0.5 it was solved in the full tube one way and a capped one the other, and
+    the two results were 0.0066 apart; fairing must commute with a rotation up to rounding."""
+    from curvefair import CubicHermite
+
+    P = np.array([
+        [2.0227895433516325, 0.07628053077341278], [1.1480449229230345, 0.7885524264776451],
+        [-0.6630527214264541, 0.9464395817495233], [-2.0056276909281148, 0.1967591352724305],
+        [-0.7896888883316877, -0.9386482993682935], [1.2721783353324405, -0.7734224795406447],
+        [2.0227895433516325, 0.07628053077341278]])
+    T = np.array([
+        [-0.0739313111465463, 0.7751805028615996], [-1.0528153051249882, 0.4428095517639927],
+        [-1.119570655884048, -0.24885255628651648], [-0.12363720133351118, -0.6980828028439758],
+        [1.0849264005863875, -0.45394288775836217], [1.0026779449985497, 0.5985818065430633],
+        [-0.0739313111465463, 0.7751805028615996]])
+    u = np.array([0.0, 1.128055585677795, 2.9460223156176233, 4.483724601680331,
+                  6.147352328756633, 8.21582906770202, 9.349589356008504])
+    a = np.radians(17.34)
+    R = np.array([[np.cos(a), np.sin(a)], [-np.sin(a), np.cos(a)]])
+    # the old cap (tol / largest extent > 1/8) held one orientation and not the other
+    assert np.ptp(P, axis=0).max() > 0.5 / 0.125 > np.ptp(P @ R.T, axis=0).max()
+    res = fair(CubicHermite(P, T, u, closed=True), "points-l1", tol=0.5)
+    rot = fair(CubicHermite(P @ R.T, T @ R.T, u, closed=True), "points-l1", tol=0.5)
+    assert ("tube_radius" in res.report["points_l1"]) == \
+        ("tube_radius" in rot.report["points_l1"])
+    np.testing.assert_allclose(np.asarray(rot.curve.points),
+                               np.asarray(res.curve.points) @ R.T, rtol=0, atol=1e-7 * 2.03)

@@ -133,7 +133,8 @@ class PointsL1Result:
         distance of the curve rebuilt from the points, chord lengths of ``q``, from the
         input's chord interpolant, :func:`_rebuilt_distance`; None without ``curve_tol``),
         ``scale`` (factor of a final scaling of the moves, 1.0: none), ``tube_radius`` (only
-        when ``tol`` exceeds ``SHRINK_CAP`` of the input's largest extent: the radius used).
+        when ``tol`` exceeds ``SHRINK_CAP`` of the input's size, :func:`_size`: the radius
+        used).
     """
 
     points: np.ndarray
@@ -640,6 +641,16 @@ def _jump_costs(scale: str, u: FloatArray, ops: NaturalOperators, xp: FloatArray
     return c / float(c.max())
 
 
+def _size(pts: FloatArray) -> float:
+    """The size of a point set that rotating it does not change, for ``SHRINK_CAP``: twice
+    the largest distance of a point from their mean (the diameter for a segment or a circle,
+    at most twice it). The largest coordinate extent, used before, changes with the rotation:
+    the same 7-point loop, rotated, was solved in a capped tube in one orientation and not in
+    the other, and the results were 0.0066 apart at tol 0.5."""
+    d = pts - pts.mean(axis=0)
+    return 2.0 * float(np.sqrt(np.max(np.einsum("ij,ij->i", d, d))))
+
+
 def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
               hold: Iterable[int] | ArrayLike = (), rounds: int = 5, delta: float = 1e-5,
               beta: float = 1e-6,
@@ -742,8 +753,9 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
         # overflow): a radius beyond 1e6 sizes binds nothing, one below 1e-12 moves nothing
         sh["centre"] = 0.5 * (pts.max(axis=0) + pts.min(axis=0))
         sh["size"] = float(np.ptp(pts, axis=0).max())
+        sh["reach"] = _size(pts)
     u_in, held, ref_in = sh["u_in"], sh["held"], sh["ref_in"]
-    centre, size = sh["centre"], sh["size"]
+    centre, size, reach = sh["centre"], sh["size"], sh["reach"]
     p_in = pts
     if not size > 0 or tolv < 1e-12 * size:
         q0 = np.array(p_in)
@@ -754,10 +766,11 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
     tol_out = tolv
     # the objective falls with the curve's scale: a curve that fits in the tube would shrink
     # towards a point (an 8-point circle 3.5 across at tol 5 came out 4e-12 across); the
-    # radius is at most SHRINK_CAP of the largest extent, so no extent loses more than
-    # 2 SHRINK_CAP of the largest (the largest keeps 3/4 of itself)
-    capped = tolv / size > SHRINK_CAP
-    tolv = min(tolv / size, SHRINK_CAP)
+    # radius is at most SHRINK_CAP of the size (:func:`_size`, which a rotation does not
+    # change; ``size`` above only scales the data for conditioning)
+    cap = SHRINK_CAP * reach / size
+    capped = tolv / size > cap
+    tolv = min(tolv / size, cap)
     ns = max(0, int(samples))
 
     def setup(u: FloatArray) -> tuple[NaturalOperators, FloatArray, Any, FloatArray, float]:
@@ -928,7 +941,7 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
               "curve_deviation": curve_dev, "param_deviation": float(cert.upper_bound),
               "scale": float(cert.scale)}
     if capped:
-        report["tube_radius"] = SHRINK_CAP * size
+        report["tube_radius"] = SHRINK_CAP * reach
     q_out.setflags(write=False)
     out = PointsL1Result(q_out, curve, report)
     if curve_e is curve_in and ref is not None:
@@ -937,8 +950,8 @@ def points_l1(points: ArrayLike, tol: float, *, params: ArrayLike | None = None,
     return out
 
 
-#: the largest tube radius of :func:`points_l1`, as a fraction of the input's largest
-#: coordinate extent (a larger ``tol`` is used as this; ``report["tube_radius"]`` then says
+#: the largest tube radius of :func:`points_l1`, as a fraction of the input's size
+#: (:func:`_size`; a larger ``tol`` is used as this; ``report["tube_radius"]`` then says
 #: the radius used): sparse third-derivative jumps are cheaper on a smaller curve, so without
 #: it a curve smaller than the tolerance collapses to a point (the small closed polygons of
 #: OCCT's ``modeling_data_continuity_curves.svg`` at tol 2 and 5, whose written files read
