@@ -239,8 +239,15 @@ def test_progress_reports_fair_phases_and_chunks(tmp_path: Path):
                                                                  0.0]), "closed loop"),
     ("0,0\n1,0\n1,0\n3,1\n", "same point"),
     ("0,0\n1,0\n1,1\n0,1.1\n", "corner"),
-    ("0,0\n1,0\nx,y\n", "line 3"),
+    ("0,0\n1,0\nx,y\n", "bad.csv:3: not a row of numbers"),
     ("0,0,0,0\n", "4 columns"),
+    # point numbers or x coordinates? (the reader without chunks refuses it too)
+    ("".join(f"{i},{np.cos(i / 9):.6f},{np.sin(i / 9):.6f}\n" for i in range(1, 40)),
+     "consecutive integers 1 .. 39"),
+    # a header keeping a point-number column: the chunked reader fairs every column
+    ("id,x,y\n" + "".join(f"{i},{np.cos(i / 9):.6f},{np.sin(i / 9):.6f}\n"
+                           for i in range(1, 40)), "bad.csv:2: the header names columns 1, 2"),
+    ("0,5;1,25\n1,5;2,5\n", "bad.csv:1: numbers with decimal commas"),
 ])
 def test_unsuitable_files_are_refused_naming_the_row(tmp_path: Path, rows: str, match: str):
     src = tmp_path / "bad.csv"

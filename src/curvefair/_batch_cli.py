@@ -334,7 +334,8 @@ def fair_in_chunks(paths: Sequence[str], out: str | None, in_place: bool,
     if options.get("tol") is None:
         raise click.UsageError("--chunk needs --tol (each chunk is faired within it)")
     for opt, v in (("--plot", plot_path), ("--decimals", options.get("decimals")),
-                   ("--history", options.get("history") or None)):
+                   ("--history", options.get("history") or None),
+                   ("--columns", options.get("columns"))):
         if v is not None:
             raise click.UsageError(f"{opt} does not apply with --chunk")
     for key, v in extra.items():
@@ -368,7 +369,11 @@ def fair_in_chunks(paths: Sequence[str], out: str | None, in_place: bool,
                 protect=options.get("protect", ()), progress=prog, report=rep_path,
                 **kw, **dict(options.get("method_options") or {}))
         except (CurvefairError, OSError) as exc:
-            raise _Failure(f"{infile}: {_batch._err(exc)}; nothing written") from None
+            msg = _batch._err(exc)
+            # a file error names the file itself (and its line)
+            where = "" if msg.startswith((f"{infile}:", f"{os.path.abspath(infile)}:")) \
+                else f"{infile}: "
+            raise _Failure(f"{where}{msg}; nothing written") from None
     if not quiet:
         click.echo(f"wrote {out} from {infile} ({rep['n_points']} points in "
                    f"{rep['n_chunks']} chunks; read back: max deviation "
@@ -460,6 +465,13 @@ def _threshold(value: str | None, name: str) -> float | None:
     return x
 
 
+def _columns(ctx: Any, param: Any, value: str | None) -> tuple[int, ...] | None:
+    """``--columns`` parsed as the other commands parse it."""
+    from .cli import _columns_option
+
+    return _columns_option(ctx, param, value)
+
+
 @click.command("check")
 @click.argument("paths", metavar="PATH...", nargs=-1, required=True)
 @click.option("--format", "out_format", type=click.Choice(["text", "json", "sarif"]),
@@ -491,13 +503,18 @@ def _threshold(value: str | None, name: str) -> float | None:
               help="SVG, DXF, 3dm: read straight-line shapes (polygons, polylines, lines, "
                    "rectangles; DXF LWPOLYLINE and POLYLINE; 3dm PolylineCurve) as point "
                    "lists and check them too [default: they are drawn shapes, not curves].")
+@click.option("--columns", callback=lambda ctx, param, value: _columns(ctx, param, value),
+              metavar="I,J[,K]",
+              help="Point files: the 0-based columns holding x, y (z) [default: the columns a "
+                   "header names x, y, z, else all of a 2- or 3-column file].")
 @click.option("--strict", is_flag=True, help="Refuse files with entities curvefair cannot "
               "represent (default: skip them).")
 @_selection_options
 def check_cmd(paths: tuple[str, ...], out_format: str, kink_angle: str | None,
               corner: str | None, g2_rel: str | None, wiggle: str | None,
               max_inflections: str | None, max_bad: str | None, out: str | None,
-              read_corner_angle: float, polylines: bool, strict: bool,
+              read_corner_angle: float, polylines: bool,
+              columns: tuple[int, ...] | None, strict: bool,
               layer: tuple[str, ...],
               name: tuple[str, ...], handle: tuple[str, ...]) -> None:
     """Report curves whose fairness measures exceed thresholds; write nothing.
@@ -529,7 +546,7 @@ def check_cmd(paths: tuple[str, ...], out_format: str, kink_angle: str | None,
     n_curves = 0
     for f in files:
         got, n = _check.check_file(f, th, corner_angle=read_corner_angle, strict=strict,
-                                   select=select, polylines=polylines)
+                                   select=select, polylines=polylines, columns=columns)
         findings += got
         n_curves += n
     if out_format == "json":

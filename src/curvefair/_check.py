@@ -312,22 +312,26 @@ def _worst(findings: list[Finding], top: int) -> list[Finding]:
 def check_file(path: str, thresholds: Mapping[str, float | None] | None = None, *,
                corner_angle: float | None = 60.0, strict: bool = False,
                select: Mapping[str, Any] | None = None,
-               polylines: bool = False) -> tuple[list[Finding], int]:
+               polylines: bool = False,
+               columns: tuple[int, ...] | None = None) -> tuple[list[Finding], int]:
     """``(findings, number of curves checked)`` for one file; an unreadable file is one
     ``unreadable`` finding. ``polylines``: a drawing's straight-line shapes (SVG, DXF, 3dm) are
-    read as point lists and checked too (point data always are)."""
+    read as point lists and checked too (point data always are). ``columns``: a points
+    file's coordinate columns (other formats ignore it)."""
     import warnings
 
     from . import read_curves
     from .batch import selected
-    from .io import detect_format, polylines_for
+    from .io import columns_for, detect_format, polylines_for
 
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
+            kind = detect_format(path)
             recs = read_curves(path, corner_angle=corner_angle,
                                on_unsupported="raise" if strict else "skip",
-                               polylines=polylines_for(detect_format(path), polylines))
+                               polylines=polylines_for(kind, polylines),
+                               columns=columns_for(kind, columns))
     except (CurvefairError, OSError) as exc:
         if isinstance(exc, FileFormatError) and "no curves in the" in str(exc):
             return [], 0  # a drawing without curves has nothing unfair in it

@@ -83,7 +83,7 @@ from typing import Any
 import numpy as np
 
 from .errors import FileFormatError, InputError
-from .io.points import column_decimals, render_row
+from .io.points import column_decimals, decimal_commas, render_row
 
 DEFAULT_CHUNK = 5000
 DEFAULT_OVERLAP = 64
@@ -180,6 +180,36 @@ class PointStream:
             raise InputError(f"{self.path!r}: text_rows reads text point files")
         yield from self._text_parse(size, keep=True)
 
+    def _all_coordinates(self, ncols: int, ln: int) -> None:
+        """Refuse a header naming columns other than x, y, z beside them (``id,x,y``): the
+        chunked reader fairs every column (:func:`curvefair.io.points.coordinate_columns`)."""
+        from .io.points import coordinate_columns
+
+        if self.header is None:
+            return
+        cols = coordinate_columns(ncols, self.header, np.zeros(0), path=self.path)
+        if cols != tuple(range(ncols)):
+            raise FileFormatError(
+                f"the header names columns {', '.join(map(str, cols))} as x, y (z) and keeps "
+                "the others; chunked fairing reads files of coordinate columns only: fair it "
+                "without --chunk", self.path, ln)
+
+    def _no_point_numbers(self, rows: list[list[float]]) -> None:
+        """Refuse 3 columns without a header whose first one holds consecutive integers
+        over the first block: point numbers or x coordinates? (The reader without chunks
+        refuses it too, :func:`curvefair.io.points.coordinate_columns`.)"""
+        if self.dim != 3 or self.header is not None:
+            return
+        from .io.points import is_point_numbers
+
+        first = np.array([r[0] for r in rows], dtype=np.float64)
+        if is_point_numbers(first):
+            raise FileFormatError(
+                f"the first of the 3 columns holds the consecutive integers {first[0]:.0f} .. "
+                f"{first[-1]:.0f} (first {len(rows)} rows): point numbers beside x, y, or the "
+                "x coordinates of a 3-D curve? Chunked fairing reads x, y, z only; without "
+                "--chunk, --columns says which columns are the coordinates", self.path)
+
     def _decimals_of(self, texts: list[str]) -> None:
         """Fold a block's number texts into :attr:`column_decimals`."""
         assert self.dim is not None
@@ -229,19 +259,27 @@ class PointStream:
                             if keep:
                                 between.append(line)
                             continue
-                        raise FileFormatError(f"line {ln}: not a row of numbers: {s[:60]!r}",
+                        raise FileFormatError(f"not a row of numbers: {s[:60]!r}",
                                               self.path, ln) from None
                     if self.dim is None:
+                        if decimal_commas(s):
+                            raise FileFormatError(
+                                f"numbers with decimal commas ({s[:40]!r}): curvefair reads "
+                                "numbers with a decimal point; save the file with decimal "
+                                "points", self.path, ln)
                         if len(vals) not in (2, 3):
-                            raise FileFormatError(f"line {ln}: {len(vals)} columns; a point "
-                                                  "list has 2 or 3", self.path, ln)
+                            raise FileFormatError(f"{len(vals)} columns; a point "
+                                                  "list has 2 or 3 (chunked fairing reads "
+                                                  "files of coordinate columns only)",
+                                                  self.path, ln)
+                        self._all_coordinates(len(vals), ln)
                         self.dim = len(vals)
                         self.sep = "," if "," in s else (";" if ";" in s else " ")
                     elif len(vals) != self.dim:
-                        raise FileFormatError(f"line {ln}: {len(vals)} columns, the rows "
-                                              f"before have {self.dim}", self.path, ln)
+                        raise FileFormatError(f"{len(vals)} columns, the rows before have "
+                                              f"{self.dim}", self.path, ln)
                     if not all(math.isfinite(v) for v in vals):
-                        raise FileFormatError(f"line {ln}: not a finite number", self.path, ln)
+                        raise FileFormatError("not a finite number", self.path, ln)
                     if track:
                         texts.extend(toks)
                     if keep:
@@ -255,6 +293,8 @@ class PointStream:
                     rows.append(vals)
                     n += 1
                     if len(rows) == size:
+                        if n == len(rows):  # the first block
+                            self._no_point_numbers(rows)
                         if track:
                             self._decimals_of(texts)
                             texts = []
@@ -263,6 +303,8 @@ class PointStream:
             except UnicodeDecodeError as exc:
                 raise FileFormatError(f"not a text file ({exc.reason})", self.path) from None
         if rows:
+            if n == len(rows):  # the first block
+                self._no_point_numbers(rows)
             if track:
                 self._decimals_of(texts)
             yield np.array(rows, dtype=np.float64), before, lines

@@ -73,13 +73,13 @@ REPORT_DIR = ".curvefair"
 #: Options that change what is written (hashed for ``resume``).
 OUTPUT_OPTIONS = ("method", "tol", "eps", "max_steps", "clamp", "protect", "mode",
                   "method_options", "decimals", "corner_angle", "strict", "layer", "name",
-                  "handle", "hold_shared", "shared_distance", "format", "polylines")
+                  "handle", "hold_shared", "shared_distance", "format", "polylines", "columns")
 _DEFAULTS: dict[str, Any] = {"method": None, "tol": None, "eps": None, "max_steps": None,
                              "clamp": "g0", "protect": (), "mode": "spline",
                              "method_options": {}, "decimals": None, "corner_angle": 60.0,
                              "strict": False, "layer": (), "name": (), "handle": (),
                              "hold_shared": False, "shared_distance": None, "history": False,
-                             "format": None, "polylines": False}
+                             "format": None, "polylines": False, "columns": None}
 _GLOB_CHARS = re.compile(r"[*?\[]")
 
 
@@ -616,21 +616,24 @@ def _read(path: str, opts: Mapping[str, Any], notes: list[str] | None = None,
     from . import read_curves
 
     poly: bool | None = None
-    if opts.get("polylines"):  # drawings only: point data are point lists always
-        from .io import detect_format, polylines_for
+    cols: tuple[int, ...] | None = None
+    if opts.get("polylines") or opts.get("columns") is not None:
+        # drawings only: point data are point lists always; columns: points files only
+        from .io import columns_for, detect_format, polylines_for
 
         try:
             kind: str | None = detect_format(path, cast("FormatName | None", fmt))
         except CurvefairError:
             kind = None  # read_curves says why
-        poly = polylines_for(kind, True)
+        poly = polylines_for(kind, bool(opts.get("polylines")))
+        cols = columns_for(kind, opts.get("columns"))
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
             recs = read_curves(path, corner_angle=opts["corner_angle"],
                                format=cast("FormatName | None", fmt),
                                on_unsupported="raise" if opts["strict"] else "skip",
-                               polylines=poly)
+                               polylines=poly, columns=cols)
         finally:  # the skip warnings also when the file then holds no curve at all
             if notes is not None:
                 notes.extend(dict.fromkeys(str(w.message) for w in caught))
@@ -848,13 +851,15 @@ def _err(exc: BaseException) -> str:
 
 def _write(outfile: str, faired: list[Any], records: list[Any], infile: str, fmt_in: str,
            fmt_out: str, opts: Mapping[str, Any], in_place: bool) -> Any:
-    from .io import reads_polylines, write_checked
+    from .io import read_columns, reads_polylines, write_checked
 
     folder = os.path.dirname(os.path.abspath(outfile))
     os.makedirs(folder, exist_ok=True)
-    # point data written to a drawing are polylines: read back as point lists
+    # point data written to a drawing are polylines: read back as point lists; a points
+    # file keeps its layout, so its points are in the columns they were read from
     back = dict(opts, polylines=opts.get("polylines")
-                or bool(reads_polylines(faired, fmt_out)))
+                or bool(reads_polylines(faired, fmt_out)),
+                columns=read_columns(faired, fmt_out))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         return write_checked(outfile, faired, records, tol=opts["tol"],
@@ -1157,7 +1162,9 @@ def fair_files(paths: str | Sequence[str], out_dir: str | os.PathLike[str], clie
         ``protect``, ``mode``, ``method_options`` (dict), ``decimals``, ``corner_angle``,
         ``strict``, ``layer``, ``name``, ``handle``, ``hold_shared``, ``shared_distance``,
         ``history``, ``polylines`` (SVG, DXF and 3dm files: read straight-line shapes as point
-        lists, as :func:`curvefair.read_curves`; other formats ignore it).
+        lists, as :func:`curvefair.read_curves`; other formats ignore it), ``columns``
+        (points files: the 0-based coordinate columns, as :func:`curvefair.read_curves`;
+        other formats ignore it).
 
     Returns
     -------

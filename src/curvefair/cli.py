@@ -385,7 +385,7 @@ def _warnings_to_stderr(quiet: bool, prefix: str = "",
         try:
             yield
         finally:
-            from .io import DrawnShapesLeft
+            from .io import ReadNote
 
             seen: set[str] = set()
             for w in caught:
@@ -395,7 +395,7 @@ def _warnings_to_stderr(quiet: bool, prefix: str = "",
                 seen.add(msg)
                 if into is not None:
                     into.append(str(w.message))
-                if isinstance(w.message, DrawnShapesLeft):  # a note, not a warning
+                if isinstance(w.message, ReadNote):  # a note, not a warning
                     if not quiet:
                         click.echo(f"Note: {msg}", err=True)
                     continue
@@ -417,18 +417,25 @@ class _AllSkipped(Exception):
 def _read(path: str, corner_angle: float | None, strict: bool = False,
           quiet: bool = False, glyphs: str | None = None,
           all_skipped_ok: bool = False, fmt: str | None = None,
-          polylines: bool = False) -> list[Any]:
+          polylines: bool = False, columns: tuple[int, ...] | None = None) -> list[Any]:
     """The records of a file; entities curvefair cannot represent are skipped with a warning
     (kept untouched on write-back) unless ``strict``, which refuses the file. With
     ``all_skipped_ok``, a file whose every curve entity was skipped raises
     :class:`_AllSkipped` (the caller writes it back unchanged) instead of failing.
     ``polylines`` (``--polylines``) reads a drawing's straight-line shapes (SVG, DXF, 3dm) as
-    point lists; it means nothing for other formats (point data are point lists always)."""
+    point lists; it means nothing for other formats (point data are point lists always).
+    ``columns`` (``--columns``): a points file's coordinate columns."""
     from . import read_curves
-    from .io import polylines_for
+    from .io import columns_for, polylines_for
 
     kind = fmt if fmt is not None else _format_of(path)  # a CLI message (not format=)
     extra: dict[str, Any] = {} if glyphs is None else {"glyphs": glyphs}
+    if columns is not None and kind != "points":
+        raise click.BadParameter(f"{path!r} is a {kind} file; --columns is for point lists "
+                                 "(points files)", param_hint="--columns")
+    cols = columns_for(kind, columns)
+    if cols is not None:
+        extra["columns"] = cols
     seen: list[str] = []
     try:
         with _warnings_to_stderr(quiet, into=seen):
@@ -505,11 +512,31 @@ def _reading_options(f: Any) -> Any:
                           "lines, rectangles; DXF LWPOLYLINE and POLYLINE; 3dm "
                           "PolylineCurve) as point lists to fair [default: leave them as "
                           "drawn].")(f)
+    f = click.option("--columns", callback=_columns_option, metavar="I,J[,K]",
+                     help="Point files: the 0-based columns holding x, y (z), e.g. 1,2 for "
+                          "'id x y' rows; the others are kept as they are [default: the "
+                          "columns a header names x, y, z, else all of a 2- or 3-column "
+                          "file].")(f)
     f = click.option("--strict", is_flag=True,
                      help="Refuse a file holding an entity curvefair cannot represent exactly "
                           "(rational or degree-1 splines, arcs, ...) [default: skip it with a "
                           "warning and write it back untouched].")(f)
     return f
+
+
+def _columns_option(ctx: Any, param: Any, value: str | None) -> tuple[int, ...] | None:
+    """``--columns 1,2`` as ``(1, 2)``: 2 or 3 different column indices, 0-based."""
+    if value is None:
+        return None
+    try:
+        cols = tuple(int(v) for v in value.split(","))
+    except ValueError:
+        raise click.BadParameter(f"{value!r}: give 2 or 3 column indices (0-based) separated "
+                                 "by commas, e.g. 1,2") from None
+    if len(cols) not in (2, 3) or len(set(cols)) != len(cols) or min(cols) < 0:
+        raise click.BadParameter(f"{value!r}: give 2 or 3 different column indices (0-based, "
+                                 ">= 0) separated by commas, e.g. 1,2")
+    return cols
 
 
 def _quiet_option(f: Any) -> Any:
@@ -647,7 +674,8 @@ def methods_cmd(as_json: bool) -> None:
 @_reading_options
 @_quiet_option
 def analyze_cmd(infile: str, as_json: bool, top: int, corner_angle: float, no_corners: bool,
-                polylines: bool, strict: bool, quiet: bool) -> None:
+                polylines: bool, columns: tuple[int, ...] | None, strict: bool,
+                quiet: bool) -> None:
     """Analyse every curve of IN: energies, inflections, curvature extrema, the worst jumps,
     and the ranked list of bad points (index, measure, kind)."""
     from . import analyze
@@ -655,7 +683,7 @@ def analyze_cmd(infile: str, as_json: bool, top: int, corner_angle: float, no_co
 
     with _user_errors():
         records = _read(infile, _corner(corner_angle, no_corners), strict, quiet,
-                        polylines=polylines)
+                        polylines=polylines, columns=columns)
         out = []
         for i, rec in enumerate(records):
             a = analyze(rec.curve)
@@ -732,7 +760,8 @@ def analyze_cmd(infile: str, as_json: bool, top: int, corner_angle: float, no_co
 def plot_cmd(infile: str, other: str | None, out: str, comb_scale: float | None,
              comb_density: int | None, no_comb: bool, no_markers: bool, tol: float | None,
              projection: str, title: str | None, corner_angle: float, no_corners: bool,
-             polylines: bool, strict: bool, quiet: bool) -> None:
+             polylines: bool, columns: tuple[int, ...] | None, strict: bool,
+             quiet: bool) -> None:
     """Draw the curves of IN with their curvature combs and curvature plots into FIG."""
     _check_outputs([(infile, "IN")] + ([(other, "--compare")] if other else []),
                    [(out, "-o/--output")])
@@ -741,10 +770,10 @@ def plot_cmd(infile: str, other: str | None, out: str, comb_scale: float | None,
 
     corner = _corner(corner_angle, no_corners)
     with _user_errors():
-        recs = _read(infile, corner, strict, quiet, polylines=polylines)
+        recs = _read(infile, corner, strict, quiet, polylines=polylines, columns=columns)
         curves = [r.curve for r in recs]
         others = None if other is None else [r.curve for r in _read(
-            other, corner, strict, quiet, polylines=polylines)]
+            other, corner, strict, quiet, polylines=polylines, columns=columns)]
     _check_comb(curves + (others or []), comb_scale, comb_density, no_comb)
     with _user_errors():
         labels = (Path(infile).name, Path(other).name if other else "")
@@ -781,7 +810,8 @@ def plot_cmd(infile: str, other: str | None, out: str, comb_scale: float | None,
 @_quiet_option
 def view_cmd(infile: str, other: str | None, out: str, tol: float | None,
              report_path: str | None, title: str | None, corner_angle: float,
-             no_corners: bool, polylines: bool, strict: bool, quiet: bool) -> None:
+             no_corners: bool, polylines: bool, columns: tuple[int, ...] | None,
+             strict: bool, quiet: bool) -> None:
     """Write an interactive HTML page of the curves of IN: combs, curvature, deviation."""
     _check_outputs([(infile, "IN")] + ([(other, "--compare")] if other else [])
                    + ([(report_path, "--report")] if report_path else []),
@@ -806,9 +836,9 @@ def view_cmd(infile: str, other: str | None, out: str, tol: float | None,
             if isinstance(t, (int, float)) and not isinstance(t, bool) and t > 0:
                 tol = float(t)
     with _user_errors():
-        recs = _read(infile, corner, strict, quiet, polylines=polylines)
+        recs = _read(infile, corner, strict, quiet, polylines=polylines, columns=columns)
         others = None if other is None else [r.curve for r in _read(
-            other, corner, strict, quiet, polylines=polylines)]
+            other, corner, strict, quiet, polylines=polylines, columns=columns)]
         if others is not None and len(others) != len(recs):
             raise InputFailure(f"--compare {other!r} has {len(others)} curves but {infile!r} "
                                f"has {len(recs)}; they are paired in order")
@@ -929,7 +959,8 @@ def _batch_fair_options(method: str | None, tol: float | None, eps: float | None
                         max_steps: int | None, clamp: str, protect: str | None, mode: str,
                         method_option: tuple[str, ...], decimals: int | None, history: bool,
                         corner_angle: float, no_corners: bool, strict: bool,
-                        batch: dict[str, Any], polylines: bool = False) -> dict[str, Any]:
+                        batch: dict[str, Any], polylines: bool = False,
+                        columns: tuple[int, ...] | None = None) -> dict[str, Any]:
     """The options of :func:`curvefair.batch.fair_file`, checked as for one file."""
     options = _parse_method_options(method_option)
     _check_option_values(method if method and "=" not in method else None, options)
@@ -937,7 +968,8 @@ def _batch_fair_options(method: str | None, tol: float | None, eps: float | None
             "protect": tuple(_parse_protect(protect)), "mode": mode, "method_options": options,
             "decimals": decimals, "history": history,
             "corner_angle": _corner(corner_angle, no_corners), "strict": strict,
-            "polylines": bool(polylines), "layer": batch["layer"], "name": batch["name"],
+            "polylines": bool(polylines), "columns": columns,
+            "layer": batch["layer"], "name": batch["name"],
             "handle": batch["handle"], "hold_shared": batch["hold_shared"],
             "shared_distance": batch["shared_distance"]}
 
@@ -997,8 +1029,8 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
              decimals: int | None, report: str | None,
              history: bool,
              plot_path: str | None, corner_angle: float, no_corners: bool,
-             polylines: bool, strict: bool, quiet: bool, glyphs: str | None = None,
-             **batch: Any) -> None:
+             polylines: bool, columns: tuple[int, ...] | None, strict: bool, quiet: bool,
+             glyphs: str | None = None, **batch: Any) -> None:
     """Fair every curve in IN and write them to OUT.
 
     Prints a before/after table: strain energy, largest third-derivative jump, inflections,
@@ -1029,7 +1061,7 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
     if wants_chunks(paths, chunk):
         fair_in_chunks(paths, out, in_place, _batch_fair_options(
             method, tol, eps, max_steps, clamp, protect, mode, method_option, decimals,
-            history, corner_angle, no_corners, strict, batch, polylines),
+            history, corner_angle, no_corners, strict, batch, polylines, columns),
             {k: batch[k] for k in ("layer", "name", "handle", "hold_shared", "shared_distance",
                                    "resume", "dry_run", "diff", "in_format")},
             chunk=chunk, overlap=overlap, jobs=batch["jobs"], scheduler=batch["scheduler"],
@@ -1043,7 +1075,8 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
                                      param_hint="--glyphs")
         fair_many(paths, out, in_place, _batch_fair_options(
             method, tol, eps, max_steps, clamp, protect, mode, method_option, decimals,
-            history, corner_angle, no_corners, strict, batch, polylines), jobs=batch["jobs"],
+            history, corner_angle, no_corners, strict, batch, polylines, columns),
+            jobs=batch["jobs"],
             resume=batch["resume"], dry_run=batch["dry_run"], diff=batch["diff"],
             scheduler=batch["scheduler"], report=report, fmt=batch["in_format"], quiet=quiet,
             plot_path=plot_path)
@@ -1082,13 +1115,14 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
             out_fmt = in_fmt
         try:
             records = _read(infile, _corner(corner_angle, no_corners), strict, quiet, glyphs,
-                            all_skipped_ok=out_fmt == in_fmt, polylines=polylines)
+                            all_skipped_ok=out_fmt == in_fmt, polylines=polylines,
+                            columns=columns)
         except _AllSkipped as exc:
             _write_unchanged(infile, out, report, exc.n, quiet, exc.drawn, exc.font)
             return
     _check_protect_range(records, user_protect)
     from . import fair
-    from .io import reads_polylines, write_checked
+    from .io import read_columns, reads_polylines, write_checked
 
     rows: list[dict[str, Any]] = []
     faired = []
@@ -1156,7 +1190,9 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
                                   reader=lambda p: _read(p, corner, strict, True, glyphs,
                                                          fmt=out_fmt, polylines=polylines
                                                          or bool(reads_polylines(faired,
-                                                                                 out_fmt))),
+                                                                                 out_fmt)),
+                                                         columns=read_columns(faired,
+                                                                              out_fmt)),
                                   template=infile if out_fmt == in_fmt else None,
                                   format=out_fmt, overwrite=in_place, decimals=decimals)
             if prog is not None:
@@ -1205,7 +1241,8 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
                             "method_options": {k: _option_default(v)
                                                for k, v in options.items()},
                             "corner_angle": _corner(corner_angle, no_corners),
-                            "polylines": polylines, "strict": strict},
+                            "polylines": polylines, "columns": columns,
+                            "strict": strict},
                 "n_curves": len(rows), "n_failed": len(failures),
                 "n_nothing_to_fair": sum(r["status"] == "nothing to fair" for r in rows),
                 "output_written": wrote_out,

@@ -88,9 +88,11 @@ from ..curves.piecewise import PiecewiseCurve
 from ..errors import FileFormatError, InputError
 from ._common import (
     KINDS,
+    ColumnsKept,
     CurveRecord,
     DrawnShapesLeft,
     DrawnShapesOnly,
+    ReadNote,
     atomic_path,
     atomic_write,
     copy_input,
@@ -101,8 +103,8 @@ from ._verify import WriteCheck, WriteCheckError, on_disk_report, rescaled_repor
 
 __all__ = ["read_curves", "write_curves", "WriteCheck", "WriteCheckError", "CurveRecord", "KINDS",
            "FORMATS", "detect_format", "DRAWN_SHAPE_FORMATS", "DrawnShapesLeft", "DrawnShapesOnly",
-           "atomic_write", "atomic_path", "copy_input", "write_checked", "rescaled_report",
-           "on_disk_report"]
+           "ReadNote", "ColumnsKept", "atomic_write", "atomic_path", "copy_input",
+           "write_checked", "rescaled_report", "on_disk_report"]
 
 FormatName = Literal["points", "airfoil", "json", "dxf", "3dm", "svg", "iges", "step", "ufo",
                      "opentype", "glyphs", "designspace"]
@@ -171,7 +173,8 @@ def read_curves(path: str | os.PathLike[str], *, format: FormatName | None = Non
                 corner_angle: float | None = 60.0,
                 on_unsupported: Literal["raise", "skip"] = "raise",
                 glyphs: Sequence[str] | str | None = None,
-                polylines: bool | None = None) -> list[CurveRecord]:
+                polylines: bool | None = None,
+                columns: Sequence[int] | None = None) -> list[CurveRecord]:
     """Read every curve of a file.
 
     Parameters
@@ -198,6 +201,13 @@ def read_curves(path: str | os.PathLike[str], *, format: FormatName | None = Non
         drawing a polygon's vertices are its design, not samples of a curve; see
         docs/formats.md). A file of point data (``points``, ``airfoil``) is point lists
         always.
+    columns : sequence of int, optional
+        Point lists (``points``): the 0-based columns holding x, y (z), as numpy's
+        ``usecols``; the other columns (point numbers, arc lengths) are kept as they are and
+        written back character for character. Default: a header naming the columns ``x``,
+        ``y`` (``z``), else every column of a 2- or 3-column file (a 3-column file whose first
+        column holds consecutive integers is refused as ambiguous), or the columns after a
+        first column of point numbers (:func:`curvefair.io.points.coordinate_columns`).
 
     Returns
     -------
@@ -247,6 +257,10 @@ def read_curves(path: str | os.PathLike[str], *, format: FormatName | None = Non
             raise InputError(f"polylines= is for drawings ({', '.join(DRAWN_SHAPE_FORMATS)}), "
                              f"not {fmt} files")
         extra["polylines"] = bool(polylines)
+    if columns is not None:
+        if fmt != "points":
+            raise InputError(f"columns= is for point lists (points files), not {fmt} files")
+        extra["columns"] = columns
     if fmt in ("iges", "step"):
         extra["format"] = fmt       # one module reads both; the path may have no extension
     records = _module(fmt).read(path, corner_angle=corner_angle, on_unsupported=on_unsupported,
@@ -403,12 +417,13 @@ def write_curves(path: str | os.PathLike[str], curves: CurveRecord | PiecewiseCu
     ref = _reference(records, reference, tol_f, corner_angle)
 
     poly = reads_polylines(records, fmt)
+    cols = read_columns(records, fmt)
 
     def reader(p: str) -> list[CurveRecord]:
         with warnings.catch_warnings():  # the input's skip warnings, again
             warnings.simplefilter("ignore")
             return read_curves(p, format=fmt, corner_angle=corner_angle,
-                               on_unsupported="skip", polylines=poly)
+                               on_unsupported="skip", polylines=poly, columns=cols)
 
     check = write_checked(path, records, ref, tol=tol_f, reader=reader, template=tpath,
                           format=fmt, overwrite=True, decimals=decimals, precision=precision)
@@ -432,6 +447,25 @@ def reads_polylines(records: Sequence[CurveRecord], fmt: str | None) -> bool | N
         if r.kind in kinds or (r.format in DRAWN_SHAPE_FORMATS and r.source.get("polylines")):
             return True
     return None
+
+
+def read_columns(records: Sequence[CurveRecord], fmt: str | None) -> tuple[int, ...] | None:
+    """``read_curves``' ``columns`` for a ``fmt`` file written from ``records``: the columns
+    they were read from (``source["columns"]``) when they come from a points file and it is
+    written as one (the written file keeps its layout, so the same columns hold the points);
+    None otherwise."""
+    if fmt != "points":
+        return None
+    got = {tuple(r.source["columns"]) for r in records
+           if r.format == "points" and r.source.get("columns") is not None}
+    return got.pop() if len(got) == 1 else None
+
+
+def columns_for(fmt: str | None, columns: Sequence[int] | None) -> tuple[int, ...] | None:
+    """``read_curves``' ``columns`` for a caller's choice (the CLI's ``--columns``, a batch
+    option) applied to a file of format ``fmt``: the columns for a points file, None (the
+    reader's default) for other formats, which have no columns."""
+    return tuple(columns) if columns is not None and fmt == "points" else None
 
 
 def polylines_for(fmt: str | None, polylines: bool) -> bool | None:
@@ -472,10 +506,11 @@ def _reference(records: list[CurveRecord], reference: object, tol: float | None,
         if src not in cache:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
+                mine = [x for x in records if x.path == src]
                 cache[src] = read_curves(src, format=r.format,  # type: ignore[arg-type]
                                          corner_angle=corner_angle, on_unsupported="skip",
-                                         polylines=reads_polylines(
-                                             [x for x in records if x.path == src], r.format))
+                                         polylines=reads_polylines(mine, r.format),
+                                         columns=read_columns(mine, r.format))
         j = r.source.get("index")
         got = cache[src]
         o = got[j] if isinstance(j, int) and 0 <= j < len(got) else None

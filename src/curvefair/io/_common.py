@@ -365,7 +365,22 @@ _POLYLINES_HINT = ("read_curves(..., polylines=True) (CLI --polylines) reads the
                    "lists")
 
 
-class DrawnShapesLeft(UserWarning):
+class ReadNote(UserWarning):
+    """Something a reader did that the user should know but that is not a problem (a note,
+    not a warning): the command line prints it as a ``Note:`` line."""
+
+
+class ColumnsKept(ReadNote):
+    """A points file's reader read some of its columns as coordinates and keeps the others
+    (``kept``, 0-based column indices: point numbers, arc lengths, labels) as they are,
+    written back character for character."""
+
+    def __init__(self, message: str, kept: tuple[int, ...] = ()) -> None:
+        super().__init__(message)
+        self.kept = kept
+
+
+class DrawnShapesLeft(ReadNote):
     """A drawing's reader left ``n_drawn`` straight-line shapes as drawn (not read, kept
     byte for byte on write-back) beside the curves it read: a note, so that they are not
     missed; ``polylines=True`` reads them. The command line prints it as a ``Note:``."""

@@ -21,7 +21,8 @@ import numpy as np
 from .._typing import FloatArray
 from ..errors import FileFormatError
 
-__all__ = ["TextLayout", "Token", "parse_text", "format_number", "rounded_number"]
+__all__ = ["TextLayout", "Token", "parse_text", "format_number", "rounded_number",
+           "decimal_commas"]
 
 _NUM = r"[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|nan|inf(?:inity)?)"
 _NUM_RE = re.compile(_NUM, re.IGNORECASE)
@@ -32,6 +33,24 @@ _COMMA_ROW = re.compile(rf"{_NUM}(?:,{_NUM})*", re.IGNORECASE).fullmatch
 _BLANK_ROW = re.compile(rf"{_NUM}(?:[ \t]+{_NUM})*", re.IGNORECASE).fullmatch
 _SEP_RE = re.compile(r"(\s*[,;]\s*|\s+)")
 _TOKEN_RE = re.compile(r"([+-]?)([^eE]*)(?:([eE])([+-]?)(\d+))?$")
+# a number written with a decimal comma (``10,25``, ``-0,5e-3``), as spreadsheets in many
+# locales write them, with ``;``, tabs or blanks between the columns
+_COMMA_NUMBER = re.compile(r"[+-]?\d*,\d+(?:[eE][+-]?\d+)?").fullmatch
+_FIELD_SEP = re.compile(r"\s*;\s*|\s+")
+
+
+def decimal_commas(line: str) -> bool:
+    """Whether a data line writes its numbers with decimal commas (``10,5;2,25`` or
+    ``10,5<TAB>2,25``): its fields between ``;``, tabs and blanks are numbers, at least one
+    of them with a comma. Such a line also splits into twice as many numbers at its commas,
+    which would read the integer and fractional parts as separate columns."""
+    hash_at = line.find("#")
+    s = (line if hash_at < 0 else line[:hash_at]).strip()
+    if "," not in s:
+        return False
+    fields = _FIELD_SEP.split(s)
+    return (len(fields) >= 2 and any(_COMMA_NUMBER(f) for f in fields)
+            and all(_COMMA_NUMBER(f) or _NUM_FULL(f) for f in fields))
 
 
 class Token(NamedTuple):
@@ -494,13 +513,14 @@ def read_lines(path: str | os.PathLike[str]) -> tuple[list[str], str, bool, str]
 
 
 def parse_text(path: str | os.PathLike[str], *, header: bool = True,
-               ncols: Sequence[int] = (2, 3), what: str = "points file",
+               ncols: Sequence[int] | None = (2, 3), what: str = "points file",
                notes: bool = False) -> TextLayout:
     """Parse a numeric text file into a :class:`TextLayout`.
 
     Comments start with ``#`` (whole lines or after the numbers), blank lines are kept, one
     non-numeric line before the first data row is the header (or the name line of an airfoil)
-    when ``header`` is True. Separators: blanks, commas or semicolons.
+    when ``header`` is True. Separators: blanks, commas or semicolons. ``ncols``: the numbers
+    of columns a row may have (None: any from 2 on, every row as many as the first).
 
     ``notes=True`` (airfoil files, where remarks, URLs and ``Thickness: 7.99%`` lines are
     common): every line before the first row of ``ncols`` numbers is a leading line (the
@@ -534,7 +554,8 @@ def parse_text(path: str | os.PathLike[str], *, header: bool = True,
                     f"a row of {width} numbers after the text at line {notes_from + 1} that "
                     "ends the coordinates (notes between coordinates are not read)", path, i + 1)
             continue
-        if notes and not data_lines and (row is None or len(row) not in ncols):
+        if notes and not data_lines and (row is None or (ncols is not None
+                                                         and len(row) not in ncols)):
             if head is None and header:
                 head = i
             else:
@@ -553,11 +574,16 @@ def parse_text(path: str | os.PathLike[str], *, header: bool = True,
             raise FileFormatError(f"not a row of numbers (and not a header): {short!r}",
                                   path, i + 1)
         k = len(row)
+        if width is None and decimal_commas(line):
+            raise FileFormatError(
+                f"numbers with decimal commas ({s[:40]!r}): curvefair reads numbers with a "
+                "decimal point, and read at its commas this row would split every number in "
+                "two; save the file with decimal points (a spreadsheet's English-locale CSV)",
+                path, i + 1)
         if width is None:
-            if k not in ncols:
-                raise FileFormatError(
-                    f"{what} rows need {' or '.join(map(str, ncols))} columns, got {k}",
-                    path, i + 1)
+            if (k not in ncols) if ncols is not None else k < 2:
+                need = " or ".join(map(str, ncols)) if ncols is not None else "at least 2"
+                raise FileFormatError(f"{what} rows need {need} columns, got {k}", path, i + 1)
             width = k
         elif k != width:
             raise FileFormatError(
