@@ -5,8 +5,8 @@ file came back with point numbers like ``2.0032625432389963`` and the command sa
 exit 0. Now the coordinate columns are chosen (``columns=`` / ``--columns``, a header naming
 ``x``, ``y``, ``z``, or a first column of point numbers beside 3 others), the other columns are
 written back character for character, and the ambiguous case -- 3 columns without a header,
-the first holding consecutive integers -- is refused. Decimal-comma files (``1,5;2,25``), which
-would split every number in two at its comma, are refused too.
+the first holding consecutive integers -- is refused. Decimal-comma files (``1,5;2,25``), whose
+every number was split in two at its comma, are read and written back with their commas.
 
 Every written file is checked with Python's ``csv`` module and numpy, not curvefair's reader:
 the kept column's texts are compared as strings, the coordinates' moves measured in float64.
@@ -155,8 +155,10 @@ def test_point_numbers_beside_three_coordinates_are_kept(tmp_path):
 @pytest.mark.parametrize("text, line, match", [
     ("0 0 0 0 1\n1 1 1 1 1\n", 1, "2 or 3 coordinate columns, got 5"),
     ("5 0 0 0\n9 1 1 1\n", 1, "2 or 3 coordinate columns, got 4"),
-    ("x;y\n10,0000;0,0035\n9,9704;0,7767\n", 2, "decimal commas"),
-    ("1,5\t2,25\n3,5\t4,25\n5,5\t6\n", 1, "decimal commas"),
+    ("x;y\n10,0000;0,0035\n9.9704;0,7767\n", 3, "decimal points in a file of decimal commas"),
+    ("1.234,5;2,25\n3,5;4,25\n5,5;6\n", 1, "decimal points in a file of decimal commas"),
+    ("1.234,5;2\n1.235,5;4\n1.236,5;6\n", 1, "decimal points in a file of decimal commas"),
+    ("1,5;2,5\n2.5;3.5\n3,5;4\n", 2, "decimal points in a file of decimal commas"),
     # Engauge Digitizer's "all curves on each line" export: two curves over one x
     ("x,Curve1,Curve2\n0.1,1,2\n0.2,1.5,2.5\n0.3,1.7,2.6\n", 2, "names a column x but no y"),
 ])
@@ -239,3 +241,41 @@ def test_folder_run_passes_columns_to_point_files(tmp_path):
                                     "--tol", str(TOL), "--columns", "1,2", "--jobs", "1"])
     assert res.exit_code == 0, res.output
     _assert_kept_and_within_tol(src, tmp_path / "out" / "a.csv", (0,), (1, 2), header=False)
+
+
+# ------------------------------------------------------------------------------------------
+# decimal commas
+# ------------------------------------------------------------------------------------------
+def _comma_table(path: Path) -> list[list[str]]:
+    """Rows of a decimal-comma file, split at semicolons or blanks (not curvefair's reader)."""
+    import re
+
+    lines = path.read_text(encoding="utf-8").splitlines()
+    return [re.split(r"\s*;\s*|\s+", ln.strip()) for ln in lines if ln.strip()]
+
+
+@pytest.mark.parametrize("sep", [";", "\t", "  "])
+def test_decimal_commas_are_read_and_written_back_as_commas(tmp_path, sep):
+    P = _noisy_arc()
+    rows = [f"{x:.4f}{sep}{y:.4f}".replace(".", ",") for x, y in P]
+    src = _write_rows(tmp_path / "in.csv", rows, "x;y" if sep == ";" else None)
+    (rec,) = read_curves(src)
+    body = _comma_table(src)[1 if sep == ";" else 0:]
+    want = np.array([[float(t.replace(",", ".")) for t in r] for r in body])
+    np.testing.assert_array_equal(rec.points, want)
+    out = tmp_path / "out.csv"
+    write_curves(out, [rec.with_curve(cf.fair(rec.curve, tol=TOL).curve)], tol=TOL)
+    a = src.read_text(encoding="utf-8").splitlines()
+    b = out.read_text(encoding="utf-8").splitlines()
+    assert len(a) == len(b)
+    if sep == ";":
+        assert a[0] == b[0]
+        a, b = a[1:], b[1:]
+    assert not any("." in ln for ln in b)  # every number with its comma
+    got = np.array([[float(t.replace(",", ".")) for t in r] for r in
+                    _comma_table(out)[1 if sep == ";" else 0:]])
+    moves = np.linalg.norm(got - want, axis=1)
+    assert moves.max() <= TOL and np.count_nonzero(moves) > 20
+    same = moves == 0  # an unmoved row is its line as read
+    assert all(x == y for x, y, k in zip(a, b, same, strict=True) if k)
+    assert all(len(r) == 2 for r in _comma_table(out)[1 if sep == ";" else 0:])

@@ -264,9 +264,9 @@ class PointStream:
                     if self.dim is None:
                         if decimal_commas(s):
                             raise FileFormatError(
-                                f"numbers with decimal commas ({s[:40]!r}): curvefair reads "
-                                "numbers with a decimal point; save the file with decimal "
-                                "points", self.path, ln)
+                                f"numbers with decimal commas ({s[:40]!r}): chunked fairing "
+                                "reads numbers with a decimal point; fair the file without "
+                                "--chunk, or save it with decimal points", self.path, ln)
                         if len(vals) not in (2, 3):
                             raise FileFormatError(f"{len(vals)} columns; a point "
                                                   "list has 2 or 3 (chunked fairing reads "

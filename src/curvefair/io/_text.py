@@ -35,8 +35,22 @@ _SEP_RE = re.compile(r"(\s*[,;]\s*|\s+)")
 _TOKEN_RE = re.compile(r"([+-]?)([^eE]*)(?:([eE])([+-]?)(\d+))?$")
 # a number written with a decimal comma (``10,25``, ``-0,5e-3``), as spreadsheets in many
 # locales write them, with ``;``, tabs or blanks between the columns
-_COMMA_NUMBER = re.compile(r"[+-]?\d*,\d+(?:[eE][+-]?\d+)?").fullmatch
+# (thousands grouped by points, ``1.234,5``, count as such a number: the file is then refused,
+# not read at its commas as two or three numbers)
+_COMMA_NUMBER = re.compile(r"[+-]?(?:\d{1,3}(?:\.\d{3})+|\d*),\d+(?:[eE][+-]?\d+)?").fullmatch
 _FIELD_SEP = re.compile(r"\s*;\s*|\s+")
+
+
+def _comma_to_point(line: str) -> str:
+    """A decimal-comma data line with decimal points (its ``#`` comment as it is)."""
+    at = line.find("#")
+    return line.replace(",", ".") if at < 0 else line[:at].replace(",", ".") + line[at:]
+
+
+def _point_to_comma(line: str) -> str:
+    """The inverse of :func:`_comma_to_point` for a line written with decimal points."""
+    at = line.find("#")
+    return line.replace(".", ",") if at < 0 else line[:at].replace(".", ",") + line[at:]
 
 
 def decimal_commas(line: str) -> bool:
@@ -294,6 +308,10 @@ class TextLayout:
     notes_from : int or None
         0-based index of the first line of the trailing notes (``notes=True``): every line
         from there on is text after the coordinates, written back verbatim.
+    decimal_comma : bool
+        The file writes its numbers with decimal commas (``10,25;0,5``): :attr:`lines` hold
+        its data rows with decimal points (as read), and :meth:`render` writes them back with
+        commas.
     """
 
     lines: tuple[str, ...]
@@ -307,6 +325,7 @@ class TextLayout:
     values: FloatArray
     leading: tuple[int, ...] = ()
     notes_from: int | None = None
+    decimal_comma: bool = False
 
     @property
     def header_text(self) -> str | None:
@@ -356,6 +375,9 @@ class TextLayout:
             lines[li] = _render_line(lines[li], values[r].tolist(), cols, decimals)
         if not isinstance(lines, list):
             lines = lines.tolist()
+        if self.decimal_comma:  # every data row as the file writes it: decimal commas
+            for li in data_lines:
+                lines[li] = _point_to_comma(lines[li])
         text = self.newline.join(lines)
         if self.final_newline:
             text += self.newline
@@ -519,7 +541,10 @@ def parse_text(path: str | os.PathLike[str], *, header: bool = True,
 
     Comments start with ``#`` (whole lines or after the numbers), blank lines are kept, one
     non-numeric line before the first data row is the header (or the name line of an airfoil)
-    when ``header`` is True. Separators: blanks, commas or semicolons. ``ncols``: the numbers
+    when ``header`` is True. Separators: blanks, commas or semicolons; a file whose first data
+    row writes decimal commas (:func:`decimal_commas`: ``10,25;0,5``) is read with them, its
+    data rows kept with decimal points in :attr:`TextLayout.lines` and written back with
+    commas (a row that then has a decimal point too is refused). ``ncols``: the numbers
     of columns a row may have (None: any from 2 on, every row as many as the first).
 
     ``notes=True`` (airfoil files, where remarks, URLs and ``Thickness: 7.99%`` lines are
@@ -543,11 +568,26 @@ def parse_text(path: str | os.PathLike[str], *, header: bool = True,
     texts: list[str] = []  # every number's text, row after row
     bulk: tuple[list[str], FloatArray] | None = None  # the rows read at once, if any
     width: int | None = None
+    comma = False  # decimal commas (``10,25;0,5``): data rows read with decimal points
     for i, line in enumerate(lines):
         s = line.strip()
         if not s or s.startswith("#"):
             continue
-        row = _split_numbers(line)
+        if not comma and not data_lines and decimal_commas(line):
+            comma = True
+        if comma:
+            if "." in line.split("#", 1)[0] and (decimal_commas(line)
+                                                  or _split_numbers(line) is not None):
+                raise FileFormatError(
+                    f"decimal points in a file of decimal commas ({s[:40]!r}): thousands "
+                    "separators, or two number styles; curvefair does not guess which",
+                    path, i + 1)
+            pointed = _comma_to_point(line)
+            row = _split_numbers(pointed)
+            if row is not None and pointed != line:
+                lines[i] = line = pointed
+        else:
+            row = _split_numbers(line)
         if notes and notes_from is not None:
             if row is not None and len(row) == width:
                 raise FileFormatError(
@@ -574,12 +614,6 @@ def parse_text(path: str | os.PathLike[str], *, header: bool = True,
             raise FileFormatError(f"not a row of numbers (and not a header): {short!r}",
                                   path, i + 1)
         k = len(row)
-        if width is None and decimal_commas(line):
-            raise FileFormatError(
-                f"numbers with decimal commas ({s[:40]!r}): curvefair reads numbers with a "
-                "decimal point, and read at its commas this row would split every number in "
-                "two; save the file with decimal points (a spreadsheet's English-locale CSV)",
-                path, i + 1)
         if width is None:
             if (k not in ncols) if ncols is not None else k < 2:
                 need = " or ".join(map(str, ncols)) if ncols is not None else "at least 2"
@@ -591,7 +625,8 @@ def parse_text(path: str | os.PathLike[str], *, header: bool = True,
                 f"{width}", path, i + 1)
         data_lines.append(i)
         texts.extend(row)
-        if len(data_lines) == 1 and not notes and len(lines) - i > _BLOCK_MIN_ROWS:
+        if len(data_lines) == 1 and not notes and not comma and \
+                len(lines) - i > _BLOCK_MIN_ROWS:
             bulk = _plain_rows(lines, i + 1, k)
             if bulk is not None:  # every line after the first row is a row like it
                 data_lines.extend(range(i + 1, len(lines)))
@@ -608,7 +643,7 @@ def parse_text(path: str | os.PathLike[str], *, header: bool = True,
     values = values.reshape(-1, width)
     col_dec = _column_decimals(texts, width)
     return TextLayout(tuple(lines), newline, final, head, tuple(data_lines), width,
-                      col_dec, encoding, values, tuple(leading), notes_from)
+                      col_dec, encoding, values, tuple(leading), notes_from, comma)
 
 
 def _plain_rows(lines: list[str], start: int, width: int
