@@ -279,3 +279,19 @@ def test_decimal_commas_are_read_and_written_back_as_commas(tmp_path, sep):
     same = moves == 0  # an unmoved row is its line as read
     assert all(x == y for x, y, k in zip(a, b, same, strict=True) if k)
     assert all(len(r) == 2 for r in _comma_table(out)[1 if sep == ";" else 0:])
+
+
+def test_an_integer_column_beside_decimal_commas_is_not_a_third_coordinate(tmp_path):
+    """``9,787;2`` was read at its comma as the 3-D point (9, 787, 2) and written back as
+    ``8.999991256080556,787.009373253457;1.9999560823056892``, exit 0."""
+    t = np.linspace(0.0, 3.0, 30)
+    rows = [f"{10 * np.cos(a):.3f};{round(10 * np.sin(a))}".replace(".", ",") for a in t]
+    src = _write_rows(tmp_path / "in.csv", rows)
+    (rec,) = read_curves(src)
+    assert rec.points.shape == (30, 2)
+    np.testing.assert_array_equal(rec.points[:, 1], [round(10 * np.sin(a)) for a in t])
+    out = tmp_path / "out.csv"
+    write_curves(out, [rec.with_curve(cf.fair(rec.curve, tol=TOL).curve)], tol=TOL)
+    got = np.array([[float(v.replace(",", ".")) for v in r] for r in _comma_table(out)])
+    assert got.shape == (30, 2)
+    assert np.linalg.norm(got - rec.points, axis=1).max() <= TOL
