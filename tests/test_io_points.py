@@ -240,7 +240,9 @@ def test_property_round_trip(tmp_path_factory, n, seed, sep, dim, dec):
     ("0,0\n1,inf\n2,2\n", 2, "non-finite"),
     ("0,0\n1,1\n1.0000000000000002,1\n2,2\n", 3, "duplicate consecutive"),
     ("0,0\n", None, "at least 2 points"),
-    ("0,0\n1,1\n2,2\n3,\n", 4, "not a row of numbers"),
+    # a separator after the last column is allowed: "3," is one number
+    ("0,0\n1,1\n2,2\n3,\n", 4, "1 columns but the first data row \\(line 1\\) has 2"),
+    ("0,0\n1,1\n2,2\n3,,\n", 4, "not a row of numbers"),
 ])
 def test_malformed_points_files(tmp_path, text, line, match):
     p = _write(tmp_path / "bad.csv", text)

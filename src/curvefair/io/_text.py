@@ -59,9 +59,12 @@ def decimal_commas(line: str) -> bool:
     of them with a comma. Such a line also splits into twice as many numbers at its commas,
     which would read the integer and fractional parts as separate columns."""
     hash_at = line.find("#")
-    s = (line if hash_at < 0 else line[:hash_at]).strip()
-    if "," not in s:
+    s = line if hash_at < 0 else line[:hash_at]
+    if "," not in s or not s.strip():
         return False
+    s = s.strip()
+    if s[-1:] == ";":  # a separator after the last column
+        s = s[:-1].rstrip()
     fields = _FIELD_SEP.split(s)
     return (len(fields) >= 2 and any(_COMMA_NUMBER(f) for f in fields)
             and all(_COMMA_NUMBER(f) or _NUM_FULL(f) for f in fields))
@@ -260,7 +263,7 @@ def _pieces(line: str) -> tuple[str, list[str], list[str], str]:
     rest of the line (trailing blanks and a ``#`` comment)."""
     hash_at = line.find("#")
     body, comment = (line, "") if hash_at < 0 else (line[:hash_at], line[hash_at:])
-    stripped = body.strip()
+    stripped = _numbers_part(body)
     lead = body.find(stripped[0])
     if _COMMA_ROW(stripped):
         texts = stripped.split(",")
@@ -491,11 +494,20 @@ def _split_row(line: str) -> Row | None:
     return Row(prefix, tuple(texts), tuple(seps), suffix)
 
 
+def _numbers_part(body: str) -> str:
+    """A data line's text without its blanks around and one trailing ``,`` or ``;`` (what
+    some exporters write after the last column), where the numbers are."""
+    stripped = body.strip()
+    if stripped[-1:] in (",", ";"):
+        stripped = stripped[:-1].rstrip()
+    return stripped
+
+
 def _split_numbers(line: str) -> list[str] | None:
     """The number texts of a data line (as :func:`_split_row`), or None when it is not all
     numbers: what reading needs, without the pieces that only a rewrite of the row uses."""
     hash_at = line.find("#")
-    stripped = (line if hash_at < 0 else line[:hash_at]).strip()
+    stripped = _numbers_part(line if hash_at < 0 else line[:hash_at])
     if not stripped:
         return None
     if _COMMA_ROW(stripped):
@@ -513,22 +525,39 @@ def read_lines(path: str | os.PathLike[str]) -> tuple[list[str], str, bool, str]
             raw = f.read()
     except OSError as exc:
         raise FileFormatError(f"cannot read the file: {exc.strerror or exc}", path) from None
-    if b"\x00" in raw:
-        line = raw[: raw.index(b"\x00")].count(b"\n") + 1
-        raise FileFormatError("binary data (NUL byte) in a text file", path, line)
-    # the BOM, if any, is part of the encoding's name so that a writer given ``encoding``
-    # writes it back (``utf-8-sig``); a file that is not UTF-8 is written back as Latin-1,
-    # byte for byte where its text is unchanged
-    encoding = "utf-8-sig" if raw.startswith(b"\xef\xbb\xbf") else "utf-8"
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError:
-        encoding = "latin-1"
-        text = raw.decode("latin-1")
-    newline = "\r\n" if "\r\n" in text else "\n"
-    final = text.endswith("\n")
-    body = text.replace("\r\n", "\n")
-    lines = body.split("\n")
+    if raw.startswith((b"\xff\xfe", b"\xfe\xff")):
+        # UTF-16 with a byte order mark (a spreadsheet's "Unicode text"): written back as
+        # UTF-16 with a mark, in the machine's byte order (Python's ``utf-16`` codec)
+        try:
+            text = raw.decode("utf-16")
+        except UnicodeDecodeError as exc:
+            raise FileFormatError(f"not UTF-16 text after its byte order mark ({exc.reason})",
+                                  path) from None
+        encoding = "utf-16"
+    else:
+        if b"\x00" in raw:
+            line = raw[: raw.index(b"\x00")].count(b"\n") + 1
+            raise FileFormatError("binary data (NUL byte) in a text file", path, line)
+        # the BOM, if any, is part of the encoding's name so that a writer given ``encoding``
+        # writes it back (``utf-8-sig``); a file that is not UTF-8 is written back as Latin-1,
+        # byte for byte where its text is unchanged
+        encoding = "utf-8-sig" if raw.startswith(b"\xef\xbb\xbf") else "utf-8"
+        try:
+            text = raw.decode("utf-8-sig")
+        except UnicodeDecodeError:
+            encoding = "latin-1"
+            text = raw.decode("latin-1")
+    # line endings: CR LF (Windows), LF, or CR alone (classic Mac OS, still written by some
+    # spreadsheets), kept as found
+    if "\r\n" in text:
+        newline = "\r\n"
+    elif "\r" in text and "\n" not in text:
+        newline = "\r"
+    else:
+        newline = "\n"
+    final = text.endswith(newline)
+    body = text.replace("\r\n", "\n") if newline == "\r\n" else text
+    lines = body.split("\n" if newline == "\r\n" else newline)
     if final:
         lines = lines[:-1]
     return lines, newline, final, encoding

@@ -84,6 +84,8 @@ def _header_parts(header: str | None, ncols: int) -> list[str] | None:
     if header is None:
         return None
     text = header.strip().lstrip("\ufeff")
+    if text[-1:] in (",", ";"):  # a separator after the last name, as after the last number
+        text = text[:-1].rstrip()
     sep = next((c for c in ",;\t" if c in text), None)
     parts = [p.strip() for p in text.split(sep)] if sep is not None else text.split()
     return [p.strip("\"'") for p in parts] if len(parts) == ncols else None

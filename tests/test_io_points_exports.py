@@ -1,0 +1,110 @@
+"""Points files as spreadsheets and older tools export them.
+
+Each of these was refused before, with a message that named the wrong cause:
+
+- UTF-16 text with a byte order mark (Excel's "Unicode Text"): "binary data (NUL byte)";
+- lines ended by a carriage return alone (classic Mac OS; some spreadsheets still write it):
+  "no data rows";
+- a separator after the last column (``1.5,2.5,``): "not a row of numbers".
+
+They are now read, and written back in their own encoding, line endings and separators. The
+written files are checked with Python's codecs and ``str.split``, not curvefair's reader.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import curvefair as cf
+from curvefair import read_curves, write_curves
+
+TOL = 0.01
+
+
+def _arc(n: int = 40) -> np.ndarray:
+    rng = np.random.default_rng(3)
+    t = np.linspace(0.0, 3.0, n)
+    return np.c_[10 * np.cos(t), 10 * np.sin(t) + 0.01 * rng.normal(size=n)]
+
+
+def _fair_file(src: Path, out: Path) -> None:
+    (rec,) = read_curves(src)
+    write_curves(out, [rec.with_curve(cf.fair(rec.curve, tol=TOL).curve)], tol=TOL)
+
+
+def _check(text_in: str, text_out: str, newline: str, sep: str, trailing: str,
+           header: str | None) -> None:
+    a, b = text_in.split(newline), text_out.split(newline)
+    assert a[-1] == b[-1] == ""  # both end with the line ending
+    a, b = a[:-1], b[:-1]
+    assert len(a) == len(b)
+    if header is not None:
+        assert a[0] == b[0] == header
+        a, b = a[1:], b[1:]
+    assert all(ln.endswith(trailing) for ln in b) and all("\r" not in ln and "\n" not in ln
+                                                           for ln in b)
+    def nums(lines: list[str]) -> np.ndarray:
+        return np.array([[float(v) for v in ln[:len(ln) - len(trailing)].split(sep)]
+                         for ln in lines])
+
+    pa, pb = nums(a), nums(b)
+    moves = np.linalg.norm(pb - pa, axis=1)
+    assert moves.max() <= TOL and np.count_nonzero(moves) > 20
+    assert all(x == y for x, y, m in zip(a, b, moves, strict=True) if m == 0)
+
+
+@pytest.mark.parametrize("bom", [b"\xff\xfe", b"\xfe\xff"])
+def test_utf16_with_a_byte_order_mark(tmp_path, bom):
+    P = _arc()
+    text = "x\ty\r\n" + "".join(f"{x:.4f}\t{y:.4f}\r\n" for x, y in P)
+    codec = "utf-16-le" if bom == b"\xff\xfe" else "utf-16-be"
+    src = tmp_path / "in.txt"
+    src.write_bytes(bom + text.encode(codec))
+    (rec,) = read_curves(src)
+    np.testing.assert_array_equal(rec.points, np.round(P, 4))
+    out = tmp_path / "out.txt"
+    _fair_file(src, out)
+    raw = out.read_bytes()
+    assert raw[:2] in (b"\xff\xfe", b"\xfe\xff")  # UTF-16 with its mark (machine's order)
+    _check(text, raw.decode("utf-16"), "\r\n", "\t", "", "x\ty")
+
+
+def test_lines_ended_by_a_carriage_return_alone(tmp_path):
+    P = _arc()
+    text = "x y\r" + "".join(f"{x:.4f} {y:.4f}\r" for x, y in P)
+    src = tmp_path / "in.txt"
+    src.write_bytes(text.encode())
+    (rec,) = read_curves(src)
+    assert rec.points.shape == (40, 2)
+    out = tmp_path / "out.txt"
+    _fair_file(src, out)
+    got = out.read_bytes().decode()
+    assert "\n" not in got
+    _check(text, got, "\r", " ", "", "x y")
+
+
+@pytest.mark.parametrize("sep", [",", ";"])
+def test_a_separator_after_the_last_column(tmp_path, sep):
+    P = _arc()
+    text = f"x{sep}y{sep}\n" + "".join(f"{x:.4f}{sep}{y:.4f}{sep}\n" for x, y in P)
+    src = tmp_path / "in.csv"
+    src.write_text(text, encoding="utf-8", newline="")
+    (rec,) = read_curves(src)
+    assert rec.points.shape == (40, 2)
+    out = tmp_path / "out.csv"
+    _fair_file(src, out)
+    _check(text, out.read_text(encoding="utf-8"), "\n", sep, sep, f"x{sep}y{sep}")
+
+
+def test_a_trailing_separator_beside_point_numbers(tmp_path):
+    """The header's own trailing separator does not hide its column names."""
+    P = _arc()
+    text = "id,x,y,\n" + "".join(f"{i + 1},{x:.4f},{y:.4f},\n" for i, (x, y) in enumerate(P))
+    src = tmp_path / "in.csv"
+    src.write_text(text, encoding="utf-8", newline="")
+    with pytest.warns(cf.io.ColumnsKept):
+        (rec,) = read_curves(src)
+    assert rec.source["columns"] == (1, 2)
