@@ -343,3 +343,18 @@ def test_a_core_read_back_over_tol_gets_its_moves_scaled(tmp_path: Path, monkeyp
     np.testing.assert_allclose(B[400:800], P[400:800] + s * (A[400:800] - P[400:800]),
                                rtol=0, atol=1e-12)
     assert np.linalg.norm(B - P, axis=1).max() <= TOL
+
+
+def test_a_units_row_after_the_header_is_kept(tmp_path: Path):
+    """Lines before the data without a number in them (a units row) are written back as they
+    are; they were refused ("not a row of numbers")."""
+    t = np.linspace(0.0, 6.0, 80)
+    rows = "".join(f"{np.cos(a):.5f},{np.sin(a) + 0.002 * np.sin(29 * a):.5f}\n" for a in t)
+    src = tmp_path / "in.csv"
+    src.write_text("x,y\nmm,mm\n" + rows)
+    fair_chunked(src, tmp_path / "o.csv", tol=0.01, chunk=40, overlap=8, hold=2, jobs=1)
+    out = (tmp_path / "o.csv").read_text().splitlines()
+    assert out[:2] == ["x,y", "mm,mm"] and len(out) == 82
+    got = np.array([[float(v) for v in ln.split(",")] for ln in out[2:]])
+    want = np.array([[float(v) for v in ln.split(",")] for ln in rows.splitlines()])
+    assert np.linalg.norm(got - want, axis=1).max() <= 0.01

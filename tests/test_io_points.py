@@ -231,7 +231,7 @@ def test_property_round_trip(tmp_path_factory, n, seed, sep, dim, dec):
     ("\n\n# only a comment\n", None, "no data"),
     ("x,y\n", None, "no data"),
     ("0,0\n1,1\nhello world\n2,2\n", 3, "not a row of numbers"),
-    ("x,y\nz,w\n0,0\n", 2, "not a header"),
+    ("x,y\n1.0,2.0O\n0,0\n", 2, "not a header"),  # a mistyped first row is no preamble
     ("0,0\n1,1\n2\n", 3, "1 columns but the first data row \\(line 1\\) has 2"),
     ("0 0 0 0\n1 1 1 1\n", 1, "2 or 3 coordinate columns, got 4"),
     ("0 0 0 0 0\n1 1 1 1 1\n", 1, "2 or 3 coordinate columns, got 5"),

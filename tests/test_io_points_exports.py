@@ -108,3 +108,33 @@ def test_a_trailing_separator_beside_point_numbers(tmp_path):
     with pytest.warns(cf.io.ColumnsKept):
         (rec,) = read_curves(src)
     assert rec.source["columns"] == (1, 2)
+
+
+def test_a_units_row_and_a_title_before_the_data_are_kept(tmp_path):
+    """Lines before the data in which no field is a number are kept as they are (they were
+    refused: "not a row of numbers (and not a header)"); the one naming the columns counts."""
+    P = _arc()
+    pre = "Curve export, tool v2\nid,x,y\n-,mm,mm\n"
+    text = pre + "".join(f"{i + 1},{x:.4f},{y:.4f}\n" for i, (x, y) in enumerate(P))
+    src = tmp_path / "in.csv"
+    src.write_text(text, encoding="utf-8", newline="")
+    with pytest.warns(cf.io.ColumnsKept):
+        (rec,) = read_curves(src)
+    assert rec.source["columns"] == (1, 2)
+    np.testing.assert_array_equal(rec.points, np.round(P, 4))
+    out = tmp_path / "out.csv"
+    with pytest.warns(cf.io.ColumnsKept):
+        _fair_file(src, out)
+    got = out.read_text(encoding="utf-8")
+    assert got.startswith(pre)
+    rows = [ln.split(",") for ln in got.splitlines()[3:]]
+    assert [r[0] for r in rows] == [str(i + 1) for i in range(40)]
+    moved = np.array([[float(r[1]), float(r[2])] for r in rows])
+    assert np.linalg.norm(moved - np.round(P, 4), axis=1).max() <= TOL
+
+
+def test_a_line_with_a_number_before_the_data_is_still_refused(tmp_path):
+    src = tmp_path / "in.csv"
+    src.write_text("x,y\n1.0,2.0O\n0,0\n1,1\n2,2\n", encoding="utf-8")
+    with pytest.raises(cf.FileFormatError, match="not a header"):
+        read_curves(src)

@@ -83,7 +83,7 @@ from typing import Any
 import numpy as np
 
 from .errors import FileFormatError, InputError
-from .io.points import column_decimals, decimal_commas, render_row
+from .io.points import column_decimals, decimal_commas, render_row, wordy
 
 DEFAULT_CHUNK = 5000
 DEFAULT_OVERLAP = 64
@@ -187,7 +187,8 @@ class PointStream:
 
         if self.header is None:
             return
-        cols = coordinate_columns(ncols, self.header, np.zeros(0), path=self.path)
+        heads = [h for h in self.preamble if h.strip() and not h.lstrip().startswith("#")]
+        cols = coordinate_columns(ncols, heads, np.zeros(0), path=self.path)
         if cols != tuple(range(ncols)):
             raise FileFormatError(
                 f"the header names columns {', '.join(map(str, cols))} as x, y (z) and keeps "
@@ -253,9 +254,11 @@ class PointStream:
                     try:
                         vals = [float(t) for t in toks]
                     except ValueError:
-                        if n == 0 and self.header is None and not rows:
-                            self.header = line.rstrip("\r\n")
-                            self.preamble.append(self.header)
+                        if n == 0 and not rows and (self.header is None or wordy(line)):
+                            # the header, then lines without a number (a units row)
+                            if self.header is None:
+                                self.header = line.rstrip("\r\n")
+                            self.preamble.append(line.rstrip("\r\n"))
                             if keep:
                                 between.append(line)
                             continue

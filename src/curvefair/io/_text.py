@@ -503,6 +503,13 @@ def _numbers_part(body: str) -> str:
     return stripped
 
 
+def _wordy(line: str) -> bool:
+    """A line none of whose fields (between blanks, commas and semicolons) is a number."""
+    hash_at = line.find("#")
+    body = (line if hash_at < 0 else line[:hash_at]).strip()
+    return not any(_NUM_FULL(f) for f in _SEP_RE.split(body)[0::2])
+
+
 def _split_numbers(line: str) -> list[str] | None:
     """The number texts of a data line (as :func:`_split_row`), or None when it is not all
     numbers: what reading needs, without the pieces that only a rewrite of the row uses."""
@@ -570,11 +577,14 @@ def parse_text(path: str | os.PathLike[str], *, header: bool = True,
 
     Comments start with ``#`` (whole lines or after the numbers), blank lines are kept, one
     non-numeric line before the first data row is the header (or the name line of an airfoil)
-    when ``header`` is True. Separators: blanks, commas or semicolons; a file whose first data
-    row writes decimal commas (:func:`decimal_commas`: ``10,25;0,5``) is read with them, its
-    data rows kept with decimal points in :attr:`TextLayout.lines` and written back with
-    commas (a row that then has a decimal point too is refused). ``ncols``: the numbers
-    of columns a row may have (None: any from 2 on, every row as many as the first).
+    when ``header`` is True; further lines before the data in which no field is a number (a
+    units row ``mm,mm``, a title) are kept as :attr:`TextLayout.leading` lines.
+
+    Separators: blanks, commas or semicolons (one after the last column allowed); a file
+    whose first data row writes decimal commas (:func:`decimal_commas`: ``10,25;0,5``) is read
+    with them, its data rows kept with decimal points in :attr:`TextLayout.lines` and written
+    back with commas (a row that then has a decimal point too is refused). ``ncols``: the
+    numbers of columns a row may have (None: any from 2 on, every row as many as the first).
 
     ``notes=True`` (airfoil files, where remarks, URLs and ``Thickness: 7.99%`` lines are
     common): every line before the first row of ``ncols`` numbers is a leading line (the
@@ -636,6 +646,11 @@ def parse_text(path: str | os.PathLike[str], *, header: bool = True,
                 continue
             if not data_lines and head is None and header:
                 head = i
+                continue
+            if not data_lines and header and _wordy(line):
+                # a further line before the data without a number in it (a units row, a
+                # title): kept as it is; one with a number may be a mistyped first row
+                leading.append(i)
                 continue
             short = s if len(s) <= 60 else s[:57] + "..."
             if data_lines:

@@ -62,13 +62,14 @@ from ._text import (
     _column_decimals,
     _render_line,
     _split_numbers,
+    _wordy,
     decimal_commas,
     fresh_text,
     parse_text,
 )
 
 __all__ = ["read", "write", "render_row", "column_decimals", "coordinate_columns",
-           "is_point_numbers", "decimal_commas"]
+           "is_point_numbers", "decimal_commas", "wordy"]
 
 FORMAT = "points"
 
@@ -104,17 +105,27 @@ def _header_names(header: str | None, ncols: int) -> list[str] | None:
     return out
 
 
+def wordy(line: str) -> bool:
+    """A line none of whose fields (between blanks, commas and semicolons) is a number: a
+    units row or a title before the data, which the readers keep as they are (a line with a
+    number in it may be a mistyped first row, and is refused)."""
+    return _wordy(line)
+
+
 def is_point_numbers(col: FloatArray) -> bool:
     """A column of at least 3 integers, each one more than the one before (point numbers)."""
     return (col.shape[0] >= 3 and bool(np.all(np.isfinite(col)))
             and bool(np.all(col == np.round(col))) and bool(np.all(np.diff(col) == 1.0)))
 
 
-def coordinate_columns(ncols: int, header: str | None, first_column: FloatArray,
-                       columns: Sequence[int] | None = None,
+def coordinate_columns(ncols: int, header: str | Sequence[str] | None,
+                       first_column: FloatArray, columns: Sequence[int] | None = None,
                        path: str | os.PathLike[str] | None = None,
                        line: int | None = None) -> tuple[int, ...]:
     """Which columns of a points file (``ncols`` numeric columns) are the coordinates.
+
+    ``header``: the header line, or the lines before the data (the first one naming ``ncols``
+    columns counts).
 
     In order of precedence:
 
@@ -147,6 +158,8 @@ def coordinate_columns(ncols: int, header: str | None, first_column: FloatArray,
             raise FileFormatError(f"columns={list(cols)}: the rows have {ncols} columns "
                                   f"(0 .. {ncols - 1}), no column {bad[0]}", path, line)
         return cols
+    heads = [header] if isinstance(header, str) or header is None else list(header)
+    header = next((h for h in heads if _header_names(h, ncols) is not None), None)
     names = _header_names(header, ncols)
     if names is not None and names.count("x") == 1 and names.count("y") == 1 and \
             names.count("z") <= 1:
@@ -183,11 +196,14 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
          columns: Sequence[int] | None = None, **_: Any) -> list[CurveRecord]:
     """Read a CSV / whitespace point list; see the module docstring."""
     lay = parse_text(path, header=True, ncols=None, what="points file")
-    cols = coordinate_columns(lay.ncols, lay.header_text, lay.values[:, 0], columns, path,
+    heads = [lay.lines[i] for i in sorted(((lay.header,) if lay.header is not None else ())
+                                          + tuple(lay.leading))]
+    cols = coordinate_columns(lay.ncols, heads, lay.values[:, 0], columns, path,
                               lay.data_lines[0] + 1)
     if cols != tuple(range(lay.ncols)):
         kept = tuple(c for c in range(lay.ncols) if c not in cols)
-        names = _header_parts(lay.header_text, lay.ncols)
+        names = next((p for p in map(lambda h: _header_parts(h, lay.ncols), heads)
+                      if p is not None), None)
         what = ", ".join(repr(names[c]) if names else str(c) for c in kept)
         import warnings
 
