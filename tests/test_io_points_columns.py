@@ -84,6 +84,7 @@ def _assert_kept_and_within_tol(src: Path, out: Path, kept: tuple[int, ...],
     ("Point,X,Y", (0,), (1, 2)),
     ("s,x [mm],y [mm]", (0,), (1, 2)),         # an arc-length column, units in the names
     ("x,y,id", (2,), (0, 1)),
+    (",x,y", (0,), (1, 2)),                     # pandas' to_csv: the index, unnamed, first
 ])
 def test_header_names_the_coordinates_and_the_other_column_is_kept(tmp_path, header, kept,
                                                                      coords):

@@ -204,7 +204,7 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
         kept = tuple(c for c in range(lay.ncols) if c not in cols)
         names = next((p for p in map(lambda h: _header_parts(h, lay.ncols), heads)
                       if p is not None), None)
-        what = ", ".join(repr(names[c]) if names else str(c) for c in kept)
+        what = ", ".join(repr(names[c]) if names and names[c] else str(c) for c in kept)
         import warnings
 
         warnings.warn(ColumnsKept(
