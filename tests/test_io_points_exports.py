@@ -138,3 +138,21 @@ def test_a_line_with_a_number_before_the_data_is_still_refused(tmp_path):
     src.write_text("x,y\n1.0,2.0O\n0,0\n1,1\n2,2\n", encoding="utf-8")
     with pytest.raises(cf.FileFormatError, match="not a header"):
         read_curves(src)
+
+
+@pytest.mark.parametrize("name, text, line, match", [
+    # the first line is taken for a header; the second is refused
+    ("f.csv", "9.970429D+00,7.766886D-01\n9.88D+00,1.5D+00\n", 2, "D exponent"),
+    ("f.csv", "x,y\n1.0D+00,2.0D+00\n3.0,4.0\n4,5\n5,7\n", 2, "D exponent"),
+    ("f.dat", "NAME\n1.0D+00 0.0D+00\n0.5D+00 0.1D+00\n0.0D+00 0.0D+00\n", None, "D exponent"),
+    ("f.csv", '"","x","y"\n"1",0.5,0.25\n"2",0.6,0.3\n', 2, "quoted values"),
+])
+def test_numbers_curvefair_does_not_read_are_named_in_the_message(tmp_path, name, text, line,
+                                                                     match):
+    """Refused as before, but the message says why (it said "no data rows", or "not a row of
+    numbers"); a row of such numbers before the data is not taken for a units row."""
+    src = tmp_path / name
+    src.write_text(text, encoding="utf-8")
+    with pytest.raises(cf.FileFormatError, match=match) as exc:
+        read_curves(src)
+    assert exc.value.line == line

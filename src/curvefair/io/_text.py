@@ -503,11 +503,33 @@ def _numbers_part(body: str) -> str:
     return stripped
 
 
+_D_EXPONENT = re.compile(r"\d[dD][+-]?\d")
+_QUOTED_NUMBER = re.compile(rf"[\"']{_NUM}[\"']", re.IGNORECASE)
+
+
+def _why_not(line: str) -> str:
+    """Why a line of numbers is not read as one, for the message: Fortran's ``D`` exponents
+    or quoted numbers (``; ...``), or nothing."""
+    body = line.split("#", 1)[0]
+    if _D_EXPONENT.search(body) and _NUM_RE.search(body):
+        return ("; numbers with a D exponent (Fortran's 1.5D+00) are not read: write them "
+                "with E")
+    if _QUOTED_NUMBER.search(body):
+        return ("; quoted values are not read as numbers (R's write.csv quotes its row "
+                "names: row.names = FALSE leaves them out)")
+    return ""
+
+
+_NUMBERISH = re.compile(r"[\"']?[+-]?\.?\d").match
+
+
 def _wordy(line: str) -> bool:
-    """A line none of whose fields (between blanks, commas and semicolons) is a number."""
+    """A line none of whose fields (between blanks, commas and semicolons) starts like a
+    number (a digit, after a quote, a sign or a point: ``1.5``, ``"2"``, ``1.5D+00``,
+    ``2024-01-05``)."""
     hash_at = line.find("#")
     body = (line if hash_at < 0 else line[:hash_at]).strip()
-    return not any(_NUM_FULL(f) for f in _SEP_RE.split(body)[0::2])
+    return not any(_NUMBERISH(f) or _NUM_FULL(f) for f in _SEP_RE.split(body)[0::2])
 
 
 def _split_numbers(line: str) -> list[str] | None:
@@ -654,9 +676,10 @@ def parse_text(path: str | os.PathLike[str], *, header: bool = True,
                 continue
             short = s if len(s) <= 60 else s[:57] + "..."
             if data_lines:
-                raise FileFormatError(f"not a row of numbers: {short!r}", path, i + 1)
-            raise FileFormatError(f"not a row of numbers (and not a header): {short!r}",
-                                  path, i + 1)
+                raise FileFormatError(f"not a row of numbers: {short!r}{_why_not(s)}", path,
+                                      i + 1)
+            raise FileFormatError(f"not a row of numbers (and not a header): {short!r}"
+                                  f"{_why_not(s)}", path, i + 1)
         k = len(row)
         if width is None:
             if (k not in ncols) if ncols is not None else k < 2:
@@ -678,7 +701,8 @@ def parse_text(path: str | os.PathLike[str], *, header: bool = True,
     if not data_lines:
         if not any(line.strip() for line in lines):
             raise FileFormatError(f"empty {what}", path)
-        raise FileFormatError(f"no data rows in the {what}", path)
+        hint = next((h for h in map(_why_not, lines) if h), "")
+        raise FileFormatError(f"no data rows in the {what}{hint}", path)
     assert width is not None
     values = np.array(list(map(float, texts)), dtype=np.float64)
     if bulk is not None:

@@ -106,9 +106,9 @@ def _header_names(header: str | None, ncols: int) -> list[str] | None:
 
 
 def wordy(line: str) -> bool:
-    """A line none of whose fields (between blanks, commas and semicolons) is a number: a
-    units row or a title before the data, which the readers keep as they are (a line with a
-    number in it may be a mistyped first row, and is refused)."""
+    """A line none of whose fields (between blanks, commas and semicolons) starts like a
+    number: a units row or a title before the data, which the readers keep as they are (a
+    line with a number in it may be a mistyped first row, and is refused)."""
     return _wordy(line)
 
 
