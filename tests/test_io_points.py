@@ -243,6 +243,14 @@ def test_property_round_trip(tmp_path_factory, n, seed, sep, dim, dec):
     # a separator after the last column is allowed: "3," is one number
     ("0,0\n1,1\n2,2\n3,\n", 4, "1 columns but the first data row \\(line 1\\) has 2"),
     ("0,0\n1,1\n2,2\n3,,\n", 4, "not a row of numbers"),
+    # columns that cannot be told apart (tests/test_io_points_columns.py has the others)
+    ("5 0 0 0\n9 1 1 1\n", 1, "2 or 3 coordinate columns, got 4"),
+    ("x;y\n10,0000;0,0035\n9.9704;0,7767\n", 3, "decimal points in a file of decimal commas"),
+    ("1.234,5;2,25\n3,5;4,25\n5,5;6\n", 1, "decimal points in a file of decimal commas"),
+    ("1.234,5;2\n1.235,5;4\n1.236,5;6\n", 1, "decimal points in a file of decimal commas"),
+    ("1,5;2,5\n2.5;3.5\n3,5;4\n", 2, "decimal points in a file of decimal commas"),
+    # Engauge Digitizer's "all curves on each line" export: two curves over one x
+    ("x,Curve1,Curve2\n0.1,1,2\n0.2,1.5,2.5\n0.3,1.7,2.6\n", 2, "names a column x but no y"),
 ])
 def test_malformed_points_files(tmp_path, text, line, match):
     p = _write(tmp_path / "bad.csv", text)

@@ -153,24 +153,6 @@ def test_point_numbers_beside_three_coordinates_are_kept(tmp_path):
     _assert_kept_and_within_tol(src, tmp_path / "out.txt", (0,), (1, 2, 3), header=False)
 
 
-@pytest.mark.parametrize("text, line, match", [
-    ("0 0 0 0 1\n1 1 1 1 1\n", 1, "2 or 3 coordinate columns, got 5"),
-    ("5 0 0 0\n9 1 1 1\n", 1, "2 or 3 coordinate columns, got 4"),
-    ("x;y\n10,0000;0,0035\n9.9704;0,7767\n", 3, "decimal points in a file of decimal commas"),
-    ("1.234,5;2,25\n3,5;4,25\n5,5;6\n", 1, "decimal points in a file of decimal commas"),
-    ("1.234,5;2\n1.235,5;4\n1.236,5;6\n", 1, "decimal points in a file of decimal commas"),
-    ("1,5;2,5\n2.5;3.5\n3,5;4\n", 2, "decimal points in a file of decimal commas"),
-    # Engauge Digitizer's "all curves on each line" export: two curves over one x
-    ("x,Curve1,Curve2\n0.1,1,2\n0.2,1.5,2.5\n0.3,1.7,2.6\n", 2, "names a column x but no y"),
-])
-def test_unclear_columns_are_refused_naming_the_line(tmp_path, text, line, match):
-    p = tmp_path / "bad.csv"
-    p.write_text(text, encoding="utf-8")
-    with pytest.raises(FileFormatError, match=match) as exc:
-        read_curves(p)
-    assert exc.value.line == line and str(p) in str(exc.value)
-
-
 # ------------------------------------------------------------------------------------------
 # the argument
 # ------------------------------------------------------------------------------------------
