@@ -13,6 +13,7 @@ written files are checked with Python's codecs and ``str.split``, not curvefair'
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -145,7 +146,6 @@ def test_a_line_with_a_number_before_the_data_is_still_refused(tmp_path):
     ("f.csv", "9.970429D+00,7.766886D-01\n9.88D+00,1.5D+00\n", 2, "D exponent"),
     ("f.csv", "x,y\n1.0D+00,2.0D+00\n3.0,4.0\n4,5\n5,7\n", 2, "D exponent"),
     ("f.dat", "NAME\n1.0D+00 0.0D+00\n0.5D+00 0.1D+00\n0.0D+00 0.0D+00\n", None, "D exponent"),
-    ("f.csv", '"","x","y"\n"1",0.5,0.25\n"2",0.6,0.3\n', 2, "quoted values"),
 ])
 def test_numbers_curvefair_does_not_read_are_named_in_the_message(tmp_path, name, text, line,
                                                                      match):
@@ -156,3 +156,38 @@ def test_numbers_curvefair_does_not_read_are_named_in_the_message(tmp_path, name
     with pytest.raises(cf.FileFormatError, match=match) as exc:
         read_curves(src)
     assert exc.value.line == line
+
+
+@pytest.mark.parametrize("quote_all", [False, True])
+def test_quoted_numbers_are_read_and_keep_their_quotes(tmp_path, quote_all):
+    """R's ``write.csv`` quotes the header and its row names (``"1",0.5,0.25``); some tools
+    quote every field. Both were refused ("not a row of numbers")."""
+    P = _arc()
+    if quote_all:
+        text = '"x","y"\n' + "".join(f'"{x:.6f}","{y:.6f}"\n' for x, y in P)
+    else:
+        text = '"","x","y"\n' + "".join(f'"{i + 1}",{x:.6f},{y:.6f}\n'
+                                          for i, (x, y) in enumerate(P))
+    src = tmp_path / "in.csv"
+    src.write_text(text, encoding="utf-8", newline="")
+    if quote_all:
+        (rec,) = read_curves(src)
+    else:
+        with pytest.warns(cf.io.ColumnsKept):
+            (rec,) = read_curves(src)
+    np.testing.assert_array_equal(rec.points, np.round(P, 6))
+    out = tmp_path / "out.csv"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", cf.io.ColumnsKept)
+        _fair_file(src, out)
+    a = [ln.split(",") for ln in text.splitlines()]
+    b = [ln.split(",") for ln in out.read_text(encoding="utf-8").splitlines()]
+    assert a[0] == b[0] and len(a) == len(b)
+    if not quote_all:
+        assert [r[0] for r in a] == [r[0] for r in b]  # the row names as they were
+    assert all(all(f.startswith('"') and f.endswith('"') for f in r) for r in b) == quote_all
+    k = 1 if not quote_all else 0
+    pa = np.array([[float(f.strip('"')) for f in r[k:]] for r in a[1:]])
+    pb = np.array([[float(f.strip('"')) for f in r[k:]] for r in b[1:]])
+    moves = np.linalg.norm(pb - pa, axis=1)
+    assert moves.max() <= TOL and np.count_nonzero(moves) > 20

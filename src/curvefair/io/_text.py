@@ -265,6 +265,12 @@ def _pieces(line: str) -> tuple[str, list[str], list[str], str]:
     body, comment = (line, "") if hash_at < 0 else (line[:hash_at], line[hash_at:])
     stripped = _numbers_part(body)
     lead = body.find(stripped[0])
+    if '"' in stripped:
+        q = _quoted(stripped)
+        assert q is not None  # a data row: _split_numbers read it
+        pre, texts, seps, closing = q
+        return (body[:lead] + pre, texts, seps,
+                closing + body[lead + len(stripped):] + comment)
     if _COMMA_ROW(stripped):
         texts = stripped.split(",")
         seps = [","] * (len(texts) - 1)
@@ -504,19 +510,15 @@ def _numbers_part(body: str) -> str:
 
 
 _D_EXPONENT = re.compile(r"\d[dD][+-]?\d")
-_QUOTED_NUMBER = re.compile(rf"[\"']{_NUM}[\"']", re.IGNORECASE)
 
 
 def _why_not(line: str) -> str:
     """Why a line of numbers is not read as one, for the message: Fortran's ``D`` exponents
-    or quoted numbers (``; ...``), or nothing."""
+    (``; ...``), or nothing."""
     body = line.split("#", 1)[0]
     if _D_EXPONENT.search(body) and _NUM_RE.search(body):
         return ("; numbers with a D exponent (Fortran's 1.5D+00) are not read: write them "
                 "with E")
-    if _QUOTED_NUMBER.search(body):
-        return ("; quoted values are not read as numbers (R's write.csv quotes its row "
-                "names: row.names = FALSE leaves them out)")
     return ""
 
 
@@ -532,6 +534,39 @@ def _wordy(line: str) -> bool:
     return not any(_NUMBERISH(f) or _NUM_FULL(f) for f in _SEP_RE.split(body)[0::2])
 
 
+_QFIELD = re.compile(rf'"({_NUM})"|({_NUM})', re.IGNORECASE)
+_SEP_AT = re.compile(r"\s*[,;]\s*|\s+")
+
+
+def _quoted(stripped: str) -> tuple[str, list[str], list[str], str] | None:
+    """``(prefix, texts, seps, suffix)`` of a row whose numbers may stand in double quotes
+    (``"1",0.5,0.25``: R's ``write.csv`` quotes its row names; some tools quote every
+    field), the quotes being part of the prefix, separators and suffix, so that the numbers
+    are read and rewritten as any other; None when it is not such a row."""
+    texts: list[str] = []
+    seps: list[str] = []
+    pre = ""
+    pos, n = 0, len(stripped)
+    while True:
+        m = _QFIELD.match(stripped, pos)
+        if m is None:
+            return None
+        g = 1 if m.group(1) is not None else 2
+        if texts:
+            seps[-1] += stripped[pos:m.start(g)]  # the opening quote
+        else:
+            pre = stripped[pos:m.start(g)]
+        texts.append(m.group(g))
+        closing = stripped[m.end(g):m.end()]
+        if m.end() == n:
+            return pre, texts, seps, closing
+        sm = _SEP_AT.match(stripped, m.end())
+        if sm is None:
+            return None
+        seps.append(closing + sm.group(0))
+        pos = sm.end()
+
+
 def _split_numbers(line: str) -> list[str] | None:
     """The number texts of a data line (as :func:`_split_row`), or None when it is not all
     numbers: what reading needs, without the pieces that only a rewrite of the row uses."""
@@ -539,6 +574,9 @@ def _split_numbers(line: str) -> list[str] | None:
     stripped = _numbers_part(line if hash_at < 0 else line[:hash_at])
     if not stripped:
         return None
+    if '"' in stripped:
+        q = _quoted(stripped)
+        return None if q is None else q[1]
     if _COMMA_ROW(stripped):
         return stripped.split(",")
     if _BLANK_ROW(stripped):
