@@ -141,21 +141,37 @@ def test_a_line_with_a_number_before_the_data_is_still_refused(tmp_path):
         read_curves(src)
 
 
-@pytest.mark.parametrize("name, text, line, match", [
-    # the first line is taken for a header; the second is refused
-    ("f.csv", "9.970429D+00,7.766886D-01\n9.88D+00,1.5D+00\n", 2, "D exponent"),
-    ("f.csv", "x,y\n1.0D+00,2.0D+00\n3.0,4.0\n4,5\n5,7\n", 2, "D exponent"),
-    ("f.dat", "NAME\n1.0D+00 0.0D+00\n0.5D+00 0.1D+00\n0.0D+00 0.0D+00\n", None, "D exponent"),
-])
-def test_numbers_curvefair_does_not_read_are_named_in_the_message(tmp_path, name, text, line,
-                                                                     match):
-    """Refused as before, but the message says why (it said "no data rows", or "not a row of
-    numbers"); a row of such numbers before the data is not taken for a units row."""
+@pytest.mark.parametrize("name", ["f.csv", "f.dat"])
+def test_fortran_d_exponents_are_read_and_written_back_with_d(tmp_path, name):
+    """Fortran's double-precision exponent (``0.9970429D+01``) was refused ("no data rows",
+    "not a row of numbers"); a row of such numbers before the data is not a units row."""
+    P = _arc()
+    sep = "," if name.endswith(".csv") else "  "
+    rows = [f"{x:.6E}{sep}{y:.6E}".replace("E", "D") for x, y in P]
+    text = ("x,y\n" if sep == "," else "NAME\n") + "\n".join(rows) + "\n"
     src = tmp_path / name
-    src.write_text(text, encoding="utf-8")
-    with pytest.raises(cf.FileFormatError, match=match) as exc:
+    src.write_text(text, encoding="utf-8", newline="")
+    (rec,) = read_curves(src)
+    want = np.array([[float(v.replace("D", "E")) for v in r.split(sep)] for r in rows])
+    np.testing.assert_array_equal(rec.points, want)
+    out = tmp_path / ("o" + name)
+    _fair_file(src, out)
+    b = out.read_text(encoding="utf-8").splitlines()
+    assert b[0] == text.splitlines()[0] and len(b) == len(rows) + 1
+    assert not any("E" in ln or "e" in ln for ln in b[1:])
+    got = np.array([[float(v.replace("D", "E")) for v in
+                     (ln.split(sep) if sep == "," else ln.split())] for ln in b[1:]])
+    moves = np.linalg.norm(got - want, axis=1)
+    assert moves.max() <= TOL and np.count_nonzero(moves) > 20
+    assert all(x == y for x, y, m in zip(rows, b[1:], moves, strict=True) if m == 0)
+
+
+def test_e_exponents_in_a_file_of_d_exponents_are_refused(tmp_path):
+    src = tmp_path / "f.csv"
+    src.write_text("1.0D+00,2.0D+00\n3.0E+00,4.0\n4,5\n5,7\n", encoding="utf-8")
+    with pytest.raises(cf.FileFormatError, match="E exponents in a file of Fortran D") as exc:
         read_curves(src)
-    assert exc.value.line == line
+    assert exc.value.line == 2
 
 
 @pytest.mark.parametrize("quote_all", [False, True])

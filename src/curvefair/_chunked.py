@@ -83,7 +83,13 @@ from typing import Any
 import numpy as np
 
 from .errors import FileFormatError, InputError
-from .io.points import column_decimals, decimal_commas, render_row, wordy
+from .io.points import (
+    column_decimals,
+    decimal_commas,
+    fortran_exponents,
+    render_row,
+    wordy,
+)
 
 DEFAULT_CHUNK = 5000
 DEFAULT_OVERLAP = 64
@@ -262,7 +268,9 @@ class PointStream:
                             if keep:
                                 between.append(line)
                             continue
-                        raise FileFormatError(f"not a row of numbers: {s[:60]!r}",
+                        why = ("; chunked fairing reads E exponents, not Fortran's D: fair "
+                               "the file without --chunk" if fortran_exponents(s) else "")
+                        raise FileFormatError(f"not a row of numbers: {s[:60]!r}{why}",
                                               self.path, ln) from None
                     if self.dim is None:
                         if decimal_commas(s):

@@ -22,7 +22,7 @@ from .._typing import FloatArray
 from ..errors import FileFormatError
 
 __all__ = ["TextLayout", "Token", "parse_text", "format_number", "rounded_number",
-           "decimal_commas"]
+           "decimal_commas", "fortran_exponents"]
 
 _NUM = r"[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|nan|inf(?:inity)?)"
 _NUM_RE = re.compile(_NUM, re.IGNORECASE)
@@ -51,6 +51,38 @@ def _point_to_comma(line: str) -> str:
     """The inverse of :func:`_comma_to_point` for a line written with decimal points."""
     at = line.find("#")
     return line.replace(".", ",") if at < 0 else line[:at].replace(".", ",") + line[at:]
+
+
+_D_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)[dD][+-]?\d+").fullmatch
+_D_EXP = re.compile(r"(?<=[\d.])([dD])(?=[+-]?\d)")
+_E_EXP = re.compile(r"(?<=[\d.])([eE])(?=[+-]?\d)")
+
+
+def fortran_exponents(line: str) -> bool:
+    """Whether a data line writes its numbers with Fortran's double-precision exponent
+    (``0.1234D+01``): its fields are numbers, at least one of them with a ``D``."""
+    hash_at = line.find("#")
+    s = _numbers_part(line if hash_at < 0 else line[:hash_at]) if line.strip() else ""
+    if not s or not ("D" in s or "d" in s):
+        return False
+    fields = _SEP_RE.split(s)[0::2]
+    return any(_D_NUMBER(f) for f in fields) and all(_D_NUMBER(f) or _NUM_FULL(f)
+                                                     for f in fields)
+
+
+def _d_to_e(line: str) -> str:
+    """A data line with ``D`` exponents written with ``E`` (``d`` with ``e``; its ``#``
+    comment as it is)."""
+    at = line.find("#")
+    body, rest = (line, "") if at < 0 else (line[:at], line[at:])
+    return _D_EXP.sub(lambda m: "E" if m.group(1) == "D" else "e", body) + rest
+
+
+def _e_to_d(line: str) -> str:
+    """The inverse of :func:`_d_to_e` for a line written with ``E`` exponents."""
+    at = line.find("#")
+    body, rest = (line, "") if at < 0 else (line[:at], line[at:])
+    return _E_EXP.sub(lambda m: "D" if m.group(1) == "E" else "d", body) + rest
 
 
 def decimal_commas(line: str) -> bool:
@@ -321,6 +353,9 @@ class TextLayout:
         The file writes its numbers with decimal commas (``10,25;0,5``): :attr:`lines` hold
         its data rows with decimal points (as read), and :meth:`render` writes them back with
         commas.
+    fortran_d : bool
+        The file writes its exponents with Fortran's ``D`` (``0.1234D+01``): :attr:`lines`
+        hold its data rows with ``E``, and :meth:`render` writes them back with ``D``.
     """
 
     lines: tuple[str, ...]
@@ -335,6 +370,7 @@ class TextLayout:
     leading: tuple[int, ...] = ()
     notes_from: int | None = None
     decimal_comma: bool = False
+    fortran_d: bool = False
 
     @property
     def header_text(self) -> str | None:
@@ -387,6 +423,9 @@ class TextLayout:
         if self.decimal_comma:  # every data row as the file writes it: decimal commas
             for li in data_lines:
                 lines[li] = _point_to_comma(lines[li])
+        if self.fortran_d:  # ... and D exponents
+            for li in data_lines:
+                lines[li] = _e_to_d(lines[li])
         text = self.newline.join(lines)
         if self.final_newline:
             text += self.newline
@@ -668,12 +707,23 @@ def parse_text(path: str | os.PathLike[str], *, header: bool = True,
     bulk: tuple[list[str], FloatArray] | None = None  # the rows read at once, if any
     width: int | None = None
     comma = False  # decimal commas (``10,25;0,5``): data rows read with decimal points
+    fortran = False  # D exponents (``0.1234D+01``): data rows read with E
     for i, line in enumerate(lines):
         s = line.strip()
         if not s or s.startswith("#"):
             continue
         if not comma and not data_lines and decimal_commas(line):
             comma = True
+        if not fortran and not data_lines and fortran_exponents(line):
+            fortran = True
+        if fortran:
+            if _E_EXP.search(line.split("#", 1)[0]):
+                raise FileFormatError(
+                    f"E exponents in a file of Fortran D exponents ({s[:40]!r}): two number "
+                    "styles; curvefair does not guess which to write", path, i + 1)
+            lined = _d_to_e(line)
+            if lined != line and _split_numbers(lined) is not None:
+                lines[i] = line = lined
         if comma:
             if "." in line.split("#", 1)[0] and (decimal_commas(line)
                                                   or _split_numbers(line) is not None):
@@ -730,7 +780,7 @@ def parse_text(path: str | os.PathLike[str], *, header: bool = True,
                 f"{width}", path, i + 1)
         data_lines.append(i)
         texts.extend(row)
-        if len(data_lines) == 1 and not notes and not comma and \
+        if len(data_lines) == 1 and not notes and not comma and not fortran and \
                 len(lines) - i > _BLOCK_MIN_ROWS:
             bulk = _plain_rows(lines, i + 1, k)
             if bulk is not None:  # every line after the first row is a row like it
@@ -749,7 +799,7 @@ def parse_text(path: str | os.PathLike[str], *, header: bool = True,
     values = values.reshape(-1, width)
     col_dec = _column_decimals(texts, width)
     return TextLayout(tuple(lines), newline, final, head, tuple(data_lines), width,
-                      col_dec, encoding, values, tuple(leading), notes_from, comma)
+                      col_dec, encoding, values, tuple(leading), notes_from, comma, fortran)
 
 
 def _plain_rows(lines: list[str], start: int, width: int

@@ -10,10 +10,11 @@ coordinates (:func:`coordinate_columns`): ``columns=`` says so, or a header nami
 ``x``, ``y`` (``z``), or a first column of consecutive integers beside 3 others. A 3-column
 file without a header whose first column holds consecutive integers is refused: point numbers
 and x coordinates look the same there, and guessing wrong either rewrites the point numbers or
-fairs a projection. Decimal commas (``10,25;0,5``, :func:`decimal_commas`) are read and
-written back as commas. A row exactly equal to the row before it is dropped with a warning
-(and written back with its twin's value). A file whose last row repeats the first (4 rows or
-more) is a closed loop. One point list per file.
+fairs a projection. Decimal commas (``10,25;0,5``, :func:`decimal_commas`) and Fortran's
+``D`` exponents (:func:`fortran_exponents`) are read and written back as they were. A row
+exactly equal to the row before it is dropped with a warning (and written back with its
+twin's value). A file whose last row repeats the first (4 rows or more) is a closed loop.
+One point list per file.
 
 Records
 -------
@@ -64,12 +65,13 @@ from ._text import (
     _split_numbers,
     _wordy,
     decimal_commas,
+    fortran_exponents,
     fresh_text,
     parse_text,
 )
 
 __all__ = ["read", "write", "render_row", "column_decimals", "coordinate_columns",
-           "is_point_numbers", "decimal_commas", "wordy"]
+           "is_point_numbers", "decimal_commas", "fortran_exponents", "wordy"]
 
 FORMAT = "points"
 
