@@ -1011,9 +1011,11 @@ def _batch_fair_options(method: str | None, tol: float | None, eps: float | None
                    "curve. fair()'s corner_turn and g1_angle (degrees) are taken too: "
                    "-O corner_turn=inf lets B-spline corners turn more than 1 degree.")
 @click.option("--decimals", type=click.IntRange(min=0), metavar="N",
-              help="Text formats: write every number with N decimals [default: the input "
-                   "file's precision]. A rounding that puts a curve read back farther than "
-                   "--tol from the input, or points onto each other, writes nothing (exit 1).")
+              help="Text formats: write every number with N decimals [default: a "
+                   "moved number keeps its own or its column's decimals where they write it "
+                   "exactly, else it is written in full (never rounded unasked)]. A "
+                   "rounding that puts a curve read back farther than --tol from the input, "
+                   "or points onto each other, writes nothing (exit 1).")
 @click.option("--report", metavar="REPORT.json", help="Write the full report as JSON.")
 @click.option("--history", is_flag=True, help="Include every step in the JSON report.")
 @click.option("--plot", "plot_path", metavar="PLOT.png",

@@ -790,6 +790,16 @@ def parse_text(path: str | os.PathLike[str], *, header: bool = True,
         if not any(line.strip() for line in lines):
             raise FileFormatError(f"empty {what}", path)
         hint = next((h for h in map(_why_not, lines) if h), "")
+        if not hint and ncols is not None:  # rows of numbers, but not of the width wanted
+            for j, ln in enumerate(lines):
+                got = _split_numbers(ln) if ln.strip() and not ln.lstrip().startswith("#") \
+                    else None
+                if got is not None:
+                    need = " or ".join(map(str, ncols))
+                    raise FileFormatError(
+                        f"no data rows in the {what}: its rows have {len(got)} "
+                        f"number{'s' if len(got) != 1 else ''}, {what} rows have {need}",
+                        path, j + 1)
         raise FileFormatError(f"no data rows in the {what}{hint}", path)
     assert width is not None
     values = np.array(list(map(float, texts)), dtype=np.float64)

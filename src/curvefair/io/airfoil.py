@@ -29,7 +29,9 @@ would be faired on its own with the leading edge as a free end, and the two fair
 would meet there at an angle. ``name`` is the name line. ``source`` keys: ``layout`` (TextLayout),
 ``airfoil_layout``
 (``"selig"`` or ``"lednicer"``), ``counts`` (Lednicer ``(NU, NL)``), ``row_map`` (file data row ->
-contour point; the count line is row 0 of a Lednicer file and maps to -1), ``indices``,
+contour point; the count line is row 0 of a Lednicer file and maps to -1, as does a Selig
+file's count line, first or last: two integers summing to the other rows, far outside the
+contour, e.g. ``129 0``), ``indices``,
 ``n_points``, ``closed`` (always False), ``piece``, ``n_pieces``, ``leading_lines`` (lines
 before the data other than the name line) and ``notes`` (the trailing lines), as text.
 
@@ -82,6 +84,24 @@ def _is_count_row(v: np.ndarray) -> bool:
     return bool(np.all(v >= 2) and np.all(v == np.round(v)))
 
 
+def _selig_count_row(vals: np.ndarray) -> int | None:
+    """The data row (0 or -1) that is a count line of a Selig file, or None: two integers
+    summing to the number of the other rows (``129 0`` before 129 rows; ``66 66`` after two
+    surfaces of 66), far outside the contour (more than twice its largest coordinate). Read
+    as a point it moved the real trailing edge (HQGA's ``rae2822.dat`` opened its sharp
+    trailing edge by 1e-4 chord)."""
+    n = vals.shape[0]
+    if n < 4:
+        return None
+    for at in (0, -1):
+        v = vals[at]
+        rest = np.delete(vals, at % n, axis=0)
+        if np.all(v >= 0) and np.all(v == np.round(v)) and int(v.sum()) == n - 1 and \
+                float(np.abs(v).max()) > 2.0 * float(np.abs(rest).max()):
+            return at
+    return None
+
+
 def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
          **_: Any) -> list[CurveRecord]:
     """Read a Selig or Lednicer airfoil file; see the module docstring."""
@@ -108,6 +128,14 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
         counts: tuple[int, int] | None = (nu, nl)
         raw_lines = [lines[1 + nu - 1 - i] for i in range(nu)] + \
             [lines[1 + nu + j] for j in range(1 if shared else 0, nl)]
+    elif (at := _selig_count_row(vals)) is not None:
+        # a count line: kept as it is (written back verbatim), not a point
+        n = vals.shape[0]
+        raw = vals[1:] if at == 0 else vals[:-1]
+        raw_map = np.r_[-1, np.arange(n - 1)] if at == 0 else np.r_[np.arange(n - 1), -1]
+        kind_layout = "selig"
+        counts = None
+        raw_lines = lines[1:] if at == 0 else lines[:-1]
     else:
         raw = vals
         raw_map = np.arange(vals.shape[0])
