@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 import os
 import re
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from itertools import repeat
 from typing import Any, NamedTuple
@@ -22,7 +22,7 @@ from .._typing import FloatArray
 from ..errors import FileFormatError
 
 __all__ = ["TextLayout", "Token", "parse_text", "format_number", "rounded_number",
-           "decimal_commas", "fortran_exponents"]
+           "decimal_commas", "fortran_exponents", "wordy"]
 
 _NUM = r"[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|nan|inf(?:inity)?)"
 _NUM_RE = re.compile(_NUM, re.IGNORECASE)
@@ -41,16 +41,20 @@ _COMMA_NUMBER = re.compile(r"[+-]?(?:\d{1,3}(?:\.\d{3})+|\d*),\d+(?:[eE][+-]?\d+
 _FIELD_SEP = re.compile(r"\s*;\s*|\s+")
 
 
-def _comma_to_point(line: str) -> str:
-    """A decimal-comma data line with decimal points (its ``#`` comment as it is)."""
+def _in_body(line: str, change: Callable[[str], str]) -> str:
+    """``line`` with ``change`` applied to the part before its ``#`` comment."""
     at = line.find("#")
-    return line.replace(",", ".") if at < 0 else line[:at].replace(",", ".") + line[at:]
+    return change(line) if at < 0 else change(line[:at]) + line[at:]
+
+
+def _comma_to_point(line: str) -> str:
+    """A decimal-comma data line with decimal points."""
+    return _in_body(line, lambda b: b.replace(",", "."))
 
 
 def _point_to_comma(line: str) -> str:
     """The inverse of :func:`_comma_to_point` for a line written with decimal points."""
-    at = line.find("#")
-    return line.replace(".", ",") if at < 0 else line[:at].replace(".", ",") + line[at:]
+    return _in_body(line, lambda b: b.replace(".", ","))
 
 
 _D_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)[dD][+-]?\d+").fullmatch
@@ -58,31 +62,36 @@ _D_EXP = re.compile(r"(?<=[\d.])([dD])(?=[+-]?\d)")
 _E_EXP = re.compile(r"(?<=[\d.])([eE])(?=[+-]?\d)")
 
 
-def fortran_exponents(line: str) -> bool:
-    """Whether a data line writes its numbers with Fortran's double-precision exponent
-    (``0.1234D+01``): its fields are numbers, at least one of them with a ``D``."""
-    hash_at = line.find("#")
-    s = _numbers_part(line if hash_at < 0 else line[:hash_at]) if line.strip() else ""
-    if not s or not ("D" in s or "d" in s):
-        return False
-    fields = _SEP_RE.split(s)[0::2]
-    return any(_D_NUMBER(f) for f in fields) and all(_D_NUMBER(f) or _NUM_FULL(f)
-                                                     for f in fields)
-
-
 def _d_to_e(line: str) -> str:
-    """A data line with ``D`` exponents written with ``E`` (``d`` with ``e``; its ``#``
-    comment as it is)."""
-    at = line.find("#")
-    body, rest = (line, "") if at < 0 else (line[:at], line[at:])
-    return _D_EXP.sub(lambda m: "E" if m.group(1) == "D" else "e", body) + rest
+    """A data line with ``D`` exponents written with ``E`` (``d`` with ``e``)."""
+    return _in_body(line, lambda b: _D_EXP.sub(lambda m: "E" if m.group(1) == "D" else "e", b))
 
 
 def _e_to_d(line: str) -> str:
     """The inverse of :func:`_d_to_e` for a line written with ``E`` exponents."""
+    return _in_body(line, lambda b: _E_EXP.sub(lambda m: "D" if m.group(1) == "E" else "d", b))
+
+
+def _written_in(line: str, marks: str, trailing: str, fields: Callable[[str], list[str]],
+                styled: Callable[[str], Any]) -> bool:
+    """Whether a data line's fields (``fields`` of the part before its comment, one
+    ``trailing`` separator after the last column dropped) are numbers, at least one of them
+    ``styled`` (a number style that has one of ``marks``)."""
     at = line.find("#")
-    body, rest = (line, "") if at < 0 else (line[:at], line[at:])
-    return _E_EXP.sub(lambda m: "D" if m.group(1) == "E" else "d", body) + rest
+    s = (line if at < 0 else line[:at]).strip()
+    if not any(m in s for m in marks):
+        return False
+    if s[-1:] in tuple(trailing):
+        s = s[:-1].rstrip()
+    got = fields(s)
+    return len(got) >= 2 and any(styled(f) for f in got) and \
+        all(styled(f) or _NUM_FULL(f) for f in got)
+
+
+def fortran_exponents(line: str) -> bool:
+    """Whether a data line writes its numbers with Fortran's double-precision exponent
+    (``0.1234D+01``): its fields are numbers, at least one of them with a ``D``."""
+    return _written_in(line, "Dd", ",;", lambda t: _SEP_RE.split(t)[0::2], _D_NUMBER)
 
 
 def decimal_commas(line: str) -> bool:
@@ -90,16 +99,7 @@ def decimal_commas(line: str) -> bool:
     ``10,5<TAB>2,25``): its fields between ``;``, tabs and blanks are numbers, at least one
     of them with a comma. Such a line also splits into twice as many numbers at its commas,
     which would read the integer and fractional parts as separate columns."""
-    hash_at = line.find("#")
-    s = line if hash_at < 0 else line[:hash_at]
-    if "," not in s or not s.strip():
-        return False
-    s = s.strip()
-    if s[-1:] == ";":  # a separator after the last column
-        s = s[:-1].rstrip()
-    fields = _FIELD_SEP.split(s)
-    return (len(fields) >= 2 and any(_COMMA_NUMBER(f) for f in fields)
-            and all(_COMMA_NUMBER(f) or _NUM_FULL(f) for f in fields))
+    return _written_in(line, ",", ";", _FIELD_SEP.split, _COMMA_NUMBER)
 
 
 class Token(NamedTuple):
@@ -420,12 +420,12 @@ class TextLayout:
             lines[li] = _render_line(lines[li], values[r].tolist(), cols, decimals)
         if not isinstance(lines, list):
             lines = lines.tolist()
-        if self.decimal_comma:  # every data row as the file writes it: decimal commas
+        if self.decimal_comma or self.fortran_d:  # every data row as the file writes it
             for li in data_lines:
-                lines[li] = _point_to_comma(lines[li])
-        if self.fortran_d:  # ... and D exponents
-            for li in data_lines:
-                lines[li] = _e_to_d(lines[li])
+                if self.decimal_comma:
+                    lines[li] = _point_to_comma(lines[li])
+                if self.fortran_d:
+                    lines[li] = _e_to_d(lines[li])
         text = self.newline.join(lines)
         if self.final_newline:
             text += self.newline
@@ -548,14 +548,11 @@ def _numbers_part(body: str) -> str:
     return stripped
 
 
-_D_EXPONENT = re.compile(r"\d[dD][+-]?\d")
-
-
 def _why_not(line: str) -> str:
     """Why a line of numbers is not read as one, for the message: Fortran's ``D`` exponents
     (``; ...``), or nothing."""
     body = line.split("#", 1)[0]
-    if _D_EXPONENT.search(body) and _NUM_RE.search(body):
+    if _D_EXP.search(body):
         return ("; numbers with a D exponent (Fortran's 1.5D+00) are not read: write them "
                 "with E")
     return ""
@@ -564,10 +561,11 @@ def _why_not(line: str) -> str:
 _NUMBERISH = re.compile(r"[\"']?[+-]?\.?\d").match
 
 
-def _wordy(line: str) -> bool:
+def wordy(line: str) -> bool:
     """A line none of whose fields (between blanks, commas and semicolons) starts like a
     number (a digit, after a quote, a sign or a point: ``1.5``, ``"2"``, ``1.5D+00``,
-    ``2024-01-05``)."""
+    ``2024-01-05``): a units row or a title before the data, which the readers keep as it
+    is (a line with a number in it may be a mistyped first row, and is refused)."""
     hash_at = line.find("#")
     body = (line if hash_at < 0 else line[:hash_at]).strip()
     return not any(_NUMBERISH(f) or _NUM_FULL(f) for f in _SEP_RE.split(body)[0::2])
@@ -757,7 +755,7 @@ def parse_text(path: str | os.PathLike[str], *, header: bool = True,
             if not data_lines and head is None and header:
                 head = i
                 continue
-            if not data_lines and header and _wordy(line):
+            if not data_lines and header and wordy(line):
                 # a further line before the data without a number in it (a units row, a
                 # title): kept as it is; one with a number may be a mistyped first row
                 leading.append(i)

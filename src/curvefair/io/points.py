@@ -63,11 +63,11 @@ from ._text import (
     _column_decimals,
     _render_line,
     _split_numbers,
-    _wordy,
     decimal_commas,
     fortran_exponents,
     fresh_text,
     parse_text,
+    wordy,
 )
 
 __all__ = ["read", "write", "render_row", "column_decimals", "coordinate_columns",
@@ -105,13 +105,6 @@ def _header_names(header: str | None, ncols: int) -> list[str] | None:
         m = _NAME_RE.match(p)
         out.append(m.group(0).lower() if m is not None else "")
     return out
-
-
-def wordy(line: str) -> bool:
-    """A line none of whose fields (between blanks, commas and semicolons) starts like a
-    number: a units row or a title before the data, which the readers keep as they are (a
-    line with a number in it may be a mistyped first row, and is refused)."""
-    return _wordy(line)
 
 
 def is_point_numbers(col: FloatArray) -> bool:
@@ -204,7 +197,7 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
                               lay.data_lines[0] + 1)
     if cols != tuple(range(lay.ncols)):
         kept = tuple(c for c in range(lay.ncols) if c not in cols)
-        names = next((p for p in map(lambda h: _header_parts(h, lay.ncols), heads)
+        names = next((p for p in (_header_parts(h, lay.ncols) for h in heads)
                       if p is not None), None)
         what = ", ".join(repr(names[c]) if names and names[c] else str(c) for c in kept)
         import warnings
