@@ -502,3 +502,36 @@ def test_analyze_from_several_threads_at_once(monkeypatch):
         assert not t.is_alive()
     for a, b in zip(ref, got, strict=True):
         _bitwise_same(a, b)
+
+
+@pytest.mark.parametrize("name", [*CURVES, "bspline-closed", "planar-3d", "long-bspline"])
+def test_fairness_figures_are_analyze_figures_bit_for_bit(name):
+    """fair()'s report reads fairness_figures (no per-knot arrays); each figure is the bits
+    of the full analysis' (the long curve: two threads and numpy's pairwise summation over
+    many blocks of the Sapidis sum)."""
+    from curvefair.analysis import fairness_figures
+
+    rng = np.random.default_rng(5)
+    if name == "bspline-closed":
+        a = np.linspace(0, 2 * np.pi, 40, endpoint=False)
+        c = cf.interpolate_bspline(np.c_[np.cos(a), 0.6 * np.sin(a)]
+                                   + 0.01 * rng.normal(size=(40, 2)), closed=True)
+    elif name == "planar-3d":  # analysed in its plane; energies from the 3-D coefficients
+        R = np.linalg.qr(rng.normal(size=(3, 3)))[0]
+        c = cf.interpolate_cubic(np.c_[_noisy(rng, 20, 2), np.zeros(20)] @ R.T)
+    elif name == "long-bspline":
+        t = np.arange(60_000, dtype=float)
+        c = cf.interpolate_bspline(np.c_[t, 20 * np.sin(t / 7)]
+                                   + 0.05 * rng.normal(size=(t.size, 2)))
+    else:
+        c = CURVES[name](rng)
+    a = cf.analyze(c)
+    got = fairness_figures(c)
+    want = {"energy2": a.energy2, "energy3": a.energy3, "max_jump": a.max_jump,
+            "max_top_jump": a.max_top_jump, "sapidis_sum": a.sapidis_sum,
+            "dkds_energy": a.dkds_energy, "inflections": a.inflections, "extrema": a.extrema}
+    assert set(got) == set(want)
+    for k, v in want.items():
+        assert type(got[k]) is type(v), k
+        assert np.float64(got[k]).tobytes() == np.float64(v).tobytes(), (k, got[k], v)
+    assert a.extrema > 0 and a.max_jump > 0

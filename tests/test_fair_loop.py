@@ -384,3 +384,33 @@ def test_bad_input():
         fair(interpolate_cubic([[0, 0], [1, 1]]), "poliakoff")
     with pytest.raises(InputError, match="curvefair curve"):
         fair(np.zeros((3, 2)))
+
+
+def test_a_result_that_moved_nothing_is_analysed_once(monkeypatch):
+    """A method that moved nothing returns the input's data: fair() reports the input's
+    figures for the result too (one analysis, not two), and they are the result's own."""
+    import sys
+
+    import curvefair as cf
+
+    fair_module = sys.modules["curvefair.fairing.fair"]
+    rng = np.random.default_rng(1)
+    t = np.linspace(0, 6, 60)
+    c = cf.interpolate_bspline(np.c_[t, np.sin(t)] + 0.01 * rng.normal(size=(60, 2)))
+    seen = []
+    block_of = fair_module._analysis_block_of
+    monkeypatch.setattr(fair_module, "_analysis_block_of",
+                        lambda cv: seen.append(cv) or block_of(cv))
+    for method, kw, moved in (("knot-removal", {"tol": 1e-9}, False),
+                              ("eck-hadenfeld", {"tol": 0.02, "max_steps": 0}, False),
+                              ("eck-hadenfeld", {"tol": 0.02}, True)):
+        seen.clear()
+        res = cf.fair(c, method, **kw)
+        assert (res.report["n_moved"] > 0) is moved
+        assert len(seen) == (2 if moved else 1)
+        a = cf.analyze(res.curve)
+        assert res.report["extrema_after"] == a.extrema
+        assert res.report["inflections_after"] == a.inflections
+        assert res.report["energy_after"] == a.energy2
+        assert res.report["dkds_energy_after"] == a.dkds_energy
+        assert res.report["sapidis_sum_after"] == a.sapidis_sum

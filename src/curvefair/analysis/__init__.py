@@ -1,7 +1,8 @@
 """Fairness analysis: exact energies, curvature and torsion, bad-point measures, deviation.
 
 Public: :func:`energy`, :func:`curvature`, :func:`curvature_derivative`, :func:`torsion`,
-:func:`analyze` (-> :class:`Analysis`), :func:`deviation` (-> :class:`Deviation`),
+:func:`analyze` (-> :class:`Analysis`; :func:`fairness_figures`: its scalar figures only),
+:func:`deviation` (-> :class:`Deviation`),
 :func:`matched_hermite_bound` (a cheap Hausdorff bound of two cubic Hermite curves),
 :func:`geometric_upper_bound` (the same for any two curves, from one dense pass),
 :func:`point_displacement` (the largest move of corresponding data points),
@@ -10,7 +11,7 @@ Public: :func:`energy`, :func:`curvature`, :func:`curvature_derivative`, :func:`
 curvature of Cheng & Yu lives in :mod:`curvefair.analysis.discrete`.
 """
 
-from ._analyze import Analysis, analyze, derivative_jumps
+from ._analyze import Analysis, analyze, derivative_jumps, fairness_figures
 from ._curvature import curvature, curvature_derivative, torsion
 from ._deviation import (
     Deviation,
@@ -32,6 +33,7 @@ from .discrete import (
 __all__ = [
     "Analysis",
     "analyze",
+    "fairness_figures",
     "derivative_jumps",
     "curvature",
     "curvature_derivative",

@@ -15,7 +15,8 @@ from ._core import bounding_diagonal, check_curve, falling, fields_to_dict
 from ._energy import segment_energies
 from ._sampling import QUAD_RTOL, sample_curve, scan_sign_changes
 
-__all__ = ["Analysis", "analyze", "derivative_jumps", "ZERO_RTOL", "PLANAR_RTOL"]
+__all__ = ["Analysis", "analyze", "fairness_figures", "derivative_jumps", "ZERO_RTOL",
+           "PLANAR_RTOL"]
 
 #: Noise band of the sign counts: ``|kappa| <= ZERO_RTOL * max(max|kappa|, 1/L)`` and
 #: ``|dkappa/ds| <= ZERO_RTOL * max(max|dkappa/ds|, 1/L^2)`` count as zero.
@@ -283,6 +284,28 @@ def analyze(curve: object, *, quad_rtol: float = QUAD_RTOL) -> Analysis:
     c = check_curve(as_curve(curve, "curve"))  # scipy splines too (curvefair.interop)
     rtol = as_positive(quad_rtol, "quad_rtol")
     assert rtol is not None
+    out = _analyze(c, rtol, False)
+    assert isinstance(out, Analysis)
+    return out
+
+
+def fairness_figures(curve: PiecewiseCurve) -> dict[str, Any]:
+    """The scalar figures of :func:`analyze` that a fairing report prints, bit for bit the
+    same, without the per-breakpoint arrays: ``energy2``, ``energy3``, ``max_jump``,
+    ``max_top_jump``, ``sapidis_sum``, ``dkds_energy``, ``inflections``, ``extrema``.
+
+    :func:`curvefair.fair` analyses its input and its result; at ten million segments the
+    frozen per-breakpoint arrays of a full :class:`Analysis` (jumps, top jumps, Sapidis
+    measure, their indices and parameters: 40 bytes a segment) would be made at the call's
+    peak and never read.
+    """
+    out = _analyze(check_curve(curve), QUAD_RTOL, True)
+    assert isinstance(out, dict)
+    return out
+
+
+def _analyze(c: PiecewiseCurve, rtol: float, summary: bool) -> Analysis | dict[str, Any]:
+    """:func:`analyze` of a checked curve; ``summary``: :func:`fairness_figures` instead."""
     pp = c.piecewise
     coeffs = np.asarray(pp.coeffs)
     breaks = np.asarray(pp.breaks)
@@ -302,20 +325,20 @@ def analyze(curve: object, *, quad_rtol: float = QUAD_RTOL) -> Analysis:
     smp = sample_curve(cw, h, planar, closed, rtol)
     if dim == 2:
         L = smp.diagonal
-    jidx = np.arange(0 if closed else 1, m, dtype=np.int64)
-    ks = slice(0 if closed else 1, m)  # the same knots as a slice (cheaper than indexing)
+    ks = slice(0 if closed else 1, m)  # the interior knots as a slice (cheaper than indexing)
+    # (the summary reads the per-knot values where the pass wrote them: no copies)
+    keep = (lambda a: a) if summary else _ro
     if cw is coeffs:
         # exact energies and jumps from the same compiled pass
         e2 = float(np.sum(smp.energies[:, 0]))
         e3 = float(np.sum(smp.energies[:, 1]))
-        jumps = _ro(smp.knots[ks, 0])  # one copy each, straight into frozen memory
-        top = _ro(smp.knots[ks, 1])
+        jumps = keep(smp.knots[ks, 0])  # one copy each, straight into frozen memory
+        top = keep(smp.knots[ks, 1])
     else:  # a planar 3-D curve: energies and jumps from its own (3-D) coefficients
         e2 = float(np.sum(segment_energies(c, 2))) if degree >= 2 else 0.0
         e3 = float(np.sum(segment_energies(c, 3))) if degree >= 3 else 0.0
         jumps = derivative_jumps(c, 3)[1]
         top = derivative_jumps(c, degree)[1]
-    max_jump, max_jump_index = _argmax_or_none(jumps, jidx)
     max_top = float(top.max()) if top.size else 0.0
 
     kap, dks = smp.kappa, smp.dkds
@@ -339,6 +362,16 @@ def analyze(curve: object, *, quad_rtol: float = QUAD_RTOL) -> Analysis:
         n_infl, infl_at = 0, np.zeros(0)
     n_ext, ext_at = scan_sign_changes(dks, smp.x, breaks, (ex_ks[0], ex_ks[1], ex_ks[2] * g * g),
                                       kstol * g * g, closed, ell_g, pos_g, 2)
+
+    if summary:
+        # the sum of a contiguous copy, as analyze() sums its frozen copy: the same bits
+        return {"energy2": e2, "energy3": e3,
+                "max_jump": float(jumps.max()) if jumps.size else 0.0, "max_top_jump": max_top,
+                "sapidis_sum": float(np.sum(np.ascontiguousarray(smp.knots[ks, 2]))),
+                "dkds_energy": float(smp.dkds_energy), "inflections": int(n_infl),
+                "extrema": int(n_ext)}
+    jidx = np.arange(0 if closed else 1, m, dtype=np.int64)
+    max_jump, max_jump_index = _argmax_or_none(jumps, jidx)
 
     # -- Sapidis-Farin measure from the one-sided samples at the knots ----------------------
     z = _ro(smp.knots[ks, 2])

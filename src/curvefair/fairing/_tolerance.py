@@ -44,7 +44,7 @@ from ..curves.hermite import (
     cubic_hermite_coefficients,
     quintic_hermite_coefficients,
 )
-from ..curves.piecewise import PiecewiseCurve, PiecewisePolynomial
+from ..curves.piecewise import PiecewiseCurve, PiecewisePolynomial, readonly
 
 __all__ = ["Certificate", "enforce_tolerance", "curve_fields", "difference_deviation",
            "point_report", "prime_power_forms"]
@@ -92,6 +92,20 @@ def _comparable(a: PiecewiseCurve, b: PiecewiseCurve) -> bool:
     if isinstance(a, BSplineCurve):
         return bool(np.array_equal(a.knots, b.knots))  # type: ignore[attr-defined]
     return bool(np.array_equal(a.params, b.params))  # type: ignore[attr-defined]
+
+
+def same_curve(a: PiecewiseCurve, b: PiecewiseCurve) -> bool:
+    """Whether ``b`` is ``a`` or has bit for bit its type, knots / parameters and data (then
+    every figure of the two is the same; a method that moved nothing returns such a curve)."""
+    if a is b:
+        return True
+    if not _comparable(a, b):
+        return False
+    fa, fb = curve_fields(a), curve_fields(b)
+    assert fa is not None and fb is not None
+    # compared as 64-bit patterns: -0.0 and 0.0 differ, a NaN equals itself
+    return all(np.array_equal(np.ascontiguousarray(fa[k]).view(np.uint64),
+                              np.ascontiguousarray(fb[k]).view(np.uint64)) for k in fa)
 
 
 class _PowerForm(PiecewiseCurve):
@@ -158,11 +172,13 @@ def prime_power_forms(original: PiecewiseCurve, new: PiecewiseCurve
     power_form(t, p, s, ctrl, bool(new.closed), coeffs, base, diff)
     if not (np.isfinite(coeffs).all() and np.isfinite(diff).all()):
         return None  # new.piecewise raises its own message when asked
-    breaks = np.append(t[s], t[s[-1] + 1])
-    own = new.__dict__["piecewise"] = PiecewisePolynomial(breaks, coeffs)  # the cached_property
-    del coeffs  # the frozen copy is the form now: not both through the certificate
-    return new, difference_deviation(original, new, PiecewisePolynomial._borrowed(own.breaks,
-                                                                                  diff))
+    breaks = readonly(np.append(t[s], t[s[-1] + 1]))
+    # the certificate first, then the frozen copy of new's form: the difference form is freed
+    # before that copy is made, so the two forms and the copy are never alive together
+    figures = difference_deviation(original, new, PiecewisePolynomial._borrowed(breaks, diff))
+    del diff
+    new.__dict__["piecewise"] = PiecewisePolynomial(breaks, coeffs)  # the cached_property
+    return new, figures
 
 
 def delta_deviation(a: PiecewiseCurve, delta: dict[str, FloatArray]) -> Any:

@@ -34,6 +34,7 @@ The report of :func:`~curvefair.fair` gives both ``eps`` and ``eps_absolute`` (t
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
@@ -89,7 +90,8 @@ class FairingHistory:
     Attributes
     ----------
     step : ndarray of int64, shape (s,)
-        Step number, 1-based.
+        Step number, 1-based (``1 .. s``: made when first read, not stored with the run; at
+        ten million steps it is 80 MB).
     index : ndarray of int64, shape (s,)
         What the step worked on, 0-based; :attr:`counts` says what that is.
     measure : ndarray of float64, shape (s,)
@@ -102,7 +104,6 @@ class FairingHistory:
         methods), or a knot ``j`` of the knot vector (knot removal).
     """
 
-    step: np.ndarray
     index: np.ndarray
     measure: np.ndarray
     displacement: np.ndarray
@@ -122,8 +123,11 @@ class FairingHistory:
         if counts not in ("data point", "control point", "knot"):
             raise InputError(f"history counts must be 'data point', 'control point' or 'knot', "
                              f"got {counts!r}")
-        step = np.arange(1, idx.shape[0] + 1, dtype=np.int64)
-        return cls(readonly(step), readonly(idx), readonly(meas), readonly(disp), counts)
+        return cls(readonly(idx), readonly(meas), readonly(disp), counts)
+
+    @functools.cached_property
+    def step(self) -> np.ndarray:
+        return readonly(np.arange(1, self.index.shape[0] + 1, dtype=np.int64))
 
     @classmethod
     def empty(cls, counts: HistoryIndex = "data point") -> "FairingHistory":
