@@ -535,3 +535,69 @@ def test_fairness_figures_are_analyze_figures_bit_for_bit(name):
         assert type(got[k]) is type(v), k
         assert np.float64(got[k]).tobytes() == np.float64(v).tobytes(), (k, got[k], v)
     assert a.extrema > 0 and a.max_jump > 0
+
+
+@pytest.mark.parametrize("kind", ["open", "closed", "quadratic", "quintic", "flat", "tiny",
+                                  "huge"])
+def test_planar_bspline_from_span_forms_is_the_whole_form_bit_for_bit(monkeypatch, kind):
+    """A planar B-spline whose power form is not built is analysed from its spans' forms made
+    range by range (analysis._sampling.SpanForms: no whole form at ten million spans); every
+    field of the Analysis is the bits of the analysis of the whole form, with the ranges on
+    two threads, the re-integration of the worst segments and the sign certificates of
+    near-straight data (their segments' rows made on demand), and at drawing scales where the
+    two paths pick another power-of-two unit for the stored samples."""
+    from curvefair import _threads
+    from curvefair.analysis import _analyze as A
+    from curvefair.analysis import _sampling
+
+    rng = np.random.default_rng(len(kind))
+    n = 150
+    x = np.sort(rng.uniform(0, 30, n))
+    pts = np.c_[x, np.sin(x)] + 0.01 * rng.normal(size=(n, 2))
+    if kind == "closed":
+        a = np.linspace(0, 2 * np.pi, n, endpoint=False)
+        c = cf.interpolate_bspline(np.c_[np.cos(a), 0.5 * np.sin(a)]
+                                   + 1e-3 * rng.normal(size=(n, 2)), closed=True)
+    elif kind in ("quadratic", "quintic"):
+        c = cf.interpolate_bspline(pts, degree=2 if kind == "quadratic" else 5)
+    elif kind == "flat":  # near-straight: gaps to certify and segments to re-integrate
+        c = cf.interpolate_bspline(np.c_[x, 1e-4 * rng.normal(size=n)])
+    else:
+        scale = {"open": 1.0, "tiny": 3e-18, "huge": 2e27}[kind]
+        c = cf.interpolate_bspline(pts * scale)
+    monkeypatch.setattr(_threads, "THREADS", 2)
+    monkeypatch.setattr(_sampling, "PAR_MIN", 4)
+    used = []
+    rows = _sampling.SpanForms.rows
+    monkeypatch.setattr(_sampling.SpanForms, "rows",
+                        lambda self, a, b: used.append(b - a) or rows(self, a, b))
+    got = cf.analyze(c)
+    assert "piecewise" not in c.__dict__  # the whole form was never built
+    assert len(used) > 1 and max(used) < c.piecewise.n_segments
+    want = A._analyze(c, 1e-9, False, True)  # the whole form (built just above)
+    _bitwise_same(want, got)
+    assert got.extrema > 0
+    if kind == "flat":
+        assert got.extremum_params.size and (got.arc_length_error > 0)
+
+
+def test_span_coefficients_are_the_whole_forms_rows():
+    """BSplineCurve.span_coefficients(idx) is piecewise.coeffs[idx] bit for bit (any order,
+    repeats), and the Taylor coefficients of the curve: scipy's BSpline derivatives at each
+    span's left knot over k!."""
+    from math import factorial
+
+    from scipy.interpolate import BSpline
+
+    rng = np.random.default_rng(2)
+    x = np.sort(rng.uniform(0, 10, 40))
+    c = cf.interpolate_bspline(np.c_[x, np.cos(x)], degree=3)
+    idx = np.array([5, 0, 5, c.piecewise.n_segments - 1, 17])
+    rows = c.span_coefficients(idx)
+    assert rows.tobytes() == np.asarray(c.piecewise.coeffs)[idx].tobytes()
+    spl = BSpline(np.asarray(c.knots), np.asarray(c.control_points), 3)
+    starts = np.asarray(c.piecewise.breaks)[idx]
+    for k in range(4):
+        np.testing.assert_allclose(rows[:, k, :], spl(starts, k) / factorial(k),
+                                   rtol=1e-9, atol=1e-9)
+    assert c.span_coefficients(np.zeros(0, dtype=int)).shape == (0, 4, 2)

@@ -114,7 +114,7 @@ def _frenet_node(r1, r2, r3, sc1, sc2, speed_rtol, cross_rtol):
 @njit(cache=True, nogil=True, fastmath=_FM, error_model="numpy", readonly=('cw', 'h'))
 def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cross_rtol,
                 kap, dks, knots, energies, quad, box, ell, pos, gaps, unit,
-                i_lo, i_hi, scratch, first, endv, ksfl):
+                i_lo, i_hi, scratch, first, endv, ksfl, off):
     """One fused pass over the segments (see
     :func:`curvefair.analysis._sampling.sample_curve`).
 
@@ -143,8 +143,14 @@ def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cr
     the third and ``degree``-th derivative at the start of segment 0 (range with ``i_lo ==
     0``), ``endv`` the left limits at the end of segment ``i_hi - 1``, ``ksfl`` ``dkappa/ds``
     at those two places: :func:`seam_jumps` makes the closed curve's seam row from them.
+
+    ``cw`` holds the rows of segments ``off .. off + len(cw) - 1`` (those the range reads, the
+    lead-in segment included): the whole form (``off = 0``) or a range's own rows made for
+    it (:class:`curvefair.analysis._sampling.SpanForms`); ``h`` covers every segment.
     """
-    m, p1, dim = cw.shape
+    m = h.shape[0]
+    p1 = cw.shape[1]
+    dim = cw.shape[2]
     K = tab.shape[1]
     p = p1 - 1
     unit2 = unit * unit
@@ -165,8 +171,8 @@ def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cr
     endv[:, :] = 0.0  # left limits at the previous segment's end
     i0 = i_lo - 1 if i_lo > 0 else 0  # the first segment run (see Ranges)
     for d in range(dim):
-        box[0, d] = cw[i0, 0, d]
-        box[1, d] = cw[i0, 0, d]
+        box[0, d] = cw[i0 - off, 0, d]
+        box[1, d] = cw[i0 - off, 0, d]
     ks_start = 0.0
     ks_end = 0.0
     ks_prev_end = 0.0
@@ -184,11 +190,11 @@ def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cr
         ih = 1.0 / hi
         ih2 = ih * ih
         ih3 = ih2 * ih
-        sc1, sc2 = _setup(cw, i, hi, fall, e)
+        sc1, sc2 = _setup(cw, i - off, hi, fall, e)
         ell[row] = sc1 * hi
         c0n = 0.0
         for d in range(dim):
-            v = cw[i, 0, d]
+            v = cw[i - off, 0, d]
             c0n += v * v
             if v < box[0, d]:
                 box[0, d] = v
@@ -216,7 +222,7 @@ def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cr
                 ihn *= ih
             jj = 0.0
             for d in range(dim):
-                right = fall[nu, nu] * cw[i, nu, d] if nu <= p else 0.0
+                right = fall[nu, nu] * cw[i - off, nu, d] if nu <= p else 0.0
                 if i == 0:
                     first[slot, d] = right
                 diff = right - endv[slot, d]
@@ -405,7 +411,7 @@ def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cr
     for d in range(dim):
         acc = 0.0
         for j in range(p1 - 1, -1, -1):
-            acc = acc * h[m - 1] + cw[m - 1, j, d]
+            acc = acc * h[m - 1] + cw[m - 1 - off, j, d]
         if acc < box[0, d]:
             box[0, d] = acc
         if acc > box[1, d]:
@@ -502,8 +508,21 @@ def _piece7(e, a, b, hi, ih, xk, w7, fall, sc1, sc2, speed_rtol, cross_rtol, r1,
     return qa * hi * w, qd * hi * w
 
 
+@njit(cache=True, error_model="numpy")
+def refine_candidates(quad, h, rtol, tot, thresh, out):
+    """The segments whose worst ratio (:func:`allowance`) exceeds ``thresh``, in order, into
+    ``out``; returns how many (those :func:`refine_kernel` may refine)."""
+    n = 0
+    for i in range(h.shape[0]):
+        w = allowance(quad, h, i, rtol, tot[0], tot[1])[2]
+        if w > thresh:
+            out[n] = i
+            n += 1
+    return n
+
+
 @njit(cache=True, fastmath=_FM, error_model="numpy", readonly=('cw', 'h'))
-def refine_kernel(cw, h, quad, rtol, tot, thresh, P, xk, w7, fall, speed_rtol,
+def refine_kernel(cw, seg, h, quad, rtol, tot, thresh, P, xk, w7, fall, speed_rtol,
                   cross_rtol, max_levels, budget):
     """Adaptive re-integration, in place, of the segments whose worst ratio (:func:`allowance`
     with the totals ``tot`` of :func:`allowances`) exceeds ``thresh``.
@@ -519,9 +538,12 @@ def refine_kernel(cw, h, quad, rtol, tot, thresh, P, xk, w7, fall, speed_rtol,
     nearly to zero, where dkappa/ds turns within a tiny parameter range), where refining
     every piece of the segment uniformly spends thousands of pieces.
     ``quad`` rows: (arc length, its error estimate, dkds energy, its error estimate).
+    ``seg``: the segments that may be refined, in curve order (every segment whose ratio
+    exceeds ``thresh``: :func:`refine_candidates`), ``cw[k]`` the power form of ``seg[k]``.
     Returns the pieces used.
     """
-    m, p1, dim = cw.shape
+    p1 = cw.shape[1]
+    dim = cw.shape[2]
     e = np.empty((p1, dim))
     r1 = np.empty(dim)
     r2 = np.empty(dim)
@@ -531,7 +553,8 @@ def refine_kernel(cw, h, quad, rtol, tot, thresh, P, xk, w7, fall, speed_rtol,
     used = 0
     ta = tot[0]
     td = tot[1]
-    for i in range(m):
+    for k_seg in range(seg.shape[0]):
+        i = seg[k_seg]
         aa, ad, w = allowance(quad, h, i, rtol, ta, td)
         if not w > thresh:
             continue
@@ -539,7 +562,7 @@ def refine_kernel(cw, h, quad, rtol, tot, thresh, P, xk, w7, fall, speed_rtol,
             break
         hi = h[i]
         ih = 1.0 / hi
-        sc1, sc2 = _setup(cw, i, hi, fall, e)
+        sc1, sc2 = _setup(cw, k_seg, hi, fall, e)
         top = 0
         if P == 1:
             # one starting piece: the whole segment, whose 7-point value the pass computed

@@ -3,17 +3,18 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
 from .._typing import FloatArray
 from .._validate import as_positive
+from ..curves.bspline import POWER_FORM_MAX_DEGREE, BSplineCurve
 from ..curves.piecewise import PiecewiseCurve, readonly
 from ..interop import as_curve
 from ._core import bounding_diagonal, check_curve, falling, fields_to_dict
 from ._energy import segment_energies
-from ._sampling import QUAD_RTOL, sample_curve, scan_sign_changes
+from ._sampling import QUAD_RTOL, SpanForms, sample_curve, scan_sign_changes
 
 __all__ = ["Analysis", "analyze", "fairness_figures", "derivative_jumps", "ZERO_RTOL",
            "PLANAR_RTOL"]
@@ -304,18 +305,40 @@ def fairness_figures(curve: PiecewiseCurve) -> dict[str, Any]:
     return out
 
 
-def _analyze(c: PiecewiseCurve, rtol: float, summary: bool) -> Analysis | dict[str, Any]:
-    """:func:`analyze` of a checked curve; ``summary``: :func:`fairness_figures` instead."""
-    pp = c.piecewise
-    coeffs = np.asarray(pp.coeffs)
-    breaks = np.asarray(pp.breaks)
-    m, p1, dim = coeffs.shape
+def _span_forms(c: PiecewiseCurve) -> SpanForms | None:
+    """A planar B-spline's span forms made where the sampling reads them (its whole power form
+    not built, or already built: then that is read), else None."""
+    if (type(c) is BSplineCurve and c.dim == 2 and "piecewise" not in c.__dict__
+            and c.degree <= POWER_FORM_MAX_DEGREE):
+        return SpanForms(c.knots, c.degree, c.spans, c.control_points, c.closed)
+    return None
+
+
+def _analyze(c: PiecewiseCurve, rtol: float, summary: bool, whole: bool = False
+             ) -> Analysis | dict[str, Any]:
+    """:func:`analyze` of a checked curve; ``summary``: :func:`fairness_figures` instead;
+    ``whole``: read the whole power form even where :class:`SpanForms` could be made."""
+    forms = None if whole else _span_forms(c)
+    coeffs: FloatArray | None
+    if forms is not None:
+        # the breaks and widths as the whole form has them (BSplineCurve's own power form)
+        s = forms.spans
+        breaks = np.append(forms.knots[s], forms.knots[s[-1] + 1])
+        h = np.diff(breaks)
+        m, p1, dim = forms.shape
+        coeffs = None
+    else:
+        pp = c.piecewise
+        coeffs = np.asarray(pp.coeffs)
+        breaks = np.asarray(pp.breaks)
+        m, p1, dim = coeffs.shape
+        h = pp.widths
     degree = p1 - 1
-    h = pp.widths
     closed = bool(c.closed)
     planar = dim == 2
-    cw = coeffs
+    cw: FloatArray | SpanForms = forms if forms is not None else cast(FloatArray, coeffs)
     if dim == 3:
+        assert coeffs is not None
         L = bounding_diagonal(pp)
         E = _plane_basis(coeffs, h, L)
         if E is not None:
@@ -323,12 +346,15 @@ def _analyze(c: PiecewiseCurve, rtol: float, summary: bool) -> Analysis | dict[s
             cw = np.ascontiguousarray(coeffs @ E)  # (m, p1, 2): coordinates in the plane
 
     smp = sample_curve(cw, h, planar, closed, rtol)
+    if forms is not None and not forms.finite:
+        c.piecewise  # noqa: B018 (a form beyond float64 raises the whole form's own message)
+        return _analyze(c, rtol, summary, True)
     if dim == 2:
         L = smp.diagonal
     ks = slice(0 if closed else 1, m)  # the interior knots as a slice (cheaper than indexing)
     # (the summary reads the per-knot values where the pass wrote them: no copies)
     keep = (lambda a: a) if summary else _ro
-    if cw is coeffs:
+    if cw is coeffs or cw is forms:
         # exact energies and jumps from the same compiled pass
         e2 = float(np.sum(smp.energies[:, 0]))
         e3 = float(np.sum(smp.energies[:, 1]))

@@ -29,6 +29,7 @@ import numpy as np
 
 from .. import _threads
 from .._kernels import sampling as _k
+from .._kernels.bspline import power_form_kernel as _power_form_kernel
 from .._typing import FloatArray
 from ._core import CROSS_RTOL, SPEED_RTOL, derivs_at, falling, frenet
 
@@ -179,6 +180,44 @@ class Samples:
     unit: float = 1.0  # the power of two near the curve's size that scales kappa and dkds
 
 
+class SpanForms:
+    """The power form of a B-spline's spans, made where it is read instead of kept whole.
+
+    ``rows(a, b)`` gives the coefficients of segments ``a .. b-1``, ``forms[idx]`` those of
+    the segments ``idx`` (any integer array), with ``shape = (m, degree + 1, dim)`` as the
+    whole form's: each span's coefficients depend on its own knots and control points only
+    (:func:`curvefair._kernels.bspline.power_form_kernel`), so every row is bitwise the row of
+    the whole form. :func:`sample_curve` reads a range's rows while it samples that range:
+    at ten million cubic spans the whole form is 640 MB, a range's rows a sixteenth of it.
+    """
+
+    def __init__(self, knots: FloatArray, degree: int, spans: np.ndarray,
+                 ctrl: FloatArray, closed: bool) -> None:
+        self.knots = np.ascontiguousarray(knots, dtype=np.float64)
+        self.degree = int(degree)
+        self.spans = np.ascontiguousarray(spans, dtype=np.int64)
+        self.ctrl = np.ascontiguousarray(ctrl, dtype=np.float64)
+        self.closed = bool(closed)
+        self.shape = (self.spans.shape[0], self.degree + 1, self.ctrl.shape[1])
+        self.finite = True  # cleared by a row that is not (the caller then reads the whole form)
+
+    def _of(self, spans: np.ndarray) -> FloatArray:
+        out = np.empty((spans.shape[0],) + self.shape[1:])
+        if spans.shape[0]:
+            _power_form_kernel(self.knots, self.degree, np.ascontiguousarray(spans), self.ctrl,
+                               self.closed, out)
+            if not np.isfinite(out).all():
+                self.finite = False
+                out[~np.isfinite(out)] = 0.0
+        return out
+
+    def rows(self, a: int, b: int) -> FloatArray:
+        return self._of(self.spans[a:b])
+
+    def __getitem__(self, idx: np.ndarray) -> FloatArray:
+        return self._of(self.spans[np.asarray(idx, dtype=np.int64)])
+
+
 def _speed_scales(cc: FloatArray, hh: FloatArray) -> tuple[FloatArray, FloatArray]:
     p1 = cc.shape[1]
     nrm = np.sqrt(np.sum(cc * cc, axis=2))  # (k, p1)
@@ -191,7 +230,7 @@ def _speed_scales(cc: FloatArray, hh: FloatArray) -> tuple[FloatArray, FloatArra
     return s1, s2
 
 
-def _frenet_at(cw: FloatArray, h: FloatArray, segs: np.ndarray, us: FloatArray,
+def _frenet_at(cw: FloatArray | SpanForms, h: FloatArray, segs: np.ndarray, us: FloatArray,
                numerators: bool = False) -> dict[str, FloatArray]:
     """Numpy evaluation of :func:`frenet` at segments ``segs``, fractions ``us``."""
     shape = np.broadcast_shapes(np.shape(segs), np.shape(us))
@@ -207,7 +246,7 @@ def _frenet_at(cw: FloatArray, h: FloatArray, segs: np.ndarray, us: FloatArray,
     return {k: v.reshape(shape) for k, v in fr.items()}
 
 
-def _refine_gaps(cw: FloatArray, h: FloatArray, plan: _Plan, gaps: np.ndarray
+def _refine_gaps(cw: FloatArray | SpanForms, h: FloatArray, plan: _Plan, gaps: np.ndarray
                  ) -> list[tuple[np.ndarray, FloatArray]]:
     """Halve the flagged gaps (de Casteljau) until every piece's Bernstein coefficients vary
     at most once; the split points are the extra samples, per quantity ``(segment, u)``."""
@@ -244,7 +283,7 @@ def _refine_gaps(cw: FloatArray, h: FloatArray, plan: _Plan, gaps: np.ndarray
     return out
 
 
-def sample_curve(cw: FloatArray, h: FloatArray, planar: bool, closed: bool,
+def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed: bool,
                  rtol: float = QUAD_RTOL) -> Samples:
     """Sample ``kappa`` and ``dkappa/ds`` on every segment; integrate; certify signs.
 
@@ -262,6 +301,11 @@ def sample_curve(cw: FloatArray, h: FloatArray, planar: bool, closed: bool,
     float32's range (dkappa/ds ~ 1e-48 flushes to zero and every extremum is lost). A power
     of two scales exactly: for curves of ordinary size the stored values are those of
     ``unit = 1`` times ``unit``, bit for bit.
+
+    ``cw`` may be a :class:`SpanForms` (a planar B-spline whose form is not built): each range
+    of the pass then makes its own rows, the re-integration and the sign certificates those of
+    the segments they read, and ``unit`` is the power of two nearest the diagonal of the
+    control points (a power of two either way: the counts and figures are the same bits).
     """
     m, p1, dim = cw.shape
     p = p1 - 1
@@ -286,13 +330,14 @@ def sample_curve(cw: FloatArray, h: FloatArray, planar: bool, closed: bool,
     spare = _threads.CHUNKS
     kap = np.empty((m + spare, K), dtype=np.float32)
     dks = np.empty((m + spare, K), dtype=np.float32)
-    unit = _unit(cw)
+    forms = cw if isinstance(cw, SpanForms) else None
+    unit = _unit(cast(FloatArray, cw)) if forms is None else _unit_of(forms.ctrl)
     knots = np.empty((m + spare, 3))
     energies = np.empty((m + spare, 2))
     quad = np.empty((m + spare, 4))
     ell = np.empty(m + spare)
     pos = np.empty(m + spare)
-    cwc = np.ascontiguousarray(cw, dtype=np.float64)
+    cwc = np.ascontiguousarray(cw, dtype=np.float64) if forms is None else None
     hc = np.ascontiguousarray(h, dtype=np.float64)
     first = np.zeros((2, dim))  # limits at the start of segment 0 (range 0 writes them)
     ksfl = np.zeros(2)
@@ -305,11 +350,15 @@ def sample_curve(cw: FloatArray, h: FloatArray, planar: bool, closed: bool,
         fl = np.zeros(2)
         gaps = np.empty((max(1 << 12, (b - a) // 4), 3), dtype=np.int64)
         scratch = m + starts.get(a, 0)
+        off = a - 1 if a > 0 else 0  # the range's rows: its lead-in segment first
+        rows = cwc if forms is None else forms.rows(off, b)
+        if forms is None:
+            off = 0
         while True:
             nsing, maxk, maxks, ngap = _k.pass_kernel(
-                cwc, hc, plan.x, plan.tab, plan.w7, plan.w4, plan.P, fall, fits, nfit, subs,
+                rows, hc, plan.x, plan.tab, plan.w7, plan.w4, plan.P, fall, fits, nfit, subs,
                 SPEED_RTOL, CROSS_RTOL, kap, dks, knots, energies, quad, box, ell, pos, gaps,
-                unit, a, b, scratch, first, endv, fl)
+                unit, a, b, scratch, first, endv, fl, off)
             if ngap <= gaps.shape[0]:
                 break
             gaps = np.empty((ngap, 3), dtype=np.int64)  # rare: the buffer was too small; redo
@@ -345,7 +394,11 @@ def sample_curve(cw: FloatArray, h: FloatArray, planar: bool, closed: bool,
         above = np.cumsum(hist[::-1])[::-1]  # above[k]: segments with worst > 2^k
         k = int(np.argmax(above <= top)) if above[0] > top else 0
         thresh = 1.0 if k == 0 else float(2.0**k)
-        _k.refine_kernel(cwc, hc, quad, float(rtol), tot, thresh, plan.P, plan.xk, plan.w7,
+        seg = np.empty(m, dtype=np.int64)  # (pages never written are never mapped)
+        seg = seg[:_k.refine_candidates(quad, hc, float(rtol), tot, thresh, seg)].copy()
+        rows = cast(FloatArray, cwc)[seg] if forms is None else forms[seg]
+        _k.refine_kernel(rows, seg, hc, quad, float(rtol), tot, thresh, plan.P, plan.xk,
+                         plan.w7,
                          fall, SPEED_RTOL, CROSS_RTOL, _MAX_LEVELS, budget)
 
     refined = _refine_gaps(cw, h, plan, gaps[:ngap])
@@ -370,11 +423,16 @@ def sample_curve(cw: FloatArray, h: FloatArray, planar: bool, closed: bool,
 
 def _unit(cw: FloatArray) -> float:
     """The power of two nearest the diagonal of the segments' start points (1.0 if none)."""
-    if cw.shape[0] == 0:
+    return _unit_of(cw[:, 0, :])
+
+
+def _unit_of(pts: FloatArray) -> float:
+    """The power of two nearest the diagonal of the bounding box of ``pts`` (1.0 if none)."""
+    if pts.shape[0] == 0:
         return 1.0
     # per coordinate, 1-D reductions of the strided column (exact, as the reduction along
     # axis 0 is, and several times faster at a million segments)
-    ext = np.array([cw[:, 0, d].max() - cw[:, 0, d].min() for d in range(cw.shape[2])])
+    ext = np.array([pts[:, d].max() - pts[:, d].min() for d in range(pts.shape[1])])
     diag = float(np.sqrt(np.sum(ext ** 2)))
     if not (np.isfinite(diag) and diag > 0.0):
         return 1.0

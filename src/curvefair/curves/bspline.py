@@ -383,6 +383,18 @@ class BSplineCurve(PiecewiseCurve):
             return PiecewisePolynomial(breaks, coeffs, evaluator=self._span_values)
         return PiecewisePolynomial(breaks, coeffs)
 
+    def span_coefficients(self, which: np.ndarray) -> FloatArray:
+        """The power-form coefficients of the spans ``which`` (indices into :attr:`spans`, any
+        order, repeats allowed): shape ``(k, degree + 1, dim)``, bit for bit the rows
+        ``piecewise.coeffs[which]`` (each span's coefficients depend on its own knots and
+        control points only), without building the whole form (72 bytes a cubic planar span)."""
+        spans = np.ascontiguousarray(np.asarray(self.spans)[np.asarray(which, dtype=np.int64)])
+        out = np.empty((spans.shape[0], self.degree + 1, self._ctrl.shape[1]))
+        if spans.shape[0]:
+            power_form_kernel(np.ascontiguousarray(self._knots), self.degree, spans,
+                              np.ascontiguousarray(self._ctrl), self._closed, out)
+        return out
+
     def _partial_form(self, u: FloatArray) -> tuple[FloatArray, FloatArray] | None:
         """The power form of the spans holding ``u`` (see
         :meth:`PiecewiseCurve._evaluate <curvefair.PiecewiseCurve>`), or None for a short curve,

@@ -724,9 +724,11 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
     if same_curve(curve, new):  # the method moved nothing: the input's figures are the result's
         primed, after = None, dict(before)
     else:
-        # a B-spline result on the input's knots: its power form (for the analysis) and the
-        # difference curve's (for the certificate below) share one pass over the spans
-        primed = prime_power_forms(curve, new)
+        # a 3-D B-spline result on the input's knots: its power form (for the analysis) and
+        # the difference curve's (for the certificate below) share one pass over the spans;
+        # a planar one's analysis reads its spans' forms range by range (never the whole
+        # form), and the certificate makes the difference form after it, not beside it
+        primed = prime_power_forms(curve, new) if new.dim == 3 else None
         after = analysis_block(new)
     guard_info: dict[str, Any] = {"kept": "output"}
     from ._guard import _adds, is_chord_interpolant, rebuilt_analysis

@@ -70,8 +70,8 @@ import numpy as np
 
 from .._kernels import joins as _k
 from .._typing import FloatArray
-from ..curves.bspline import BSplineCurve, basis_derivatives
-from ..curves.piecewise import PiecewiseCurve
+from ..curves.bspline import POWER_FORM_MAX_DEGREE, BSplineCurve, basis_derivatives
+from ..curves.piecewise import PiecewiseCurve, horner_rows
 
 __all__ = ["plan", "JoinPlan", "Corner", "join_angles", "corner_turns", "DEFAULT_G1_ANGLE",
            "DEFAULT_CORNER_TURN"]
@@ -247,6 +247,36 @@ def _vanishes(d: FloatArray, w: float, k: int, size: float) -> bool:
     return float(np.linalg.norm(d)) * float(w) ** k <= _VANISH * size
 
 
+class _SpanForm:
+    """What a join plan reads of a B-spline's power form (breaks, widths, degree, values at a
+    few breaks on given pieces) without the whole form, which the analysis no longer builds
+    either (it reads its spans range by range): the rows of the pieces asked for
+    (:meth:`~curvefair.BSplineCurve.span_coefficients`), evaluated by Horner's rule as
+    :meth:`~curvefair.PiecewisePolynomial.evaluate` evaluates a few pieces: the same bits."""
+
+    def __init__(self, curve: BSplineCurve) -> None:
+        t = np.asarray(curve.knots)
+        s = np.asarray(curve.spans)
+        self.curve = curve
+        self.breaks = np.append(t[s], t[s[-1] + 1])  # as BSplineCurve's power form has them
+        self.widths = np.diff(self.breaks)
+        self.degree = int(curve.degree)
+
+    def evaluate(self, u: Any, nu: int, segment: np.ndarray) -> FloatArray:
+        uf = np.asarray(u, dtype=float).reshape(-1)
+        seg = np.asarray(segment).reshape(-1)
+        rows = self.curve.span_coefficients(seg)
+        return horner_rows(rows, (uf - self.breaks[seg])[:, None], nu)
+
+
+def _form_of(curve: BSplineCurve) -> Any:
+    """The curve's power form if it is built (or has its own evaluator), else a
+    :class:`_SpanForm`."""
+    if "piecewise" in curve.__dict__ or curve.degree > POWER_FORM_MAX_DEGREE:
+        return curve.piecewise
+    return _SpanForm(curve)
+
+
 def _side_tangent(pp: Any, v: float, seg: int, left: bool, size: float
                   ) -> tuple[FloatArray | None, int]:
     """The direction in which the curve arrives at (``left``) or leaves the break ``v`` of
@@ -257,7 +287,7 @@ def _side_tangent(pp: Any, v: float, seg: int, left: bool, size: float
     handle lies on its node (``P_2 = P_3``) arrives along ``P_3 - P_1``."""
     w = float(np.asarray(pp.widths)[seg])
     x, s = np.array([v]), np.array([seg])
-    for k in range(1, int(np.asarray(pp.coeffs).shape[1])):
+    for k in range(1, int(pp.degree) + 1):
         d = np.asarray(pp.evaluate(x, k, segment=s), dtype=float).reshape(-1)
         if not _vanishes(d, w, k, size):
             return (-d if left and k % 2 == 0 else d), k
@@ -323,7 +353,7 @@ def _bspline_plan(curve: BSplineCurve, clamp: tuple[str, str], protect: frozense
     # distinct interior knots of the domain and their multiplicities
     lo, hi = curve.domain
     vals, first, counts = np.unique(t, return_index=True, return_counts=True)
-    pp = curve.piecewise
+    pp = _form_of(curve)
     br = np.asarray(pp.breaks)
     reduce: list[tuple[int, int, float, float]] = []  # (j, knot position a, dl, dr)
     g2_cand: dict[int, set[int]] = {}  # G2 C0 join point -> the control points it depends on
