@@ -27,6 +27,7 @@ from .._kernels.bspline import band_energy, band_residual
 from .._typing import FloatArray
 from .._validate import as_step_count, check_finite, choice, parse_clamp
 from ..curves.bspline import BSplineCurve
+from ..curves.piecewise import readonly
 from ..errors import InputError
 from .problem import check_bspline
 from .stop import StopReason
@@ -432,15 +433,21 @@ def solve(problem: FairingProblem, *, l: int = 2, eps_relative: bool = True,  # 
                                             curve.closed, tolv, eps_abs, int(max_steps), hist,
                                             np.empty(n, dtype=np.int64),
                                             np.empty(n, dtype=np.uint8))
-    # the loop keeps every coordinate finite and the knots are the input's: no re-validation
-    out = BSplineCurve._trusted(np.ascontiguousarray(X[:, :dim]), curve.knots, curve.degree,
+    # the loop's state is freed before the result's copy is made (on chord-length knots the
+    # band rows Wu hold as many bytes as W again: 4 of the input's coordinate bytes)
+    del Wu, pat, z
+    # the loop keeps every coordinate finite and the knots are the input's: no re-validation;
+    # one copy of the coordinates, straight into frozen memory
+    out = BSplineCurve._trusted(readonly(X[:, :dim]), curve.knots, curve.degree,
                                 curve.closed, same_knots_as=curve)
+    del X
     e1 = _energy(out, W)
     if not np.isfinite(e1):
         check_finite(out.control_points, "control_points")
     reason = STOP_REASONS[int(code)]
     if reason == "converged":
-        zfree = float(_k.largest_free_z(W, curve.degree, curve.closed, X[:, :dim], mask))
+        zfree = float(_k.largest_free_z(W, curve.degree, curve.closed,
+                                        np.asarray(out.control_points), mask))
         if zfree > eps_abs and zfree > 0.0:
             reason = "tolerance"  # the unconstrained moves are still worth making
         elif eps_abs > 0.0 and zfree > 0.0:
