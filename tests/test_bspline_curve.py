@@ -434,3 +434,39 @@ def test_few_parameters_without_the_power_form_are_bitwise_the_same(p, closed):
     many = BSplineCurve(ctrl, t, p, closed=closed)
     v = np.linspace(lo, hi, 50)
     assert np.array_equal(many(v), full(v)) and "piecewise" in many.__dict__
+
+
+@pytest.mark.parametrize("knots", ["chord", "uniform", "repeated"])
+@pytest.mark.parametrize("degree,l", [(3, 2), (3, 3), (2, 2), (5, 3)])
+def test_gram_band_in_two_halves_is_bitwise_one_pass(monkeypatch, knots, degree, l):  # noqa: E741
+    """A long open curve's Gram band is accumulated in two halves on two threads (the second
+    from p spans before its own, into rows of its own): every row bitwise the one-pass sum,
+    whether the spans reuse their neighbour's element matrix (uniform knots) or not, and
+    across repeated interior knots (empty spans skipped)."""
+    from curvefair import _threads
+    from curvefair.curves import bspline as B
+
+    rng = np.random.default_rng(degree + 7 * l)
+    n = 300
+    if knots == "repeated":
+        inner = np.repeat(np.arange(1.0, 100.0), 2)[: n - degree - 1]
+        t = np.r_[[0.0] * (degree + 1), inner, [inner[-1] + 1.0] * (degree + 1)]
+        c = BSplineCurve(rng.normal(size=(t.size - degree - 1, 2)), t, degree)
+    else:
+        x = np.arange(n, dtype=float) if knots == "uniform" else np.sort(rng.uniform(0, 90, n))
+        c = interpolate_bspline(np.c_[x, np.sin(x)] + 0.01 * rng.normal(size=(n, 2)),
+                                degree=degree, param="uniform" if knots == "uniform" else "chord")
+    def fresh():  # a new curve: no Gram band cached with its knots
+        return BSplineCurve(np.array(c.control_points), np.array(c.knots), degree)
+
+    monkeypatch.setattr(_threads, "THREADS", 1)
+    one = np.asarray(fresh().gram_band(l))
+    monkeypatch.setattr(_threads, "THREADS", 2)
+    monkeypatch.setattr(B, "GRAM_PAR_MIN", 8)
+    calls = []
+    kernel = B.gram_kernel
+    monkeypatch.setattr(B, "gram_kernel", lambda *a: calls.append(a[-1]) or kernel(*a))
+    two = np.asarray(fresh().gram_band(l))
+    assert len(calls) == 2 and calls[1] > 0  # the second half starts at a later row
+    assert one.tobytes() == two.tobytes()
+    assert np.abs(one).max() > 0

@@ -206,8 +206,8 @@ def power_form_pair_kernel(knots, p, spans, ctrl, base, closed, out, out_diff):
         _power_form_body(knots, p, spans, ctrl, base, closed, out, out_diff, True)
 
 
-@njit(cache=True)
-def gram_kernel(knots, p, spans, l, xq, wq, n, closed, W):  # noqa: E741
+@njit(cache=True, nogil=True)
+def gram_kernel(knots, p, spans, l, xq, wq, n, closed, W, row0):  # noqa: E741
     """Banded Gram matrix ``W`` (n, 2p+1) of ``int N_i^(l) N_j^(l)`` (see
     :meth:`curvefair.BSplineCurve.gram_band`), accumulated into ``W`` (zeros on entry,
     allocated by numpy: huge pages, see :func:`natural_cubic_kernel`).
@@ -215,6 +215,12 @@ def gram_kernel(knots, p, spans, l, xq, wq, n, closed, W):  # noqa: E741
     One Gauss-Legendre rule per knot span, on local offsets ``x - knots[s]``; a span whose
     local knot pattern (``knots[s-p+1 .. s+p] - knots[s]``) equals the previous span's reuses
     its element matrix bitwise (uniform knots: a handful of evaluations in all).
+
+    ``row0`` (open curves): ``W`` holds rows ``row0 ..`` of the band, and the rows before it
+    are skipped, so that the spans from ``s >= row0`` on accumulate every row from ``row0``
+    on completely, in the order of one pass (a row ``r`` sums the spans ``r .. r + p``):
+    :meth:`curvefair.BSplineCurve.gram_band` runs the second half of a long curve's spans so
+    on a second thread, bitwise the one pass. ``0`` for the whole band.
     """
     nq = xq.shape[0]
     ndu = np.empty((p + 1, p + 1))
@@ -252,8 +258,10 @@ def gram_kernel(knots, p, spans, l, xq, wq, n, closed, W):  # noqa: E741
                 for j in range(p + 1):
                     W[row, p + j - i] += M[i, j]
         else:  # the same additions in the same order, flat indices
-            base = (s - p) * w2 + p
+            base = (s - p - row0) * w2 + p
             for i in range(p + 1):
+                if s - p + i < row0:
+                    continue
                 b = base + i * (w2 - 1)
                 for j in range(p + 1):
                     Wf[b + j] += M[i, j]

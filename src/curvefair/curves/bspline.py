@@ -111,6 +111,8 @@ POWER_FORM_MAX_DEGREE = 5
 
 #: Knot spans: from this many on, the power form is computed in ranges on two threads.
 POWER_FORM_PAR_MIN = 50_000
+#: Spans from which :meth:`BSplineCurve.gram_band` runs its two halves on two threads.
+GRAM_PAR_MIN = 50_000
 
 
 def power_form(knots: FloatArray, p: int, spans: np.ndarray, ctrl: FloatArray, closed: bool,
@@ -469,9 +471,30 @@ class BSplineCurve(PiecewiseCurve):
     def _gram_band(self, l: int) -> FloatArray:  # noqa: E741
         p = self.degree
         xq, wq = _gauss(p - int(l) + 1)
-        return gram_kernel(np.ascontiguousarray(self._knots), p,
-                           np.ascontiguousarray(self.spans, dtype=np.int64), int(l), xq, wq,
-                           self.n_ctrl, self._closed, np.zeros((self.n_ctrl, 2 * p + 1)))
+        t = np.ascontiguousarray(self._knots)
+        s = np.ascontiguousarray(self.spans, dtype=np.int64)
+        n = self.n_ctrl
+        W = np.zeros((n, 2 * p + 1))
+        if self._closed or s.shape[0] < GRAM_PAR_MIN or _threads.THREADS < 2:
+            return gram_kernel(t, p, s, int(l), xq, wq, n, self._closed, W, 0)
+        # two halves of the spans on two threads: the first accumulates into W, the second
+        # (from p spans before its own: every span of its rows) rows row0 .. into its own
+        # zeros, which then replace W's rows there (the first half's partial sums): each row
+        # is one pass's sum, in one pass's order, bitwise
+        k = s.shape[0] // 2
+        row0 = int(s[k]) - p
+        lead = int(np.searchsorted(s, row0, side="left"))
+        tail = np.zeros((n - row0, 2 * p + 1))
+
+        def half(a: int, b: int) -> None:
+            if a == 0:
+                gram_kernel(t, p, s[:k], int(l), xq, wq, n, False, W, 0)
+            else:
+                gram_kernel(t, p, s[lead:], int(l), xq, wq, n, False, tail, row0)
+
+        _threads.ranges(half, 0, 2, 2, 0, chunks=2)
+        W[row0:] = tail
+        return W
 
     def gram_matrix(self, l: int) -> Any:  # noqa: E741
         """The Gram matrix of :meth:`gram_band` as a ``scipy.sparse`` CSR matrix ``(n, n)``."""
