@@ -5,11 +5,11 @@ at ``t = 0, 1, ...`` plus Gaussian noise 0.05.
 
 Table 1 (per size): one csaps fit of the points (``csaps.CubicSmoothingSpline(t, P.T,
 smooth=0.5)``, best of ``--repeat``), the whole ``fair(interpolate_bspline(P), "eck-hadenfeld",
-tol=0.02)`` call, and the pieces of its fixed cost timed one by one on the same curves: the
-before and after analysis (``analyze`` of a fresh copy, power form included; the after one with
-the difference curve's power form built in the same pass, as ``fair()`` does), the joins plan,
-``enforce_tolerance`` (the deviation certificate on the difference curve, given that form), the
-point report and
+tol=0.02)`` call, and the pieces of its fixed cost timed one by one on the same curves, as
+``fair()`` runs them: the before and after analysis (``fairness_figures`` of a fresh copy: a
+planar B-spline's span forms made range by range; a 3-D result's power form built together with
+the difference curve's), the joins plan, ``enforce_tolerance`` (the deviation certificate on
+the difference curve: for a planar result its power form is made there), the point report and
 ``report.to_dict()`` (JSON-ready, what the CLI's ``--report`` pays). Ratios are against the csaps
 fit measured in the same run.
 
@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 
 import curvefair as cf
+from curvefair.analysis import fairness_figures
 from curvefair.fairing import joins as _joins
 from curvefair.fairing import point_report
 from curvefair.fairing._tolerance import enforce_tolerance, prime_power_forms
@@ -67,15 +68,16 @@ def fresh(c: Any) -> Any:
 
 def after_analysis(c: Any, new: Any) -> Any:
     f = fresh(new)
-    prime_power_forms(c, f)
-    return cf.analyze(f)
+    if f.dim == 3:  # as fair(): a 3-D result's form and the difference form in one pass
+        prime_power_forms(c, f)
+    return fairness_figures(f)
 
 
 def enforce_primed(c: Any, new: Any) -> float:
-    """Time of ``enforce_tolerance`` given the primed difference form (not timed itself: it is
-    counted in the after-analysis)."""
+    """Time of ``enforce_tolerance`` as fair() calls it (a 3-D result: given the primed
+    difference form, whose making is counted in the after-analysis)."""
     f = fresh(new)
-    pr = prime_power_forms(c, f)
+    pr = prime_power_forms(c, f) if f.dim == 3 else None
     t0 = CLOCK()
     enforce_tolerance(c, f, 0.02, primed=pr)
     return CLOCK() - t0
@@ -96,9 +98,7 @@ def table1(sizes: list[int], repeat: int) -> None:
         cf.fair(cf.interpolate_bspline(P[:200]), "eck-hadenfeld", tol=0.02)  # warm
         tf, res = best(lambda c=c: cf.fair(fresh(c), "eck-hadenfeld", tol=0.02), repeat)
         new = res.curve
-        ta0, _ = best(lambda c=c: cf.analyze(fresh(c)), repeat)
-        # the after-analysis as fair() runs it: the result's power form built together with
-        # the difference curve's (prime_power_forms), which enforce_tolerance then uses
+        ta0, _ = best(lambda c=c: fairness_figures(fresh(c)), repeat)
         ta1, _ = best(lambda c=c, new=new: after_analysis(c, new), repeat)
         tj, _ = best(lambda c=c: _joins.plan(c, ("g0", "g0"), frozenset(),
                                              _joins.DEFAULT_G1_ANGLE, 0.02), repeat)
