@@ -352,13 +352,14 @@ def _analyze(c: PiecewiseCurve, rtol: float, summary: bool, whole: bool = False
     if dim == 2:
         L = smp.diagonal
     ks = slice(0 if closed else 1, m)  # the interior knots as a slice (cheaper than indexing)
-    # (the summary reads the per-knot values where the pass wrote them: no copies)
+    # analyze() keeps one frozen copy of each per-knot column; the summary reads the values
+    # where the pass wrote them
     keep = (lambda a: a) if summary else _ro
     if cw is coeffs or cw is forms:
         # exact energies and jumps from the same compiled pass
         e2 = float(np.sum(smp.energies[:, 0]))
         e3 = float(np.sum(smp.energies[:, 1]))
-        jumps = keep(smp.knots[ks, 0])  # one copy each, straight into frozen memory
+        jumps = keep(smp.knots[ks, 0])
         top = keep(smp.knots[ks, 1])
     else:  # a planar 3-D curve: energies and jumps from its own (3-D) coefficients
         e2 = float(np.sum(segment_energies(c, 2))) if degree >= 2 else 0.0

@@ -350,10 +350,11 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
         fl = np.zeros(2)
         gaps = np.empty((max(1 << 12, (b - a) // 4), 3), dtype=np.int64)
         scratch = m + starts.get(a, 0)
-        off = a - 1 if a > 0 else 0  # the range's rows: its lead-in segment first
-        rows = cwc if forms is None else forms.rows(off, b)
         if forms is None:
-            off = 0
+            rows, off = cwc, 0
+        else:  # the range's own rows, its lead-in segment first
+            off = a - 1 if a > 0 else 0
+            rows = forms.rows(off, b)
         while True:
             nsing, maxk, maxks, ngap = _k.pass_kernel(
                 rows, hc, plan.x, plan.tab, plan.w7, plan.w4, plan.P, fall, fits, nfit, subs,
@@ -398,8 +399,7 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
         seg = seg[:_k.refine_candidates(quad, hc, float(rtol), tot, thresh, seg)].copy()
         rows = cast(FloatArray, cwc)[seg] if forms is None else forms[seg]
         _k.refine_kernel(rows, seg, hc, quad, float(rtol), tot, thresh, plan.P, plan.xk,
-                         plan.w7,
-                         fall, SPEED_RTOL, CROSS_RTOL, _MAX_LEVELS, budget)
+                         plan.w7, fall, SPEED_RTOL, CROSS_RTOL, _MAX_LEVELS, budget)
 
     refined = _refine_gaps(cw, h, plan, gaps[:ngap])
     extra = []
