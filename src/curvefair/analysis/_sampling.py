@@ -283,6 +283,33 @@ def _refine_gaps(cw: FloatArray | SpanForms, h: FloatArray, plan: _Plan, gaps: n
     return out
 
 
+@lru_cache(maxsize=32)
+def _kernel_tables(degree: int, planar: bool
+                   ) -> tuple[FloatArray, FloatArray, np.ndarray, FloatArray]:
+    """The pass's constant tables for a degree (made once: on a short curve their Python
+    loops were a twentieth of a small fair() call): the sign polynomials' fit and gap
+    matrices padded to one shape, their sizes, and ``fall[j, nu] = j!/(j-nu)!``. The kernels
+    only read them."""
+    plan = _plan(degree, planar)
+    p1 = degree + 1
+    K = plan.K
+    dmax = max(plan.degs) + 1
+    fits = np.zeros((2, K, dmax))
+    subs = np.zeros((2, K - 1, K, dmax))
+    nfit = np.zeros(2, dtype=np.int64)
+    for which in (0, 1):
+        f, sb = plan.fit[which], plan.sub[which]
+        if f is not None and sb is not None:
+            nfit[which] = f.shape[1]
+            fits[which, :, : f.shape[1]] = f
+            subs[which, :, :, : f.shape[1]] = sb
+    fall = np.zeros((p1, max(p1, 4)))
+    for j in range(p1):
+        for nu in range(j + 1):
+            fall[j, nu] = falling(j, nu)[0]
+    return fits, subs, nfit, fall
+
+
 def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed: bool,
                  rtol: float = QUAD_RTOL) -> Samples:
     """Sample ``kappa`` and ``dkappa/ds`` on every segment; integrate; certify signs.
@@ -311,20 +338,7 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
     p = p1 - 1
     plan = _plan(p, planar)
     K = plan.K
-    dmax = max(plan.degs) + 1
-    fits = np.zeros((2, K, dmax))
-    subs = np.zeros((2, K - 1, K, dmax))
-    nfit = np.zeros(2, dtype=np.int64)
-    for which in (0, 1):
-        f, sb = plan.fit[which], plan.sub[which]
-        if f is not None and sb is not None:
-            nfit[which] = f.shape[1]
-            fits[which, :, : f.shape[1]] = f
-            subs[which, :, :, : f.shape[1]] = sb
-    fall = np.zeros((p1, max(p1, 4)))
-    for j in range(p1):
-        for nu in range(j + 1):
-            fall[j, nu] = falling(j, nu)[0]
+    fits, subs, nfit, fall = _kernel_tables(p, planar)
     # one spare row per range (the lead-in segment of a range, see pass_kernel); the views of
     # the first m rows are what the analysis keeps
     spare = _threads.CHUNKS
