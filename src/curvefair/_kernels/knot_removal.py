@@ -225,7 +225,7 @@ def _ls_moves(d, k, p, ctrl, alphas, new, Q, A, f):
             new[r, e] = al * hi + (1.0 - al) * lo
 
 
-@njit(cache=True)
+@njit(cache=True, readonly=('orig',))
 def kr_loop(d, orig, mask, tol, p, n, closed, js, pos, C, right, left2, ctrl, a1, denom,
             alphas, lsq, eps_abs, max_steps, stop_on_tol, z, rank, tv, ti, total,
             cap, floor):

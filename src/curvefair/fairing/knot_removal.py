@@ -234,8 +234,11 @@ class _KnotData:
             self.right[a:b] = right[:, 1:3, :]
             self.left2[a:b] = left[:, 2, :]
         self.c = c  # (k, p+2)
-        self.ctrl = np.ascontiguousarray(  # (k, p+2)
-            curve.control_index(js[:, None] + np.arange(-p - 1, 1)[None, :]), dtype=np.int64)
+        # (k, p+2) control point indices, int32 below 2**31 control points: 20 bytes a knot
+        # less at a cubic's ten million knots (the kernels only index with them)
+        self.ctrl = np.ascontiguousarray(
+            curve.control_index(js[:, None] + np.arange(-p - 1, 1)[None, :]),
+            dtype=np.int32 if curve.n_ctrl < 2**31 else np.int64)
 
     def jumps(self, d: FloatArray, k: np.ndarray | slice = slice(None)) -> FloatArray:
         """Sapidis-Farin measure at knots ``js[k]``: :func:`sapidis_measure` of the one-sided
@@ -461,7 +464,7 @@ def solve(problem: FairingProblem, *, variant: Variant = "one-point",
     js = kd.js
     nk = js.size
     d = np.array(curve.control_points)
-    orig = d.copy()
+    orig = np.asarray(curve.control_points)  # frozen, only read: no second copy
     max_steps = as_step_count(problem.max_steps, default=10 * nk)
 
     def outcome(c: BSplineCurve, steps: int, reason: StopReason, hist: FloatArray,
@@ -538,7 +541,7 @@ def _loop_args(curve: BSplineCurve, kd: _KnotData, d: FloatArray, orig: FloatArr
     pos = np.full(t.size, -1, dtype=np.int64)
     pos[js] = np.arange(nk)
     C = np.ascontiguousarray(kd.c)
-    ctrl = np.ascontiguousarray(kd.ctrl, dtype=np.int64)
+    ctrl = np.ascontiguousarray(kd.ctrl)
     # one-point: the moved basis function a (of j-p-1 .. j; _one_point_index) and the sum of
     # the jump coefficients of its control point (a closed curve's wrapped copies add up)
     if p % 2 == 1:
