@@ -538,8 +538,9 @@ def test_fairness_figures_are_analyze_figures_bit_for_bit(name):
 
 
 @pytest.mark.parametrize("kind", ["open", "closed", "quadratic", "quintic", "flat", "tiny",
-                                  "huge"])
-def test_planar_bspline_from_span_forms_is_the_whole_form_bit_for_bit(monkeypatch, kind):
+                                  "huge", "hermite", "hermite-closed", "hermite-c1",
+                                  "hermite-quintic", "hermite-flat"])
+def test_planar_curve_from_span_forms_is_the_whole_form_bit_for_bit(monkeypatch, kind):
     """A planar B-spline whose power form is not built is analysed from its spans' forms made
     range by range (analysis._sampling.SpanForms: no whole form at ten million spans); every
     field of the Analysis is the bits of the analysis of the whole form, with the ranges on
@@ -562,6 +563,19 @@ def test_planar_bspline_from_span_forms_is_the_whole_form_bit_for_bit(monkeypatc
         c = cf.interpolate_bspline(pts, degree=2 if kind == "quadratic" else 5)
     elif kind == "flat":  # near-straight: gaps to certify and segments to re-integrate
         c = cf.interpolate_bspline(np.c_[x, 1e-4 * rng.normal(size=n)])
+    elif kind == "hermite":
+        c = cf.interpolate_cubic(pts)
+    elif kind == "hermite-closed":
+        a = np.linspace(0, 2 * np.pi, n, endpoint=False)
+        ring = np.c_[np.cos(a), 0.5 * np.sin(a)] + 1e-3 * rng.normal(size=(n, 2))
+        c = cf.interpolate_cubic(np.vstack([ring, ring[:1]]), "chord", "periodic")
+    elif kind == "hermite-c1":  # tangents of their own: curvature jumps at every point
+        c = cf.CubicHermite(pts, np.c_[np.ones(n), np.cos(x)] + 0.05 * rng.normal(size=(n, 2)),
+                            x + np.arange(n) * 1e-3)
+    elif kind == "hermite-quintic":
+        c = cf.interpolate_quintic(pts)
+    elif kind == "hermite-flat":
+        c = cf.interpolate_cubic(np.c_[x, 1e-4 * rng.normal(size=n)])
     else:
         scale = {"open": 1.0, "tiny": 3e-18, "huge": 2e27}[kind]
         c = cf.interpolate_bspline(pts * scale)
@@ -571,14 +585,45 @@ def test_planar_bspline_from_span_forms_is_the_whole_form_bit_for_bit(monkeypatc
     rows = _sampling.SpanForms.rows
     monkeypatch.setattr(_sampling.SpanForms, "rows",
                         lambda self, a, b: used.append(b - a) or rows(self, a, b))
+    gathered = []
+    gather = _sampling.SpanForms.__getitem__
+    monkeypatch.setattr(_sampling.SpanForms, "__getitem__",
+                        lambda self, idx: gathered.append(len(idx)) or gather(self, idx))
     got = cf.analyze(c)
     assert "piecewise" not in c.__dict__  # the whole form was never built
     assert len(used) > 1 and max(used) < c.piecewise.n_segments
+    if kind in ("flat", "hermite-flat"):  # the gathers of the few segments refined
+        assert gathered
     want = A._analyze(c, 1e-9, False, True)  # the whole form (built just above)
     _bitwise_same(want, got)
     assert got.extrema > 0
-    if kind == "flat":
+    if kind in ("flat", "hermite-flat"):
         assert got.extremum_params.size and (got.arc_length_error > 0)
+
+
+@pytest.mark.parametrize("make", [cf.interpolate_cubic, cf.interpolate_quintic])
+def test_hermite_span_coefficients_are_the_whole_forms_rows(make):
+    """CubicHermite / QuinticHermite.span_coefficients(idx) is piecewise.coeffs[idx] bit for
+    bit (any order, repeats), the Taylor coefficients of the curve (its derivatives at the
+    segment's start over k!, by scipy's splines); out-of-range indices are refused."""
+    from math import factorial
+
+    rng = np.random.default_rng(4)
+    x = np.sort(rng.uniform(0, 10, 30))
+    c = make(np.c_[x, np.cos(x)])
+    idx = np.array([3, 0, 3, c.piecewise.n_segments - 1, 11])
+    rows = c.span_coefficients(idx)
+    assert rows.tobytes() == np.asarray(c.piecewise.coeffs)[idx].tobytes()
+    spl = _scipy_spline(c)
+    starts = np.asarray(c.params)[idx]
+    for k in range(c.degree + 1):
+        # (scipy's high derivatives of a Bernstein piece lose a few digits: 2e-7 at k = 4)
+        np.testing.assert_allclose(rows[:, k, :], spl(starts, k) / factorial(k),
+                                   rtol=1e-6, atol=1e-6)
+    with pytest.raises(InputError, match="segment indices"):
+        c.span_coefficients([c.piecewise.n_segments])
+    with pytest.raises(InputError, match="span indices"):
+        cf.interpolate_bspline(np.c_[x, np.cos(x)]).span_coefficients([-1])
 
 
 def test_span_coefficients_are_the_whole_forms_rows():

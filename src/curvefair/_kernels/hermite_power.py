@@ -31,38 +31,66 @@ def _widths(t, i):  # pragma: no cover - compiled
     return D, D * D, math.pow(D, 3.0)
 
 
-@njit(cache=True, readonly=('p', 'm', 't'))
+@njit(cache=True, inline="always")
+def _cubic_row(p, m, t, i, out, r):  # pragma: no cover - compiled
+    """Segment ``i``'s coefficients into ``out[r]`` (the one place the formula is written)."""
+    D, D2, D3 = _widths(t, i)
+    for d in range(out.shape[2]):
+        dp = p[i + 1, d] - p[i, d]
+        out[r, 0, d] = p[i, d]
+        out[r, 1, d] = m[i, d]
+        out[r, 2, d] = 3.0 * dp / D2 - (2.0 * m[i, d] + m[i + 1, d]) / D
+        out[r, 3, d] = -2.0 * dp / D3 + (m[i, d] + m[i + 1, d]) / D2
+
+
+@njit(cache=True, nogil=True, readonly=('p', 'm', 't'))
 def cubic_power_kernel(p, m, t, out):  # pragma: no cover - compiled
     """``out[i, j, d]`` (shape ``(n - 1, 4, dim)``) from points ``p``, tangents ``m`` and
     parameters ``t`` (``n`` of each)."""
     for i in range(out.shape[0]):
-        D, D2, D3 = _widths(t, i)
-        for d in range(out.shape[2]):
-            dp = p[i + 1, d] - p[i, d]
-            out[i, 0, d] = p[i, d]
-            out[i, 1, d] = m[i, d]
-            out[i, 2, d] = 3.0 * dp / D2 - (2.0 * m[i, d] + m[i + 1, d]) / D
-            out[i, 3, d] = -2.0 * dp / D3 + (m[i, d] + m[i + 1, d]) / D2
+        _cubic_row(p, m, t, i, out, i)
 
 
-@njit(cache=True, readonly=('p', 'm', 's', 't'))
+@njit(cache=True, nogil=True, readonly=('p', 'm', 't', 'idx'))
+def cubic_power_rows(p, m, t, idx, out):  # pragma: no cover - compiled
+    """``out[r]`` = the coefficients of segment ``idx[r]`` (:func:`cubic_power_kernel`'s row,
+    bit for bit: the same inlined code), for a few segments of a long curve."""
+    for r in range(idx.shape[0]):
+        _cubic_row(p, m, t, idx[r], out, r)
+
+
+@njit(cache=True, inline="always")
+def _quintic_row(p, m, s, t, i, out, r):  # pragma: no cover - compiled
+    """Segment ``i``'s coefficients into ``out[r]`` (the one place the formula is written)."""
+    D, D2, D3 = _widths(t, i)
+    D4 = math.pow(D, 4.0)
+    D5 = math.pow(D, 5.0)
+    for d in range(out.shape[2]):
+        b1 = p[i + 1, d] - p[i, d] - m[i, d] * D - 0.5 * s[i, d] * D2
+        b2 = m[i + 1, d] - m[i, d] - s[i, d] * D
+        b3 = s[i + 1, d] - s[i, d]
+        out[r, 0, d] = p[i, d]
+        out[r, 1, d] = m[i, d]
+        out[r, 2, d] = 0.5 * s[i, d]
+        out[r, 3, d] = (10.0 * b1 - 4.0 * b2 * D + 0.5 * b3 * D2) / D3
+        out[r, 4, d] = (-15.0 * b1 + 7.0 * b2 * D - b3 * D2) / D4
+        out[r, 5, d] = (6.0 * b1 - 3.0 * b2 * D + 0.5 * b3 * D2) / D5
+
+
+@njit(cache=True, nogil=True, readonly=('p', 'm', 's', 't'))
 def quintic_power_kernel(p, m, s, t, out):  # pragma: no cover - compiled
     """``out[i, j, d]`` (shape ``(n - 1, 6, dim)``) from points ``p``, first and second
     derivatives ``m``, ``s`` and parameters ``t``."""
     for i in range(out.shape[0]):
-        D, D2, D3 = _widths(t, i)
-        D4 = math.pow(D, 4.0)
-        D5 = math.pow(D, 5.0)
-        for d in range(out.shape[2]):
-            b1 = p[i + 1, d] - p[i, d] - m[i, d] * D - 0.5 * s[i, d] * D2
-            b2 = m[i + 1, d] - m[i, d] - s[i, d] * D
-            b3 = s[i + 1, d] - s[i, d]
-            out[i, 0, d] = p[i, d]
-            out[i, 1, d] = m[i, d]
-            out[i, 2, d] = 0.5 * s[i, d]
-            out[i, 3, d] = (10.0 * b1 - 4.0 * b2 * D + 0.5 * b3 * D2) / D3
-            out[i, 4, d] = (-15.0 * b1 + 7.0 * b2 * D - b3 * D2) / D4
-            out[i, 5, d] = (6.0 * b1 - 3.0 * b2 * D + 0.5 * b3 * D2) / D5
+        _quintic_row(p, m, s, t, i, out, i)
+
+
+@njit(cache=True, nogil=True, readonly=('p', 'm', 's', 't', 'idx'))
+def quintic_power_rows(p, m, s, t, idx, out):  # pragma: no cover - compiled
+    """``out[r]`` = the coefficients of segment ``idx[r]`` (:func:`quintic_power_kernel`'s row,
+    bit for bit)."""
+    for r in range(idx.shape[0]):
+        _quintic_row(p, m, s, t, idx[r], out, r)
 
 
 def cubic_power_reference(p: np.ndarray, m: np.ndarray, t: np.ndarray) -> np.ndarray:

@@ -10,6 +10,7 @@ import numpy as np
 from .._typing import FloatArray
 from .._validate import as_positive
 from ..curves.bspline import POWER_FORM_MAX_DEGREE, BSplineCurve
+from ..curves.hermite import CubicHermite, QuinticHermite
 from ..curves.piecewise import PiecewiseCurve, readonly
 from ..interop import as_curve
 from ._core import bounding_diagonal, check_curve, falling, fields_to_dict
@@ -306,11 +307,13 @@ def fairness_figures(curve: PiecewiseCurve) -> dict[str, Any]:
 
 
 def _span_forms(c: PiecewiseCurve) -> SpanForms | None:
-    """A planar B-spline's span forms made where the sampling reads them (its whole power form
-    not built, or already built: then that is read), else None."""
-    if (type(c) is BSplineCurve and c.dim == 2 and "piecewise" not in c.__dict__
-            and c.degree <= POWER_FORM_MAX_DEGREE):
-        return SpanForms(c.knots, c.degree, c.spans, c.control_points, c.closed)
+    """A planar B-spline's or Hermite spline's segment forms made where the sampling reads
+    them, when its whole power form is not built (else that is read), else None."""
+    if c.dim != 2 or "piecewise" in c.__dict__:
+        return None
+    if ((type(c) is BSplineCurve and c.degree <= POWER_FORM_MAX_DEGREE)
+            or type(c) in (CubicHermite, QuinticHermite)):
+        return SpanForms(c)
     return None
 
 
@@ -321,9 +324,7 @@ def _analyze(c: PiecewiseCurve, rtol: float, summary: bool, whole: bool = False
     forms = None if whole else _span_forms(c)
     coeffs: FloatArray | None
     if forms is not None:
-        # the breaks and widths as the whole form has them (BSplineCurve's own power form)
-        s = forms.spans
-        breaks = np.append(forms.knots[s], forms.knots[s[-1] + 1])
+        breaks = forms.breaks  # and the widths, as the whole form has them
         h = np.diff(breaks)
         m, p1, dim = forms.shape
         coeffs = None

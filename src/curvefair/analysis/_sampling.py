@@ -23,7 +23,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from functools import lru_cache
 from math import comb
-from typing import cast
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
@@ -31,7 +31,12 @@ from .. import _threads
 from .._kernels import sampling as _k
 from .._kernels.bspline import power_form_kernel as _power_form_kernel
 from .._typing import FloatArray
+from ..curves.bspline import BSplineCurve
+from ..curves.piecewise import PiecewiseCurve
 from ._core import CROSS_RTOL, SPEED_RTOL, derivs_at, falling, frenet
+
+if TYPE_CHECKING:
+    from ..curves.hermite import HermiteSpline
 
 __all__ = ["Samples", "sample_curve", "scan_sign_changes", "QUAD_RTOL"]
 
@@ -181,41 +186,63 @@ class Samples:
 
 
 class SpanForms:
-    """The power form of a B-spline's spans, made where it is read instead of kept whole.
+    """The power form of a planar curve's segments, made where it is read instead of kept
+    whole: a :class:`~curvefair.BSplineCurve`'s spans or a Hermite spline's segments.
 
     ``rows(a, b)`` gives the coefficients of segments ``a .. b-1``, ``forms[idx]`` those of
-    the segments ``idx`` (any integer array), with ``shape = (m, degree + 1, dim)`` as the
-    whole form's: each span's coefficients depend on its own knots and control points only
-    (:func:`curvefair._kernels.bspline.power_form_kernel`), so every row is bitwise the row of
-    the whole form. :func:`sample_curve` reads a range's rows while it samples that range:
-    at ten million cubic spans the whole form is 640 MB, a range's rows a sixteenth of it.
+    the segments ``idx`` (any integer array), with ``shape = (m, degree + 1, dim)`` and
+    ``breaks`` as the whole form's: each segment's coefficients depend on its own knots and
+    control points, or its own two points, only (the same compiled code: ``span_coefficients``
+    of either curve type), so every row is bitwise the row of the whole form.
+    :func:`sample_curve` reads a range's rows while it samples that range: at ten million
+    cubic segments the whole form is 640 MB (and was copied once more into frozen memory),
+    a range's rows a sixteenth of it.
     """
 
-    def __init__(self, knots: FloatArray, degree: int, spans: np.ndarray,
-                 ctrl: FloatArray, closed: bool) -> None:
-        self.knots = np.ascontiguousarray(knots, dtype=np.float64)
-        self.degree = int(degree)
-        self.spans = np.ascontiguousarray(spans, dtype=np.int64)
-        self.ctrl = np.ascontiguousarray(ctrl, dtype=np.float64)
-        self.closed = bool(closed)
-        self.shape = (self.spans.shape[0], self.degree + 1, self.ctrl.shape[1])
+    def __init__(self, curve: PiecewiseCurve) -> None:
+        self.curve = curve
+        if isinstance(curve, BSplineCurve):
+            t = np.ascontiguousarray(curve.knots, dtype=np.float64)
+            s = np.ascontiguousarray(curve.spans, dtype=np.int64)
+            ctrl = np.ascontiguousarray(curve.control_points, dtype=np.float64)
+            closed, p = bool(curve.closed), int(curve.degree)
+
+            def rows(a: int, b: int) -> FloatArray:
+                out = np.empty((b - a, p + 1, ctrl.shape[1]))
+                if b > a:
+                    _power_form_kernel(t, p, s[a:b], ctrl, closed, out)
+                return out
+
+            self.breaks = np.append(t[s], t[s[-1] + 1])  # as BSplineCurve's own power form
+            # (the stored samples' unit: a power of two near the control points' size)
+            self.unit_points = ctrl
+            m = s.shape[0]
+        else:
+            h = cast("HermiteSpline", curve)
+            pts = np.asarray(h.points)
+
+            def rows(a: int, b: int) -> FloatArray:
+                return h._rows(a, b + 1)
+
+            self.breaks = np.array(h.params)  # as HermiteSpline's own power form
+            self.unit_points = pts[:-1]  # the segments' start points: the whole form's unit
+            m = pts.shape[0] - 1
+        self._rows = rows
+        self.shape = (m, int(curve.degree) + 1, int(curve.dim))
         self.finite = True  # cleared by a row that is not (the caller then reads the whole form)
 
-    def _of(self, spans: np.ndarray) -> FloatArray:
-        out = np.empty((spans.shape[0],) + self.shape[1:])
-        if spans.shape[0]:
-            _power_form_kernel(self.knots, self.degree, np.ascontiguousarray(spans), self.ctrl,
-                               self.closed, out)
-            if not np.isfinite(out).all():
-                self.finite = False
-                out[~np.isfinite(out)] = 0.0
+    def _checked(self, out: FloatArray) -> FloatArray:
+        if not np.isfinite(out).all():
+            self.finite = False
+            out[~np.isfinite(out)] = 0.0
         return out
 
     def rows(self, a: int, b: int) -> FloatArray:
-        return self._of(self.spans[a:b])
+        return self._checked(self._rows(a, b))
 
     def __getitem__(self, idx: np.ndarray) -> FloatArray:
-        return self._of(self.spans[np.asarray(idx, dtype=np.int64)])
+        span_coefficients = cast(Any, self.curve).span_coefficients
+        return self._checked(span_coefficients(np.asarray(idx, dtype=np.int64)))
 
 
 def _speed_scales(cc: FloatArray, hh: FloatArray) -> tuple[FloatArray, FloatArray]:
@@ -329,10 +356,11 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
     of two scales exactly: for curves of ordinary size the stored values are those of
     ``unit = 1`` times ``unit``, bit for bit.
 
-    ``cw`` may be a :class:`SpanForms` (a planar B-spline whose form is not built): each range
-    of the pass then makes its own rows, the re-integration and the sign certificates those of
-    the segments they read, and ``unit`` is the power of two nearest the diagonal of the
-    control points (a power of two either way: the counts and figures are the same bits).
+    ``cw`` may be a :class:`SpanForms` (a planar curve whose form is not built): each range of
+    the pass then makes its own rows, the re-integration and the sign certificates those of
+    the segments they read; for a B-spline ``unit`` is then the power of two nearest the
+    diagonal of the control points (a power of two either way: the counts and figures are the
+    same bits).
     """
     m, p1, dim = cw.shape
     p = p1 - 1
@@ -345,7 +373,7 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
     kap = np.empty((m + spare, K), dtype=np.float32)
     dks = np.empty((m + spare, K), dtype=np.float32)
     forms = cw if isinstance(cw, SpanForms) else None
-    unit = _unit(cast(FloatArray, cw)) if forms is None else _unit_of(forms.ctrl)
+    unit = _unit(cast(FloatArray, cw)) if forms is None else _unit_of(forms.unit_points)
     knots = np.empty((m + spare, 3))
     energies = np.empty((m + spare, 2))
     quad = np.empty((m + spare, 4))

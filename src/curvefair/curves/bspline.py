@@ -390,7 +390,12 @@ class BSplineCurve(PiecewiseCurve):
         order, repeats allowed): shape ``(k, degree + 1, dim)``, bit for bit the rows
         ``piecewise.coeffs[which]`` (each span's coefficients depend on its own knots and
         control points only), without building the whole form (72 bytes a cubic planar span)."""
-        spans = np.ascontiguousarray(np.asarray(self.spans)[np.asarray(which, dtype=np.int64)])
+        idx = np.asarray(which, dtype=np.int64).reshape(-1)
+        all_spans = np.asarray(self.spans)
+        if idx.size and (int(idx.min()) < 0 or int(idx.max()) >= all_spans.shape[0]):
+            raise InputError(f"span_coefficients: span indices must lie in 0 .. "
+                             f"{all_spans.shape[0] - 1}")
+        spans = np.ascontiguousarray(all_spans[idx])
         out = np.empty((spans.shape[0], self.degree + 1, self._ctrl.shape[1]))
         if spans.shape[0]:
             power_form_kernel(np.ascontiguousarray(self._knots), self.degree, spans,

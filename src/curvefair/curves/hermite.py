@@ -9,7 +9,12 @@ from typing import Any, cast
 
 import numpy as np
 
-from .._kernels.hermite_power import cubic_power_kernel, quintic_power_kernel
+from .._kernels.hermite_power import (
+    cubic_power_kernel,
+    cubic_power_rows,
+    quintic_power_kernel,
+    quintic_power_rows,
+)
 from .._typing import ArrayLike, FloatArray
 from .._validate import as_params, as_points, as_vectors, magnitude
 from ..errors import InputError
@@ -89,6 +94,20 @@ class HermiteSpline(PiecewiseCurve):
     def _make_piecewise(self) -> PiecewisePolynomial:
         return PiecewisePolynomial(np.array(self._params), self._rows(0, len(self._params)))
 
+    def span_coefficients(self, which: ArrayLike) -> FloatArray:
+        """The power-form coefficients of the segments ``which`` (0-based, any order, repeats
+        allowed): shape ``(k, degree + 1, dim)``, bit for bit the rows
+        ``piecewise.coeffs[which]`` (each segment's coefficients come from its own two points
+        by the same compiled code), without building the whole form."""
+        idx = np.ascontiguousarray(np.asarray(which, dtype=np.int64).reshape(-1))
+        m = self._params.shape[0] - 1
+        if idx.size and (int(idx.min()) < 0 or int(idx.max()) >= m):
+            raise InputError(f"span_coefficients: segment indices must lie in 0 .. {m - 1}")
+        return self._segment_rows(idx)
+
+    def _segment_rows(self, idx: np.ndarray) -> FloatArray:
+        raise NotImplementedError
+
     def _partial_form(self, u: FloatArray) -> tuple[FloatArray, FloatArray] | None:
         """The coefficients of the segments holding ``u``, each from its own two points (as
         the whole form computes them), and the local offsets; None for a short curve."""
@@ -97,8 +116,7 @@ class HermiteSpline(PiecewiseCurve):
         if 64 * u.size >= m:
             return None
         seg = np.clip(np.searchsorted(t, u, side="right") - 1, 0, m - 1)
-        rows = np.concatenate([self._rows(int(k), int(k) + 2) for k in seg])
-        return rows, u - t[seg]
+        return self._segment_rows(np.ascontiguousarray(seg, dtype=np.int64)), u - t[seg]
 
     @property
     def closed(self) -> bool:
@@ -187,6 +205,11 @@ class CubicHermite(HermiteSpline):
         return cubic_hermite_coefficients(self._points[lo:hi], self.tangents[lo:hi],
                                           self._params[lo:hi])
 
+    def _segment_rows(self, idx: np.ndarray) -> FloatArray:
+        out = np.empty((idx.shape[0], 4, self.dim))
+        cubic_power_rows(self._points, self.tangents, self._params, idx, out)
+        return out
+
 
 class QuinticHermite(HermiteSpline):
     """C2 parametric quintic Hermite spline (position, first and second derivative per point).
@@ -241,6 +264,11 @@ class QuinticHermite(HermiteSpline):
     def _rows(self, lo: int, hi: int) -> FloatArray:
         return quintic_hermite_coefficients(self._points[lo:hi], self.d1[lo:hi], self.d2[lo:hi],
                                             self._params[lo:hi])
+
+    def _segment_rows(self, idx: np.ndarray) -> FloatArray:
+        out = np.empty((idx.shape[0], 6, self.dim))
+        quintic_power_rows(self._points, self.d1, self.d2, self._params, idx, out)
+        return out
 
 
 def _c64(a: ArrayLike) -> FloatArray:
