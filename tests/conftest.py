@@ -53,6 +53,7 @@ COMPILED_FILES = frozenset({
     "test_bspline_fairing_properties.py",
     "test_reproducible.py",
     "test_recorded_cases.py",
+    "test_distance.py",
 })
 
 #: test files whose tests each take more than ~20 s (marked ``slow``); measured with
