@@ -54,6 +54,7 @@ COMPILED_FILES = frozenset({
     "test_reproducible.py",
     "test_recorded_cases.py",
     "test_distance.py",
+    "test_analysis_analyze.py",
 })
 
 #: test files whose tests each take more than ~20 s (marked ``slow``); measured with

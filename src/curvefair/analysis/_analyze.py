@@ -311,9 +311,10 @@ def _span_forms(c: PiecewiseCurve) -> SpanForms | None:
     them, when its whole power form is not built (else that is read), else None."""
     if c.dim != 2 or "piecewise" in c.__dict__:
         return None
-    if ((type(c) is BSplineCurve and c.degree <= POWER_FORM_MAX_DEGREE)
-            or type(c) in (CubicHermite, QuinticHermite)):
+    if type(c) is BSplineCurve and c.degree <= POWER_FORM_MAX_DEGREE:
         return SpanForms(c)
+    if type(c) in (CubicHermite, QuinticHermite):
+        return SpanForms(cast(CubicHermite | QuinticHermite, c))
     return None
 
 

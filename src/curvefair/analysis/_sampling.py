@@ -23,16 +23,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 from functools import lru_cache
 from math import comb
-from typing import TYPE_CHECKING, Any, cast
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
 from .. import _threads
 from .._kernels import sampling as _k
-from .._kernels.bspline import power_form_kernel as _power_form_kernel
 from .._typing import FloatArray
 from ..curves.bspline import BSplineCurve
-from ..curves.piecewise import PiecewiseCurve
 from ._core import CROSS_RTOL, SPEED_RTOL, derivs_at, falling, frenet
 
 if TYPE_CHECKING:
@@ -191,58 +189,35 @@ class SpanForms:
 
     ``rows(a, b)`` gives the coefficients of segments ``a .. b-1``, ``forms[idx]`` those of
     the segments ``idx`` (any integer array), with ``shape = (m, degree + 1, dim)`` and
-    ``breaks`` as the whole form's: each segment's coefficients depend on its own knots and
-    control points, or its own two points, only (the same compiled code: ``span_coefficients``
-    of either curve type), so every row is bitwise the row of the whole form.
-    :func:`sample_curve` reads a range's rows while it samples that range: at ten million
-    cubic segments the whole form is 640 MB (and was copied once more into frozen memory),
-    a range's rows a sixteenth of it.
+    ``breaks`` as the whole form's: both are the curve's ``span_coefficients``, whose rows
+    are bitwise those of the whole form (each segment's coefficients depend on its own knots
+    and control points, or its own two points, only). :func:`sample_curve` reads a range's
+    rows while it samples that range: at ten million cubic segments the whole form is 640 MB
+    (and was copied once more into frozen memory), a range's rows a sixteenth of it.
     """
 
-    def __init__(self, curve: PiecewiseCurve) -> None:
+    def __init__(self, curve: BSplineCurve | HermiteSpline) -> None:
         self.curve = curve
         if isinstance(curve, BSplineCurve):
-            t = np.ascontiguousarray(curve.knots, dtype=np.float64)
-            s = np.ascontiguousarray(curve.spans, dtype=np.int64)
-            ctrl = np.ascontiguousarray(curve.control_points, dtype=np.float64)
-            closed, p = bool(curve.closed), int(curve.degree)
-
-            def rows(a: int, b: int) -> FloatArray:
-                out = np.empty((b - a, p + 1, ctrl.shape[1]))
-                if b > a:
-                    _power_form_kernel(t, p, s[a:b], ctrl, closed, out)
-                return out
-
-            self.breaks = np.append(t[s], t[s[-1] + 1])  # as BSplineCurve's own power form
+            self.breaks = np.asarray(curve.span_breaks)
             # (the stored samples' unit: a power of two near the control points' size)
-            self.unit_points = ctrl
-            m = s.shape[0]
+            self.unit_points = np.asarray(curve.control_points)
         else:
-            h = cast("HermiteSpline", curve)
-            pts = np.asarray(h.points)
-
-            def rows(a: int, b: int) -> FloatArray:
-                return h._rows(a, b + 1)
-
-            self.breaks = np.array(h.params)  # as HermiteSpline's own power form
-            self.unit_points = pts[:-1]  # the segments' start points: the whole form's unit
-            m = pts.shape[0] - 1
-        self._rows = rows
-        self.shape = (m, int(curve.degree) + 1, int(curve.dim))
+            self.breaks = np.array(curve.params)  # as HermiteSpline's own power form
+            # the segments' start points: the whole form's unit
+            self.unit_points = np.asarray(curve.points)[:-1]
+        self.shape = (self.breaks.shape[0] - 1, int(curve.degree) + 1, int(curve.dim))
         self.finite = True  # cleared by a row that is not (the caller then reads the whole form)
 
-    def _checked(self, out: FloatArray) -> FloatArray:
+    def rows(self, a: int, b: int) -> FloatArray:
+        return self[np.arange(a, b)]
+
+    def __getitem__(self, idx: np.ndarray) -> FloatArray:
+        out = self.curve.span_coefficients(np.asarray(idx, dtype=np.int64))
         if not np.isfinite(out).all():
             self.finite = False
             out[~np.isfinite(out)] = 0.0
         return out
-
-    def rows(self, a: int, b: int) -> FloatArray:
-        return self._checked(self._rows(a, b))
-
-    def __getitem__(self, idx: np.ndarray) -> FloatArray:
-        span_coefficients = cast(Any, self.curve).span_coefficients
-        return self._checked(span_coefficients(np.asarray(idx, dtype=np.int64)))
 
 
 def _speed_scales(cc: FloatArray, hh: FloatArray) -> tuple[FloatArray, FloatArray]:
@@ -396,7 +371,9 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
             rows, off = cwc, 0
         else:  # the range's own rows, its lead-in segment first
             off = a - 1 if a > 0 else 0
-            rows = forms.rows(off, b)
+            # (an empty range still reads the row of its first segment for the box's start,
+            # as it does in the whole form)
+            rows = forms.rows(off, max(b, off + 1))
         while True:
             nsing, maxk, maxks, ngap = _k.pass_kernel(
                 rows, hc, plan.x, plan.tab, plan.w7, plan.w4, plan.P, fall, fits, nfit, subs,

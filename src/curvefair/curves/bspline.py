@@ -347,6 +347,14 @@ class BSplineCurve(PiecewiseCurve):
         s += p
         return readonly(s)
 
+    @property
+    def span_breaks(self) -> FloatArray:
+        """The breakpoints of the power form (:attr:`piecewise`'s ``breaks``, the same values):
+        the left knot of each of :attr:`spans` and the end of the domain, without building the
+        form."""
+        t, s = self._knots, self.spans
+        return np.append(t[s], t[s[-1] + 1])
+
     def __repr__(self) -> str:
         return (f"BSplineCurve(n_ctrl={self.n_ctrl}, degree={self.degree}, dim={self.dim}, "
                 f"closed={self.closed}, domain={self.domain})")
@@ -380,7 +388,7 @@ class BSplineCurve(PiecewiseCurve):
         coeffs = np.empty((s.size, p + 1, self._ctrl.shape[1]))
         power_form(np.ascontiguousarray(t), p, s, np.ascontiguousarray(self._ctrl),
                    self._closed, coeffs)
-        breaks = np.append(t[s], t[s[-1] + 1])
+        breaks = self.span_breaks
         if p > POWER_FORM_MAX_DEGREE:
             return PiecewisePolynomial(breaks, coeffs, evaluator=self._span_values)
         return PiecewisePolynomial(breaks, coeffs)
@@ -415,13 +423,11 @@ class BSplineCurve(PiecewiseCurve):
         # the non-empty span [t_k, t_k+1) holding each u (right-continuous, the last one closed:
         # the whole form's segment_of on its breaks t[spans]), found in the knots themselves
         k = np.clip(np.searchsorted(t, u, side="right") - 1, s[0], s[-1])
-        span = s[np.searchsorted(s, k)]
-        rows = np.empty((span.shape[0], p + 1, self._ctrl.shape[1]))
-        power_form(np.ascontiguousarray(t), p, np.ascontiguousarray(span, dtype=np.int64),
-                   np.ascontiguousarray(self._ctrl), self._closed, rows)
+        pos = np.searchsorted(s, k)
+        rows = self.span_coefficients(pos)
         if not np.isfinite(rows).all():
             return None
-        return rows, u - t[span]
+        return rows, u - t[s[pos]]
 
     def _span_values(self, seg: np.ndarray, s: FloatArray, nu: int) -> FloatArray:
         """``r^(nu)`` on power-form segments ``seg`` at local offsets ``s`` from the basis:

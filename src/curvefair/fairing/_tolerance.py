@@ -139,7 +139,7 @@ def _difference_form(a: PiecewiseCurve, delta: dict[str, FloatArray]) -> Piecewi
         d = np.ascontiguousarray(delta["control_points"], dtype=np.float64)
         coeffs = np.empty((s.size, p + 1, d.shape[1]))
         power_form(t, p, s, d, bool(a.closed), coeffs)
-        return PiecewisePolynomial._borrowed(np.append(t[s], t[s[-1] + 1]), coeffs)
+        return PiecewisePolynomial._borrowed(a.span_breaks, coeffs)
     params = np.asarray(a.params)  # type: ignore[attr-defined]
     if isinstance(a, QuinticHermite):
         c = quintic_hermite_coefficients(delta["points"], delta["d1"], delta["d2"], params)
@@ -172,7 +172,7 @@ def prime_power_forms(original: PiecewiseCurve, new: PiecewiseCurve
     power_form(t, p, s, ctrl, bool(new.closed), coeffs, base, diff)
     if not (np.isfinite(coeffs).all() and np.isfinite(diff).all()):
         return None  # new.piecewise raises its own message when asked
-    breaks = readonly(np.append(t[s], t[s[-1] + 1]))
+    breaks = readonly(new.span_breaks)
     # the certificate first, then the frozen copy of new's form: the difference form is freed
     # before that copy is made, so the two forms and the copy are never alive together
     figures = difference_deviation(original, new, PiecewisePolynomial._borrowed(breaks, diff))

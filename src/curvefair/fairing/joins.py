@@ -255,10 +255,8 @@ class _SpanForm:
     :meth:`~curvefair.PiecewisePolynomial.evaluate` evaluates a few pieces: the same bits."""
 
     def __init__(self, curve: BSplineCurve) -> None:
-        t = np.asarray(curve.knots)
-        s = np.asarray(curve.spans)
         self.curve = curve
-        self.breaks = np.append(t[s], t[s[-1] + 1])  # as BSplineCurve's power form has them
+        self.breaks = np.asarray(curve.span_breaks)
         self.widths = np.diff(self.breaks)
         self.degree = int(curve.degree)
 
