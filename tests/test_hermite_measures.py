@@ -205,3 +205,46 @@ def test_structure_free_removes_knots_within_tol():
     assert d["moved"]["indices"] == np.asarray(r.report["moved"]["indices"]).tolist()
     with pytest.raises(InputError, match="structure"):
         fair(b, tol=4e-3, structure="new")
+
+
+@pytest.mark.parametrize("closed", [False, True])
+@pytest.mark.parametrize("dim", [2, 3])
+def test_range_measures_are_measure_at_bit_for_bit(closed, dim):
+    """The loop's measures of a range (each segment's coefficients computed once, for the
+    cubic jump and for Poliakoff's and Wang-Cao's move) and of the whole curve are the bytes
+    of the per-point :func:`measure_at`, for every method and measure code, on ranges that
+    wrap round a closed curve's seam."""
+    from curvefair._kernels import hermite as k
+    from curvefair.fairing.hermite_data import distinct_data
+
+    rng = np.random.default_rng(40 + dim + 2 * closed)
+    n = 23
+    t = np.cumsum(rng.uniform(0.05, 3.0, n))
+    P = rng.normal(size=(n, dim)) * rng.uniform(0.1, 100.0)
+    T = rng.normal(size=(n, dim))
+    if closed:
+        P[-1], T[-1] = P[0], T[0]
+    Pd, D, h = distinct_data(CubicHermite(P, T, t, closed=closed))
+    nd = Pd.shape[0]
+    assert nd == n - closed
+    ranges = [(-4, 5), (nd - 6, nd + 3), (0, nd - 1), (7, 7)] if closed else \
+        [(1, nd - 2), (1, 1), (nd - 2, nd - 2), (5, 12), (4, 3)]
+    seen = set()
+    for method in (k.KJELLANDER, k.POLIAKOFF, k.WANG_CAO):
+        for mcode in (k.M_DEFAULT, k.M_ENERGY, k.M_SAPIDIS, k.M_MOVE):
+            for spline in (False, True):
+                args = (Pd, D, h, closed, 3, spline, method, 0.7, mcode)
+                mf = k.fast_measure_code(3, method, mcode)
+                seen.add(mf)
+                # an open curve's end points have no measure (one segment each)
+                ref = np.array([k.measure_at(Pd, D, h, i, 3, spline, method, 0.7, mcode)
+                                if closed or 0 < i < nd - 1 else 0.0 for i in range(nd)])
+                for a, b in ranges:
+                    out = np.full(max(b - a + 1, 0), np.nan)
+                    seg = np.empty((b - a + 3, 2, dim))
+                    k.range_measures(*args, mf, a, b, seg, out)
+                    want = ref[np.arange(a, b + 1) % nd]
+                    assert out.tobytes() == want.tobytes(), (method, mcode, a, b)
+                whole = k.all_measures(*args)
+                assert whole.tobytes() == ref.tobytes()
+    assert seen == {k.MF_GENERIC, k.MF_JUMP, k.MF_POLIAKOFF_MOVE, k.MF_WANG_CAO_MOVE}

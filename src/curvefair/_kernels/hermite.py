@@ -80,12 +80,28 @@ def hermite_gram(degree: int, q: int) -> tuple[np.ndarray, np.ndarray]:
 # segment coefficients
 # ----------------------------------------------------------------------------------------------
 @njit(cache=True, inline="always")
+def _prev(i, nd):
+    """``(i - 1) % nd`` for ``0 <= i < nd`` without an integer division (a division is tens of
+    cycles, and the loops below take several per point)."""
+    return i - 1 if i > 0 else nd - 1
+
+
+@njit(cache=True, inline="always")
+def _next(i, nd):
+    """``(i + 1) % nd`` for ``0 <= i < nd``."""
+    return i + 1 if i < nd - 1 else 0
+
+
+@njit(cache=True, inline="always")
 def _cubic_a23(P, D, h, j, c):
     """``(a_{j,2}, a_{j,3})`` of cubic segment ``j``, coordinate ``c`` (Wang & Cao, eq. (6))."""
-    nd = P.shape[0]
-    i0 = j
-    i1 = (j + 1) % nd
-    H = h[j]
+    return _cubic_seg(P, D, h, j, _next(j, P.shape[0]), c)
+
+
+@njit(cache=True, inline="always")
+def _cubic_seg(P, D, h, i0, i1, c):
+    """:func:`_cubic_a23` of the segment from point ``i0`` to point ``i1``."""
+    H = h[i0]
     dp = P[i1, c] - P[i0, c]
     a2 = 3.0 * dp / (H * H) - (2.0 * D[i0, 0, c] + D[i1, 0, c]) / H
     a3 = -2.0 * dp / (H * H * H) + (D[i0, 0, c] + D[i1, 0, c]) / (H * H)
@@ -97,7 +113,7 @@ def _quintic_a2345(P, D, h, j, c):
     """``a_{j,2..5}`` of quintic segment ``j``, coordinate ``c`` (Wang 2005, eq. (2))."""
     nd = P.shape[0]
     i0 = j
-    i1 = (j + 1) % nd
+    i1 = _next(j, nd)
     H = h[j]
     m0 = D[i0, 0, c]
     s0 = D[i0, 1, c]
@@ -110,6 +126,24 @@ def _quintic_a2345(P, D, h, j, c):
     a4 = (-15.0 * b1 + 7.0 * b2 * H - b3 * H2) / (H2 * H2)
     a5 = (6.0 * b1 - 3.0 * b2 * H + 0.5 * b3 * H2) / (H2 * H2 * H)
     return a2, a3, a4, a5
+
+
+@njit(cache=True, inline="always")
+def _poliakoff_den(D0, D1):
+    """Denominator of Poliakoff's step (eq. (8) as corrected in ERRATA)."""
+    return 2.0 / D1**3 + 2.0 / D0**3
+
+
+@njit(cache=True, inline="always")
+def _wang_cao_de(al2, al3, ar2, ar3, D0, D1):
+    """Wang-Cao's ``(delta*, eta*)`` in one coordinate (eqs. (11)-(12)) from the ``a_2, a_3``
+    of the segments left and right of the point."""
+    J = al3 - ar3
+    G = ar2 - al2 - 3.0 * al3 * D0
+    f = D1 * D0 / (D1 + D0) ** 3
+    d = f * D1 * D0 * (2.0 * D1 * D0 * J + (D1 - D0) * G)
+    e = f * (3.0 * D1 * D0 * (D1 - D0) * J + 2.0 * (D1 * D1 - D1 * D0 + D0 * D0) * G)
+    return d, e
 
 
 # ----------------------------------------------------------------------------------------------
@@ -127,8 +161,8 @@ def cubic_step(P, D, h, k, method, hstep, delta, eta):
     ``eta`` is zero for the position-only methods.
     """
     nd = P.shape[0]
-    km = (k - 1) % nd
-    kp = (k + 1) % nd
+    km = _prev(k, nd)
+    kp = _next(k, nd)
     D0 = h[km]
     D1 = h[k]
     for c in range(P.shape[1]):
@@ -140,13 +174,9 @@ def cubic_step(P, D, h, k, method, hstep, delta, eta):
         al2, al3 = _cubic_a23(P, D, h, km, c)
         ar2, ar3 = _cubic_a23(P, D, h, k, c)
         if method == POLIAKOFF:
-            delta[c] = -(ar3 - al3) / (2.0 / D1**3 + 2.0 / D0**3)
+            delta[c] = -(ar3 - al3) / _poliakoff_den(D0, D1)
         else:
-            J = al3 - ar3
-            G = ar2 - al2 - 3.0 * al3 * D0
-            f = D1 * D0 / (D1 + D0) ** 3
-            delta[c] = f * D1 * D0 * (2.0 * D1 * D0 * J + (D1 - D0) * G)
-            eta[c] = f * (3.0 * D1 * D0 * (D1 - D0) * J + 2.0 * (D1 * D1 - D1 * D0 + D0 * D0) * G)
+            delta[c], eta[c] = _wang_cao_de(al2, al3, ar2, ar3, D0, D1)
 
 
 @njit(cache=True)
@@ -157,7 +187,7 @@ def wang_cao_eta_given_delta(P, D, h, k, delta, eta):
     ``G = a_{k,2} - a_{k-1,2} - 3 a_{k-1,3} D0``. With ``delta = delta*`` this is ``eta*``.
     """
     nd = P.shape[0]
-    km = (k - 1) % nd
+    km = _prev(k, nd)
     D0 = h[km]
     D1 = h[k]
     for c in range(P.shape[1]):
@@ -171,7 +201,7 @@ def wang_cao_eta_given_delta(P, D, h, k, delta, eta):
 def _quintic_C(P, D, h, k, c):
     """Wang 2005, Lemma: ``(C1, C2, C3)`` of coordinate ``c`` at point ``k``."""
     nd = P.shape[0]
-    km = (k - 1) % nd
+    km = _prev(k, nd)
     D0 = h[km]
     D1 = h[k]
     l2, l3, l4, l5 = _quintic_a2345(P, D, h, km, c)
@@ -203,7 +233,7 @@ def quintic_system(P, D, h, k, C):
     nd = P.shape[0]
     for c in range(P.shape[1]):
         C[c, 0], C[c, 1], C[c, 2] = _quintic_C(P, D, h, k, c)
-    return _quintic_H(h[(k - 1) % nd], h[k])
+    return _quintic_H(h[_prev(k, nd)], h[k])
 
 
 @njit(cache=True)
@@ -218,7 +248,7 @@ def quintic_step(P, D, h, k, delta, eta, xi, clamped_delta):
     ``(drop_total, drop_position)`` of the unconstrained step (``int |r''|^2`` units).
     """
     nd = P.shape[0]
-    H00, H01, H02, H11, H22 = _quintic_H(h[(k - 1) % nd], h[k])
+    H00, H01, H02, H11, H22 = _quintic_H(h[_prev(k, nd)], h[k])
     S = H00 - H01 * H01 / H11 - H02 * H02 / H22
     drop_pos = 0.0
     drop_der = 0.0
@@ -239,7 +269,7 @@ def quintic_step(P, D, h, k, delta, eta, xi, clamped_delta):
 def quintic_measure(P, D, h, k, spline):
     """Energy drop of the Wang step at ``k`` (whole step, or only its position part)."""
     nd = P.shape[0]
-    H00, H01, H02, H11, H22 = _quintic_H(h[(k - 1) % nd], h[k])
+    H00, H01, H02, H11, H22 = _quintic_H(h[_prev(k, nd)], h[k])
     S = H00 - H01 * H01 / H11 - H02 * H02 / H22
     out = 0.0
     for c in range(P.shape[1]):
@@ -255,7 +285,7 @@ def quintic_measure(P, D, h, k, spline):
 def cubic_jump(P, D, h, k):
     """``|r'''(t_k+) - r'''(t_k-)| = 6 |a_{k,3} - a_{k-1,3}|`` (Wang & Cao 2006, eq. (7))."""
     nd = P.shape[0]
-    km = (k - 1) % nd
+    km = _prev(k, nd)
     s = 0.0
     for c in range(P.shape[1]):
         al2, al3 = _cubic_a23(P, D, h, km, c)
@@ -276,24 +306,20 @@ def _cubic_step_coord(P, D, h, k, method, hstep, c):
     """``(delta_c, eta_c, delta_poliakoff_c)`` of :func:`cubic_step`, one coordinate, no
     allocation (the same formulas)."""
     nd = P.shape[0]
-    km = (k - 1) % nd
-    kp = (k + 1) % nd
+    km = _prev(k, nd)
+    kp = _next(k, nd)
     D0 = h[km]
     D1 = h[k]
     al2, al3 = _cubic_a23(P, D, h, km, c)
     ar2, ar3 = _cubic_a23(P, D, h, k, c)
-    dpol = -(ar3 - al3) / (2.0 / D1**3 + 2.0 / D0**3)
+    dpol = -(ar3 - al3) / _poliakoff_den(D0, D1)
     if method == KJELLANDER:
         d = (0.5 * (P[km, c] + P[kp, c]) + 0.25 * hstep * (D[km, 0, c] - D[kp, 0, c])
              - P[k, c])
         return d, 0.0, dpol
     if method == POLIAKOFF:
         return dpol, 0.0, dpol
-    J = al3 - ar3
-    G = ar2 - al2 - 3.0 * al3 * D0
-    f = D1 * D0 / (D1 + D0) ** 3
-    d = f * D1 * D0 * (2.0 * D1 * D0 * J + (D1 - D0) * G)
-    e = f * (3.0 * D1 * D0 * (D1 - D0) * J + 2.0 * (D1 * D1 - D1 * D0 + D0 * D0) * G)
+    d, e = _wang_cao_de(al2, al3, ar2, ar3, D0, D1)
     return d, e, dpol
 
 
@@ -310,7 +336,7 @@ def cubic_energy_drop(P, D, h, k, method, hstep):
     with the gradient ``g = -Hpp delta_Poliakoff`` (it can be negative).
     """
     nd = P.shape[0]
-    D0 = h[(k - 1) % nd]
+    D0 = h[_prev(k, nd)]
     D1 = h[k]
     Hpp = 24.0 * (1.0 / D0**3 + 1.0 / D1**3)
     Hpd = 12.0 * (1.0 / D1**2 - 1.0 / D0**2)
@@ -371,7 +397,7 @@ def cubic_sapidis(P, D, h, k):
     coordinates of a curve in more than three dimensions)."""
     nd = P.shape[0]
     dim = P.shape[1]
-    km = (k - 1) % nd
+    km = _prev(k, nd)
     D0 = h[km]
     m = 3 if dim > 3 else dim
     l1 = np.zeros(3)
@@ -396,7 +422,7 @@ def cubic_sapidis(P, D, h, k):
 def quintic_move(P, D, h, k):
     """Length of the position change of the unclamped Wang step at ``k``."""
     nd = P.shape[0]
-    H00, H01, H02, H11, H22 = _quintic_H(h[(k - 1) % nd], h[k])
+    H00, H01, H02, H11, H22 = _quintic_H(h[_prev(k, nd)], h[k])
     S = H00 - H01 * H01 / H11 - H02 * H02 / H22
     s = 0.0
     for c in range(P.shape[1]):
@@ -426,6 +452,92 @@ def measure_at(P, D, h, k, degree, spline, method=POLIAKOFF, hstep=0.0, mcode=M_
     return quintic_measure(P, D, h, k, spline)
 
 
+# the measures that :func:`range_measures` computes from each segment's coefficients once
+MF_GENERIC = 0  # measure_at per point
+MF_JUMP = 1  # cubic, M_DEFAULT
+MF_POLIAKOFF_MOVE = 2  # cubic, M_MOVE, Poliakoff
+MF_WANG_CAO_MOVE = 3  # cubic, M_MOVE, Wang-Cao
+
+
+@njit(cache=True)
+def fast_measure_code(degree, method, mcode):
+    """Which :data:`MF_GENERIC` .. :data:`MF_WANG_CAO_MOVE` path :func:`range_measures`
+    takes for these options."""
+    if degree != 3:
+        return MF_GENERIC
+    if mcode == M_DEFAULT:
+        return MF_JUMP
+    if mcode == M_MOVE and method == POLIAKOFF:
+        return MF_POLIAKOFF_MOVE
+    if mcode == M_MOVE and method == WANG_CAO:
+        return MF_WANG_CAO_MOVE
+    return MF_GENERIC
+
+
+@njit(cache=True, inline="always")
+def _wrap(v, nd):
+    """``v % nd`` for ``-nd <= v < 2 nd``."""
+    if v < 0:
+        return v + nd
+    if v >= nd:
+        return v - nd
+    return v
+
+
+@njit(cache=True)
+def range_measures(P, D, h, closed, degree, spline, method, hstep, mcode, mfast, a, b, seg,
+                   out):
+    """``out[v - a]`` = :func:`measure_at` of point ``v`` (``v % nd`` on a closed curve) for
+    ``v`` in ``a .. b``, bit for bit (``-nd <= a``, ``b < 2 nd``; ``1 <= a``, ``b <= nd - 2``
+    when open).
+
+    The cubic measures that read only the coefficients ``a_2, a_3`` of the two segments at a
+    point (``mfast``, :func:`fast_measure_code`) compute each segment's once into ``seg``
+    (``(b - a + 2, 2, dim)``): a point's measure reads the segment on each side, so per
+    point this halves the segment work of :func:`measure_at`, which also repeats it per
+    coordinate (Poliakoff's and Wang-Cao's step formulas read them once per coordinate).
+    Same formulas in the same order as :func:`cubic_jump` and :func:`cubic_move`.
+    """
+    nd = P.shape[0]
+    dim = P.shape[1]
+    if b < a:
+        return
+    if mfast == MF_GENERIC:
+        for v in range(a, b + 1):
+            out[v - a] = measure_at(P, D, h, _wrap(v, nd) if closed else v, degree, spline,
+                                    method, hstep, mcode)
+        return
+    for v in range(a - 1, b + 1):
+        j = _wrap(v, nd) if closed else v
+        j1 = _next(j, nd)
+        for c in range(dim):
+            a2, a3 = _cubic_seg(P, D, h, j, j1, c)
+            seg[v - a + 1, 0, c] = a2
+            seg[v - a + 1, 1, c] = a3
+    for v in range(a, b + 1):
+        i = _wrap(v, nd) if closed else v
+        r = v - a + 1
+        s = 0.0
+        if mfast == MF_JUMP:
+            for c in range(dim):
+                s += (seg[r, 1, c] - seg[r - 1, 1, c]) ** 2
+            out[v - a] = 6.0 * np.sqrt(s)
+            continue
+        D0 = h[_prev(i, nd)]
+        D1 = h[i]
+        if mfast == MF_POLIAKOFF_MOVE:
+            den = _poliakoff_den(D0, D1)
+            for c in range(dim):
+                d = -(seg[r, 1, c] - seg[r - 1, 1, c]) / den
+                s += d * d
+        else:
+            for c in range(dim):
+                d, e = _wang_cao_de(seg[r - 1, 0, c], seg[r - 1, 1, c], seg[r, 0, c],
+                                    seg[r, 1, c], D0, D1)
+                s += d * d
+        out[v - a] = np.sqrt(s)
+
+
 # ----------------------------------------------------------------------------------------------
 # window solve of the spline system (block tridiagonal, SPD, block size nb = 1 or 2)
 # ----------------------------------------------------------------------------------------------
@@ -445,7 +557,7 @@ def _kseg(K0, pe, pw, a, b):
     return K0[a, b] * pw[pe[a] + pe[b]]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _inv_small(M, nb, out):
     if nb == 1:
         out[0, 0] = 1.0 / M[0, 0]
@@ -457,7 +569,7 @@ def _inv_small(M, nb, out):
         out[1, 0] = -M[1, 0] / det
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _assemble_window(nd, closed, h, K0, pe, q, nb, fixed, idx, L, Bd, Cu, pw):
     """Diagonal blocks ``Bd[v]`` and super-diagonal blocks ``Cu[v]`` (v -> v+1) of the window
     whose actual point indices are ``idx[0..L-1]``; fixed unknowns become identity rows/cols."""
@@ -469,7 +581,7 @@ def _assemble_window(nd, closed, h, K0, pe, q, nb, fixed, idx, L, Bd, Cu, pw):
                 Bd[v, a, b] = 0.0
                 Cu[v, a, b] = 0.0
         if closed or i >= 1:  # segment i-1 ends at i
-            _powers(h[(i - 1) % nd], q, pw)
+            _powers(h[_prev(i, nd)], q, pw)
             for a in range(nb):
                 for b in range(nb):
                     Bd[v, a, b] += _kseg(K0, pe, pw, r1 + 1 + a, r1 + 1 + b)
@@ -493,7 +605,7 @@ def _assemble_window(nd, closed, h, K0, pe, q, nb, fixed, idx, L, Bd, Cu, pw):
                 Bd[v, a, a] = 1.0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _block_thomas(L, nb, dim, Bd, Cu, R, X, Bp, Y, inv, W):
     """Solve the symmetric block tridiagonal system (sub-diagonal = Cu^T) for X (L, nb, dim);
     ``inv`` and ``W`` are 2x2 scratch arrays."""
@@ -539,7 +651,7 @@ def _block_thomas(L, nb, dim, Bd, Cu, R, X, Bp, Y, inv, W):
                 X[v, a, c] = s
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _rhs_for_move(nd, closed, h, K0, pe, q, nb, k, dr, idx, L, fixed, R, pw):
     """Right-hand side (minus the gradient change) caused by moving point ``k`` by ``dr``.
 
@@ -554,7 +666,7 @@ def _rhs_for_move(nd, closed, h, K0, pe, q, nb, k, dr, idx, L, fixed, R, pw):
             coef = 0.0
             if not fixed[i, a]:
                 if closed or i >= 1:  # segment j = i-1: i is its end point
-                    j = (i - 1) % nd
+                    j = _prev(i, nd)
                     if i == k or j == k:
                         _powers(h[j], q, pw)
                         if i == k:
@@ -562,14 +674,25 @@ def _rhs_for_move(nd, closed, h, K0, pe, q, nb, k, dr, idx, L, fixed, R, pw):
                         if j == k:
                             coef += _kseg(K0, pe, pw, r1 + 1 + a, 0)
                 if closed or i <= nd - 2:  # segment i: i is its start point
-                    if i == k or (i + 1) % nd == k:
+                    if i == k or _next(i, nd) == k:
                         _powers(h[i], q, pw)
                         if i == k:
                             coef += _kseg(K0, pe, pw, 1 + a, 0)
-                        if (i + 1) % nd == k:
+                        if _next(i, nd) == k:
                             coef += _kseg(K0, pe, pw, 1 + a, r1)
             for c in range(dim):
                 R[v, a, c] = -coef * dr[c]
+
+
+@njit(cache=True, inline="always")
+def _window_solve(nd, closed, h, K0, pe, q, nb, dim, fixed, idx, L, k, dr, Bd, Cu, R, X, Bp, Y,
+                  pw, inv, W):
+    """The change ``X`` of the window's derivative data when point ``k`` moves by ``dr``:
+    assemble, right-hand side, block Thomas. Inlined, so that a caller passing constant
+    ``nb`` and ``dim`` gets their loops unrolled."""
+    _assemble_window(nd, closed, h, K0, pe, q, nb, fixed, idx, L, Bd, Cu, pw)
+    _rhs_for_move(nd, closed, h, K0, pe, q, nb, k, dr, idx, L, fixed, R, pw)
+    _block_thomas(L, nb, dim, Bd, Cu, R, X, Bp, Y, inv, W)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -680,6 +803,12 @@ def drive(P, D, h, orig, closed, degree, method, spline, hstep, eligible, tol, e
     if Lmax < 3:
         Lmax = 3
     idx = np.empty(Lmax, dtype=np.int64)
+    # the measures a step recomputes (a window and its two neighbours, or every point when
+    # the dense inverse updates them all) and their segments' coefficients
+    mfast = fast_measure_code(degree, method, mcode)
+    nm = nd + 3 if dense else Lmax + 3
+    mbuf = np.empty(nm)
+    seg = np.empty((nm + 1, 2, dim))
     Bd = np.empty((Lmax, nb, nb))
     Cu = np.empty((Lmax, nb, nb))
     R = np.empty((Lmax, nb, dim))
@@ -785,9 +914,20 @@ def drive(P, D, h, orig, closed, degree, method, spline, hstep, eligible, tol, e
                             idx[vv] = lo + vv
                         left_open = lo > 0
                         right_open = hi < nd - 1
-                    _assemble_window(nd, closed, h, K0, pe, q, nb, fixed, idx, L, Bd, Cu, pw)
-                    _rhs_for_move(nd, closed, h, K0, pe, q, nb, k, delta, idx, L, fixed, R, pw)
-                    _block_thomas(L, nb, dim, Bd, Cu, R, X, Bp, Y, inv2, W2)
+                    # the block and coordinate counts as constants where they are the common
+                    # ones, so that the compiler unrolls their loops (the same operations)
+                    if nb == 1 and dim == 2:
+                        _window_solve(nd, closed, h, K0, pe, q, 1, 2, fixed, idx, L, k, delta,
+                                      Bd, Cu, R, X, Bp, Y, pw, inv2, W2)
+                    elif nb == 1 and dim == 3:
+                        _window_solve(nd, closed, h, K0, pe, q, 1, 3, fixed, idx, L, k, delta,
+                                      Bd, Cu, R, X, Bp, Y, pw, inv2, W2)
+                    elif nb == 2 and dim == 2:
+                        _window_solve(nd, closed, h, K0, pe, q, 2, 2, fixed, idx, L, k, delta,
+                                      Bd, Cu, R, X, Bp, Y, pw, inv2, W2)
+                    else:
+                        _window_solve(nd, closed, h, K0, pe, q, nb, dim, fixed, idx, L, k,
+                                      delta, Bd, Cu, R, X, Bp, Y, pw, inv2, W2)
                     ok = True
                     for e in range(nb):
                         big = 0.0
@@ -831,9 +971,11 @@ def drive(P, D, h, orig, closed, degree, method, spline, hstep, eligible, tol, e
                 a = 1
             if b > nd - 2:
                 b = nd - 2
+        range_measures(P, D, h, closed, degree, spline, method, hstep, mcode, mfast, a, b, seg,
+                       mbuf)
         for vv in range(a, b + 1):
             i = vv % nd if closed else vv
-            m_new = measure_at(P, D, h, i, degree, spline, method, hstep, mcode)
+            m_new = mbuf[vv - a]
             measure[i] = m_new
             if not eligible[i]:
                 values[i] = -np.inf
@@ -871,7 +1013,18 @@ def all_measures(P, D, h, closed, degree, spline, method=POLIAKOFF, hstep=0.0,
     """Ranking measure of every point (0 at the ends of an open curve)."""
     nd = P.shape[0]
     out = np.zeros(nd)
-    for i in range(nd):
-        if closed or (i >= 1 and i <= nd - 2):
-            out[i] = measure_at(P, D, h, i, degree, spline, method, hstep, mcode)
+    if closed:
+        a, b = 0, nd - 1
+    else:
+        a, b = 1, nd - 2
+    mfast = fast_measure_code(degree, method, mcode)
+    # in blocks, so that the segments' buffer stays small
+    seg = np.empty((_MEASURE_BLOCK + 1, 2, P.shape[1]))
+    for lo in range(a, b + 1, _MEASURE_BLOCK):
+        hi = min(lo + _MEASURE_BLOCK - 1, b)
+        range_measures(P, D, h, closed, degree, spline, method, hstep, mcode, mfast, lo, hi,
+                       seg, out[lo:hi + 1])
     return out
+
+
+_MEASURE_BLOCK = 4096
