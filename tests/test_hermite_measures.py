@@ -207,13 +207,14 @@ def test_structure_free_removes_knots_within_tol():
         fair(b, tol=4e-3, structure="new")
 
 
+@pytest.mark.parametrize("degree", [3, 5])
 @pytest.mark.parametrize("closed", [False, True])
 @pytest.mark.parametrize("dim", [2, 3])
-def test_range_measures_are_measure_at_bit_for_bit(closed, dim):
+def test_range_measures_are_measure_at_bit_for_bit(closed, dim, degree):
     """The loop's measures of a range (each segment's coefficients computed once, for the
-    cubic jump and for Poliakoff's and Wang-Cao's move) and of the whole curve are the bytes
-    of the per-point :func:`measure_at`, for every method and measure code, on ranges that
-    wrap round a closed curve's seam."""
+    cubic jump, Poliakoff's and Wang-Cao's move and the quintic measures) and of the whole
+    curve are the bytes of the per-point :func:`measure_at`, for every method and measure
+    code, on ranges that wrap round a closed curve's seam."""
     from curvefair._kernels import hermite as k
     from curvefair.fairing.hermite_data import distinct_data
 
@@ -224,7 +225,14 @@ def test_range_measures_are_measure_at_bit_for_bit(closed, dim):
     T = rng.normal(size=(n, dim))
     if closed:
         P[-1], T[-1] = P[0], T[0]
-    Pd, D, h = distinct_data(CubicHermite(P, T, t, closed=closed))
+    if degree == 3:
+        curve = CubicHermite(P, T, t, closed=closed)
+    else:
+        S = rng.normal(size=(n, dim)) * 3.0
+        if closed:
+            S[-1] = S[0]
+        curve = QuinticHermite(P, T, S, t, closed=closed)
+    Pd, D, h = distinct_data(curve)
     nd = Pd.shape[0]
     assert nd == n - closed
     ranges = [(-4, 5), (nd - 6, nd + 3), (0, nd - 1), (7, 7)] if closed else \
@@ -233,18 +241,19 @@ def test_range_measures_are_measure_at_bit_for_bit(closed, dim):
     for method in (k.KJELLANDER, k.POLIAKOFF, k.WANG_CAO):
         for mcode in (k.M_DEFAULT, k.M_ENERGY, k.M_SAPIDIS, k.M_MOVE):
             for spline in (False, True):
-                args = (Pd, D, h, closed, 3, spline, method, 0.7, mcode)
-                mf = k.fast_measure_code(3, method, mcode)
+                args = (Pd, D, h, closed, degree, spline, method, 0.7, mcode)
+                mf = k.fast_measure_code(degree, method, mcode)
                 seen.add(mf)
                 # an open curve's end points have no measure (one segment each)
-                ref = np.array([k.measure_at(Pd, D, h, i, 3, spline, method, 0.7, mcode)
+                ref = np.array([k.measure_at(Pd, D, h, i, degree, spline, method, 0.7, mcode)
                                 if closed or 0 < i < nd - 1 else 0.0 for i in range(nd)])
                 for a, b in ranges:
                     out = np.full(max(b - a + 1, 0), np.nan)
-                    seg = np.empty((b - a + 3, 2, dim))
+                    seg = np.empty((b - a + 3, 4, dim))
                     k.range_measures(*args, mf, a, b, seg, out)
                     want = ref[np.arange(a, b + 1) % nd]
                     assert out.tobytes() == want.tobytes(), (method, mcode, a, b)
                 whole = k.all_measures(*args)
                 assert whole.tobytes() == ref.tobytes()
-    assert seen == {k.MF_GENERIC, k.MF_JUMP, k.MF_POLIAKOFF_MOVE, k.MF_WANG_CAO_MOVE}
+    assert seen == ({k.MF_GENERIC, k.MF_JUMP, k.MF_POLIAKOFF_MOVE, k.MF_WANG_CAO_MOVE}
+                    if degree == 3 else {k.MF_QUINTIC, k.MF_QUINTIC_MOVE})

@@ -111,10 +111,13 @@ def _cubic_seg(P, D, h, i0, i1, c):
 @njit(cache=True, inline="always")
 def _quintic_a2345(P, D, h, j, c):
     """``a_{j,2..5}`` of quintic segment ``j``, coordinate ``c`` (Wang 2005, eq. (2))."""
-    nd = P.shape[0]
-    i0 = j
-    i1 = _next(j, nd)
-    H = h[j]
+    return _quintic_seg(P, D, h, j, _next(j, P.shape[0]), c)
+
+
+@njit(cache=True, inline="always")
+def _quintic_seg(P, D, h, i0, i1, c):
+    """:func:`_quintic_a2345` of the segment from point ``i0`` to point ``i1``."""
+    H = h[i0]
     m0 = D[i0, 0, c]
     s0 = D[i0, 1, c]
     b1 = P[i1, c] - P[i0, c] - m0 * H - 0.5 * s0 * H * H
@@ -202,10 +205,15 @@ def _quintic_C(P, D, h, k, c):
     """Wang 2005, Lemma: ``(C1, C2, C3)`` of coordinate ``c`` at point ``k``."""
     nd = P.shape[0]
     km = _prev(k, nd)
-    D0 = h[km]
-    D1 = h[k]
     l2, l3, l4, l5 = _quintic_a2345(P, D, h, km, c)
     r2, r3, r4, r5 = _quintic_a2345(P, D, h, k, c)
+    return _quintic_C_of(l2, l3, l4, l5, r2, r3, r4, r5, h[km], h[k])
+
+
+@njit(cache=True, inline="always")
+def _quintic_C_of(l2, l3, l4, l5, r2, r3, r4, r5, D0, D1):
+    """:func:`_quintic_C` from the coefficients of the segments left (``l``) and right (``r``)
+    of the point and their widths ``D0``, ``D1``."""
     C1 = (12.0 * (r3 - l3) + 24.0 * (r4 * D1 - l4 * D0)
           + 240.0 / 7.0 * (r5 * D1**2 - l5 * D0**2))
     C2 = (-4.0 * (r2 - l2) + 12.0 * l3 * D0 + 24.0 / 5.0 * r4 * D1**2
@@ -274,10 +282,17 @@ def quintic_measure(P, D, h, k, spline):
     out = 0.0
     for c in range(P.shape[1]):
         C1, C2, C3 = _quintic_C(P, D, h, k, c)
-        c1 = C1 - H01 * C2 / H11 - H02 * C3 / H22
-        out += 0.5 * c1 * c1 / S
-        if not spline:
-            out += 0.5 * (C2 * C2 / H11 + C3 * C3 / H22)
+        out = _quintic_drop_add(out, C1, C2, C3, H01, H02, H11, H22, S, spline)
+    return out
+
+
+@njit(cache=True, inline="always")
+def _quintic_drop_add(out, C1, C2, C3, H01, H02, H11, H22, S, spline):
+    """``out`` plus one coordinate's part of :func:`quintic_measure`."""
+    c1 = C1 - H01 * C2 / H11 - H02 * C3 / H22
+    out += 0.5 * c1 * c1 / S
+    if not spline:
+        out += 0.5 * (C2 * C2 / H11 + C3 * C3 / H22)
     return out
 
 
@@ -427,9 +442,15 @@ def quintic_move(P, D, h, k):
     s = 0.0
     for c in range(P.shape[1]):
         C1, C2, C3 = _quintic_C(P, D, h, k, c)
-        d = -(C1 - H01 * C2 / H11 - H02 * C3 / H22) / S
+        d = _quintic_delta(C1, C2, C3, H01, H02, H11, H22, S)
         s += d * d
     return np.sqrt(s)
+
+
+@njit(cache=True, inline="always")
+def _quintic_delta(C1, C2, C3, H01, H02, H11, H22, S):
+    """The position change of the Wang step in one coordinate (:func:`quintic_move`)."""
+    return -(C1 - H01 * C2 / H11 - H02 * C3 / H22) / S
 
 
 @njit(cache=True)
@@ -457,12 +478,16 @@ MF_GENERIC = 0  # measure_at per point
 MF_JUMP = 1  # cubic, M_DEFAULT
 MF_POLIAKOFF_MOVE = 2  # cubic, M_MOVE, Poliakoff
 MF_WANG_CAO_MOVE = 3  # cubic, M_MOVE, Wang-Cao
+MF_QUINTIC = 4  # quintic, M_DEFAULT (the energy drop)
+MF_QUINTIC_MOVE = 5  # quintic, M_MOVE
 
 
 @njit(cache=True)
 def fast_measure_code(degree, method, mcode):
     """Which :data:`MF_GENERIC` .. :data:`MF_WANG_CAO_MOVE` path :func:`range_measures`
     takes for these options."""
+    if degree == 5:
+        return MF_QUINTIC_MOVE if mcode == M_MOVE else MF_QUINTIC
     if degree != 3:
         return MF_GENERIC
     if mcode == M_DEFAULT:
@@ -491,12 +516,13 @@ def range_measures(P, D, h, closed, degree, spline, method, hstep, mcode, mfast,
     ``v`` in ``a .. b``, bit for bit (``-nd <= a``, ``b < 2 nd``; ``1 <= a``, ``b <= nd - 2``
     when open).
 
-    The cubic measures that read only the coefficients ``a_2, a_3`` of the two segments at a
-    point (``mfast``, :func:`fast_measure_code`) compute each segment's once into ``seg``
-    (``(b - a + 2, 2, dim)``): a point's measure reads the segment on each side, so per
-    point this halves the segment work of :func:`measure_at`, which also repeats it per
-    coordinate (Poliakoff's and Wang-Cao's step formulas read them once per coordinate).
-    Same formulas in the same order as :func:`cubic_jump` and :func:`cubic_move`.
+    The measures that read only the coefficients of the two segments at a point (``mfast``,
+    :func:`fast_measure_code`: the cubic jump, Poliakoff's and Wang-Cao's move, both quintic
+    measures) compute each segment's once into ``seg`` (``(b - a + 2, 4, dim)``, ``a_2 ..
+    a_5``): a point's measure reads the segment on each side, so this halves the segment
+    work of :func:`measure_at` per point, and the cubic moves no longer repeat it per
+    coordinate. The same formulas (shared inlined functions) in the same order as
+    :func:`cubic_jump`, :func:`cubic_move`, :func:`quintic_measure` and :func:`quintic_move`.
     """
     nd = P.shape[0]
     dim = P.shape[1]
@@ -511,9 +537,17 @@ def range_measures(P, D, h, closed, degree, spline, method, hstep, mcode, mfast,
         j = _wrap(v, nd) if closed else v
         j1 = _next(j, nd)
         for c in range(dim):
-            a2, a3 = _cubic_seg(P, D, h, j, j1, c)
+            if degree == 5:
+                a2, a3, a4, a5 = _quintic_seg(P, D, h, j, j1, c)
+                seg[v - a + 1, 2, c] = a4
+                seg[v - a + 1, 3, c] = a5
+            else:
+                a2, a3 = _cubic_seg(P, D, h, j, j1, c)
             seg[v - a + 1, 0, c] = a2
             seg[v - a + 1, 1, c] = a3
+    if degree == 5:
+        _quintic_range(h, nd, dim, closed, spline, mfast == MF_QUINTIC_MOVE, a, b, seg, out)
+        return
     for v in range(a, b + 1):
         i = _wrap(v, nd) if closed else v
         r = v - a + 1
@@ -536,6 +570,30 @@ def range_measures(P, D, h, closed, degree, spline, method, hstep, mcode, mfast,
                                     seg[r, 1, c], D0, D1)
                 s += d * d
         out[v - a] = np.sqrt(s)
+
+
+@njit(cache=True, inline="always")
+def _quintic_range(h, nd, dim, closed, spline, move, a, b, seg, out):
+    """The quintic part of :func:`range_measures`: :func:`quintic_measure` (or, ``move``,
+    :func:`quintic_move`) of the points ``a .. b`` from their segments' coefficients."""
+    for v in range(a, b + 1):
+        i = _wrap(v, nd) if closed else v
+        r = v - a + 1
+        D0 = h[_prev(i, nd)]
+        D1 = h[i]
+        H00, H01, H02, H11, H22 = _quintic_H(D0, D1)
+        S = H00 - H01 * H01 / H11 - H02 * H02 / H22
+        s = 0.0
+        for c in range(dim):
+            C1, C2, C3 = _quintic_C_of(seg[r - 1, 0, c], seg[r - 1, 1, c], seg[r - 1, 2, c],
+                                       seg[r - 1, 3, c], seg[r, 0, c], seg[r, 1, c],
+                                       seg[r, 2, c], seg[r, 3, c], D0, D1)
+            if move:
+                d = _quintic_delta(C1, C2, C3, H01, H02, H11, H22, S)
+                s += d * d
+            else:
+                s = _quintic_drop_add(s, C1, C2, C3, H01, H02, H11, H22, S, spline)
+        out[v - a] = np.sqrt(s) if move else s
 
 
 # ----------------------------------------------------------------------------------------------
@@ -808,7 +866,7 @@ def drive(P, D, h, orig, closed, degree, method, spline, hstep, eligible, tol, e
     mfast = fast_measure_code(degree, method, mcode)
     nm = nd + 3 if dense else Lmax + 3
     mbuf = np.empty(nm)
-    seg = np.empty((nm + 1, 2, dim))
+    seg = np.empty((nm + 1, 4, dim))
     Bd = np.empty((Lmax, nb, nb))
     Cu = np.empty((Lmax, nb, nb))
     R = np.empty((Lmax, nb, dim))
@@ -1019,7 +1077,7 @@ def all_measures(P, D, h, closed, degree, spline, method=POLIAKOFF, hstep=0.0,
         a, b = 1, nd - 2
     mfast = fast_measure_code(degree, method, mcode)
     # in blocks, so that the segments' buffer stays small
-    seg = np.empty((_MEASURE_BLOCK + 1, 2, P.shape[1]))
+    seg = np.empty((_MEASURE_BLOCK + 1, 4, P.shape[1]))
     for lo in range(a, b + 1, _MEASURE_BLOCK):
         hi = min(lo + _MEASURE_BLOCK - 1, b)
         range_measures(P, D, h, closed, degree, spline, method, hstep, mcode, mfast, lo, hi,
