@@ -387,14 +387,15 @@ def prepare(curve: HermiteSpline, *, method: str, tol: float | None, eps: float 
     Hinv = np.zeros((0, 0))
     if spline and closed and nd * nb <= _DENSE_MAX:
         Hinv = _dense_inverse(nd, nb, h, degree)
-    args = (P, D, h, P.copy(), closed, degree, code, spline, hstep, eligible,
+    orig = P.copy()  # the loop's tolerance centres, and the start of a re-run
+    args = (P, D, h, orig, closed, degree, code, spline, hstep, eligible,
             np.inf if tol is None else float(tol), eps_eff, max_eff, floor,
             K0, pe, q, fixed, Hinv, _W0[degree], _WMAX, _THR, meas, values, tv, ti,
             blocked, block_measure, mcode)
     return {"args": args, "extra": extra, "held": held, "eligible": eligible, "m0": m0,
             "floor0": 8.0 * np.finfo(float).eps * scale,
             "measure_name": mname,
-            "P0": P.copy(), "D0": D.copy(),
+            "P0": orig, "D0": D.copy(),
             "eps": eps_eff, "eps_rel": eps_rel, "max_steps": max_eff, "n_elig": n_elig,
             "measure": meas,
             "P": P, "D": D, "spline": spline, "degree": degree, "nd": nd, "Hinv": Hinv}
@@ -407,27 +408,35 @@ _SHRINK = 0.98
 _DRIVE_STATE = (0, 1, 22, 23, 24, 25, 26, 27)
 
 
-def _copy_state(st: dict[str, Any]) -> dict[str, Any]:
-    """A copy of :func:`prepare`'s result whose in-place loop state is fresh."""
-    args = list(st["args"])
+def _restart(st: dict[str, Any], tol: float) -> dict[str, Any]:
+    """:func:`prepare`'s result for another point tolerance, after a run that changed ``st``'s
+    loop state: the loop's start again from the pristine data ``st["P0"]``, ``st["D0"]``
+    (copies) and the same compiled set-up :func:`prepare` ran on them
+    (:func:`curvefair._kernels.hermite.drive_setup`: the same measures, tree and flags, bit
+    for bit); only ``tol`` and the move floor differ. The run's state is dropped first.
+
+    Rebuilding costs one measure pass and one tree build; keeping a copy of the first state
+    for a re-run cost about 125 bytes a point (8x a planar input's coordinates) for the whole
+    run, and copying it more time than rebuilding it."""
+    args: list[Any] = list(st["args"])
     for k in _DRIVE_STATE:
-        args[k] = args[k].copy()
-    out = dict(st)
-    out["args"] = tuple(args)
-    out["P"], out["D"], out["measure"] = args[0], args[1], args[22]
-    out["extra"] = dict(st["extra"])
-    return out
-
-
-def _retarget(snap: dict[str, Any], tol: float) -> dict[str, Any]:
-    """:func:`prepare`'s result for another point tolerance, from a pristine copy ``snap``:
-    only ``tol`` and the move floor depend on it (no ``O(n)`` setup repeated)."""
-    st = _copy_state(snap)
-    args = list(st["args"])
+        args[k] = None
+    out = st  # the caller's, updated in place: nothing keeps the run's state alive
+    out["args"] = None
+    out["P"] = out["D"] = out["measure"] = None
+    P, D = out["P0"].copy(), out["D0"].copy()
+    h, closed, degree, code, spline, hstep, eligible = (args[2], args[4], args[5], args[6],
+                                                       args[7], args[8], args[9])
+    state = _k.drive_setup(P, D, h, closed, degree, spline, eligible, code, hstep, args[28])
+    args[0], args[1] = P, D
+    for k, a in zip(_DRIVE_STATE[2:], state, strict=True):
+        args[k] = a
     args[10] = float(tol)
-    args[13] = max(snap["floor0"], 1e-9 * tol)
-    st["args"] = tuple(args)
-    return st
+    args[13] = max(out["floor0"], 1e-9 * tol)
+    out["args"] = tuple(args)
+    out["P"], out["D"], out["measure"] = P, D, args[22]
+    out["extra"] = dict(out["extra"])
+    return out
 
 
 def _curve_deviation(curve: HermiteSpline, P: FloatArray, D: FloatArray) -> float:
@@ -516,14 +525,11 @@ def hermite_solve(problem: FairingProblem, *, method: str, tol_on: str = "curve"
                               clamp=problem.clamp, protect=protect, mode=problem.mode,
                               measure=measure)
     point_tol = tol
-    snap = None
     for attempt in range(_CURVE_TOL_RERUNS + 1):
-        if snap is None:
+        if attempt == 0:
             st = prepare(curve, tol=point_tol, **kw)
-            if tol is not None and tol_on == "curve":
-                snap = _copy_state(st)  # a re-run starts from this state
         else:
-            st = _retarget(snap, cast(float, point_tol))
+            st = _restart(st, cast(float, point_tol))  # from the same start
         (steps, stop, h_idx, h_meas, h_disp, blocked, n_trunc, n_skip,
          max_window) = _k.drive(*st["args"])
         if tol is None or tol_on == "points":
