@@ -116,6 +116,7 @@ from .._kernels import hermite as _k
 from .._typing import FloatArray
 from ..curves.hermite import CubicHermite, HermiteSpline, QuinticHermite
 from ..curves.interpolate import cubic_slopes, quintic_hermite_data
+from ..curves.piecewise import horner_rows
 from ..errors import InputError
 from .fair import MethodSpec, register_method
 from .hermite_data import distinct_data, full_data, rebuild, uniform_spacing
@@ -142,7 +143,12 @@ def _end_bc(curve: HermiteSpline, clamp: str, side: int) -> list[tuple[int, Floa
     """Re-interpolation conditions at one end (side 0 = left, -1 = right), from the input."""
     t = curve.params[side]
     seg = np.array([0 if side == 0 else curve.n_points - 2])
-    ev = lambda nu: curve.piecewise.evaluate(np.array([t]), nu, segment=seg)[0]  # noqa: E731
+    # the end segment's own power form (span_coefficients: bit for bit the whole form's row,
+    # and Horner's rule as PiecewisePolynomial.evaluate applies it), not the whole curve's:
+    # 72 bytes a segment of a planar cubic, alive through the whole loop before
+    rows = curve.span_coefficients(seg)
+    s = (np.array([t]) - np.asarray(curve.params)[seg])[:, None]
+    ev = lambda nu: horner_rows(rows, s, nu)[0]  # noqa: E731
     if curve.degree == 3:
         return [(2, ev(2))] if clamp == "g0" else [(1, ev(1))]
     if clamp == "g0":
@@ -559,8 +565,8 @@ def hermite_solve(problem: FairingProblem, *, method: str, tol_on: str = "curve"
         reason = "no_movable_point"
     else:
         reason = "tolerance" if np.any(blocked == 1) else "converged"
-    interior = set(range(1, nd - 1))
-    if n_elig == 0 and held and interior and interior <= set(held) | set(protect):
+    if n_elig == 0 and held and nd > 2 and \
+            set(range(1, nd - 1)) <= set(held) | set(protect):
         # the G2 hold of a short C2 cubic spline covers every interior point: say why
         # nothing moved (the hold is exact, from hold_zone_cubic; see the module docstring)
         note = (f"clamp='g2' on this {nd}-point C2 cubic spline holds the points next to each "
@@ -573,9 +579,6 @@ def hermite_solve(problem: FairingProblem, *, method: str, tol_on: str = "curve"
         warnings.warn(note, UserWarning, stacklevel=2)
     if not (np.isfinite(P).all() and np.isfinite(D).all()):  # pragma: no cover - safety net
         raise FloatingPointError(f"method {method!r} produced non-finite data")
-    # no step taken: the input is returned as it was (spline mode would otherwise hand back its
-    # re-interpolation, a changed curve reported as "0 steps")
-    new = curve if int(steps) == 0 else rebuild(curve, P, D)
     extra.update({
         "measure": _MEASURE_REPORT[st["measure_name"]] if degree == 3 or
                    st["measure_name"] != "energy" else
@@ -585,14 +588,22 @@ def hermite_solve(problem: FairingProblem, *, method: str, tol_on: str = "curve"
         "held": sorted(held),
         "skipped": int(n_skip),
         "blocked_by_tol": int(np.sum(blocked == 1)),
-        "driver_time_s": time.perf_counter() - t0,
     })
+    # the loop's state is no longer read: freed before the result's copies are made
+    eps_rel, max_eff = st["eps_rel"], st["max_steps"]
+    st.clear()
+    del measure, eligible, blocked
+    # no step taken: the input is returned as it was (spline mode would otherwise hand back its
+    # re-interpolation, a changed curve reported as "0 steps")
+    new = curve if int(steps) == 0 else rebuild(curve, P, D)
+    del P, D
+    extra["driver_time_s"] = time.perf_counter() - t0
     if spline:
         extra["window_max_points"] = int(nd if Hinv.shape[0] else max_window)
         extra["window_truncations"] = int(n_trunc)
     return Outcome(new, int(steps), reason,
                    FairingHistory.from_arrays(h_idx, h_meas, h_disp, "data point"),
-                   eps=st["eps_rel"], max_steps=st["max_steps"], extra=extra,
+                   eps=eps_rel, max_steps=max_eff, extra=extra,
                    curve_within_tol=tol_on == "curve", eps_absolute=eps_eff)
 
 
