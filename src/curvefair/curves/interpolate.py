@@ -268,7 +268,10 @@ def _banded(h: FloatArray, npt: int, nseg_band: int, lo: int, up: int
     """Jacobi scale ``dsc = diag(K)**-1/2`` (shape ``(2 npt,)``, all ``h.size`` segments; a
     periodic seam segment joins point ``npt-1`` to 0) and the scaled stiffness
     ``diag(dsc) K diag(dsc)`` of segments ``0 .. nseg_band-1`` in ``solve_banded`` layout
-    (``ab[up + r - c, c] = K[r, c]``)."""
+    (``ab[up + r - c, c] = K[r, c]``). ``ab`` is the view ``full[lo:]`` of a Fortran array
+    ``full`` with ``lo`` zero rows on top: the layout LAPACK's ``dgbsv`` factors in place, so
+    that :func:`_solve` hands it over without a copy (the copy was 80 bytes a point for every
+    row of the band, at the peak of a quintic interpolation)."""
     M = 2 * npt
     ih = 1.0 / h
     hp = {1: ih, 2: ih * ih}
@@ -281,7 +284,7 @@ def _banded(h: FloatArray, npt: int, nseg_band: int, lo: int, up: int
         diag[:-1] += w
         diag[1:] += w
     dsc = diag.reshape(M) ** -0.5
-    ab = np.zeros((lo + up + 1, M))
+    ab = np.zeros((2 * lo + up + 1, M), order="F")[lo:]
     nb = nseg_band
     ds = [dsc[e: e + 2 * nb: 2] for e in range(4)]  # unknown e of every band segment
     for a in range(4):
@@ -314,11 +317,18 @@ def _nak_row(k: int, h: FloatArray, dsc: FloatArray) -> tuple[np.ndarray, FloatA
 
 
 def _solve(ab: FloatArray, lo: int, up: int, rhs: FloatArray) -> FloatArray:
-    """``solve_banded((lo, up), ab, rhs)``, calling its LAPACK driver ``dgbsv`` directly on
-    Fortran-ordered copies (saves scipy's checks and C-to-Fortran conversions)."""
-    a2 = np.empty((2 * lo + up + 1, ab.shape[1]), order="F")
-    a2[:lo] = 0.0
-    a2[lo:] = ab
+    """``solve_banded((lo, up), ab, rhs)``, calling its LAPACK driver ``dgbsv`` directly
+    (saves scipy's checks and C-to-Fortran conversions). ``ab`` made by :func:`_banded` is
+    factored in place (its values are lost); any other ``ab`` is copied first."""
+    full = ab.base
+    if not (isinstance(full, np.ndarray) and full.flags.f_contiguous
+            and full.shape == (2 * lo + up + 1, ab.shape[1])
+            and ab.__array_interface__["data"][0] == full[lo:].__array_interface__["data"][0]
+            and not full[:lo].any()):
+        full = np.empty((2 * lo + up + 1, ab.shape[1]), order="F")
+        full[:lo] = 0.0
+        full[lo:] = ab
+    a2 = full
     _, _, y, info = dgbsv(lo, up, a2, np.asfortranarray(rhs), overwrite_ab=1, overwrite_b=1)
     if info != 0 or not np.isfinite(y).all():
         raise InputError("the quintic spline's end conditions do not determine it for these "
