@@ -1065,6 +1065,10 @@ def drive(P, D, h, orig, closed, degree, method, spline, hstep, eligible, tol, e
             blocked, n_trunc, n_skip, max_window)
 
 
+# all_measures works in blocks of this many points (its segment buffer stays small)
+_MEASURE_BLOCK = 4096
+
+
 @njit(cache=True)
 def all_measures(P, D, h, closed, degree, spline, method=POLIAKOFF, hstep=0.0,
                  mcode=M_DEFAULT):
@@ -1084,5 +1088,3 @@ def all_measures(P, D, h, closed, degree, spline, method=POLIAKOFF, hstep=0.0,
                        seg, out[lo:hi + 1])
     return out
 
-
-_MEASURE_BLOCK = 4096

@@ -421,9 +421,9 @@ def _restart(st: dict[str, Any], tol: float) -> dict[str, Any]:
     (:func:`curvefair._kernels.hermite.drive_setup`: the same measures, tree and flags, bit
     for bit); only ``tol`` and the move floor differ. The run's state is dropped first.
 
-    Rebuilding costs one measure pass and one tree build; keeping a copy of the first state
-    for a re-run cost about 125 bytes a point (8x a planar input's coordinates) for the whole
-    run, and copying it more time than rebuilding it."""
+    Rebuilding costs one measure pass and one tree build. The alternative, a copy of the
+    first state kept for a re-run, holds about 125 bytes a point (8x a planar input's
+    coordinates) through the whole call, and its copies took 1.4 s of a 1e7-point call."""
     args: list[Any] = list(st["args"])
     for k in _DRIVE_STATE:
         args[k] = None
@@ -441,7 +441,6 @@ def _restart(st: dict[str, Any], tol: float) -> dict[str, Any]:
     args[13] = max(out["floor0"], 1e-9 * tol)
     out["args"] = tuple(args)
     out["P"], out["D"], out["measure"] = P, D, args[22]
-    out["extra"] = dict(out["extra"])
     return out
 
 
