@@ -480,3 +480,25 @@ def test_errors(call, fragment):
     with pytest.raises(InputError) as exc:
         call()
     assert fragment in str(exc.value)
+
+
+@pytest.mark.parametrize("own", [True, False])
+def test_band_solve_in_place_and_on_a_copy(own):
+    """``_solve`` factors the band made by ``_banded`` in place (no copy of it) and copies any
+    other band first; both give scipy's ``solve_banded`` on the same matrix (an independent
+    LAPACK call through scipy's checks and conversions)."""
+    from scipy.linalg import solve_banded
+
+    from curvefair.curves import interpolate as ip
+
+    rng = np.random.default_rng(11)
+    h = rng.uniform(0.3, 2.0, 9)
+    dsc, ab = ip._banded(h, 10, 9, 3, 3)
+    rhs = rng.normal(size=(20, 2))
+    want = solve_banded((3, 3), np.array(ab), rhs)
+    band = ab if own else np.array(ab)  # a C-ordered copy: not _banded's layout
+    before = np.array(band)
+    got = ip._solve(band, 3, 3, rhs)
+    np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12 * np.abs(want).max())
+    # in place: _banded's band was factored (overwritten); a copy leaves the argument alone
+    assert np.array_equal(band, before) != own
