@@ -138,6 +138,13 @@ def _poliakoff_den(D0, D1):
 
 
 @njit(cache=True, inline="always")
+def _poliakoff_delta(al3, ar3, den):
+    """Poliakoff's step in one coordinate, ``-(a_{k,3} - a_{k-1,3}) / den``, ``den`` from
+    :func:`_poliakoff_den`."""
+    return -(ar3 - al3) / den
+
+
+@njit(cache=True, inline="always")
 def _wang_cao_de(al2, al3, ar2, ar3, D0, D1):
     """Wang-Cao's ``(delta*, eta*)`` in one coordinate (eqs. (11)-(12)) from the ``a_2, a_3``
     of the segments left and right of the point."""
@@ -177,7 +184,7 @@ def cubic_step(P, D, h, k, method, hstep, delta, eta):
         al2, al3 = _cubic_a23(P, D, h, km, c)
         ar2, ar3 = _cubic_a23(P, D, h, k, c)
         if method == POLIAKOFF:
-            delta[c] = -(ar3 - al3) / _poliakoff_den(D0, D1)
+            delta[c] = _poliakoff_delta(al3, ar3, _poliakoff_den(D0, D1))
         else:
             delta[c], eta[c] = _wang_cao_de(al2, al3, ar2, ar3, D0, D1)
 
@@ -327,7 +334,7 @@ def _cubic_step_coord(P, D, h, k, method, hstep, c):
     D1 = h[k]
     al2, al3 = _cubic_a23(P, D, h, km, c)
     ar2, ar3 = _cubic_a23(P, D, h, k, c)
-    dpol = -(ar3 - al3) / _poliakoff_den(D0, D1)
+    dpol = _poliakoff_delta(al3, ar3, _poliakoff_den(D0, D1))
     if method == KJELLANDER:
         d = (0.5 * (P[km, c] + P[kp, c]) + 0.25 * hstep * (D[km, 0, c] - D[kp, 0, c])
              - P[k, c])
@@ -484,7 +491,7 @@ MF_QUINTIC_MOVE = 5  # quintic, M_MOVE
 
 @njit(cache=True)
 def fast_measure_code(degree, method, mcode):
-    """Which :data:`MF_GENERIC` .. :data:`MF_WANG_CAO_MOVE` path :func:`range_measures`
+    """Which :data:`MF_GENERIC` .. :data:`MF_QUINTIC_MOVE` path :func:`range_measures`
     takes for these options."""
     if degree == 5:
         return MF_QUINTIC_MOVE if mcode == M_MOVE else MF_QUINTIC
@@ -562,7 +569,7 @@ def range_measures(P, D, h, closed, degree, spline, method, hstep, mcode, mfast,
         if mfast == MF_POLIAKOFF_MOVE:
             den = _poliakoff_den(D0, D1)
             for c in range(dim):
-                d = -(seg[r, 1, c] - seg[r - 1, 1, c]) / den
+                d = _poliakoff_delta(seg[r - 1, 1, c], seg[r, 1, c], den)
                 s += d * d
         else:
             for c in range(dim):
