@@ -55,6 +55,8 @@ COMPILED_FILES = frozenset({
     "test_recorded_cases.py",
     "test_distance.py",
     "test_analysis_analyze.py",
+    "test_text_kernel.py",
+    "test_io_text_layout.py",
 })
 
 #: test files whose tests each take more than ~20 s (marked ``slow``); measured with

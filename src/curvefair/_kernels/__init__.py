@@ -22,7 +22,9 @@ the kernels and read their results live in the public packages (:mod:`curvefair.
   ``dkappa/ds`` on a grid, quadratures, sign certificates, sign changes);
 * :mod:`.deviation` -- the parametric search of :func:`curvefair.deviation` and the per-span
   bound :func:`curvefair.analysis.matched_hermite_bound`;
-* :mod:`.corners` -- the corner search of the point-list readers at the data's noise scale.
+* :mod:`.corners` -- the corner search of the point-list readers at the data's noise scale;
+* :mod:`.text` -- the bulk rows of numeric text files: read (values, decimals per column) and
+  rewritten (the decimals of each changed number decided and written) from their bytes.
 
 Every kernel is decorated with :func:`curvefair._jit.njit`, and no module outside this package
 defines one (``tests/test_numba_layering.py`` checks it). A slow reference that a kernel is
@@ -55,7 +57,10 @@ the other kernels are checked by independent computations in their tests:
 * :mod:`.points` -- no reference: scipy's ``CubicSpline``, scipy.optimize, KKT conditions;
 * :mod:`.ranking` -- :func:`.ranking.tt_top_reference` (argmax over the values);
 * :mod:`.sampling` -- no reference: scipy evaluation and quadrature, brute-force dense
-  sampling, closed forms on curves of known shape.
+  sampling, closed forms on curves of known shape;
+* :mod:`.text` -- :func:`.text.plain_rows_reference` (``str.split``, ``re`` and ``float``)
+  for the reader; the writer against the row renderer of :mod:`curvefair.io._text` (the
+  Python rule it compiles).
 
 The package is private, but its public names (no leading underscore) may be imported by every
 other curvefair package (``tests/test_layering.py`` treats it as a shared internal, like

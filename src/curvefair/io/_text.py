@@ -449,13 +449,17 @@ def _render_plain_block(lines: np.ndarray, data_lines: np.ndarray, redo: np.ndar
     fixed point (:func:`_is_plain`) with at least one decimal. For such a line
     :func:`_render_line` reduces to the separator joining :func:`_plain_number` of each
     changed value, a blank separator growing by what a shorter number gave up (a comma or
-    semicolon has no padding to give or take), which is what is computed here with
-    whole-array operations: an unchanged value keeps its text; a
-    changed one is written with its token's decimals, else the column's, where that reads
-    back as exactly the value (tried only where the value times ``10**d`` is within 0.01 of
-    an integer, a necessary condition), else in the shortest exact form. The same text as
+    semicolon has no padding to give or take): an unchanged value keeps its text; a changed
+    one is written with its token's decimals, else the column's, where that reads back as
+    exactly the value, else in the shortest exact form. The rows' bytes are planned and
+    written by compiled passes (:func:`curvefair._kernels.text.plain_block_plan`, which
+    decides the decimals exactly where ``|v| 10**d < 2**49``, and
+    :func:`~curvefair._kernels.text.plain_block_write`); Python writes the shortest forms
+    (``repr``) and the few values outside that range (:func:`_plain_number`). The same text as
     the row renderer, character for character (tests/test_io_text_layout.py compares both).
     """
+    from .._kernels.text import PYTHON, SHORTEST, plain_block_plan, plain_block_write
+
     m = len(redo)
     k = values.shape[1]
     at = data_lines[redo]
@@ -463,71 +467,49 @@ def _render_plain_block(lines: np.ndarray, data_lines: np.ndarray, redo: np.ndar
     sep = next((c for c in _PLAIN_SEPS if c in first), None)
     if sep is None:
         return redo
-    block = "\n".join(lines[at].tolist())
-    if re.search(rf"[^0-9.\n{re.escape(sep)}-]", block) is not None:
+    try:
+        buf = np.frombuffer("\n".join(lines[at].tolist()).encode("ascii"), dtype=np.uint8)
+    except UnicodeEncodeError:
         return redo
-    texts = block.replace("\n", sep).split(sep)
-    if len(texts) != m * k:
+    new = np.ascontiguousarray(values[redo], dtype=np.float64).ravel()
+    was = np.ascontiguousarray(old[redo], dtype=np.float64).ravel()
+    cols = np.asarray(column_decimals, dtype=np.int64)
+    status = np.empty(m * k, dtype=np.int8)
+    dec = np.empty(m * k, dtype=np.int64)
+    start = np.empty(m * k, dtype=np.int64)
+    length = np.empty(m * k, dtype=np.int64)
+    new_len = np.empty(m * k, dtype=np.int64)
+    row_ok = np.empty(m, dtype=bool)
+    npy = plain_block_plan(buf, ord(sep), k, m, new, was, cols, status, dec, start, length,
+                           new_len, row_ok)
+    if npy < 0 or not row_ok.any():
         return redo
-    new = values[redo].ravel()
-    was = old[redo].ravel()
-    n = len(texts)
-    length = np.fromiter(map(len, texts), np.intp, count=n)
-    point = np.fromiter(map(str.find, texts, repeat(".")), np.intp, count=n)
-    minus = np.fromiter(map(str.startswith, texts, repeat("-")), bool, count=n)
-    dec = length - point - 1
-    plain = (point > 0) & ~((point == 1) & minus) & (dec > 0) & (length > 0)
-    finite = np.isfinite(new)
-    row_ok = np.all((plain & finite).reshape(m, k), axis=1)
-    if not row_ok.any():
-        return redo
-    ok = np.repeat(row_ok, k)
-    change = ok & (new != was)
-    out = np.array(texts, dtype=object)
-    todo = np.flatnonzero(change)
-    col = todo % k
-    v = new[todo]
-    done = np.zeros(len(todo), dtype=bool)
-    tries = [dec[todo]]
-    cd = np.asarray(column_decimals, dtype=np.intp)[col]
-    tries.append(np.where((cd > 0) & (np.maximum(cd, 1) != dec[todo]), np.maximum(cd, 1), -1))
-    for d_try in tries:
-        for d in np.unique(d_try[~done & (d_try >= 0)]).tolist():
-            sel = np.flatnonzero(~done & (d_try == d))
-            # exact needs v * 10**d within |k| 2^-52 of an integer k: below 0.01 for
-            # |k| < 2^45 (10**d itself exact up to d = 22); beyond that every value is tried
-            x = v[sel] * 10.0 ** d
-            cand = sel[(np.abs(x - np.rint(x)) <= 0.01) | (np.abs(x) >= 2.0 ** 45) | (d > 22)]
-            if not len(cand):
-                continue
-            strs = (f"%.{d}f\x1f" * len(cand) % tuple(v[cand].tolist())).split("\x1f")[:-1]
-            back = np.fromiter(map(float, strs), np.float64, count=len(cand))
-            # a minus only where the token had one: "-0.00" for a tiny negative value
-            # becomes "0.00" (then exact only for -0.0)
-            for i in np.flatnonzero((back == 0.0) & np.signbit(v[cand])
-                                    & ~minus[todo[cand]]).tolist():
-                strs[i] = strs[i][1:]
-            exact = back == v[cand]
-            hit = cand[exact]
-            out[todo[hit]] = [s for s, e in zip(strs, exact.tolist(), strict=True) if e]
-            done[hit] = True
-    rest = np.flatnonzero(~done)
-    if len(rest):
-        # the shortest exact form of each (:func:`_shortest`): the list's repr, then its
-        # ".0" endings and "-0" signs dropped (twice: a match consumes the ", " of the next)
-        short = f", {repr(v[rest].tolist())[1:-1]}, ".replace(".0, ", ", ")
-        short = short.replace(", -0, ", ", 0, ").replace(", -0, ", ", 0, ")
-        out[todo[rest]] = short[2:-2].split(", ")
-    if sep in " \t" and len(todo):
-        # a blank separator is the padding of the number after it: a shorter number gets the
-        # blanks it gave up, so right-aligned columns stay aligned (the first number of a
-        # line has none before it)
-        shrink = length[todo] - np.fromiter(map(len, out[todo].tolist()), np.intp,
-                                            count=len(todo))
-        for i in np.flatnonzero((shrink > 0) & (col > 0)).tolist():
-            out[todo[i]] = sep * int(shrink[i]) + out[todo[i]]
-    rows_text = ((sep.join(["%s"] * k) + "\n") * m % tuple(out.tolist())).split("\n")
-    lines[at[row_ok]] = np.array(rows_text[:-1], dtype=object)[row_ok]
+    strs: list[str] = []
+    if npy:
+        py = np.flatnonzero((status == PYTHON) | (status == SHORTEST))
+        strs = [""] * len(py)
+        short = np.flatnonzero(status[py] == SHORTEST)
+        if len(short):
+            # the shortest exact form of each (:func:`_shortest`): the list's repr, then its
+            # ".0" endings and "-0" signs dropped (twice: a match consumes the ", " of the
+            # next)
+            text = f", {repr(new[py[short]].tolist())[1:-1]}, ".replace(".0, ", ", ")
+            text = text.replace(", -0, ", ", 0, ").replace(", -0, ", ", 0, ")
+            for i, s in zip(short.tolist(), text[2:-2].split(", "), strict=True):
+                strs[i] = s
+        raw = buf.tobytes()
+        for i in np.flatnonzero(status[py] == PYTHON).tolist():
+            t = int(py[i])
+            a = int(start[t])
+            strs[i] = _plain_number(float(new[t]), raw[a:a + int(length[t])].decode("ascii"),
+                                    int(cols[t % k]))
+    py_start = np.zeros(len(strs) + 1, dtype=np.int64)
+    py_start[1:] = np.cumsum(np.fromiter(map(len, strs), np.int64, count=len(strs)))
+    py_buf = np.frombuffer("".join(strs).encode("ascii"), dtype=np.uint8)
+    out = plain_block_write(buf, ord(sep), k, m, new, status, dec, start, length, new_len,
+                            py_buf, py_start)
+    rows_text = out.tobytes().decode("ascii").split("\n")
+    lines[at[row_ok]] = np.array(rows_text, dtype=object)[row_ok]
     return redo[~row_ok]
 
 
@@ -702,7 +684,7 @@ def parse_text(path: str | os.PathLike[str], *, header: bool = True,
     notes_from: int | None = None
     data_lines: list[int] = []
     texts: list[str] = []  # every number's text, row after row
-    bulk: tuple[list[str], FloatArray] | None = None  # the rows read at once, if any
+    bulk: tuple[FloatArray, tuple[int, ...]] | None = None  # the rows read at once, if any
     width: int | None = None
     comma = False  # decimal commas (``10,25;0,5``): data rows read with decimal points
     fortran = False  # D exponents (``0.1234D+01``): data rows read with E
@@ -801,41 +783,48 @@ def parse_text(path: str | os.PathLike[str], *, header: bool = True,
         raise FileFormatError(f"no data rows in the {what}{hint}", path)
     assert width is not None
     values = np.array(list(map(float, texts)), dtype=np.float64)
-    if bulk is not None:
-        texts.extend(bulk[0])
-        values = np.concatenate([values, bulk[1]])
-    values = values.reshape(-1, width)
     col_dec = _column_decimals(texts, width)
+    if bulk is not None:
+        values = np.concatenate([values, bulk[0]])
+        col_dec = tuple(map(max, col_dec, bulk[1]))
+    values = values.reshape(-1, width)
     return TextLayout(tuple(lines), newline, final, head, tuple(data_lines), width,
                       col_dec, encoding, values, tuple(leading), notes_from, comma, fortran)
 
 
 def _plain_rows(lines: list[str], start: int, width: int
-                ) -> tuple[list[str], FloatArray] | None:
-    """The number texts and values of ``lines[start:]`` when every one of them is a row of
-    ``width`` numbers joined by one separator character (``,``, ``;``, a blank or a tab) and nothing
-    else, or None (the line-by-line reader then goes on, with its own messages).
+                ) -> tuple[FloatArray, tuple[int, ...]] | None:
+    """The values (row after row) and the largest decimals per column of ``lines[start:]``
+    when every one of them is a row of ``width`` numbers joined by one separator character
+    (``,``, ``;``, a blank or a tab) and nothing else, or None (the line-by-line reader then
+    goes on, with its own messages).
 
-    One check of the whole block instead of one per line: only digits, ``.``, ``e``/``E``,
-    signs and the separator occur, every line has ``width - 1`` separators, and every piece
-    between them is a number Python's ``float`` reads -- over those characters exactly the
-    numbers ``_NUM`` matches (no empty piece, no lone sign or point, no ``1e``)."""
+    One compiled pass over the block's bytes (:func:`curvefair._kernels.text.scan_plain_rows`)
+    instead of one check per line: every piece between the separators is a number of
+    ``_NUM``'s grammar without ``nan`` / ``inf`` (exactly what Python's ``float`` reads over
+    digits, ``.``, ``e``/``E`` and signs), every line has ``width`` of them. The values are
+    those ``float`` gives (the kernel's fast path is exact; the rest is read by ``float``)."""
+    from .._kernels.text import scan_plain_rows
+
     rows = lines[start:]
     sep = next((c for c in _PLAIN_SEPS if c in rows[0]), None)
     if sep is None or width < 2:
         return None
-    block = "\n".join(rows)
-    if re.search(rf"[^0-9.eE+\n{re.escape(sep)}-]", block) is not None:
+    buf = np.frombuffer("\n".join(rows).encode("utf-8"), dtype=np.uint8)
+    nrows = len(rows)
+    values = np.empty(nrows * width)
+    col_dec = np.zeros(width, dtype=np.int64)
+    slow_start = np.empty(nrows * width, dtype=np.int64)
+    slow_end = np.empty(nrows * width, dtype=np.int64)
+    nslow = scan_plain_rows(buf, ord(sep), width, nrows, values, col_dec, slow_start, slow_end)
+    if nslow < 0:
         return None
-    counts = np.fromiter(map(str.count, rows, repeat(sep)), np.intp, count=len(rows))
-    if np.any(counts != width - 1):
-        return None
-    texts = block.replace("\n", sep).split(sep)
-    try:
-        values = np.fromiter(map(float, texts), np.float64, count=len(texts))
-    except ValueError:
-        return None
-    return texts, values
+    if nslow:  # the kernel's NaN marks them, in order (no NaN is read: "nan" is not a row's)
+        raw = buf.tobytes()
+        values[np.isnan(values)] = [
+            float(raw[a:b]) for a, b in zip(slow_start[:nslow].tolist(),
+                                            slow_end[:nslow].tolist(), strict=True)]
+    return values, tuple(int(d) for d in col_dec)
 
 
 def _column_decimals(texts: list[str], width: int) -> tuple[int, ...]:
