@@ -57,6 +57,7 @@ COMPILED_FILES = frozenset({
     "test_analysis_analyze.py",
     "test_text_kernel.py",
     "test_io_text_layout.py",
+    "test_reader_scans.py",
 })
 
 #: test files whose tests each take more than ~20 s (marked ``slow``); measured with

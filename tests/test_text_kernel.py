@@ -139,3 +139,29 @@ def test_block_writer_at_the_fast_paths_edges(tmp_path, monkeypatch, sep):
     back = tmp_path / "back.txt"
     back.write_text(fast)
     np.testing.assert_array_equal(parse_text(back, header=False, ncols=None).values, new)
+
+
+def test_long_mantissas_are_rounded_once():
+    """The mantissas past 2^53 (Python's 17-digit ``repr``, up to 18 digits) divided by
+    ``10**q`` with one rounding: random mantissas and every ``q`` of the range, exact halves
+    between two floats (ties to even) and their neighbours, against Python's ``float``."""
+    from curvefair._kernels.text import _long_quotient
+
+    rng = np.random.default_rng(11)
+    cases = [(int(m), int(q)) for m, q in zip(rng.integers(2 ** 53 + 1, 10 ** 18, size=20000),
+                                              rng.integers(0, 23, size=20000), strict=True)]
+    for base in (2 ** 54, 2 ** 55, 2 ** 58, 3 * 2 ** 55):
+        for odd in range(1, 40, 2):
+            cases += [(base + odd, 0), (base + odd - 1, 0), (base + odd + 1, 0)]
+    for m in (9007199254740993, 18014398509481985, 18014398509481987, 999999999999999999,
+              123456789012345678, 100000000000000001):
+        cases += [(m, q) for q in range(23)]
+    for m, q in cases:
+        assert _long_quotient(m, q) == float(f"{m}e-{q}"), (m, q)
+    # and through the reader: 17-digit texts of random floats, bit for bit
+    vals = rng.normal(size=5000) * 10.0 ** rng.integers(-4, 8, size=5000)
+    text = "\n".join(f"{float(a)!r},{float(b)!r}" for a, b in zip(vals, -vals, strict=True))
+    text = text.replace("e", "E")  # no exponent form is ever kept out of the check
+    got = _scan(text, ",", 2)
+    assert got is not None
+    assert got[0].tobytes() == np.ravel(np.c_[vals, -vals]).tobytes()

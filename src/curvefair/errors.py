@@ -38,7 +38,8 @@ class FileFormatError(CurvefairError):
 
     def __init__(self, message: str, path: object = None, line: int | None = None) -> None:
         self.path = None if path is None else str(path)
-        self.line = line
+        self.line = None if line is None else int(line)  # a numpy integer too
+        line = self.line
         where = ""
         if self.path is not None:
             where = self.path + (f":{line}" if line is not None else "") + ": "

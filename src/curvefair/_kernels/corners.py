@@ -88,3 +88,127 @@ def chord_turns_reference(p: FloatArray, closed: bool, Lmin: float) -> FloatArra
         na, nb = float(np.linalg.norm(a)), float(np.linalg.norm(b))
         out[i] = np.degrees(np.arccos(np.clip(float(a @ b) / (na * nb), -1.0, 1.0)))
     return out
+
+
+@njit(cache=True)
+def noise_terms_2d(p, closed, ratio):
+    """The O(n) part of :func:`curvefair.io._common.noise_scale` for a planar list, in one
+    pass: for every point ``b`` between its neighbours ``a`` and ``c`` (an open list's inner
+    points, every point of a closed one) with a chord ``d = c - a`` of positive length ``L``,
+    ``|(b - a) x d| / L`` into ``ratio`` (in point order, only where ``L > 0``); returns the
+    count of those and the count of sign flips of the turn ``(b - a) x (c - b)`` between
+    consecutive points. The same IEEE operations, in the same order, as the numpy
+    expressions it replaces (``sqrt(d0*d0 + d1*d1)``, ``|v0*d1 - v1*d0|``), so the same
+    bits."""
+    m = p.shape[0]
+    lo, hi = (0, m) if closed else (1, m - 1)
+    nr = 0
+    flips = 0
+    prev = 0.0
+    for i in range(lo, hi):
+        ia = i - 1 if i > 0 else m - 1
+        ic = i + 1 if i < m - 1 else 0
+        ax = p[ia, 0]
+        ay = p[ia, 1]
+        bx = p[i, 0]
+        by = p[i, 1]
+        cx = p[ic, 0]
+        cy = p[ic, 1]
+        d0 = cx - ax
+        d1 = cy - ay
+        L = np.sqrt(d0 * d0 + d1 * d1)
+        v0 = bx - ax
+        v1 = by - ay
+        if L > 0:
+            ratio[nr] = abs(v0 * d1 - v1 * d0) / L
+            nr += 1
+        e0 = cx - bx
+        e1 = cy - by
+        sg = np.sign(v0 * e1 - v1 * e0)
+        if i > lo and sg * prev < 0:
+            flips += 1
+        prev = sg
+    return nr, flips
+
+
+@njit(cache=True)
+def point_checks(p, max_magnitude, eps4):
+    """The scans of :func:`curvefair.io._common.check_points` in two passes: the first row
+    with a non-finite coordinate, the first with one beyond ``max_magnitude``, the largest
+    coordinate range, and the first ``i`` whose step to ``i + 1`` is at most ``eps4`` times
+    the largest magnitude (at least the smallest normal float) in every coordinate
+    (-1 where none). Compared as numpy compares them."""
+    m, dim = p.shape
+    bad = -1
+    big = -1
+    amax = 0.0
+    for i in range(m):
+        for c in range(dim):
+            v = p[i, c]
+            if not np.isfinite(v):
+                return i, -1, 0.0, -1
+            if abs(v) > amax:
+                amax = abs(v)
+        if big < 0:
+            for c in range(dim):
+                if abs(p[i, c]) > max_magnitude:
+                    big = i
+                    break
+    if big >= 0 or m < 2:
+        return bad, big, 0.0, -1
+    extent = 0.0
+    for c in range(dim):
+        lo = p[0, c]
+        hi = p[0, c]
+        for i in range(1, m):
+            v = p[i, c]
+            if v < lo:
+                lo = v
+            if v > hi:
+                hi = v
+        if hi - lo > extent:
+            extent = hi - lo
+    scale = max(amax, 2.2250738585072014e-308)
+    lim = eps4 * scale
+    for i in range(m - 1):
+        d = 0.0
+        for c in range(dim):
+            t = abs(p[i + 1, c] - p[i, c])
+            if t > d:
+                d = t
+        if d <= lim:
+            return bad, big, extent, i
+    return bad, big, extent, -1
+
+
+def noise_terms_reference(p: FloatArray, closed: bool) -> tuple[FloatArray, int]:
+    """:func:`noise_terms_2d` by whole-array numpy expressions (the code it replaced): the
+    ratios (where the chord is positive) and the sign flips of the turn."""
+    if closed:
+        a, b, c = np.roll(p, 1, 0), p, np.roll(p, -1, 0)
+    else:
+        a, b, c = p[:-2], p[1:-1], p[2:]
+    d = c - a
+    L = np.linalg.norm(d, axis=1)
+    v = b - a
+    cr = np.abs(v[:, 0] * d[:, 1] - v[:, 1] * d[:, 0])
+    ok = L > 0
+    e2 = c - b
+    sg = np.sign(v[:, 0] * e2[:, 1] - v[:, 1] * e2[:, 0])
+    return cr[ok] / L[ok], int(np.count_nonzero(sg[1:] * sg[:-1] < 0))
+
+
+def point_checks_reference(p: FloatArray, max_magnitude: float, eps4: float
+                           ) -> tuple[int, int, float, int]:
+    """:func:`point_checks` by whole-array numpy expressions (the code it replaced)."""
+    bad = np.flatnonzero(~np.isfinite(p).all(axis=1))
+    if bad.size:
+        return int(bad[0]), -1, 0.0, -1
+    big = np.flatnonzero(np.abs(p).max(axis=1) > max_magnitude)
+    if big.size or p.shape[0] < 2:
+        return -1, int(big[0]) if big.size else -1, 0.0, -1
+    extent = float(np.ptp(p, axis=0).max())
+    d = np.abs(np.diff(p, axis=0)).max(axis=1)
+    scale = max(float(np.abs(p).max()), np.finfo(float).tiny)
+    dup = np.flatnonzero(d <= eps4 * scale)
+    return -1, -1, extent, int(dup[0]) if dup.size else -1

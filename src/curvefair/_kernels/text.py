@@ -11,10 +11,15 @@ Values: a number whose decimal mantissa ``M`` (all its digits, the point ignored
 is within [-22, 22] is ``M * 10**e`` or ``M / 10**-e`` with ``10**|e|`` exact: one correctly
 rounded IEEE operation on exact operands, hence the correctly rounded value of the text, the
 one Python's ``float`` gives (Clinger 1990, "How to read floating point numbers accurately",
-the fast path). Every other number is left to Python's ``float`` (its position returned).
+the fast path). A number of up to 18 digits, ``e`` in [-22, 0], whose mantissa is larger
+(the 17 digits of Python's ``repr``) is the quotient of two integers rounded once
+(:func:`_long_quotient`). Every other number is left to Python's ``float`` (its position
+returned).
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 
@@ -24,6 +29,42 @@ from .._jit import njit
 POW10 = np.array([float(10 ** k) for k in range(23)])
 _TWO53 = 2 ** 53
 _MANT_CAP = 10 ** 17  # digits beyond this are not accumulated (the number goes to Python)
+
+
+# 5**q exactly, q = 0..22 (5**22 < 2**52)
+POW5 = np.array([5 ** q for q in range(23)], dtype=np.int64)
+
+
+@njit(cache=True)
+def _long_quotient(mant, q):
+    """The float nearest ``mant / 10**q`` (ties to even) for ``2**53 < mant < 10**18`` and
+    ``0 <= q <= 22``, the 17-digit numbers of Python's ``repr``: ``mant / 10**q =
+    (mant / 5**q) 2**-q``, and the quotient by ``D = 5**q < 2**52`` is computed by long
+    division to ``Q = floor(mant 2**s / D)`` with at least 55 bits and the remainder ``r``;
+    ``Q`` is rounded to 53 bits (a discarded half with ``r > 0`` rounds up, an exact half to
+    even) and scaled by ``2**-(s + q)`` (exact: no result is near the subnormal range)."""
+    d = POW5[q]
+    quo = mant // d
+    r = mant - quo * d
+    s = 0
+    while quo < (1 << 54):
+        r2 = r + r
+        bit = 1 if r2 >= d else 0
+        quo = quo + quo + bit
+        r = r2 - bit * d
+        s += 1
+    nbits = 0
+    x = quo
+    while x > 0:
+        nbits += 1
+        x >>= 1
+    shift = nbits - 53
+    top = quo >> shift
+    rest = quo - (top << shift)
+    half = np.int64(1) << (shift - 1)
+    if rest > half or (rest == half and (r != 0 or (top & 1) == 1)):
+        top += 1
+    return math.ldexp(float(top), shift - s - q)
 
 
 @njit(cache=True)
@@ -116,6 +157,9 @@ def scan_plain_rows(buf, sep, width, nrows, values, col_dec, slow_start, slow_en
                     v = v * POW10[e10]
                 else:
                     v = v / POW10[-e10]
+                values[tok] = -v if neg else v
+            elif not big and -22 <= e10 <= 0:
+                v = _long_quotient(mant, -e10)
                 values[tok] = -v if neg else v
             else:
                 values[tok] = np.nan
@@ -270,27 +314,59 @@ def plain_block_plan(buf, sep, k, m, new, old, col_dec, status, dec_out, tok_sta
 
 
 @njit(cache=True)
+def _shortest_pieces(short_buf, nshort):
+    """Start and length of each of the ``nshort`` numbers in ``short_buf`` (the text of
+    Python's ``repr`` of a list of floats without its brackets: ``1.5, -0.0, 2.0``), each
+    made the shortest form of :func:`curvefair.io._text._shortest`: a ``.0`` ending dropped,
+    then ``-0`` written ``0``."""
+    start = np.empty(nshort, dtype=np.int64)
+    length = np.empty(nshort, dtype=np.int64)
+    size = short_buf.shape[0]
+    a = 0
+    for i in range(nshort):
+        p = a
+        while p < size and short_buf[p] != 44:  # a float's repr has no comma
+            p += 1
+        ln = p - a
+        if ln >= 2 and short_buf[a + ln - 2] == 46 and short_buf[a + ln - 1] == 48:
+            ln -= 2
+        if ln == 2 and short_buf[a] == 45 and short_buf[a + 1] == 48:
+            a += 1
+            ln = 1
+        start[i] = a
+        length[i] = ln
+        a = p + 2
+    return start, length
+
+
+@njit(cache=True)
 def plain_block_write(buf, sep, k, m, new, status, dec_out, tok_start, tok_len, new_len,
-                      py_buf, py_start):
+                      short_buf, nshort, py_buf, py_start):
     """The rows planned by :func:`plain_block_plan`, as bytes joined by ``\\n``: kept tokens
     and odd rows copied, :data:`FIXED` ones written digit by digit (the decimal ``k 10**-d``
     of :func:`_exact_at`, a minus where the value is negative and not a zero the token wrote
-    without one), Python's texts (``py_buf``, token ``i`` of them at
-    ``py_start[i]:py_start[i + 1]``) copied in token order; with a blank or tab separator a
-    changed number shorter than the text it replaces gets the blanks it gave up in front (not
-    the first of a row), so right-aligned columns stay aligned."""
+    without one), the :data:`SHORTEST` ones from ``short_buf`` (Python's ``repr`` of their
+    list, :func:`_shortest_pieces`), the :data:`PYTHON` ones from ``py_buf`` (number ``i`` of
+    them at ``py_start[i]:py_start[i + 1]``), both in token order; with a blank or tab
+    separator a changed number shorter than the text it replaces gets the blanks it gave up
+    in front (not the first of a row), so right-aligned columns stay aligned."""
     blank = sep == 32 or sep == 9
+    s_start, s_len = _shortest_pieces(short_buf, nshort)
     total = 0
     t = 0
     ip = 0
+    js = 0
     for _r in range(m):
         for c in range(k):
+            st = status[t]
             ln = new_len[t]
-            if status[t] == PYTHON or status[t] == SHORTEST:
+            if st == PYTHON:
                 ln = py_start[ip + 1] - py_start[ip]
                 ip += 1
-            if blank and c > 0 and status[t] != KEEP and status[t] != ODD_ROW and \
-                    ln < tok_len[t]:
+            elif st == SHORTEST:
+                ln = s_len[js]
+                js += 1
+            if blank and c > 0 and st != KEEP and st != ODD_ROW and ln < tok_len[t]:
                 ln = tok_len[t]
             total += ln + 1
             t += 1
@@ -298,6 +374,7 @@ def plain_block_write(buf, sep, k, m, new, status, dec_out, tok_start, tok_len, 
     w = 0
     t = 0
     ip = 0
+    js = 0
     for r in range(m):
         for c in range(k):
             st = status[t]
@@ -309,8 +386,10 @@ def plain_block_write(buf, sep, k, m, new, status, dec_out, tok_start, tok_len, 
             else:
                 if st == FIXED:
                     ln = new_len[t]
-                else:
+                elif st == PYTHON:
                     ln = py_start[ip + 1] - py_start[ip]
+                else:
+                    ln = s_len[js]
                 if blank and c > 0 and ln < tok_len[t]:
                     for _ in range(tok_len[t] - ln):
                         out[w] = sep
@@ -336,12 +415,18 @@ def plain_block_write(buf, sep, k, m, new, status, dec_out, tok_start, tok_len, 
                     if neg:
                         out[j] = 45
                     w += ln
-                else:
-                    s = py_start[ip]
+                elif st == PYTHON:
+                    src = py_start[ip]
                     for i in range(ln):
-                        out[w] = py_buf[s + i]
+                        out[w] = py_buf[src + i]
                         w += 1
                     ip += 1
+                else:
+                    src = s_start[js]
+                    for i in range(ln):
+                        out[w] = short_buf[src + i]
+                        w += 1
+                    js += 1
             if c < k - 1:
                 out[w] = sep
                 w += 1

@@ -447,38 +447,40 @@ def frozen_index(values: Any) -> np.ndarray:
     return out
 
 
-def check_points(pts: FloatArray, path: object, lines: Sequence[int | None] | None = None,
+def check_points(pts: FloatArray, path: object,
+                 lines: Sequence[int | None] | np.ndarray | None = None,
                  what: str = "point") -> None:
     """FileFormatError for NaN/inf coordinates and duplicate consecutive points.
 
     ``lines`` (1-based line numbers per point) makes the message name the line.
     """
-    bad = ~np.isfinite(pts).all(axis=1)
-    if bad.any():
-        i = int(np.flatnonzero(bad)[0])
+    q = np.ascontiguousarray(pts, dtype=np.float64)
+    if q.ndim == 1:
+        q = q[:, None]
+    if not q.size:
+        return
+    # one compiled scan (:func:`curvefair._kernels.corners.point_checks`): the first bad row
+    # of each kind, the extent
+    bad, big, extent, dup = _k.point_checks(q, MAX_MAGNITUDE, 4 * np.finfo(float).eps)
+    if bad >= 0:
+        i = int(bad)
         ln = None if lines is None else lines[i]
         raise FileFormatError(f"{what} {i} has a non-finite coordinate {pts[i].tolist()}",
                               path, ln)
-    big: np.ndarray | list[int] = (np.flatnonzero(np.abs(pts).max(axis=1) > MAX_MAGNITUDE)
-                                   if pts.size else [])
-    if len(big):
-        i = int(big[0])
+    if big >= 0:
+        i = int(big)
         ln = None if lines is None else lines[i]
         raise FileFormatError(f"{what} {i} has the coordinate {pts[i].tolist()}: curvefair works "
                               f"with magnitudes up to {MAX_MAGNITUDE:g} (float64 must hold the "
                               f"powers of the data its formulas take); rescale the data", path, ln)
     if pts.shape[0] > 1:
-        extent = float(np.ptp(pts, axis=0).max())
         if 0.0 < extent < MIN_EXTENT:
             raise FileFormatError(f"the {what}s span only {extent!r}: curvefair works with "
                                   f"point sets at least {MIN_EXTENT:g} across (float64 must hold "
                                   f"the powers of the data its formulas take); rescale the data",
                                   path)
-        d = np.abs(np.diff(pts, axis=0)).max(axis=1)
-        scale = max(float(np.abs(pts).max()), np.finfo(float).tiny)
-        dup = np.flatnonzero(d <= 4 * np.finfo(float).eps * scale)
-        if dup.size:
-            i = int(dup[0])
+        if dup >= 0:
+            i = int(dup)
             ln = None if lines is None else lines[i + 1]
             where = "" if lines is None or lines[i] is None else f" (lines {lines[i]} and {ln})"
             raise FileFormatError(
@@ -486,7 +488,8 @@ def check_points(pts: FloatArray, path: object, lines: Sequence[int | None] | No
                 path, ln)
 
 
-def drop_duplicates(pts: FloatArray, path: object, lines: Sequence[int | None] | None = None,
+def drop_duplicates(pts: FloatArray, path: object,
+                    lines: Sequence[int | None] | np.ndarray | None = None,
                     what: str = "point", tiny: float = 0.0) -> tuple[FloatArray, np.ndarray]:
     """Drop exactly-duplicate consecutive points, with a warning naming them.
 
@@ -590,6 +593,18 @@ def noise_scale(points: FloatArray, closed: bool) -> float:
     m = p.shape[0]
     if m < _NOISE_MIN_POINTS:
         return 0.0
+    if p.shape[1] == 2:  # one compiled pass, the same figures bit for bit
+        q = np.ascontiguousarray(p)
+        ratio = np.empty(m)
+        nr, flips = _k.noise_terms_2d(q, bool(closed), ratio)
+        if nr == 0:
+            return 0.0
+        alt = flips / ((m if closed else m - 2) - 1)
+        sigma = float(np.median(ratio[:nr])) / 0.6745
+        size = float(np.ptp(q, axis=0).max())
+        if alt < _NOISE_ALTERNATION or not sigma <= _NOISE_MAX_REL * size:
+            return 0.0
+        return sigma
     if closed:
         a, b, c = np.roll(p, 1, 0), p, np.roll(p, -1, 0)
     else:

@@ -455,7 +455,8 @@ def _render_plain_block(lines: np.ndarray, data_lines: np.ndarray, redo: np.ndar
     written by compiled passes (:func:`curvefair._kernels.text.plain_block_plan`, which
     decides the decimals exactly where ``|v| 10**d < 2**49``, and
     :func:`~curvefair._kernels.text.plain_block_write`); Python writes the shortest forms
-    (``repr``) and the few values outside that range (:func:`_plain_number`). The same text as
+    (the ``repr`` of their list, cut in the kernel) and the few values outside that range
+    (:func:`_plain_number`). The same text as
     the row renderer, character for character (tests/test_io_text_layout.py compares both).
     """
     from .._kernels.text import PYTHON, SHORTEST, plain_block_plan, plain_block_write
@@ -484,30 +485,25 @@ def _render_plain_block(lines: np.ndarray, data_lines: np.ndarray, redo: np.ndar
                            new_len, row_ok)
     if npy < 0 or not row_ok.any():
         return redo
+    short = status == SHORTEST
+    nshort = int(np.count_nonzero(short)) if npy else 0
+    # the shortest exact forms (:func:`_shortest`) from the repr of their list, cut and
+    # trimmed in the kernel; the few values outside the kernel's exact range by the rule
+    # the row renderer follows (:func:`_plain_number`)
+    short_buf = np.frombuffer(repr(new[short].tolist())[1:-1].encode("ascii") if nshort
+                              else b"", dtype=np.uint8)
     strs: list[str] = []
-    if npy:
-        py = np.flatnonzero((status == PYTHON) | (status == SHORTEST))
-        strs = [""] * len(py)
-        short = np.flatnonzero(status[py] == SHORTEST)
-        if len(short):
-            # the shortest exact form of each (:func:`_shortest`): the list's repr, then its
-            # ".0" endings and "-0" signs dropped (twice: a match consumes the ", " of the
-            # next)
-            text = f", {repr(new[py[short]].tolist())[1:-1]}, ".replace(".0, ", ", ")
-            text = text.replace(", -0, ", ", 0, ").replace(", -0, ", ", 0, ")
-            for i, s in zip(short.tolist(), text[2:-2].split(", "), strict=True):
-                strs[i] = s
+    if npy > nshort:
         raw = buf.tobytes()
-        for i in np.flatnonzero(status[py] == PYTHON).tolist():
-            t = int(py[i])
+        for t in np.flatnonzero(status == PYTHON).tolist():
             a = int(start[t])
-            strs[i] = _plain_number(float(new[t]), raw[a:a + int(length[t])].decode("ascii"),
-                                    int(cols[t % k]))
+            strs.append(_plain_number(float(new[t]), raw[a:a + int(length[t])].decode("ascii"),
+                                      int(cols[t % k])))
     py_start = np.zeros(len(strs) + 1, dtype=np.int64)
     py_start[1:] = np.cumsum(np.fromiter(map(len, strs), np.int64, count=len(strs)))
     py_buf = np.frombuffer("".join(strs).encode("ascii"), dtype=np.uint8)
     out = plain_block_write(buf, ord(sep), k, m, new, status, dec, start, length, new_len,
-                            py_buf, py_start)
+                            short_buf, nshort, py_buf, py_start)
     rows_text = out.tobytes().decode("ascii").split("\n")
     lines[at[row_ok]] = np.array(rows_text, dtype=object)[row_ok]
     return redo[~row_ok]

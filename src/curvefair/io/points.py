@@ -207,11 +207,11 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
             f"{'they are' if len(kept) > 1 else 'it is'}; columns {', '.join(map(str, cols))} "
             f"read as {', '.join(_AXES[:len(cols)])}", kept), stacklevel=3)
     vals = lay.values[:, cols] if cols != tuple(range(lay.ncols)) else lay.values
-    lines = lay.line_numbers()
+    lines = np.asarray(lay.data_lines, dtype=np.int64) + 1  # 1-based, per row
     # exactly repeated consecutive rows: dropped, written back with their twin's value
     vals, where = drop_duplicates(vals, path, lines)
     keep = np.r_[True, where[1:] != where[:-1]]
-    check_points(vals, path, [ln for ln, k in zip(lines, keep, strict=True) if k])
+    check_points(vals, path, lines[keep])
     R = vals.shape[0]
     if R < 2:
         raise FileFormatError(f"a curve needs at least 2 points, the file has {R}", path)
