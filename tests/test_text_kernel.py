@@ -165,3 +165,40 @@ def test_long_mantissas_are_rounded_once():
     got = _scan(text, ",", 2)
     assert got is not None
     assert got[0].tobytes() == np.ravel(np.c_[vals, -vals]).tobytes()
+
+
+def test_shortest_form_is_pythons_repr():
+    """The writer's compiled shortest form (:func:`shortest_decimal`, :func:`write_shortest`)
+    against Python's ``repr`` (with :func:`curvefair.io._text._shortest`'s ``.0`` dropped),
+    character for character, wherever the kernel decides it: random magnitudes over the whole
+    range, short decimals, neighbours of short decimals one unit in the last place away,
+    powers of ten and their neighbours, the range's ends; the values it leaves to Python are
+    only those out of its range, power-of-two significands and ties."""
+    from curvefair._kernels.text import shortest_decimal, shortest_length, write_shortest
+    from curvefair.io._text import _shortest
+
+    rng = np.random.default_rng(12)
+    n = 60000
+    short = [float(f"{x:.{k}f}") for x, k in zip(rng.normal(size=n) * 1000,
+                                                 rng.integers(0, 10, size=n), strict=True)]
+    tens = [10.0 ** e for e in range(-4, 15)]
+    vals = np.concatenate([
+        rng.normal(size=n) * 10.0 ** rng.integers(-5, 16, size=n),
+        rng.random(n), short, np.nextafter(short, np.inf), np.nextafter(short, -np.inf),
+        tens, np.nextafter(tens, 0), np.nextafter(tens, np.inf), np.arange(1, 3000) / 7.0,
+        [1e-4, np.nextafter(1e-4, 0), 9.999999999999999e14, 1e15, 0.1, 0.2, 0.3, 2 / 3]])
+    vals = np.concatenate([vals, -vals])
+    buf = np.empty(64, dtype=np.uint8)
+    fast = 0
+    for v in vals.tolist():
+        ok, d, kk, nd = shortest_decimal(v)
+        a = abs(v)
+        if not ok:
+            frac = np.frexp(a)[0]
+            assert (not 1e-4 <= a < 1e15) or frac == 0.5 or len(repr(v).strip("-")) >= 17, v
+            continue
+        fast += 1
+        end = write_shortest(buf, 0, v, d, kk, nd)
+        assert end == shortest_length(v, d, kk, nd)
+        assert buf[:end].tobytes().decode() == _shortest(v), v
+    assert fast > 0.8 * len(vals)

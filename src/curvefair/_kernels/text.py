@@ -15,6 +15,13 @@ the fast path). A number of up to 18 digits, ``e`` in [-22, 0], whose mantissa i
 (the 17 digits of Python's ``repr``) is the quotient of two integers rounded once
 (:func:`_long_quotient`). Every other number is left to Python's ``float`` (its position
 returned).
+
+Rewriting the block (:func:`plain_block_plan`, :func:`plain_block_write`): a changed number is
+written with its token's or its column's decimals where that is exact (decided exactly, see
+:func:`_exact_at`), else in the shortest form Python's ``repr`` gives, which
+:func:`shortest_decimal` computes with exact integer arithmetic for ``1e-4 <= |v| < 1e15``
+(the rest, and the rare values it does not decide, by ``repr`` itself). The writer is tested
+against the row renderer of :mod:`curvefair.io._text` and ``repr``, character for character.
 """
 
 from __future__ import annotations
@@ -29,6 +36,18 @@ from .._jit import njit
 POW10 = np.array([float(10 ** k) for k in range(23)])
 _TWO53 = 2 ** 53
 _MANT_CAP = 10 ** 17  # digits beyond this are not accumulated (the number goes to Python)
+
+
+@njit(cache=True, inline="always")
+def _bit_length(x):
+    """Bits of the integer ``0 <= x < 2**63``: the binary exponent of ``float(x)``, one less
+    where the conversion rounded up to the next power of two."""
+    if x == 0:
+        return 0
+    n = math.frexp(float(x))[1]
+    if (x >> (n - 1)) == 0:
+        n -= 1
+    return n
 
 
 # 5**q exactly, q = 0..22 (5**22 < 2**52)
@@ -47,17 +66,15 @@ def _long_quotient(mant, q):
     quo = mant // d
     r = mant - quo * d
     s = 0
-    while quo < (1 << 54):
-        r2 = r + r
-        bit = 1 if r2 >= d else 0
-        quo = quo + quo + bit
-        r = r2 - bit * d
-        s += 1
-    nbits = 0
-    x = quo
-    while x > 0:
-        nbits += 1
-        x >>= 1
+    room = 62 - _bit_length(d)  # r < d: r 2**room stays below 2**62
+    while quo < (np.int64(1) << 54):
+        t = min(room, 55 - _bit_length(quo))  # quo 2**t below 2**55
+        rr = r << t
+        bits = rr // d
+        r = rr - bits * d
+        quo = (quo << t) + bits
+        s += t
+    nbits = _bit_length(quo)
     shift = nbits - 53
     top = quo >> shift
     rest = quo - (top << shift)
@@ -194,12 +211,203 @@ def plain_rows_reference(text: str, sep: str, width: int
     return np.array(vals), dec
 
 
+_MASK26 = (1 << 26) - 1
+# 10**p as integers, p = 0..18
+IPOW10 = np.array([10 ** p for p in range(19)], dtype=np.int64)
+
+
+@njit(cache=True, inline="always")
+def _limb(j, l0, l1, l2, l3, l4, l5):
+    if j == 0:
+        return l0
+    if j == 1:
+        return l1
+    if j == 2:
+        return l2
+    if j == 3:
+        return l3
+    if j == 4:
+        return l4
+    return l5
+
+
+@njit(cache=True)
+def _scaled_floor(mant, s, k):
+    """``floor(mant 5**s / 2**k)`` for ``mant < 2**53``, ``0 <= s <= 22``, ``k >= 0``, with
+    the bit just below it (``half``) and whether any bit below that is set (``sticky``):
+    the product held exactly in six 26-bit limbs (each partial product below 2**54).
+    ``ok`` is False when the floor would not fit in 60 bits."""
+    f = POW5[s]
+    a0 = mant & _MASK26
+    a1 = (mant >> 26) & _MASK26
+    a2 = mant >> 52
+    b0 = f & _MASK26
+    b1 = f >> 26
+    c = a0 * b0
+    l0 = c & _MASK26
+    c = (c >> 26) + a0 * b1 + a1 * b0
+    l1 = c & _MASK26
+    c = (c >> 26) + a1 * b1 + a2 * b0
+    l2 = c & _MASK26
+    c = (c >> 26) + a2 * b1
+    l3 = c & _MASK26
+    c = c >> 26
+    l4 = c & _MASK26
+    l5 = c >> 26
+    q = k // 26
+    r = k - 26 * q
+    if q > 5:
+        return False, np.int64(0), np.int64(0), False
+    out = _limb(q, l0, l1, l2, l3, l4, l5) >> r
+    for j in range(q + 1, 6):
+        lj = _limb(j, l0, l1, l2, l3, l4, l5)
+        if lj != 0:
+            sh = 26 * (j - q) - r
+            if sh >= 60 or (lj >> (60 - sh)) != 0:
+                return False, np.int64(0), np.int64(0), False
+            out += lj << sh
+    if k == 0:
+        return True, out, np.int64(0), False
+    hq = (k - 1) // 26
+    hr = k - 1 - 26 * hq
+    lh = _limb(hq, l0, l1, l2, l3, l4, l5)
+    half = (lh >> hr) & 1
+    sticky = (lh & ((np.int64(1) << hr) - 1)) != 0
+    for j in range(hq):
+        if _limb(j, l0, l1, l2, l3, l4, l5) != 0:
+            sticky = True
+    return True, out, half, sticky
+
+
+@njit(cache=True)
+def shortest_decimal(v):
+    """The digits ``D`` (an integer of ``nd`` digits, no trailing zero) and the decimal
+    exponent ``K`` (``|v|`` is about ``D 10**(K - nd + 1)``) of Python's ``repr(v)``, the
+    shortest decimal that reads back as ``v`` (the nearest of that length), for ``1e-4 <=
+    |v| < 1e15`` (where ``repr`` writes positional notation); ``ok`` False where this does
+    not decide it (out of range, a power-of-two significand, whose rounding interval is
+    lopsided, a tie at some length): Python's ``repr`` then.
+
+    ``v = M 2**E`` (``M`` the 53-bit significand). For ``p`` = 15, 16, 17 the nearest
+    ``p``-digit decimal is ``round(M 5**s 2**(E + s))``, ``s = p - 1 - K``, computed exactly
+    (:func:`_scaled_floor`); it reads back as ``v`` -- checked exactly, by the reader's own
+    exact conversions -- for some ``p <= 17``. Every decimal of at most 15 digits reads back
+    as a float that rounds back to it at 15 digits, so a shorter decimal that reads back as
+    ``v`` is the 15-digit one without its trailing zeros; a 16- or 17-digit one that reads
+    back is the nearest of its length."""
+    a = abs(v)
+    if not (1e-4 <= a < 1e15):
+        return False, 0, 0, 0
+    mant_f, ex = math.frexp(a)  # a = mant_f 2**ex, 0.5 <= mant_f < 1
+    mant = np.int64(math.ldexp(mant_f, 53))
+    e2 = ex - 53
+    if mant == (np.int64(1) << 52):
+        return False, 0, 0, 0
+    k10 = np.int64(math.floor(math.log10(a)))
+    for p in range(15, 18):
+        d = np.int64(0)
+        half = 0
+        sticky = False
+        found = False
+        for _ in range(3):  # the estimate of K is off by one at most
+            s = p - 1 - k10
+            if s < 0 or s > 22 or e2 + s > 0:
+                return False, 0, 0, 0
+            ok, d, half, sticky = _scaled_floor(mant, s, -(e2 + s))
+            if not ok:
+                return False, 0, 0, 0
+            if d >= IPOW10[p]:
+                k10 += 1
+            elif d < IPOW10[p - 1]:
+                k10 -= 1
+            else:
+                found = True
+                break
+        if not found:
+            return False, 0, 0, 0
+        if half == 1 and not sticky:
+            return False, 0, 0, 0  # a tie: repr's own rule
+        if half == 1:
+            d += 1
+        kk = k10
+        s = p - 1 - kk
+        if d == IPOW10[p]:
+            d = IPOW10[p - 1]
+            kk += 1
+            s -= 1
+            if s < 0:
+                return False, 0, 0, 0
+        if d <= _TWO53:
+            back = float(d) / POW10[s]
+        else:
+            back = _long_quotient(d, s)
+        if back == a:
+            nd = p
+            while d % 10 == 0:
+                d //= 10
+                nd -= 1
+            return True, d, kk, nd
+    return False, 0, 0, 0
+
+
+@njit(cache=True)
+def shortest_length(v, d, kk, nd):
+    """Length of the text :func:`write_shortest` writes."""
+    n = 1 if v < 0 else 0
+    if kk >= 0:  # kk + 1 digits before the point; a point and the rest if any
+        n += nd + 1 if nd > kk + 1 else kk + 1
+    else:
+        n += 2 + (-kk - 1) + nd
+    return n
+
+
+@njit(cache=True)
+def write_shortest(out, w, v, d, kk, nd):
+    """Write ``v`` as :func:`curvefair.io._text._shortest` does (``repr`` without a ``.0``
+    ending) from :func:`shortest_decimal`'s digits at ``out[w:]``; returns the end."""
+    if v < 0:
+        out[w] = 45
+        w += 1
+    n = shortest_length(abs(v), d, kk, nd)
+    end = w + n
+    j = end - 1
+    q = d
+    if kk >= 0:
+        # digits after the point: nd - (kk + 1) of them; zeros to pad the integer part
+        for _ in range(nd - (kk + 1)):
+            out[j] = 48 + q % 10
+            q //= 10
+            j -= 1
+        if nd > kk + 1:
+            out[j] = 46
+            j -= 1
+        for _ in range(kk + 1 - nd):
+            out[j] = 48
+            j -= 1
+        while j >= w:
+            out[j] = 48 + q % 10
+            q //= 10
+            j -= 1
+    else:
+        for _ in range(nd):
+            out[j] = 48 + q % 10
+            q //= 10
+            j -= 1
+        while j > w + 1:
+            out[j] = 48
+            j -= 1
+        out[w + 1] = 46
+        out[w] = 48
+    return end
+
+
 # decimals of the changed numbers of a block (:func:`plain_block_plan`)
 KEEP = 0      # unchanged: the token's text
 FIXED = 1     # exact at the decimals in ``dec_out``: written by :func:`plain_block_write`
 PYTHON = 2    # outside the fast path's range: Python decides (the row renderer's rule)
-SHORTEST = 3  # exact at neither the token's nor the column's decimals: the shortest form
+SHORTEST = 3  # exact at neither the token's nor the column's decimals: Python's shortest form
 ODD_ROW = 4   # a row not of the plain layout (or a non-finite value): left as it is
+SHORT = 5     # the shortest form, its digits from :func:`shortest_decimal` (in ``digits``)
 _TWO49 = float(2 ** 49)
 
 
@@ -221,7 +429,7 @@ def _exact_at(v, d):
 
 @njit(cache=True)
 def plain_block_plan(buf, sep, k, m, new, old, col_dec, status, dec_out, tok_start,
-                     tok_len, new_len, row_ok):
+                     tok_len, new_len, row_ok, digits):
     """Plan the rewrite of ``m`` rows of ``k`` plain fixed-point numbers (``buf``: the rows
     joined by ``\\n``; only digits, ``.``, ``-`` and ``sep``) with the values ``new`` (``old``:
     the values read), the rule of :func:`curvefair.io._text._render_plain_block`: a value
@@ -230,11 +438,13 @@ def plain_block_plan(buf, sep, k, m, new, old, col_dec, status, dec_out, tok_sta
     as exactly the value, else in the shortest exact form. A row with a token that is not
     plain (digits before and after one point, no ``+``) or a non-finite new value is left.
 
-    Fills per token ``status`` (:data:`KEEP` ... :data:`ODD_ROW`), ``dec_out``, ``tok_start``,
-    ``tok_len`` and ``new_len`` (the written length without padding; -1 for :data:`PYTHON`
-    and :data:`SHORTEST`), and ``row_ok``. Returns the number of tokens Python must write
-    (:data:`PYTHON` and :data:`SHORTEST`), or -1 when ``buf`` is not ``m`` rows of ``k``
-    pieces of those characters (then the caller leaves every row to the row renderer).
+    Fills per token ``status`` (:data:`KEEP` ... :data:`SHORT`), ``dec_out`` (the decimals of
+    :data:`FIXED`, the decimal exponent of :data:`SHORT`), ``digits`` (of :data:`SHORT`),
+    ``tok_start``, ``tok_len`` and ``new_len`` (the written length without padding; -1 for
+    :data:`PYTHON` and :data:`SHORTEST`), and ``row_ok``. Returns the number of tokens
+    Python must write (:data:`PYTHON` and :data:`SHORTEST`), or -1 when ``buf`` is not ``m``
+    rows of ``k`` pieces of those characters (then the caller leaves every row to the row
+    renderer).
     """
     n = buf.shape[0]
     pos = 0
@@ -297,19 +507,30 @@ def plain_block_plan(buf, sep, k, m, new, old, col_dec, status, dec_out, tok_sta
             if res == 1:
                 q = np.int64(abs(np.rint(v * POW10[d])))
                 neg = np.signbit(v) and (q != 0 or buf[tok_start[j]] == 45)
-                digits = 1
+                ndig = 1
                 while q >= 10:
-                    digits += 1
+                    ndig += 1
                     q //= 10
-                if digits < d + 1:
-                    digits = d + 1
+                if ndig < d + 1:
+                    ndig = d + 1
                 status[j] = FIXED
                 dec_out[j] = d
-                new_len[j] = digits + 1 + (1 if neg else 0)
-            else:
-                status[j] = PYTHON if res == -1 else SHORTEST
+                new_len[j] = ndig + 1 + (1 if neg else 0)
+            elif res == -1:
+                status[j] = PYTHON
                 new_len[j] = -1
                 npy += 1
+            else:
+                done, dd, kk, nd = shortest_decimal(v)
+                if done:
+                    status[j] = SHORT
+                    digits[j] = dd
+                    dec_out[j] = kk
+                    new_len[j] = shortest_length(v, dd, kk, nd)
+                else:
+                    status[j] = SHORTEST
+                    new_len[j] = -1
+                    npy += 1
     return npy
 
 
@@ -341,11 +562,12 @@ def _shortest_pieces(short_buf, nshort):
 
 @njit(cache=True)
 def plain_block_write(buf, sep, k, m, new, status, dec_out, tok_start, tok_len, new_len,
-                      short_buf, nshort, py_buf, py_start):
+                      short_buf, nshort, py_buf, py_start, digits):
     """The rows planned by :func:`plain_block_plan`, as bytes joined by ``\\n``: kept tokens
     and odd rows copied, :data:`FIXED` ones written digit by digit (the decimal ``k 10**-d``
     of :func:`_exact_at`, a minus where the value is negative and not a zero the token wrote
-    without one), the :data:`SHORTEST` ones from ``short_buf`` (Python's ``repr`` of their
+    without one), the :data:`SHORT` ones from their digits (:func:`write_shortest`), the
+    :data:`SHORTEST` ones from ``short_buf`` (Python's ``repr`` of their
     list, :func:`_shortest_pieces`), the :data:`PYTHON` ones from ``py_buf`` (number ``i`` of
     them at ``py_start[i]:py_start[i + 1]``), both in token order; with a blank or tab
     separator a changed number shorter than the text it replaces gets the blanks it gave up
@@ -384,7 +606,7 @@ def plain_block_write(buf, sep, k, m, new, status, dec_out, tok_start, tok_len, 
                     out[w] = buf[a + i]
                     w += 1
             else:
-                if st == FIXED:
+                if st == FIXED or st == SHORT:
                     ln = new_len[t]
                 elif st == PYTHON:
                     ln = py_start[ip + 1] - py_start[ip]
@@ -415,6 +637,12 @@ def plain_block_write(buf, sep, k, m, new, status, dec_out, tok_start, tok_len, 
                     if neg:
                         out[j] = 45
                     w += ln
+                elif st == SHORT:
+                    dd = digits[t]
+                    nd = 1
+                    while dd >= IPOW10[nd] and nd < 18:
+                        nd += 1
+                    w = write_shortest(out, w, new[t], dd, dec_out[t], nd)
                 elif st == PYTHON:
                     src = py_start[ip]
                     for i in range(ln):

@@ -453,10 +453,12 @@ def _render_plain_block(lines: np.ndarray, data_lines: np.ndarray, redo: np.ndar
     one is written with its token's decimals, else the column's, where that reads back as
     exactly the value, else in the shortest exact form. The rows' bytes are planned and
     written by compiled passes (:func:`curvefair._kernels.text.plain_block_plan`, which
-    decides the decimals exactly where ``|v| 10**d < 2**49``, and
-    :func:`~curvefair._kernels.text.plain_block_write`); Python writes the shortest forms
-    (the ``repr`` of their list, cut in the kernel) and the few values outside that range
-    (:func:`_plain_number`). The same text as
+    decides the decimals exactly where ``|v| 10**d < 2**49`` and the shortest form, as
+    ``repr`` writes it, for ``1e-4 <= |v| < 1e15``
+    (:func:`~curvefair._kernels.text.shortest_decimal`), and
+    :func:`~curvefair._kernels.text.plain_block_write`); Python writes the other shortest
+    forms (the ``repr`` of their list, cut in the kernel) and the few values outside the
+    decimals' range (:func:`_plain_number`). The same text as
     the row renderer, character for character (tests/test_io_text_layout.py compares both).
     """
     from .._kernels.text import PYTHON, SHORTEST, plain_block_plan, plain_block_write
@@ -481,15 +483,16 @@ def _render_plain_block(lines: np.ndarray, data_lines: np.ndarray, redo: np.ndar
     length = np.empty(m * k, dtype=np.int64)
     new_len = np.empty(m * k, dtype=np.int64)
     row_ok = np.empty(m, dtype=bool)
+    digits = np.empty(m * k, dtype=np.int64)
     npy = plain_block_plan(buf, ord(sep), k, m, new, was, cols, status, dec, start, length,
-                           new_len, row_ok)
+                           new_len, row_ok, digits)
     if npy < 0 or not row_ok.any():
         return redo
     short = status == SHORTEST
     nshort = int(np.count_nonzero(short)) if npy else 0
-    # the shortest exact forms (:func:`_shortest`) from the repr of their list, cut and
-    # trimmed in the kernel; the few values outside the kernel's exact range by the rule
-    # the row renderer follows (:func:`_plain_number`)
+    # the shortest exact forms (:func:`_shortest`) the kernel did not decide from the repr
+    # of their list, cut and trimmed in the kernel; the few values outside the kernel's
+    # exact range by the rule the row renderer follows (:func:`_plain_number`)
     short_buf = np.frombuffer(repr(new[short].tolist())[1:-1].encode("ascii") if nshort
                               else b"", dtype=np.uint8)
     strs: list[str] = []
@@ -503,7 +506,7 @@ def _render_plain_block(lines: np.ndarray, data_lines: np.ndarray, redo: np.ndar
     py_start[1:] = np.cumsum(np.fromiter(map(len, strs), np.int64, count=len(strs)))
     py_buf = np.frombuffer("".join(strs).encode("ascii"), dtype=np.uint8)
     out = plain_block_write(buf, ord(sep), k, m, new, status, dec, start, length, new_len,
-                            short_buf, nshort, py_buf, py_start)
+                            short_buf, nshort, py_buf, py_start, digits)
     rows_text = out.tobytes().decode("ascii").split("\n")
     lines[at[row_ok]] = np.array(rows_text, dtype=object)[row_ok]
     return redo[~row_ok]
