@@ -119,7 +119,6 @@ def cubic_slopes(t: FloatArray, pts: FloatArray, bc: Any) -> FloatArray:
     second derivative; zero: natural) or ``"not-a-knot"``. Given slopes and second derivatives
     go through the compiled tridiagonal solve of :mod:`curvefair._kernels.cubic_spline` (its
     docstring has the equations); a not-a-knot end through scipy's ``CubicSpline``."""
-    from scipy.interpolate import CubicSpline
     t = np.ascontiguousarray(t, dtype=np.float64)
     y = np.ascontiguousarray(pts, dtype=np.float64)
     n, dim = y.shape
@@ -130,6 +129,10 @@ def cubic_slopes(t: FloatArray, pts: FloatArray, bc: Any) -> FloatArray:
         return out
     left, right = bc
     if isinstance(left, str) or isinstance(right, str):
+        # imported here: scipy.interpolate takes 0.3-0.5 s to import, which a points file's
+        # reading (natural ends) never needs
+        from scipy.interpolate import CubicSpline
+
         spl = CubicSpline(t, y, bc_type=(left, right), axis=0)
         return np.asarray(spl(t, 1))
     (lo, lv), (hi, hv) = left, right
