@@ -134,6 +134,27 @@ def test_hermite_mode_replays_with_public_steps(method, interp, fn):
         assert _rel(a, b) < 1e-12
 
 
+@pytest.mark.parametrize("method,interp,fn", [
+    ("poliakoff", interpolate_cubic, steps.poliakoff),
+    ("wang-quintic", interpolate_quintic, steps.wang_quintic),
+])
+def test_large_curve_loop_replays_with_public_steps(method, interp, fn):
+    """On data too large for the caches (60,000 points, above the loop's 4 MB threshold) the
+    loop prefetches the runner-up's data while its steps jump far; the result must still be
+    the public steps replayed at the indices it chose."""
+    n = 60000
+    c = interp(_noisy(n, 2, seed=13, noise=2e-4))
+    res = fair(c, method, mode="hermite", eps=0.0, max_steps=60, guard=False, joins="free")
+    k = np.asarray(res.history.index)
+    assert np.mean(np.abs(np.diff(k)) > 16) > 0.5  # far jumps: the prefetching path ran
+    cur = c
+    for i in k:
+        cur = fn(cur, int(i))
+    assert _rel(res.curve.points, cur.points) < 1e-12
+    for a, b in zip(res.curve._derivs, cur._derivs, strict=True):
+        assert _rel(a, b) < 1e-12
+
+
 def test_loop_picks_the_largest_third_derivative_jump():
     c = interpolate_cubic(_example1())
     res = fair(c, "poliakoff", eps=0.0, max_steps=1, measure="jump")  # the papers' measure

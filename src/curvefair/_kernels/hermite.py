@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._jit import njit
+from .._jit import njit, prefetch
 from ..curves.hermite import cubic_hermite_coefficients, quintic_hermite_coefficients
 from .ranking import tt_build, tt_top, tt_update, tt_update_range
 
@@ -839,6 +839,42 @@ def drive_setup(P, D, h, closed, degree, spline, eligible, method=POLIAKOFF, hst
     return measure, values, tv, ti, np.zeros(nd, dtype=np.int8), np.zeros(nd)
 
 
+_SPECULATE_BYTES = 1 << 22  # prefetch the runner-up's data when the state exceeds ~4 MB
+_RUNNER_UP_TOP = 256  # the runner-up is sought among the siblings of the nodes below 256
+_FAR = 16  # a step farther than this from the previous one is a far jump
+
+
+@njit(cache=True, inline="always")
+def _runner_up(tv, ti, k):
+    """The entry that leads the tournament tree (:mod:`.ranking`) outside the winner ``k``'s
+    subtree at the first level below node 256: the best of the siblings of the winner's path
+    above that level, all in the tree's top (hot) levels. Unless the next step's winner
+    shares that subtree with ``k`` or is changed by this step, it is the next step's point.
+    -1 for a tree without such siblings."""
+    n = np.int64(tv[0])
+    ptop = (tv.shape[0] - n) // 2
+    j = ptop + (k >> ti[0])
+    while j >= _RUNNER_UP_TOP:
+        j >>= 1
+    bv = -np.inf
+    bi = np.int64(-1)
+    while j > 1:
+        sj = j ^ 1
+        if tv[sj] > bv:
+            bv = tv[sj]
+            bi = ti[sj]
+        j >>= 1
+    return bi
+
+
+@njit(cache=True, inline="always")
+def _prefetch_rows(arr, lo, hi, cols):
+    """Prefetch rows ``lo .. hi`` of ``arr`` (``cols`` float64s per row, C order)."""
+    for f in range(lo * cols, (hi + 1) * cols, 8):
+        prefetch(arr, f)
+    prefetch(arr, (hi + 1) * cols - 1)
+
+
 @njit(cache=True)
 def drive(P, D, h, orig, closed, degree, method, spline, hstep, eligible, tol, eps,
           max_steps, move_floor, K0, pe, q, fixed, Hinv, w0, wmax, thr,
@@ -889,6 +925,13 @@ def drive(P, D, h, orig, closed, degree, method, spline, hstep, eligible, tol, e
     n_skip = 0
     max_window = 0
     stop = STOP_MAX_STEPS
+    # on data too large for the caches a step waits for memory: the next point is usually far
+    # away (the largest measure anywhere). The runner-up's data are prefetched one step ahead
+    # while far jumps are frequent (a running share above 1/4); prefetches never change results
+    big = nd * (dim * (2 + nb) + 6) * 8 >= _SPECULATE_BYTES and not dense
+    farrate = 0.0
+    prev = np.int64(-(1 << 40))
+    base = tv.shape[0] - nd  # the entries' own values in the tree's array
     while True:
         if steps >= max_steps:
             stop = STOP_MAX_STEPS
@@ -900,6 +943,33 @@ def drive(P, D, h, orig, closed, degree, method, spline, hstep, eligible, tol, e
         if v < eps:
             stop = STOP_EPS
             break
+        farrate = 0.9375 * farrate + (0.0625 if abs(k - prev) > _FAR else 0.0)
+        prev = k
+        if big and farrate > 0.25:
+            r = _runner_up(tv, ti, k)
+            if r >= 0:
+                rlo = r - w_cur - 2
+                rhi = r + w_cur + 2
+                if rlo < 0:
+                    rlo = 0
+                if rhi > nd - 1:
+                    rhi = nd - 1
+                _prefetch_rows(P, rlo, rhi, dim)
+                _prefetch_rows(D, rlo, rhi, nb * dim)
+                _prefetch_rows(h, rlo, rhi, 1)
+                _prefetch_rows(measure, rlo, rhi, 1)
+                _prefetch_rows(values, rlo, rhi, 1)
+                _prefetch_rows(tv, base + rlo, base + rhi, 1)
+                prefetch(orig, r * dim)
+                prefetch(eligible, rlo)
+                prefetch(eligible, rhi)
+                prefetch(blocked, rlo)
+                prefetch(blocked, rhi)
+                j = (base >> 1) + (rlo >> ti[0])  # the lower levels of its tree path
+                for _ in range(4):
+                    prefetch(tv, j)
+                    prefetch(ti, j)
+                    j >>= 1
         mv, clamped, want = _clamped_move(P, D, h, orig, k, method, degree, spline, hstep, tol,
                                           delta, eta, xi)
         if _is_blocked(mv, clamped, want, move_floor):
