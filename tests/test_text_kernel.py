@@ -202,3 +202,38 @@ def test_shortest_form_is_pythons_repr():
         assert end == shortest_length(v, d, kk, nd)
         assert buf[:end].tobytes().decode() == _shortest(v), v
     assert fast > 0.8 * len(vals)
+
+
+@pytest.mark.parametrize("newline", ["\n", "\r\n", "\r"])
+@pytest.mark.parametrize("final", [True, False])
+@pytest.mark.parametrize("around", [False, True])
+def test_whole_block_render_is_the_row_renderers(tmp_path, monkeypatch, newline, final, around):
+    """A file whose data rows are one run of plain lines is rendered as one block, unchanged
+    rows included, the header and any lines after the data joined around it: the same text as
+    the row renderer, for every line ending, with and without a final newline, with comment
+    and blank lines before and after the data; a row that is not plain sends the file back to
+    the line-by-line path (the same text again)."""
+    from curvefair.io import _text
+    from curvefair.io._text import parse_text
+
+    rng = np.random.default_rng(len(newline) + 2 * final + 4 * around)
+    rows = [f"{x:.6f},{y:.4f}" for x, y in rng.normal(size=(300, 2)) * 10]
+    lines = (["# exported", "x,y"] if around else ["x,y"]) + rows
+    if around:
+        lines += ["", "# end of data"]
+    path = tmp_path / "p.csv"
+    path.write_bytes((newline.join(lines) + (newline if final else "")).encode())
+    lay = parse_text(path)
+    for odd in (False, True):
+        new = lay.values.copy()
+        moved = rng.random(len(new)) < 0.7
+        new[moved] += rng.normal(size=(moved.sum(), 2)) * 1e-3
+        new[5] = [float(f"{new[5, 0]:.6f}"), float(f"{new[5, 1]:.4f}")]
+        if odd:
+            new[7, 0] = np.nan                     # not a plain row: the line-by-line path
+        fast = lay.render(new)
+        with monkeypatch.context() as mp:
+            mp.setattr(_text, "_BLOCK_MIN_ROWS", 10 ** 12)
+            slow = lay.render(new)
+        assert fast == slow
+        assert fast.count(newline) == path.read_bytes().decode().count(newline)

@@ -398,6 +398,10 @@ class TextLayout:
             raise ValueError(f"values must have shape {(nrows, self.ncols)}, "
                              f"got {values.shape}")
         keep = set(int(k) for k in keep_rows)
+        if decimals is None and not keep and not self.decimal_comma and not self.fortran_d:
+            text = self._render_whole_block(values)
+            if text is not None:
+                return text
         if decimals is None:
             # a row whose every value is the one read is its line as read (format_number's
             # rule 2 for each number, and nothing to re-align): only the others are rendered
@@ -432,6 +436,34 @@ class TextLayout:
         return text
 
 
+    def _render_whole_block(self, values: FloatArray) -> str | None:
+        """:meth:`render` (no ``decimals``, no kept rows, decimal points) for a file whose data
+        rows are one run of lines of the common layout (:func:`_render_plain_block`), every
+        row rendered at once, unchanged ones included (the compiled writer copies their text):
+        the header and the trailing lines joined around the written block, without splitting
+        it into lines. None when the rows are not such a run (then :meth:`render` does the
+        rows line by line): the same text either way."""
+        nrows = len(self.data_lines)
+        if nrows < _BLOCK_MIN_ROWS:
+            return None
+        a, b = self.data_lines[0], self.data_lines[-1]
+        if b - a + 1 != nrows:
+            return None
+        lines = self.lines
+        sep = next((c for c in _PLAIN_SEPS if c in lines[a]), None)
+        if sep is None:
+            return None
+        got = _plain_block_bytes("\n".join(lines[a:b + 1]), sep, values, self.values,
+                                 self.column_decimals)
+        if got is None or not got[1].all():
+            return None
+        nl = self.newline
+        body = got[0] if nl == "\n" else got[0].replace("\n", nl)
+        head = nl.join(lines[:a]) + nl if a > 0 else ""
+        tail = nl + nl.join(lines[b + 1:]) if b + 1 < len(lines) else ""
+        return head + body + tail + (nl if self.final_newline else "")
+
+
 # below this many rows to rewrite the row renderer is as fast as the block set-up
 _BLOCK_MIN_ROWS = 64
 _PLAIN_SEPS = (",", ";", " ", "\t")
@@ -461,21 +493,37 @@ def _render_plain_block(lines: np.ndarray, data_lines: np.ndarray, redo: np.ndar
     decimals' range (:func:`_plain_number`). The same text as
     the row renderer, character for character (tests/test_io_text_layout.py compares both).
     """
-    from .._kernels.text import PYTHON, SHORTEST, plain_block_plan, plain_block_write
-
-    m = len(redo)
-    k = values.shape[1]
     at = data_lines[redo]
     first = lines[at[0]]
     sep = next((c for c in _PLAIN_SEPS if c in first), None)
     if sep is None:
         return redo
-    try:
-        buf = np.frombuffer("\n".join(lines[at].tolist()).encode("ascii"), dtype=np.uint8)
-    except UnicodeEncodeError:
+    got = _plain_block_bytes("\n".join(lines[at].tolist()), sep, values[redo], old[redo],
+                             column_decimals)
+    if got is None:
         return redo
-    new = np.ascontiguousarray(values[redo], dtype=np.float64).ravel()
-    was = np.ascontiguousarray(old[redo], dtype=np.float64).ravel()
+    out, row_ok = got
+    rows_text = out.split("\n")
+    lines[at[row_ok]] = np.array(rows_text, dtype=object)[row_ok]
+    return redo[~row_ok]
+
+
+def _plain_block_bytes(block: str, sep: str, values: FloatArray, old: FloatArray,
+                       column_decimals: Sequence[int]) -> tuple[str, np.ndarray] | None:
+    """The rows of ``block`` (lines joined by ``\\n``, ``m`` of them) rewritten with
+    ``values`` (shape ``(m, k)``; ``old`` the values read) by the compiled plan and write
+    passes, and which rows were of the plain layout (the others come back as they were), or
+    None when the block is not ``m`` rows of ``k`` pieces of digits, points and minus signs
+    joined by ``sep``."""
+    from .._kernels.text import PYTHON, SHORTEST, plain_block_plan, plain_block_write
+
+    m, k = values.shape
+    try:
+        buf = np.frombuffer(block.encode("ascii"), dtype=np.uint8)
+    except UnicodeEncodeError:
+        return None
+    new = np.ascontiguousarray(values, dtype=np.float64).ravel()
+    was = np.ascontiguousarray(old, dtype=np.float64).ravel()
     cols = np.asarray(column_decimals, dtype=np.int64)
     status = np.empty(m * k, dtype=np.int8)
     dec = np.empty(m * k, dtype=np.int64)
@@ -487,7 +535,7 @@ def _render_plain_block(lines: np.ndarray, data_lines: np.ndarray, redo: np.ndar
     npy = plain_block_plan(buf, ord(sep), k, m, new, was, cols, status, dec, start, length,
                            new_len, row_ok, digits)
     if npy < 0 or not row_ok.any():
-        return redo
+        return None
     short = status == SHORTEST
     nshort = int(np.count_nonzero(short)) if npy else 0
     # the shortest exact forms (:func:`_shortest`) the kernel did not decide from the repr
@@ -507,9 +555,7 @@ def _render_plain_block(lines: np.ndarray, data_lines: np.ndarray, redo: np.ndar
     py_buf = np.frombuffer("".join(strs).encode("ascii"), dtype=np.uint8)
     out = plain_block_write(buf, ord(sep), k, m, new, status, dec, start, length, new_len,
                             short_buf, nshort, py_buf, py_start, digits)
-    rows_text = out.tobytes().decode("ascii").split("\n")
-    lines[at[row_ok]] = np.array(rows_text, dtype=object)[row_ok]
-    return redo[~row_ok]
+    return out.tobytes().decode("ascii"), row_ok
 
 
 def _split_row(line: str) -> Row | None:
