@@ -16,6 +16,7 @@ from click.testing import CliRunner
 
 from curvefair import read_curves
 from curvefair.cli import main
+from curvefair.errors import FileFormatError
 
 TOL = 1e-4
 
@@ -67,3 +68,17 @@ def test_rows_of_another_width_are_named(tmp_path, text, line, match):
     with pytest.raises(FileFormatError, match=match) as exc:
         read_curves(src)
     assert exc.value.line == line
+
+
+@pytest.mark.parametrize("text", [
+    "inf inf\n1.0 0.0\n0.5 0.05\n0.0 0.0\n0.5 -0.05\n1.0 0.0\n",          # a Lednicer-like count
+    "name\n1.0 0.0\n0.5 0.05\n0.0 0.0\n0.5 -0.05\n1.0 0.0\n1e999 0\n",     # a Selig-like count
+])
+def test_infinite_count_like_row_is_a_clear_error(tmp_path, text):
+    """A row of infinite numbers where a count line could stand is refused with the file's
+    error (a non-finite coordinate), not taken for a count (``int(inf)`` raised
+    OverflowError; found by the mutation fuzz test)."""
+    p = tmp_path / "f.dat"
+    p.write_text(text)
+    with pytest.raises(FileFormatError, match="non-finite"):
+        read_curves(p)

@@ -651,6 +651,13 @@ def _split_numbers(line: str) -> list[str] | None:
 
 def read_lines(path: str | os.PathLike[str]) -> tuple[list[str], str, bool, str]:
     """Lines, newline, final-newline flag and encoding of a text file."""
+    lines, newline, final, encoding, _ = _read_text(path)
+    return lines, newline, final, encoding
+
+
+def _read_text(path: str | os.PathLike[str]) -> tuple[list[str], str, bool, str, str | None]:
+    """:func:`read_lines` and the decoded text when its lines are joined by ``\\n`` (LF and
+    CR LF files; None for CR files): what a block of lines is a slice of."""
     try:
         with open(path, "rb") as f:
             raw = f.read()
@@ -690,8 +697,8 @@ def read_lines(path: str | os.PathLike[str]) -> tuple[list[str], str, bool, str]
     body = text.replace("\r\n", "\n") if newline == "\r\n" else text
     lines = body.split("\n" if newline == "\r\n" else newline)
     if final:
-        lines = lines[:-1]
-    return lines, newline, final, encoding
+        lines.pop()
+    return lines, newline, final, encoding, body if newline != "\r" else None
 
 
 def parse_text(path: str | os.PathLike[str], *, header: bool = True,
@@ -723,7 +730,7 @@ def parse_text(path: str | os.PathLike[str], *, header: bool = True,
         than the first data row, a column count not in ``ncols``; with ``notes=True``, a row of
         ``ncols`` numbers after the notes began (notes between coordinates are ambiguous).
     """
-    lines, newline, final, encoding = read_lines(path)
+    lines, newline, final, encoding, body = _read_text(path)
     head: int | None = None
     leading: list[int] = []
     notes_from: int | None = None
@@ -807,7 +814,7 @@ def parse_text(path: str | os.PathLike[str], *, header: bool = True,
         texts.extend(row)
         if len(data_lines) == 1 and not notes and not comma and not fortran and \
                 len(lines) - i > _BLOCK_MIN_ROWS:
-            bulk = _plain_rows(lines, i + 1, k)
+            bulk = _plain_rows(lines, i + 1, k, body, final)
             if bulk is not None:  # every line after the first row is a row like it
                 data_lines.extend(range(i + 1, len(lines)))
                 break
@@ -837,8 +844,8 @@ def parse_text(path: str | os.PathLike[str], *, header: bool = True,
                       col_dec, encoding, values, tuple(leading), notes_from, comma, fortran)
 
 
-def _plain_rows(lines: list[str], start: int, width: int
-                ) -> tuple[FloatArray, tuple[int, ...]] | None:
+def _plain_rows(lines: list[str], start: int, width: int, body: str | None = None,
+                final: bool = False) -> tuple[FloatArray, tuple[int, ...]] | None:
     """The values (row after row) and the largest decimals per column of ``lines[start:]``
     when every one of them is a row of ``width`` numbers joined by one separator character
     (``,``, ``;``, a blank or a tab) and nothing else, or None (the line-by-line reader then
@@ -848,15 +855,28 @@ def _plain_rows(lines: list[str], start: int, width: int
     instead of one check per line: every piece between the separators is a number of
     ``_NUM``'s grammar without ``nan`` / ``inf`` (exactly what Python's ``float`` reads over
     digits, ``.``, ``e``/``E`` and signs), every line has ``width`` of them. The values are
-    those ``float`` gives (the kernel's fast path is exact; the rest is read by ``float``)."""
+    those ``float`` gives (the kernel's fast path is exact; the rest is read by ``float``).
+
+    ``body`` (the file's text, its lines joined by ``\\n``, ``final``: it ends with one), when
+    given, is sliced from the block's first line instead of joining the lines again (the
+    lines before it are as read: a reader that rewrites lines does not read in bulk); the
+    kernel checks the row count either way."""
     from .._kernels.text import scan_plain_rows
 
-    rows = lines[start:]
-    sep = next((c for c in _PLAIN_SEPS if c in rows[0]), None)
+    nrows = len(lines) - start
+    first = lines[start]
+    sep = next((c for c in _PLAIN_SEPS if c in first), None)
     if sep is None or width < 2:
         return None
-    buf = np.frombuffer("\n".join(rows).encode("utf-8"), dtype=np.uint8)
-    nrows = len(rows)
+    block = None
+    if body is not None:
+        off = sum(len(ln) + 1 for ln in lines[:start])
+        block = body[off:len(body) - 1] if final else body[off:]
+        if not block.startswith(first):
+            block = None
+    if block is None:
+        block = "\n".join(lines[start:])
+    buf = np.frombuffer(block.encode("utf-8"), dtype=np.uint8)
     values = np.empty(nrows * width)
     col_dec = np.zeros(width, dtype=np.int64)
     slow_start = np.empty(nrows * width, dtype=np.int64)

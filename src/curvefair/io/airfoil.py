@@ -81,7 +81,7 @@ def leading_edge(contour: np.ndarray) -> int:
 
 
 def _is_count_row(v: np.ndarray) -> bool:
-    return bool(np.all(v >= 2) and np.all(v == np.round(v)))
+    return bool(np.all(np.isfinite(v)) and np.all(v >= 2) and np.all(v == np.round(v)))
 
 
 def _selig_count_row(vals: np.ndarray) -> int | None:
@@ -96,7 +96,8 @@ def _selig_count_row(vals: np.ndarray) -> int | None:
     for at in (0, -1):
         v = vals[at]
         rest = np.delete(vals, at % n, axis=0)
-        if np.all(v >= 0) and np.all(v == np.round(v)) and int(v.sum()) == n - 1 and \
+        if np.all(np.isfinite(v)) and np.all(v >= 0) and np.all(v == np.round(v)) and \
+                int(v.sum()) == n - 1 and \
                 float(np.abs(v).max()) > 2.0 * float(np.abs(rest).max()):
             return at
     return None

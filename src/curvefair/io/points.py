@@ -207,7 +207,9 @@ def read(path: str | os.PathLike[str], *, corner_angle: float | None = 60.0,
             f"{'they are' if len(kept) > 1 else 'it is'}; columns {', '.join(map(str, cols))} "
             f"read as {', '.join(_AXES[:len(cols)])}", kept), stacklevel=3)
     vals = lay.values[:, cols] if cols != tuple(range(lay.ncols)) else lay.values
-    lines = np.asarray(lay.data_lines, dtype=np.int64) + 1  # 1-based, per row
+    dl = lay.data_lines  # 1-based line numbers, per row (one run of lines: no conversion)
+    lines = (np.arange(dl[0] + 1, dl[-1] + 2, dtype=np.int64) if dl[-1] - dl[0] + 1 == len(dl)
+             else np.asarray(dl, dtype=np.int64) + 1)
     # exactly repeated consecutive rows: dropped, written back with their twin's value
     vals, where = drop_duplicates(vals, path, lines)
     keep = np.r_[True, where[1:] != where[:-1]]
