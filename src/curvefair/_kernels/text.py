@@ -84,6 +84,19 @@ def _long_quotient(mant, q):
     return math.ldexp(float(top), shift - s - q)
 
 
+@njit(cache=True, inline="always")
+def _piece_ends(buf, pos, sep, c, width, r, nrows):
+    """Whether the piece of column ``c`` of row ``r`` ends at ``pos`` as the layout wants:
+    at the separator (not the last column), at ``\\n`` (the last column of every row but
+    the last), at the end of ``buf`` (the last row's last column)."""
+    n = buf.shape[0]
+    if c < width - 1:
+        return pos < n and buf[pos] == sep
+    if r < nrows - 1:
+        return pos < n and buf[pos] == 10
+    return pos == n
+
+
 @njit(cache=True)
 def scan_plain_rows(buf, sep, width, nrows, values, col_dec, slow_start, slow_end):
     """Read ``nrows`` rows of ``width`` numbers from ``buf`` (uint8: the rows' text joined by
@@ -153,13 +166,7 @@ def scan_plain_rows(buf, sep, width, nrows, values, col_dec, slow_start, slow_en
                     return -1
                 if eneg:
                     ex = -ex
-            if c < width - 1:
-                if pos >= n or buf[pos] != sep:
-                    return -1
-            elif r < nrows - 1:
-                if pos >= n or buf[pos] != 10:
-                    return -1
-            elif pos != n:
+            if not _piece_ends(buf, pos, sep, c, width, r, nrows):
                 return -1
             end = pos
             pos += 1
@@ -469,13 +476,7 @@ def plain_block_plan(buf, sep, k, m, new, old, col_dec, status, dec_out, tok_sta
                     return -1
                 pos += 1
             length = pos - start
-            if c < k - 1:
-                if pos >= n or buf[pos] != sep:
-                    return -1
-            elif r < m - 1:
-                if pos >= n or buf[pos] != 10:
-                    return -1
-            elif pos != n:
+            if not _piece_ends(buf, pos, sep, c, k, r, m):
                 return -1
             pos += 1
             dec = length - point - 1

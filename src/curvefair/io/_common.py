@@ -605,6 +605,7 @@ def noise_scale(points: FloatArray, closed: bool) -> float:
         if alt < _NOISE_ALTERNATION or not sigma <= _NOISE_MAX_REL * size:
             return 0.0
         return sigma
+    # in space: the same figures with cross products (the normal vector across the chord)
     if closed:
         a, b, c = np.roll(p, 1, 0), p, np.roll(p, -1, 0)
     else:
@@ -612,21 +613,13 @@ def noise_scale(points: FloatArray, closed: bool) -> float:
     d = c - a
     L = np.linalg.norm(d, axis=1)
     v = b - a
-    if p.shape[1] == 2:
-        cr = np.abs(v[:, 0] * d[:, 1] - v[:, 1] * d[:, 0])
-    else:
-        cr = np.linalg.norm(np.cross(v, d), axis=1)
+    cr = np.linalg.norm(np.cross(v, d), axis=1)
     ok = L > 0
     if not ok.any():
         return 0.0
-    e1, e2 = b - a, c - b
-    if p.shape[1] == 2:
-        sg = np.sign(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
-        alt = float(np.mean(sg[1:] * sg[:-1] < 0))
-    else:
-        bn = np.cross(e1, e2)
-        alt = float(np.mean(np.einsum("ij,ij->i", bn[1:], bn[:-1]) < 0))
-    sigma = float(np.median(cr[ok] / L[ok])) / (0.6745 if p.shape[1] == 2 else _RAYLEIGH_MEDIAN)
+    bn = np.cross(v, c - b)
+    alt = float(np.mean(np.einsum("ij,ij->i", bn[1:], bn[:-1]) < 0))
+    sigma = float(np.median(cr[ok] / L[ok])) / _RAYLEIGH_MEDIAN
     size = float(np.ptp(p, axis=0).max())
     if alt < _NOISE_ALTERNATION or not sigma <= _NOISE_MAX_REL * size:
         return 0.0
