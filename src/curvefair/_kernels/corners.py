@@ -139,23 +139,19 @@ def point_checks(p, max_magnitude, eps4):
     the largest magnitude (at least the smallest normal float) in every coordinate
     (-1 where none). Compared as numpy compares them."""
     m, dim = p.shape
-    bad = -1
     big = -1
     amax = 0.0
     for i in range(m):
         for c in range(dim):
-            v = p[i, c]
+            v = abs(p[i, c])
             if not np.isfinite(v):
                 return i, -1, 0.0, -1
-            if abs(v) > amax:
-                amax = abs(v)
-        if big < 0:
-            for c in range(dim):
-                if abs(p[i, c]) > max_magnitude:
-                    big = i
-                    break
+            if v > amax:
+                amax = v
+            if big < 0 and v > max_magnitude:
+                big = i
     if big >= 0 or m < 2:
-        return bad, big, 0.0, -1
+        return -1, big, 0.0, -1
     extent = 0.0
     for c in range(dim):
         lo = p[0, c]
@@ -177,8 +173,8 @@ def point_checks(p, max_magnitude, eps4):
             if t > d:
                 d = t
         if d <= lim:
-            return bad, big, extent, i
-    return bad, big, extent, -1
+            return -1, -1, extent, i
+    return -1, -1, extent, -1
 
 
 def noise_terms_reference(p: FloatArray, closed: bool) -> tuple[FloatArray, int]:

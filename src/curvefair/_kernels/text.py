@@ -565,7 +565,8 @@ def _shortest_pieces(short_buf, nshort):
 def plain_block_write(buf, sep, k, m, new, status, dec_out, tok_start, tok_len, new_len,
                       short_buf, nshort, py_buf, py_start, digits):
     """The rows planned by :func:`plain_block_plan`, as bytes joined by ``\\n``: kept tokens
-    and odd rows copied, :data:`FIXED` ones written digit by digit (the decimal ``k 10**-d``
+    and odd rows copied (``new_len`` is overwritten with every token's written length),
+    :data:`FIXED` ones written digit by digit (the decimal ``k 10**-d``
     of :func:`_exact_at`, a minus where the value is negative and not a zero the token wrote
     without one), the :data:`SHORT` ones from their digits (:func:`write_shortest`), the
     :data:`SHORTEST` ones from ``short_buf`` (Python's ``repr`` of their
@@ -575,24 +576,22 @@ def plain_block_write(buf, sep, k, m, new, status, dec_out, tok_start, tok_len, 
     in front (not the first of a row), so right-aligned columns stay aligned."""
     blank = sep == 32 or sep == 9
     s_start, s_len = _shortest_pieces(short_buf, nshort)
+    # every token's written length into new_len (Python's texts' lengths too), then the size
     total = 0
-    t = 0
     ip = 0
     js = 0
-    for _r in range(m):
-        for c in range(k):
-            st = status[t]
-            ln = new_len[t]
-            if st == PYTHON:
-                ln = py_start[ip + 1] - py_start[ip]
-                ip += 1
-            elif st == SHORTEST:
-                ln = s_len[js]
-                js += 1
-            if blank and c > 0 and st != KEEP and st != ODD_ROW and ln < tok_len[t]:
-                ln = tok_len[t]
-            total += ln + 1
-            t += 1
+    for t in range(m * k):
+        st = status[t]
+        if st == PYTHON:
+            new_len[t] = py_start[ip + 1] - py_start[ip]
+            ip += 1
+        elif st == SHORTEST:
+            new_len[t] = s_len[js]
+            js += 1
+        ln = new_len[t]
+        if blank and t % k > 0 and st != KEEP and st != ODD_ROW and ln < tok_len[t]:
+            ln = tok_len[t]  # the blanks a shorter number gave up
+        total += ln + 1
     out = np.empty(max(total - 1, 0), dtype=np.uint8)
     w = 0
     t = 0
@@ -607,12 +606,7 @@ def plain_block_write(buf, sep, k, m, new, status, dec_out, tok_start, tok_len, 
                     out[w] = buf[a + i]
                     w += 1
             else:
-                if st == FIXED or st == SHORT:
-                    ln = new_len[t]
-                elif st == PYTHON:
-                    ln = py_start[ip + 1] - py_start[ip]
-                else:
-                    ln = s_len[js]
+                ln = new_len[t]
                 if blank and c > 0 and ln < tok_len[t]:
                     for _ in range(tok_len[t] - ln):
                         out[w] = sep

@@ -331,8 +331,7 @@ def _solve(ab: FloatArray, lo: int, up: int, rhs: FloatArray) -> FloatArray:
         full = np.empty((2 * lo + up + 1, ab.shape[1]), order="F")
         full[:lo] = 0.0
         full[lo:] = ab
-    a2 = full
-    _, _, y, info = dgbsv(lo, up, a2, np.asfortranarray(rhs), overwrite_ab=1, overwrite_b=1)
+    _, _, y, info = dgbsv(lo, up, full, np.asfortranarray(rhs), overwrite_ab=1, overwrite_b=1)
     if info != 0 or not np.isfinite(y).all():
         raise InputError("the quintic spline's end conditions do not determine it for these "
                          "points (singular system)")
