@@ -58,6 +58,7 @@ COMPILED_FILES = frozenset({
     "test_text_kernel.py",
     "test_io_text_layout.py",
     "test_reader_scans.py",
+    "test_hermite_delta_deviation.py",
 })
 
 #: test files whose tests each take more than ~20 s (marked ``slow``); measured with

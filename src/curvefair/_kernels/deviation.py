@@ -19,10 +19,56 @@ import numpy as np
 
 from .._jit import njit
 from .._typing import FloatArray
+from .hermite_power import _cubic_row, _quintic_row
 
 #: values at 0, 1/3, 2/3, 1 -> Bernstein control points of a cubic
 TO_BERNSTEIN = np.linalg.inv(np.array([[(1 - x) ** 3, 3 * x * (1 - x) ** 2, 3 * x * x * (1 - x),
                                         x ** 3] for x in (0.0, 1 / 3, 2 / 3, 1.0)]))
+
+
+_FRACTIONS = np.array([0.0, 0.25, 0.5, 0.75, 1.0])
+
+
+@njit(cache=True, inline="always")
+def _scaled(d, i, wi, ds):  # pragma: no cover - compiled
+    """``ds[j] = d[i, j] wi^j``: piece ``i``'s power coefficients on the unit interval."""
+    hp = 1.0
+    for j in range(ds.shape[0]):
+        for c in range(ds.shape[1]):
+            ds[j, c] = d[i, j, c] * hp
+        hp *= wi
+
+
+@njit(cache=True, inline="always")
+def _piece_first(ds, M, fr):  # pragma: no cover - compiled
+    """One piece of :func:`first_pass` from its unit-interval coefficients ``ds``: the
+    Bernstein bound ``max_r |sum_k M[r, k] ds[k]|``, the largest squared sample ``|d(f)|^2``
+    over ``fr`` (the first one if tied) and its fraction."""
+    q, dim = ds.shape
+    u = 0.0
+    for r in range(q):
+        nn = 0.0
+        for c in range(dim):
+            acc = 0.0
+            for k in range(r + 1):
+                acc += M[r, k] * ds[k, c]
+            nn += acc * acc
+        if nn > u:
+            u = nn
+    best = -1.0
+    bf = 0.0
+    for t in range(fr.shape[0]):
+        f = fr[t]
+        nn = 0.0
+        for c in range(dim):
+            acc = 0.0
+            for j in range(q - 1, -1, -1):
+                acc = acc * f + ds[j, c]
+            nn += acc * acc
+        if nn > best:
+            best = nn
+            bf = f
+    return np.sqrt(u), best, bf
 
 
 @njit(cache=True, error_model="numpy")
@@ -35,37 +81,97 @@ def first_pass(d, w, M, U):
     best = -1.0
     bi = 0
     bf = 0.0
-    fr = np.array([0.0, 0.25, 0.5, 0.75, 1.0])
     for i in range(m):
-        hp = 1.0
+        _scaled(d, i, w[i], ds)
+        U[i], nn, f = _piece_first(ds, M, _FRACTIONS)
+        if nn > best:
+            best = nn
+            bi = i
+            bf = f
+    return np.sqrt(max(best, 0.0)), bi, bf
+
+
+@njit(cache=True, inline="always")
+def _delta_data(pa, ma, sa, pb, mb, sb, t, quintic, i, p2, m2, s2, t2):
+    """Piece ``i``'s data of the difference curve ``b - a`` of two Hermite splines on the
+    parameters ``t``: rows ``i``, ``i + 1`` of ``pb - pa`` (and of the derivatives) into
+    ``p2``, ``m2``, ``s2``, and ``t[i]``, ``t[i + 1]`` into ``t2``. A row of ``b`` past its end
+    is read from its start, and so is ``a``'s same row: ``b`` may hold a closed curve's
+    distinct data only (the difference at the seam is that of row 0, as
+    :func:`curvefair.fairing.hermite_data.full_data` repeats it)."""
+    nb = pb.shape[0]
+    for k in range(2):
+        j = i + k
+        if j >= nb:
+            j -= nb
+        for c in range(pa.shape[1]):
+            p2[k, c] = pb[j, c] - pa[j, c]
+            m2[k, c] = mb[j, c] - ma[j, c]
+            if quintic:
+                s2[k, c] = sb[j, c] - sa[j, c]
+        t2[k] = t[i + k]
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def hermite_delta_pass(pa, ma, sa, pb, mb, sb, t, quintic, M, U):
+    """:func:`first_pass` of the difference curve ``b - a`` of two cubic (``quintic`` False;
+    ``sa``, ``sb`` unread) or quintic Hermite splines on the parameters ``t``, bit for bit as
+    on its whole power form (each piece's coefficients are those of
+    :func:`curvefair._kernels.hermite_power.cubic_power_kernel` / ``quintic_power_kernel`` on
+    the data's differences, the same inlined row), without that form: one piece at a time.
+    Also returns ``max |c_i0|`` over the pieces (the form's largest constant coefficient, the
+    deviation's rounding scale) and whether every coefficient was finite."""
+    n, dim = pa.shape
+    q = 6 if quintic else 4
+    p2 = np.empty((2, dim))
+    m2 = np.empty((2, dim))
+    s2 = np.empty((2, dim))
+    t2 = np.empty(2)
+    row = np.empty((1, q, dim))
+    ds = np.empty((q, dim))
+    best = -1.0
+    bi = 0
+    bf = 0.0
+    scale = 0.0
+    finite = True
+    for i in range(n - 1):
+        _delta_data(pa, ma, sa, pb, mb, sb, t, quintic, i, p2, m2, s2, t2)
+        if quintic:
+            _quintic_row(p2, m2, s2, t2, 0, row, 0)
+        else:
+            _cubic_row(p2, m2, t2, 0, row, 0)
         for j in range(q):
             for c in range(dim):
-                ds[j, c] = d[i, j, c] * hp
-            hp *= w[i]
-        u = 0.0
-        for r in range(q):
-            nn = 0.0
-            for c in range(dim):
-                acc = 0.0
-                for k in range(r + 1):
-                    acc += M[r, k] * ds[k, c]
-                nn += acc * acc
-            if nn > u:
-                u = nn
-        U[i] = np.sqrt(u)
-        for t in range(5):
-            f = fr[t]
-            nn = 0.0
-            for c in range(dim):
-                acc = 0.0
-                for j in range(q - 1, -1, -1):
-                    acc = acc * f + ds[j, c]
-                nn += acc * acc
-            if nn > best:
-                best = nn
-                bi = i
-                bf = f
-    return np.sqrt(max(best, 0.0)), bi, bf
+                if not math.isfinite(row[0, j, c]):
+                    finite = False
+        for c in range(dim):
+            v = abs(row[0, 0, c])
+            if v > scale:
+                scale = v
+        _scaled(row, 0, t[i + 1] - t[i], ds)
+        U[i], nn, f = _piece_first(ds, M, _FRACTIONS)
+        if nn > best:
+            best = nn
+            bi = i
+            bf = f
+    return np.sqrt(max(best, 0.0)), bi, bf, scale, finite
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def hermite_delta_rows(pa, ma, sa, pb, mb, sb, t, quintic, idx, out):
+    """``out[r]`` = the power coefficients of piece ``idx[r]`` of the difference curve of
+    :func:`hermite_delta_pass` (the same bits)."""
+    dim = pa.shape[1]
+    p2 = np.empty((2, dim))
+    m2 = np.empty((2, dim))
+    s2 = np.empty((2, dim))
+    t2 = np.empty(2)
+    for r in range(idx.shape[0]):
+        _delta_data(pa, ma, sa, pb, mb, sb, t, quintic, idx[r], p2, m2, s2, t2)
+        if quintic:
+            _quintic_row(p2, m2, s2, t2, 0, out, r)
+        else:
+            _cubic_row(p2, m2, t2, 0, out, r)
 
 
 @njit(cache=True, error_model="numpy")

@@ -2,7 +2,8 @@
 
 Public: :func:`energy`, :func:`curvature`, :func:`curvature_derivative`, :func:`torsion`,
 :func:`analyze` (-> :class:`Analysis`; :func:`fairness_figures`: its scalar figures only),
-:func:`deviation` (-> :class:`Deviation`),
+:func:`deviation` (-> :class:`Deviation`; :func:`hermite_delta_deviation`: its figures for two
+Hermite splines on the same parameters, without their difference's power form),
 :func:`matched_hermite_bound` (a cheap Hausdorff bound of two cubic Hermite curves),
 :func:`geometric_upper_bound` (the same for any two curves, from one dense pass),
 :func:`point_displacement` (the largest move of corresponding data points),
@@ -17,6 +18,7 @@ from ._deviation import (
     Deviation,
     deviation,
     geometric_upper_bound,
+    hermite_delta_deviation,
     matched_hermite_bound,
     point_displacement,
 )
@@ -40,6 +42,7 @@ __all__ = [
     "torsion",
     "Deviation",
     "deviation",
+    "hermite_delta_deviation",
     "matched_hermite_bound",
     "geometric_upper_bound",
     "point_displacement",

@@ -15,7 +15,8 @@ from ..curves.piecewise import PiecewiseCurve
 from ..errors import InputError
 from ._core import bernstein_matrix, check_curve, fields_to_dict, taylor_shift, to_bernstein
 
-__all__ = ["Deviation", "deviation", "DEVIATION_RTOL", "matched_hermite_bound"]
+__all__ = ["Deviation", "deviation", "hermite_delta_deviation", "DEVIATION_RTOL",
+           "matched_hermite_bound"]
 
 #: Relative accuracy of :attr:`Deviation.max_distance` (see :func:`deviation`).
 DEVIATION_RTOL = 1e-12
@@ -140,6 +141,120 @@ def _de_casteljau_split(b: FloatArray) -> tuple[FloatArray, FloatArray]:
 
 def _norms(b: FloatArray) -> FloatArray:
     return np.sqrt(np.sum(b * b, axis=-1))
+
+
+def _search(U: FloatArray, best: float, best_t: float, rows: Any, w: FloatArray,
+            starts: FloatArray, ends: FloatArray, atol: float) -> tuple[float, float, float]:
+    """The branch-and-bound of :func:`deviation` after its first pass: ``U`` the pieces'
+    Bernstein bounds, ``best`` the largest sample (at ``best_t``), ``rows(sel)`` the power
+    coefficients of the pieces ``sel`` (the few whose bound exceeds the best sample), ``w``,
+    ``starts``, ``ends`` the pieces' widths and ends, ``atol`` the absolute part of the
+    search's tolerance. Returns ``(max_distance, upper_bound, param)``, the parameter not yet
+    clamped to the domain."""
+
+    def tol() -> float:
+        return DEVIATION_RTOL * best + atol
+
+    sel = np.flatnonzero(U > best + tol())
+    ub = float(np.max(U)) if sel.size == 0 else float(np.max(np.where(U > best + tol(), 0.0, U)))
+    cb, lo, hi = to_bernstein(rows(sel), w[sel]), starts[sel], ends[sel]
+    levels = _MAX_LEVELS
+    cap = max(_MAX_CANDIDATES, U.shape[0] // _CANDIDATE_SHARE)
+    if cb.shape[0]:
+        cb, lo, hi, best, best_t, ub, done = _k.branch_and_bound(
+            np.ascontiguousarray(cb, dtype=np.float64), np.ascontiguousarray(lo, dtype=np.float64),
+            np.ascontiguousarray(hi, dtype=np.float64), float(best), float(best_t), float(ub),
+            DEVIATION_RTOL, float(atol), _MAX_LEVELS, cap)
+        best, best_t, ub = float(best), float(best_t), float(ub)
+        levels -= int(done)
+    for _ in range(levels):  # only when more than cap pieces are left
+        if cb.shape[0] == 0:
+            break
+        if cb.shape[0] > cap:
+            order = np.argsort(-np.max(_norms(cb), axis=1))
+            drop = order[cap:]
+            ub = max(ub, float(np.max(_norms(cb[drop]))))
+            keep = order[:cap]
+            cb, lo, hi = cb[keep], lo[keep], hi[keep]
+        left, right = _de_casteljau_split(cb)
+        mid = 0.5 * (lo + hi)
+        cb = np.concatenate([left, right])
+        lo, hi = np.concatenate([lo, mid]), np.concatenate([mid, hi])
+        # sample each child's midpoint (de Casteljau at 1/2 = first point of the right half)
+        _, rr = _de_casteljau_split(cb)
+        sv = _norms(rr[:, 0])
+        kk = int(np.argmax(sv))
+        if sv[kk] > best:
+            best = float(sv[kk])
+            best_t = float(0.5 * (lo[kk] + hi[kk]))
+        ends_v = _norms(left[:, -1])
+        kk = int(np.argmax(ends_v))
+        if ends_v[kk] > best:
+            best = float(ends_v[kk])
+            best_t = float(hi[kk])  # the split point: the end of left child kk
+        Uc = np.max(_norms(cb), axis=1)
+        sel = Uc > best + tol()
+        if np.any(~sel):
+            ub = max(ub, float(np.max(Uc[~sel])))
+        cb, lo, hi = cb[sel], lo[sel], hi[sel]
+    if cb.shape[0]:
+        ub = max(ub, float(np.max(_norms(cb))))
+    ub = max(ub, best)
+    return best, best_t, ub
+
+
+def hermite_delta_deviation(curve: Any, points: FloatArray, derivs: tuple[FloatArray, ...]
+                            ) -> tuple[float, float, float] | None:
+    """``(max_distance, upper_bound, param)`` of ``max_t |b(t) - a(t)|``, ``a = curve`` a
+    :class:`~curvefair.CubicHermite` or :class:`~curvefair.QuinticHermite` and ``b`` the curve
+    with ``a``'s parameters and the data ``points``, ``derivs`` (the tangents; or the first
+    and second derivatives), all ``(n, dim)``; for a closed ``a`` they may hold the distinct
+    rows only (the seam's row is then row 0's).
+
+    The figures are those of :func:`deviation` on the difference curve (the power form of the
+    data's differences against the zero curve: exactly linear in them, no rounding of the
+    coordinates' offset), bit for bit, but the difference curve's power form is never built:
+    one compiled pass forms each piece's coefficients, bounds it (Bernstein hull) and samples
+    it (:func:`curvefair._kernels.deviation.hermite_delta_pass`), and only the pieces left to
+    the branch-and-bound are formed again. A certificate of a long curve then costs one read
+    of the two curves' data, not a form of ``q (n - 1) dim`` numbers and its copies (at 1e7
+    planar cubic points: 640 MB of fresh memory per certificate, several per fair() call).
+
+    Returns None when a coefficient is not finite (the caller then measures the usual way,
+    which reports it)."""
+    from ..curves.hermite import QuinticHermite
+
+    quintic = isinstance(curve, QuinticHermite)
+    pa = np.ascontiguousarray(curve.points, dtype=np.float64)
+    da = [np.ascontiguousarray(x, dtype=np.float64) for x in curve._derivs]
+    pb = np.asarray(points, dtype=np.float64)
+    db = [np.asarray(x, dtype=np.float64) for x in derivs]
+    if len(db) != len(da) or pb.ndim != 2 or pb.shape[1] != pa.shape[1] \
+            or pb.shape[0] not in ((pa.shape[0] - 1, pa.shape[0]) if curve.closed
+                                   else (pa.shape[0],)) \
+            or any(x.shape != pb.shape for x in db):
+        raise InputError("hermite_delta_deviation: points and derivs must be (n, dim) rows of "
+                         f"the curve's {pa.shape[0]} x {pa.shape[1]} data")
+    t = np.ascontiguousarray(curve.params, dtype=np.float64)
+    sa, sb = (da[1], db[1]) if quintic else (da[0], db[0])
+    q = 6 if quintic else 4
+    U = np.empty(pa.shape[0] - 1)
+    best, i, f, scale, finite = _k.hermite_delta_pass(
+        pa, da[0], sa, pb, db[0], sb, t, quintic, bernstein_matrix(q - 1), U)
+    if not finite:
+        return None
+
+    def rows(sel: np.ndarray) -> FloatArray:
+        out = np.empty((sel.shape[0], q, pa.shape[1]))
+        _k.hermite_delta_rows(pa, da[0], sa, pb, db[0], sb, t, quintic,
+                              np.ascontiguousarray(sel, dtype=np.int64), out)
+        return out
+
+    starts, ends = t[:-1], t[1:]
+    w = ends - starts
+    best, best_t, ub = _search(U, float(best), float(starts[i] + f * w[i]), rows, w, starts,
+                               ends, 1e-13 * max(float(scale), np.finfo(float).tiny))
+    return best, ub, min(max(best_t, float(t[0])), float(t[-1]))
 
 
 def deviation(curve_a: object, curve_b: object,
@@ -268,7 +383,6 @@ def deviation(curve_a: object, curve_b: object,
     w = ends - starts
     scale = max(float(np.max(np.abs(ca[:, 0, :]))),
                 0.0 if zero else float(np.max(np.abs(cb[:, 0, :]))), np.finfo(float).tiny)
-    atol = 1e-13 * scale
 
     # every piece: Bernstein bound U and samples at the ends (exact) and quarter points
     U = np.empty(d.shape[0])
@@ -280,56 +394,8 @@ def deviation(curve_a: object, curve_b: object,
         d.flags.writeable = False
     best, i, f = _k.first_pass(d, np.ascontiguousarray(w),
                              bernstein_matrix(q - 1), U)
-    best_t = float(starts[i] + f * w[i])
-
-    def tol() -> float:
-        return DEVIATION_RTOL * best + atol
-
-    sel = np.flatnonzero(U > best + tol())
-    ub = float(np.max(U)) if sel.size == 0 else float(np.max(np.where(U > best + tol(), 0.0, U)))
-    cb, lo, hi = to_bernstein(d[sel], w[sel]), starts[sel], ends[sel]
-    levels = _MAX_LEVELS
-    cap = max(_MAX_CANDIDATES, d.shape[0] // _CANDIDATE_SHARE)
-    if cb.shape[0]:
-        cb, lo, hi, best, best_t, ub, done = _k.branch_and_bound(
-            np.ascontiguousarray(cb, dtype=np.float64), np.ascontiguousarray(lo, dtype=np.float64),
-            np.ascontiguousarray(hi, dtype=np.float64), float(best), float(best_t), float(ub),
-            DEVIATION_RTOL, float(atol), _MAX_LEVELS, cap)
-        best, best_t, ub = float(best), float(best_t), float(ub)
-        levels -= int(done)
-    for _ in range(levels):  # only when more than cap pieces are left
-        if cb.shape[0] == 0:
-            break
-        if cb.shape[0] > cap:
-            order = np.argsort(-np.max(_norms(cb), axis=1))
-            drop = order[cap:]
-            ub = max(ub, float(np.max(_norms(cb[drop]))))
-            keep = order[:cap]
-            cb, lo, hi = cb[keep], lo[keep], hi[keep]
-        left, right = _de_casteljau_split(cb)
-        mid = 0.5 * (lo + hi)
-        cb = np.concatenate([left, right])
-        lo, hi = np.concatenate([lo, mid]), np.concatenate([mid, hi])
-        # sample each child's midpoint (de Casteljau at 1/2 = first point of the right half)
-        _, rr = _de_casteljau_split(cb)
-        sv = _norms(rr[:, 0])
-        kk = int(np.argmax(sv))
-        if sv[kk] > best:
-            best = float(sv[kk])
-            best_t = float(0.5 * (lo[kk] + hi[kk]))
-        ends_v = _norms(left[:, -1])
-        kk = int(np.argmax(ends_v))
-        if ends_v[kk] > best:
-            best = float(ends_v[kk])
-            best_t = float(hi[kk])  # the split point: the end of left child kk
-        Uc = np.max(_norms(cb), axis=1)
-        sel = Uc > best + tol()
-        if np.any(~sel):
-            ub = max(ub, float(np.max(Uc[~sel])))
-        cb, lo, hi = cb[sel], lo[sel], hi[sel]
-    if cb.shape[0]:
-        ub = max(ub, float(np.max(_norms(cb))))
-    ub = max(ub, best)
+    best, best_t, ub = _search(U, float(best), float(starts[i] + f * w[i]),
+                               lambda sel: d[sel], w, starts, ends, 1e-13 * scale)
     t = min(max(best_t, a0), a1)
     pa = np.asarray(a(t), dtype=float).reshape(-1)
     pb = np.asarray(b(min(max(t, b0), b1)), dtype=float).reshape(-1)

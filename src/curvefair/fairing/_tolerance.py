@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import weakref
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -243,10 +243,14 @@ def _same_data(x: Any, y: Any) -> bool:
 
 def _difference_deviation(a: PiecewiseCurve, b: PiecewiseCurve,
                           form: PiecewisePolynomial | None) -> tuple[float, float, float]:
-    from ..analysis import deviation
+    from ..analysis import deviation, hermite_delta_deviation
 
     if form is not None:
         d = _against_zero(form, a.closed)
+    elif _comparable(a, b) and isinstance(a, (CubicHermite, QuinticHermite)) \
+            and (got := hermite_delta_deviation(a, cast(Any, b).points,
+                                                tuple(cast(Any, b)._derivs))) is not None:
+        return got  # the same figures, without the difference curve's power form
     elif _comparable(a, b):
         fa, fb = curve_fields(a), curve_fields(b)
         assert fa is not None and fb is not None

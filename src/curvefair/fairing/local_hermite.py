@@ -447,10 +447,15 @@ def _restart(st: dict[str, Any], tol: float) -> dict[str, Any]:
 def _curve_deviation(curve: HermiteSpline, P: FloatArray, D: FloatArray) -> float:
     """Certified upper bound of ``max_t |curve(t) - new(t)|`` (Bernstein hull bound), ``new``
     the curve with ``curve``'s parameters and distinct data ``P``, ``D``: measured on the
-    difference curve (:func:`curvefair.fairing._tolerance.delta_deviation`), whose data are
-    the differences of the two curves' data (the seam repeated if closed)."""
+    difference curve, one piece at a time (:func:`curvefair.analysis.hermite_delta_deviation`;
+    with a non-finite coefficient, on its whole power form,
+    :func:`curvefair.fairing._tolerance.delta_deviation`, which reports it)."""
+    from ..analysis import hermite_delta_deviation
     from ._tolerance import delta_deviation
 
+    got = hermite_delta_deviation(curve, P, tuple(D[:, k] for k in range(D.shape[1])))
+    if got is not None:
+        return got[1]
     nd = P.shape[0]
     dP, dD = full_data(curve, P - np.asarray(curve.points)[:nd],
                        D - np.stack([np.asarray(d)[:nd] for d in curve._derivs], axis=1))

@@ -1,0 +1,137 @@
+"""The deviation certificate of two Hermite splines on the same parameters, formed one piece
+at a time (:func:`curvefair.analysis.hermite_delta_deviation`).
+
+Checked against (a) :func:`curvefair.deviation` on the whole power form of the difference
+curve (``fairing._tolerance.delta_deviation``, the path it replaces: the same figures bit for
+bit) and (b) an independent measure: the difference curve evaluated densely through
+``scipy.interpolate.CubicHermiteSpline`` / ``BPoly.from_derivatives`` (cubic, quintic), whose
+maximum must lie between the certified ``max_distance`` and ``upper_bound``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.interpolate import BPoly, CubicHermiteSpline
+
+import curvefair as cf
+from curvefair.analysis import hermite_delta_deviation
+from curvefair.errors import CurvefairError
+from curvefair.fairing._tolerance import delta_deviation, difference_deviation
+
+
+def _curve(kind: str, n: int, dim: int, closed: bool, seed: int):
+    rng = np.random.default_rng(seed)
+    t = np.cumsum(rng.uniform(0.3, 2.0, n))
+    P = np.c_[t, np.sin(t)] if dim == 2 else np.c_[t, np.sin(t), np.cos(t / 2)]
+    P = P + 0.05 * rng.normal(size=P.shape)
+    if closed:
+        a = np.linspace(0.0, 2 * np.pi, n, endpoint=False)
+        P = np.c_[np.cos(a), np.sin(a), 0.1 * np.sin(3 * a)][:, :dim] * 10.0 \
+            + 0.05 * rng.normal(size=(n, dim))
+    if kind == "cubic":
+        return cf.interpolate_cubic(P, bc="periodic" if closed else "natural")
+    return cf.interpolate_quintic(P, bc="periodic" if closed else "natural")
+
+
+def _moved(c, rng, scale: float):
+    """A second data set on ``c``'s parameters: every row moved by up to ``scale``."""
+    pts = np.asarray(c.points) + scale * rng.normal(size=c.points.shape)
+    ders = [np.asarray(d) + scale * rng.normal(size=d.shape) for d in c._derivs]
+    if c.closed:  # the seam repeated exactly, as a closed curve holds it
+        pts[-1] = pts[0]
+        for d in ders:
+            d[-1] = d[0]
+    return pts, ders
+
+
+def _fields(c, pts, ders):
+    if isinstance(c, cf.QuinticHermite):
+        return {"points": pts, "d1": ders[0], "d2": ders[1]}
+    return {"points": pts, "tangents": ders[0]}
+
+
+CASES = [(kind, n, dim, closed, seed)
+         for kind in ("cubic", "quintic") for n in (4, 9, 60, 700)
+         for dim in (2, 3) for closed in (False, True) for seed in (0, 1)]
+
+
+@pytest.mark.parametrize(("kind", "n", "dim", "closed", "seed"), CASES)
+def test_same_bits_as_the_whole_form(kind, n, dim, closed, seed):
+    c = _curve(kind, n, dim, closed, seed)
+    rng = np.random.default_rng(100 + seed)
+    for scale in (1e-3, 0.3):
+        pts, ders = _moved(c, rng, scale)
+        delta = _fields(c, pts - c.points, [d - e for d, e in zip(ders, c._derivs, strict=True)])
+        ref = delta_deviation(c, delta)
+        got = hermite_delta_deviation(c, pts, tuple(ders))
+        assert got is not None
+        want = (ref.max_distance, ref.upper_bound, ref.param)
+        assert [x.hex() for x in got] == [float(x).hex() for x in want]
+        if closed:  # the distinct rows only: the seam's row is row 0's
+            nd = pts.shape[0] - 1
+            got2 = hermite_delta_deviation(c, pts[:nd], tuple(d[:nd] for d in ders))
+            assert got2 == got
+
+
+def _dense_max(c, pts, ders) -> float:
+    """max over 200 samples per piece of ``|b(t) - a(t)|``, by scipy's Hermite forms of the
+    data's differences (an evaluation independent of curvefair's power forms)."""
+    t = np.asarray(c.params)
+    dp = pts - np.asarray(c.points)
+    dd = [d - np.asarray(e) for d, e in zip(ders, c._derivs, strict=True)]
+    if len(dd) == 1:
+        f = CubicHermiteSpline(t, dp, dd[0])
+    else:
+        f = BPoly.from_derivatives(t, np.stack([dp, dd[0], dd[1]], axis=1))
+    s = np.concatenate([np.linspace(t[i], t[i + 1], 200) for i in range(t.size - 1)])
+    return float(np.max(np.linalg.norm(f(s), axis=1)))
+
+
+@pytest.mark.parametrize(("kind", "closed"), [("cubic", False), ("cubic", True),
+                                              ("quintic", False), ("quintic", True)])
+def test_brackets_a_dense_evaluation(kind, closed):
+    c = _curve(kind, 40, 3, closed, 5)
+    pts, ders = _moved(c, np.random.default_rng(9), 0.02)
+    best, ub, param = hermite_delta_deviation(c, pts, tuple(ders))
+    dense = _dense_max(c, pts, ders)
+    assert best <= dense * (1 + 1e-12) + 1e-15 or best <= ub
+    assert dense <= ub * (1 + 1e-12)
+    # the dense maximum is within the search's stated gap of the certified figures
+    assert best >= dense * (1 - 1e-6)
+    assert ub - best <= 1e-12 * best + 1e-13 * 20.0
+    assert c.params[0] <= param <= c.params[-1]
+
+
+def test_fair_reports_the_same_certificate_as_the_whole_form():
+    """fair()'s certificate of a Hermite result (difference_deviation) and the loop's curve
+    bound take the new path; the figures are the whole form's."""
+    c = _curve("cubic", 300, 2, False, 3)
+    r = cf.fair(c, "poliakoff", tol=0.01)
+    got = difference_deviation(c, r.curve)
+    delta = _fields(c, np.asarray(r.curve.points) - c.points,
+                    [np.asarray(d) - e for d, e in zip(r.curve._derivs, c._derivs, strict=True)])
+    ref = delta_deviation(c, delta)
+    assert got == (ref.max_distance, ref.upper_bound, ref.param)
+    assert r.report["max_deviation"] <= 0.01
+
+
+def test_non_finite_data_fall_back():
+    c = _curve("cubic", 10, 2, False, 0)
+    pts = np.array(c.points)
+    pts[4, 0] = np.inf
+    assert hermite_delta_deviation(c, pts, (np.asarray(c.tangents),)) is None
+
+
+@pytest.mark.parametrize("bad", ["rows", "dim", "derivs"])
+def test_wrong_shapes_are_clear_errors(bad):
+    c = _curve("cubic", 10, 2, False, 0)
+    pts, ders = np.asarray(c.points), (np.asarray(c.tangents),)
+    if bad == "rows":  # an open curve's data must have all its rows
+        pts, ders = pts[:-1], (ders[0][:-1],)
+    elif bad == "dim":
+        pts = np.c_[pts, pts[:, :1]]
+    else:
+        ders = ders + ders
+    with pytest.raises(CurvefairError, match="hermite_delta_deviation"):
+        hermite_delta_deviation(c, pts, ders)
