@@ -135,3 +135,46 @@ def test_wrong_shapes_are_clear_errors(bad):
         ders = ders + ders
     with pytest.raises(CurvefairError, match="hermite_delta_deviation"):
         hermite_delta_deviation(c, pts, ders)
+
+
+@pytest.mark.parametrize("case", ["mixed", "none", "all", "nan", "one"])
+def test_split_bounds_is_numpys_selection(case):
+    """The compiled selection of the pieces to search and the others' largest bound are
+    numpy's flatnonzero(U > thr) and max(where(U > thr, 0.0, U)) (max(U) when none)."""
+    from curvefair._kernels.deviation import split_bounds
+
+    rng = np.random.default_rng(7)
+    U = rng.uniform(0.0, 1.0, 1000)
+    thr = {"mixed": 0.7, "none": 2.0, "all": -1.0, "nan": 0.7, "one": 0.7}[case]
+    if case == "nan":
+        U[10] = np.nan
+    if case == "one":
+        U = np.array([0.9])
+    sel = np.empty(U.size, dtype=np.int64)
+    k, ub = split_bounds(U, thr, sel)
+    want = np.flatnonzero(U > thr)
+    np.testing.assert_array_equal(sel[:k], want)
+    ref = np.max(U) if want.size == 0 else np.max(np.where(U > thr, 0.0, U))
+    assert (np.isnan(ub) and np.isnan(ref)) or float(ub).hex() == float(ref).hex()
+
+
+@pytest.mark.parametrize(("kind", "closed", "dim"), [("cubic", False, 2), ("quintic", True, 3)])
+def test_long_curve_on_two_threads_same_bits(kind, closed, dim):
+    """Past ``_PAR_MIN`` pieces the pass runs in ranges on two threads, combined in curve
+    order: the figures are still the whole form's, bit for bit (ties of the largest sample
+    across ranges keep the first, as one pass does)."""
+    from curvefair.analysis import _deviation
+
+    n = _deviation._PAR_MIN + 20_000
+    c = _curve(kind, n, dim, closed, 11)
+    rng = np.random.default_rng(12)
+    pts, ders = _moved(c, rng, 1e-3)
+    # a tie: the same largest move at two places far apart (the earlier one must win)
+    for k in (n // 5, 4 * n // 5):
+        pts[k] = np.asarray(c.points)[k] + 0.5
+    delta = _fields(c, pts - c.points, [d - e for d, e in zip(ders, c._derivs, strict=True)])
+    ref = delta_deviation(c, delta)
+    got = hermite_delta_deviation(c, pts, tuple(ders))
+    assert got is not None
+    assert [x.hex() for x in got] == [float(x).hex() for x in
+                                      (ref.max_distance, ref.upper_bound, ref.param)]

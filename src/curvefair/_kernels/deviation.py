@@ -113,15 +113,17 @@ def _delta_data(pa, ma, sa, pb, mb, sb, t, quintic, i, p2, m2, s2, t2):
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def hermite_delta_pass(pa, ma, sa, pb, mb, sb, t, quintic, M, U):
-    """:func:`first_pass` of the difference curve ``b - a`` of two cubic (``quintic`` False;
-    ``sa``, ``sb`` unread) or quintic Hermite splines on the parameters ``t``, bit for bit as
-    on its whole power form (each piece's coefficients are those of
-    :func:`curvefair._kernels.hermite_power.cubic_power_kernel` / ``quintic_power_kernel`` on
-    the data's differences, the same inlined row), without that form: one piece at a time.
-    Also returns ``max |c_i0|`` over the pieces (the form's largest constant coefficient, the
-    deviation's rounding scale) and whether every coefficient was finite."""
-    n, dim = pa.shape
+def hermite_delta_pass(pa, ma, sa, pb, mb, sb, t, quintic, M, U, lo, hi):
+    """:func:`first_pass` on the pieces ``lo .. hi - 1`` of the difference curve ``b - a`` of
+    two cubic (``quintic`` False; ``sa``, ``sb`` unread) or quintic Hermite splines on the
+    parameters ``t``, bit for bit as on its whole power form (each piece's coefficients are
+    those of :func:`curvefair._kernels.hermite_power.cubic_power_kernel` /
+    ``quintic_power_kernel`` on the data's differences, the same inlined row), without that
+    form: one piece at a time. Returns the largest squared sample (not its root: ranges are
+    compared on it, as one pass compares its pieces), its piece and fraction, ``max |c_i0|``
+    over the pieces (the form's largest constant coefficient, the deviation's rounding scale)
+    and whether every coefficient was finite. Each range writes only its own ``U[lo:hi]``."""
+    dim = pa.shape[1]
     q = 6 if quintic else 4
     p2 = np.empty((2, dim))
     m2 = np.empty((2, dim))
@@ -134,7 +136,8 @@ def hermite_delta_pass(pa, ma, sa, pb, mb, sb, t, quintic, M, U):
     bf = 0.0
     scale = 0.0
     finite = True
-    for i in range(n - 1):
+    bi = lo
+    for i in range(lo, hi):
         _delta_data(pa, ma, sa, pb, mb, sb, t, quintic, i, p2, m2, s2, t2)
         if quintic:
             _quintic_row(p2, m2, s2, t2, 0, row, 0)
@@ -154,7 +157,7 @@ def hermite_delta_pass(pa, ma, sa, pb, mb, sb, t, quintic, M, U):
             best = nn
             bi = i
             bf = f
-    return np.sqrt(max(best, 0.0)), bi, bf, scale, finite
+    return best, bi, bf, scale, finite
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
@@ -172,6 +175,28 @@ def hermite_delta_rows(pa, ma, sa, pb, mb, sb, t, quintic, idx, out):
             _quintic_row(p2, m2, s2, t2, 0, out, r)
         else:
             _cubic_row(p2, m2, t2, 0, out, r)
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def split_bounds(U, thr, sel):
+    """``sel[:k]`` = the indices ``i`` (ascending) with ``U[i] > thr``, and the largest of
+    the others' ``U``, with 0.0 among them when ``k > 0``: ``numpy.max(numpy.where(U > thr,
+    0.0, U))`` (NaN if a bound is NaN), as :func:`curvefair.deviation` has always computed it.
+    Returns ``(k, that maximum)``; ``U`` not empty."""
+    k = 0
+    ub = -np.inf
+    nan = False
+    for i in range(U.shape[0]):
+        u = U[i]
+        if u > thr:
+            sel[k] = i
+            k += 1
+            u = 0.0
+        if u != u:
+            nan = True
+        elif u > ub:
+            ub = u
+    return k, (np.nan if nan else ub)
 
 
 @njit(cache=True, error_model="numpy")

@@ -8,6 +8,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from .. import _threads
 from .._distance import point_distances
 from .._kernels import deviation as _k
 from .._typing import ArrayLike, FloatArray
@@ -26,6 +27,8 @@ _MAX_LEVELS = 64
 #: pieces of a 1e7-point cubic are candidates at the first level); beyond it the pieces with
 #: the smallest bounds are dropped into ``upper_bound``.
 _MAX_CANDIDATES = 1 << 18
+#: pieces from which hermite_delta_deviation's pass runs on two threads
+_PAR_MIN = 50_000
 _CANDIDATE_SHARE = 8  # the cap's other term: pieces // _CANDIDATE_SHARE
 
 
@@ -143,21 +146,25 @@ def _norms(b: FloatArray) -> FloatArray:
     return np.sqrt(np.sum(b * b, axis=-1))
 
 
-def _search(U: FloatArray, best: float, best_t: float, rows: Any, w: FloatArray,
+def _search(U: FloatArray, best: float, best_t: float, rows: Any,
             starts: FloatArray, ends: FloatArray, atol: float) -> tuple[float, float, float]:
     """The branch-and-bound of :func:`deviation` after its first pass: ``U`` the pieces'
     Bernstein bounds, ``best`` the largest sample (at ``best_t``), ``rows(sel)`` the power
-    coefficients of the pieces ``sel`` (the few whose bound exceeds the best sample), ``w``,
-    ``starts``, ``ends`` the pieces' widths and ends, ``atol`` the absolute part of the
-    search's tolerance. Returns ``(max_distance, upper_bound, param)``, the parameter not yet
-    clamped to the domain."""
+    coefficients of the pieces ``sel`` (the few whose bound exceeds the best sample),
+    ``starts``, ``ends`` the pieces' ends, ``atol`` the absolute part of the search's
+    tolerance. Returns ``(max_distance, upper_bound, param)``, the parameter not yet clamped
+    to the domain."""
 
     def tol() -> float:
         return DEVIATION_RTOL * best + atol
 
-    sel = np.flatnonzero(U > best + tol())
-    ub = float(np.max(U)) if sel.size == 0 else float(np.max(np.where(U > best + tol(), 0.0, U)))
-    cb, lo, hi = to_bernstein(rows(sel), w[sel]), starts[sel], ends[sel]
+    # the pieces to search and the largest bound of the others (0.0 counts when some are
+    # searched, as in max(where(U > thr, 0, U))), in one compiled pass over U
+    sel = np.empty(U.shape[0], dtype=np.int64)  # (pages never written are never mapped)
+    k, ub = _k.split_bounds(U, best + tol(), sel)
+    sel = sel[:k]
+    ub = float(ub)
+    cb, lo, hi = to_bernstein(rows(sel), ends[sel] - starts[sel]), starts[sel], ends[sel]
     levels = _MAX_LEVELS
     cap = max(_MAX_CANDIDATES, U.shape[0] // _CANDIDATE_SHARE)
     if cb.shape[0]:
@@ -238,11 +245,24 @@ def hermite_delta_deviation(curve: Any, points: FloatArray, derivs: tuple[FloatA
     t = np.ascontiguousarray(curve.params, dtype=np.float64)
     sa, sb = (da[1], db[1]) if quintic else (da[0], db[0])
     q = 6 if quintic else 4
-    U = np.empty(pa.shape[0] - 1)
-    best, i, f, scale, finite = _k.hermite_delta_pass(
-        pa, da[0], sa, pb, db[0], sb, t, quintic, bernstein_matrix(q - 1), U)
+    m = pa.shape[0] - 1
+    U = np.empty(m)
+    M = bernstein_matrix(q - 1)
+
+    def run(lo: int, hi: int) -> tuple[float, int, float, float, bool]:
+        return _k.hermite_delta_pass(pa, da[0], sa, pb, db[0], sb, t, quintic, M, U, lo, hi)
+
+    # the ranges on two threads, combined in curve order as one pass compares its pieces
+    best_sq, i, f, scale, finite = -1.0, 0, 0.0, 0.0, True
+    for r_best, r_i, r_f, r_scale, r_finite in _threads.ranges(run, 0, m, _threads.THREADS,
+                                                                _PAR_MIN):
+        if r_best > best_sq:
+            best_sq, i, f = r_best, r_i, r_f
+        scale = max(scale, r_scale)
+        finite = finite and r_finite
     if not finite:
         return None
+    best = math.sqrt(max(best_sq, 0.0))
 
     def rows(sel: np.ndarray) -> FloatArray:
         out = np.empty((sel.shape[0], q, pa.shape[1]))
@@ -251,9 +271,8 @@ def hermite_delta_deviation(curve: Any, points: FloatArray, derivs: tuple[FloatA
         return out
 
     starts, ends = t[:-1], t[1:]
-    w = ends - starts
-    best, best_t, ub = _search(U, float(best), float(starts[i] + f * w[i]), rows, w, starts,
-                               ends, 1e-13 * max(float(scale), np.finfo(float).tiny))
+    best, best_t, ub = _search(U, float(best), float(starts[i] + f * (ends[i] - starts[i])),
+                               rows, starts, ends, 1e-13 * max(float(scale), np.finfo(float).tiny))
     return best, ub, min(max(best_t, float(t[0])), float(t[-1]))
 
 
@@ -395,7 +414,7 @@ def deviation(curve_a: object, curve_b: object,
     best, i, f = _k.first_pass(d, np.ascontiguousarray(w),
                              bernstein_matrix(q - 1), U)
     best, best_t, ub = _search(U, float(best), float(starts[i] + f * w[i]),
-                               lambda sel: d[sel], w, starts, ends, 1e-13 * scale)
+                               lambda sel: d[sel], starts, ends, 1e-13 * scale)
     t = min(max(best_t, a0), a1)
     pa = np.asarray(a(t), dtype=float).reshape(-1)
     pb = np.asarray(b(min(max(t, b0), b1)), dtype=float).reshape(-1)
