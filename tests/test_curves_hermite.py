@@ -264,3 +264,33 @@ def test_domain_without_power_form():
         dom = k.domain
         assert "piecewise" not in k.__dict__  # not built
         assert dom == (float(k.piecewise.breaks[0]), float(k.piecewise.breaks[-1]))
+
+
+def test_construction_never_writes_the_callers_arrays_and_shares_frozen_ones():
+    """The curve validates the caller's float64 arrays where they are and freezes its own
+    copy: a closed curve's seam snapped to row 0 is snapped in that copy, the caller's array
+    keeps its values; another curve's (frozen, whole) arrays are shared, not copied; a frozen
+    part of a larger array is copied (the curve does not keep the larger one alive)."""
+    a = np.linspace(0.0, 2 * np.pi, 9)
+    P = np.c_[np.cos(a), np.sin(a)]
+    P[-1] = P[0] + 1e-13  # within the seam tolerance, not equal
+    T = np.c_[-np.sin(a), np.cos(a)]
+    T[-1] = T[0]
+    keep_P, keep_T = P.copy(), T.copy()
+    c = cf.CubicHermite(P, T, a, closed=True)
+    np.testing.assert_array_equal(P, keep_P)
+    np.testing.assert_array_equal(T, keep_T)
+    assert c.points[-1].tobytes() == c.points[0].tobytes()
+    assert not np.shares_memory(c.points, P)
+    P[2] = 7.0  # the caller changes its array: the curve does not see it
+    assert c.points[2, 0] != 7.0
+    d = cf.CubicHermite(c.points, c.tangents, c.params, closed=True)
+    assert np.shares_memory(d.points, c.points) and np.shares_memory(d.params, c.params)
+    part = cf.CubicHermite(c.points[:4], c.tangents[:4], c.params[:4])
+    assert not np.shares_memory(part.points, c.points)
+    r = cf.interpolate_cubic(c.points[:-1])  # a reader's rebuild of the distinct points
+    assert not r.points.flags.writeable
+    Q = np.c_[np.arange(6.0), np.arange(6.0) ** 2]
+    keep_Q = Q.copy()
+    cf.interpolate_cubic(Q, bc="periodic")  # closing the points never writes Q
+    np.testing.assert_array_equal(Q, keep_Q)

@@ -111,13 +111,16 @@ def _refuse_kind(a: np.ndarray, name: str) -> None:
                                  f"({type(v).__name__})")
 
 
-def as_float(x: ArrayLike, name: str) -> FloatArray:
+def as_float(x: ArrayLike, name: str, *, copy: bool = True) -> FloatArray:
     """A float64 copy of ``x``; complex, boolean, string and date values are refused (a complex
-    value would lose its imaginary part, a string would be parsed)."""
+    value would lose its imaginary part, a string would be parsed). ``copy=False``: ``x``
+    itself when it is a float64 array (for a caller that only reads it, or freezes its own
+    copy afterwards, as the curves do)."""
     try:
         a = np.asarray(x)
         _refuse_kind(a, name)
-        arr = np.array(a, dtype=np.float64, copy=True)
+        arr = np.array(a, dtype=np.float64, copy=True) if copy else \
+            np.asarray(a, dtype=np.float64)
     except (TypeError, ValueError, OverflowError) as exc:
         if isinstance(exc, InputError):
             raise
@@ -133,8 +136,10 @@ def as_points(
     dims: Sequence[int] = (2, 3),
     allow_coincident: bool = False,
     closed_ok: bool = True,
+    copy: bool = True,
 ) -> FloatArray:
-    """Validate an ``(n, dim)`` point array; return a float64 copy.
+    """Validate an ``(n, dim)`` point array; return a float64 copy (``copy=False``: the
+    array itself if it is float64, see :func:`as_float`).
 
     Parameters
     ----------
@@ -149,8 +154,10 @@ def as_points(
         If False, two consecutive equal points raise (a zero chord breaks every parameterisation).
     closed_ok : bool
         Ignored for consecutive checks: first == last is never "consecutive".
+    copy : bool
+        False: no copy of a float64 array (the caller only reads it or copies it itself).
     """
-    arr = as_float(points, name)
+    arr = as_float(points, name, copy=copy)
     if arr.ndim != 2:
         raise InputError(f"{name} must be a 2-D array of shape (n, dim), got shape {arr.shape}")
     n, dim = arr.shape
@@ -227,13 +234,15 @@ def check_steps(arr: FloatArray, name: str, *, strict: bool) -> None:
                          f"of the steps the formulas take); rescale the parameters")
 
 
-def as_vectors(vectors: ArrayLike, shape: tuple[int, ...], name: str) -> FloatArray:
-    """Validate an array of the exact ``shape`` (e.g. tangents matching points); float64 copy.
+def as_vectors(vectors: ArrayLike, shape: tuple[int, ...], name: str, *,
+               copy: bool = True) -> FloatArray:
+    """Validate an array of the exact ``shape`` (e.g. tangents matching points); float64 copy
+    (``copy=False``: see :func:`as_float`).
 
     Derivative data are bounded by ``MAX_DERIVATIVE = 1e60`` (about a coordinate of ``1e30``
     over the smallest parameter step): the power coefficients and energies built from them
     stay finite (see the module docstring)."""
-    arr = as_float(vectors, name)
+    arr = as_float(vectors, name, copy=copy)
     if arr.shape != tuple(shape):
         raise InputError(f"{name} must have shape {tuple(shape)}, got {arr.shape}")
     check_finite(arr, name)
@@ -241,9 +250,11 @@ def as_vectors(vectors: ArrayLike, shape: tuple[int, ...], name: str) -> FloatAr
     return arr
 
 
-def as_params(params: ArrayLike, n: int, name: str = "params") -> FloatArray:
-    """Validate a strictly increasing parameter vector of length ``n``; float64 copy."""
-    arr = as_float(params, name)
+def as_params(params: ArrayLike, n: int, name: str = "params", *,
+              copy: bool = True) -> FloatArray:
+    """Validate a strictly increasing parameter vector of length ``n``; float64 copy
+    (``copy=False``: see :func:`as_float`)."""
+    arr = as_float(params, name, copy=copy)
     if arr.ndim != 1:
         raise InputError(f"{name} must be 1-D, got shape {arr.shape}")
     if arr.shape[0] != n:

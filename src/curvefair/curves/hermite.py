@@ -18,12 +18,21 @@ from .._kernels.hermite_power import (
 from .._typing import ArrayLike, FloatArray
 from .._validate import as_params, as_points, as_vectors, magnitude
 from ..errors import InputError
-from .piecewise import PiecewiseCurve, PiecewisePolynomial, readonly
+from .piecewise import (
+    PiecewiseCurve,
+    PiecewisePolynomial,
+    _frozen,
+    readonly,
+    shares_whole_frozen,
+)
 
 __all__ = ["CubicHermite", "QuinticHermite", "HermiteSpline"]
 
 
-def _check_closed(name: str, arrs: list[tuple[str, FloatArray]]) -> None:
+def _check_closed(name: str, arrs: list[tuple[str, FloatArray]]) -> list[FloatArray]:
+    """The arrays with the last row exactly the first (a copy where it was only within
+    ``1e-10`` of the size: the caller's arrays are never written)."""
+    out = []
     for label, a in arrs:
         scale = magnitude(a)
         if not np.allclose(a[0], a[-1], rtol=0.0, atol=1e-10 * scale):
@@ -31,8 +40,22 @@ def _check_closed(name: str, arrs: list[tuple[str, FloatArray]]) -> None:
                 f"closed {name}: {label}[0] = {a[0].tolist()} must equal {label}[-1] = "
                 f"{a[-1].tolist()} (a closed curve repeats its first point last)"
             )
-        a[-1] = a[0]
+        if a[-1].tobytes() != a[0].tobytes():  # (bitwise: a -0.0 becomes row 0's 0.0)
+            a = a.copy()
+            a[-1] = a[0]
+        out.append(a)
+    return out
 
+
+
+def _own(arr: FloatArray) -> FloatArray:
+    """The curve's read-only copy of ``arr``; none when ``arr`` is already the whole of a
+    frozen buffer (another curve's array: immutable, so it can be shared). A frozen part of a
+    larger buffer is copied, so that a curve never keeps a larger one alive."""
+    if shares_whole_frozen(arr):
+        return arr
+    # readonly() returns any frozen array as it is: a frozen part is copied first
+    return readonly(np.array(arr) if _frozen(arr) else arr)
 
 class HermiteSpline(PiecewiseCurve):
     """Common machinery of :class:`CubicHermite` and :class:`QuinticHermite`.
@@ -47,24 +70,28 @@ class HermiteSpline(PiecewiseCurve):
     def _init(self, points: ArrayLike, derivs: list[ArrayLike], params: ArrayLike,
               closed: bool, _valid: tuple[bool, bool] = (False, False)) -> None:
         # ``_valid`` (internal): ``points`` is already a float64 array that as_points(...,
-        # min_points=2) accepted, and ``params`` one that as_params accepted, both fresh
-        # copies nobody else writes (interpolate_cubic's own): not validated again
+        # min_points=2) accepted, and ``params`` one that as_params accepted
+        # (interpolate_cubic's): not validated again
+        # validated where they are (no copy of a float64 array): readonly() below makes the
+        # curve's one copy, or none of an array already frozen (another curve's)
         pts = (cast(FloatArray, points) if _valid[0]
-               else as_points(points, "points", min_points=2))
+               else as_points(points, "points", min_points=2, copy=False))
         n, dim = pts.shape
-        ders = [as_vectors(d, (n, dim), name)
+        ders = [as_vectors(d, (n, dim), name, copy=False)
                 for d, name in zip(derivs, self._deriv_names, strict=True)]
-        t = cast(FloatArray, params) if _valid[1] else as_params(params, n, "params")
+        t = (cast(FloatArray, params) if _valid[1]
+             else as_params(params, n, "params", copy=False))
         closed = bool(closed)
         if closed:
             if n < 3:
                 raise InputError("a closed curve needs at least 3 points (first repeated last), "
                                  f"got {n}")
-            _check_closed(type(self).__name__,
-                          [("points", pts)] + list(zip(self._deriv_names, ders, strict=True)))
-        self._points = readonly(pts)
-        self._derivs = [readonly(d) for d in ders]
-        self._params = readonly(t)
+            pts, *ders = _check_closed(
+                type(self).__name__,
+                [("points", pts)] + list(zip(self._deriv_names, ders, strict=True)))
+        self._points = _own(pts)
+        self._derivs = [_own(d) for d in ders]
+        self._params = _own(t)
         self._closed = closed
 
     # -- data -------------------------------------------------------------------------------

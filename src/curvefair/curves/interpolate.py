@@ -42,7 +42,9 @@ def _close_points(pts: FloatArray) -> FloatArray:
 def _prepare(points: ArrayLike, param: Any, bc: Any, min_points: int
              ) -> tuple[FloatArray, FloatArray, bool]:
     periodic = isinstance(bc, str) and bc == "periodic"
-    pts = as_points(points, "points", min_points=min_points)
+    # no copy of a float64 array: the curve made from pts freezes its own copy (none of an
+    # array already frozen, e.g. another curve's points), and nothing here writes pts
+    pts = as_points(points, "points", min_points=min_points, copy=False)
     if periodic:
         pts = _close_points(pts)
         if pts.shape[0] < 4:

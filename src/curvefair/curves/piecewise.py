@@ -36,6 +36,16 @@ def _frozen(arr: np.ndarray) -> bool:
     return isinstance(base, bytes)
 
 
+def shares_whole_frozen(arr: np.ndarray) -> bool:
+    """True if ``arr`` is frozen (:func:`readonly`) and spans its whole ``bytes`` buffer."""
+    if not _frozen(arr) or not arr.flags.c_contiguous:
+        return False
+    base: object = arr
+    while isinstance(base, np.ndarray):
+        base = base.base
+    return isinstance(base, bytes) and len(base) == arr.nbytes
+
+
 def readonly(arr: np.ndarray) -> np.ndarray:
     """A read-only array with the values of ``arr`` whose memory nobody can write.
 

@@ -72,8 +72,8 @@ def rebuilt_curve(curve: CubicHermite) -> CubicHermite | None:
     from ..errors import InputError
 
     try:
-        return interpolate_cubic(np.array(curve.points), "chord",
-                                 "periodic" if curve.closed else "natural")
+        # curve's own (frozen) points: the rebuilt curve shares them, no copy
+        return interpolate_cubic(curve.points, "chord", "periodic" if curve.closed else "natural")
     except InputError:
         return None
 
