@@ -370,9 +370,17 @@ def prepare(curve: HermiteSpline, *, method: str, tol: float | None, eps: float 
     if spline:
         D_new = spline_derivatives(curve, P, clamp, (g2_segment[0], g2_segment[1]))
         D_new[fixed] = D[fixed]
-        scale = np.abs(D).max(axis=(0, 2)) + 1e-300
-        extra["input_reinterpolation_change"] = float(
-            (np.abs(D_new - D).max(axis=(0, 2)) / scale).max())
+        # max |.| per derivative as max(max, -min) of each coordinate's column (exact, as the
+        # reduction of |.| over axes (0, 2) is, without its temporaries of the data's size)
+        change = 0.0
+        for b in range(D.shape[1]):
+            big = sml = 0.0
+            for c in range(D.shape[2]):
+                col, dif = D[:, b, c], D_new[:, b, c] - D[:, b, c]
+                big = max(big, float(col.max()), -float(col.min()))
+                sml = max(sml, float(dif.max()), -float(dif.min()))
+            change = max(change, sml / (big + 1e-300))
+        extra["input_reinterpolation_change"] = change
         D = D_new
 
     # -- ranking and defaults
@@ -384,7 +392,10 @@ def prepare(curve: HermiteSpline, *, method: str, tol: float | None, eps: float 
     eps_rel, eps_eff = eps_threshold(eps, m0, rel)
     n_elig = int(eligible.sum())
     max_eff = 20 * n_elig + 1000 if max_steps is None else int(max_steps)
-    scale = float(np.abs(P).max()) + float(np.ptp(P, axis=0).max())
+    # max |P| + the largest extent of a coordinate, as 1-D reductions of each column (exact:
+    # np.abs(P).max() + np.ptp(P, axis=0).max(), without a reduction across the short axis)
+    cols = [(float(P[:, c].max()), float(P[:, c].min())) for c in range(P.shape[1])]
+    scale = max(max(hi, -lo) for hi, lo in cols) + max(hi - lo for hi, lo in cols)
     floor: float = 8.0 * np.finfo(float).eps * scale
     if tol is not None:
         floor = max(floor, 1e-9 * tol)
