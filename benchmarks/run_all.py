@@ -30,7 +30,7 @@ FULL = [
     ["bench_plot.py"],
     ["bench_dxf_entities.py", "1000", "10000", "--cpu"],  # entity counts: not given --sizes
     ["bench_scale.py", "--sizes", "1e6", "1e7"],
-    ["bench_hermite_certificate.py", "--sizes", "1e5", "1e6", "1e7"],
+    ["bench_certificate.py", "--sizes", "1e5", "1e6", "1e7"],
     ["bench_airfoil_files.py", "--airfoils", "240"],  # a corpus, not a size: not given --sizes
 ]
 # how each script takes sizes: "pos" positional, "--sizes" an option, "--n" one size (largest)
@@ -39,7 +39,7 @@ SIZE_ARG = {"bench_analyze.py": "pos", "bench_fair_step.py": "--sizes",
             "bench_knot_removal.py": "--sizes", "bench_bspline_e2e.py": "--n",
             "bench_call_cost.py": "pos", "bench_io.py": "--sizes", "bench_plot.py": "pos",
             "bench_cli_vs_fair.py": "--sizes", "bench_scale.py": "--sizes",
-            "bench_hermite_certificate.py": "--sizes"}
+            "bench_certificate.py": "--sizes"}
 
 
 def with_sizes(cmd: list[str], sizes: list[int]) -> list[str]:
@@ -79,7 +79,7 @@ QUICK = [
     ["bench_call_cost.py", "1e3", "1e4", "--repeat", "1", "--cpu"],
     ["bench_io.py", "--sizes", "1000", "10000"],
     ["bench_cli_vs_fair.py", "--sizes", "10000"],
-    ["bench_hermite_certificate.py", "--sizes", "1e4", "1e5", "--repeat", "1"],
+    ["bench_certificate.py", "--sizes", "1e4", "1e5", "--repeat", "1"],
     ["bench_plot.py", "1e3", "--repeat", "1"],
     ["bench_dxf_entities.py", "100", "--cpu"],
     ["bench_scale.py", "--sizes", "1e4", "1e5", "--methods", "eck-hadenfeld", "poliakoff"],

@@ -178,3 +178,76 @@ def test_long_curve_on_two_threads_same_bits(kind, closed, dim):
     assert got is not None
     assert [x.hex() for x in got] == [float(x).hex() for x in
                                       (ref.max_distance, ref.upper_bound, ref.param)]
+
+
+# -- B-splines: bspline_delta_deviation ------------------------------------------------------
+
+def _bspline(p: int, n: int, dim: int, closed: bool, seed: int, repeated: bool = False):
+    rng = np.random.default_rng(seed)
+    if closed:
+        a = np.linspace(0.0, 2 * np.pi, n, endpoint=False)
+        P = np.c_[np.cos(a), np.sin(a), 0.2 * np.sin(2 * a)][:, :dim] * 5.0
+        return cf.interpolate_bspline(P + 0.02 * rng.normal(size=P.shape), p, closed=True)
+    P = np.cumsum(rng.normal(size=(n, dim)), axis=0)
+    inner = np.sort(rng.uniform(0.0, 10.0, n - p - 1))
+    if repeated and inner.size > 4:
+        inner[3] = inner[2]  # a double knot (one span of zero width, skipped)
+        inner = np.sort(inner)
+    knots = np.r_[[0.0] * (p + 1), inner, [10.0] * (p + 1)]
+    return cf.BSplineCurve(P, knots, p)
+
+
+BCASES = [(p, n, dim, closed, seed, rep)
+          for p in (2, 3, 5) for n in (8, 40, 400) for dim in (2, 3)
+          for closed in (False, True) for seed in (0,) for rep in ((False, True) if not closed
+                                                                   else (False,))]
+
+
+@pytest.mark.parametrize(("p", "n", "dim", "closed", "seed", "rep"), BCASES)
+def test_bspline_same_bits_as_the_whole_form(p, n, dim, closed, seed, rep):
+    from curvefair.analysis import bspline_delta_deviation
+
+    c = _bspline(p, n, dim, closed, seed, rep)
+    rng = np.random.default_rng(50 + n)
+    for scale in (1e-4, 0.2):
+        cb = np.asarray(c.control_points) + scale * rng.normal(size=c.control_points.shape)
+        ref = delta_deviation(c, {"control_points": cb - c.control_points})
+        got = bspline_delta_deviation(c, cb)
+        assert got is not None
+        assert [x.hex() for x in got] == [float(x).hex() for x in
+                                          (ref.max_distance, ref.upper_bound, ref.param)]
+
+
+def test_bspline_brackets_scipy_and_runs_on_two_threads():
+    """A long cubic (past _PAR_MIN spans: the threaded path) against scipy's BSpline of the
+    control points' differences, sampled densely near the certified maximum; and bit for bit
+    the whole form's figures."""
+    from scipy.interpolate import BSpline
+
+    from curvefair.analysis import _deviation, bspline_delta_deviation
+
+    n = _deviation._PAR_MIN + 10_000
+    c = _bspline(3, n, 2, False, 4)
+    rng = np.random.default_rng(3)
+    cb = np.asarray(c.control_points) + 1e-3 * rng.normal(size=c.control_points.shape)
+    got = bspline_delta_deviation(c, cb)
+    ref = delta_deviation(c, {"control_points": cb - c.control_points})
+    assert got == (ref.max_distance, ref.upper_bound, ref.param)
+    best, ub, param = got
+    f = BSpline(np.asarray(c.knots), cb - c.control_points, 3)
+    s = np.linspace(0.0, 10.0, 2_000_001)
+    dense = float(np.max(np.linalg.norm(f(s), axis=1)))
+    assert dense <= ub * (1 + 1e-12)
+    assert best >= dense * (1 - 1e-6)
+    assert np.linalg.norm(f(param)) == pytest.approx(best, rel=1e-9)
+
+
+def test_bspline_shape_error_and_non_finite():
+    from curvefair.analysis import bspline_delta_deviation
+
+    c = _bspline(3, 12, 2, False, 0)
+    with pytest.raises(CurvefairError, match="bspline_delta_deviation"):
+        bspline_delta_deviation(c, np.asarray(c.control_points)[:-1])
+    cb = np.array(c.control_points)
+    cb[5, 1] = np.inf
+    assert bspline_delta_deviation(c, cb) is None

@@ -19,6 +19,7 @@ import numpy as np
 
 from .._jit import njit
 from .._typing import FloatArray
+from .bspline import _factorials, _span_basis
 from .hermite_power import _cubic_row, _quintic_row
 
 #: values at 0, 1/3, 2/3, 1 -> Bernstein control points of a cubic
@@ -175,6 +176,103 @@ def hermite_delta_rows(pa, ma, sa, pb, mb, sb, t, quintic, idx, out):
             _quintic_row(p2, m2, s2, t2, 0, out, r)
         else:
             _cubic_row(p2, m2, t2, 0, out, r)
+
+
+@njit(cache=True, inline="always")
+def _bspline_delta_row(knots, p, s, ctrl, base, closed, prev, have, ndu, left, right, a, d,
+                       fact, out, r):
+    """Span ``s``'s power coefficients of the B-spline with control points ``ctrl - base``
+    into ``out[r]``: :func:`curvefair._kernels.bspline.power_form_kernel`'s operations in its
+    order (the basis derivatives of ``_span_basis``, reused while the local knot pattern
+    repeats), the differences taken where they are read. Returns ``have``."""
+    have = _span_basis(knots, p, s, prev, have, ndu, left, right, a, d)
+    n = ctrl.shape[0]
+    for k in range(p + 1):
+        for e in range(ctrl.shape[1]):
+            acc = 0.0
+            for b in range(p + 1):
+                i = s - p + b
+                if closed:
+                    i = i % n
+                acc += d[0, k, b] * (ctrl[i, e] - base[i, e])
+            out[r, k, e] = acc / fact[k]
+    return have
+
+
+@njit(cache=True, inline="always")
+def _bspline_delta_body(knots, p, spans, ctrl, base, closed, breaks, M, U, lo, hi, idx, out,
+                        rows):
+    """The pieces ``lo .. hi - 1`` (``rows`` False: :func:`first_pass` on each, as
+    :func:`hermite_delta_pass`) or the rows ``idx`` into ``out`` (``rows`` True)."""
+    dim = ctrl.shape[1]
+    ndu = np.empty((p + 1, p + 1))
+    left = np.empty(p + 1)
+    right = np.empty(p + 1)
+    a = np.empty((2, p + 1))
+    d = np.empty((1, p + 1, p + 1))
+    fact = _factorials(p)
+    prev = np.empty(2 * p)
+    have = np.bool_(False)
+    best = -1.0
+    bi = lo
+    bf = 0.0
+    scale = 0.0
+    finite = True
+    if rows:
+        for r in range(idx.shape[0]):
+            have = _bspline_delta_row(knots, p, spans[idx[r]], ctrl, base, closed, prev, have,
+                                      ndu, left, right, a, d, fact, out, r)
+        return best, bi, bf, scale, finite
+    row = np.empty((1, p + 1, dim))
+    ds = np.empty((p + 1, dim))
+    for i in range(lo, hi):
+        have = _bspline_delta_row(knots, p, spans[i], ctrl, base, closed, prev, have, ndu,
+                                  left, right, a, d, fact, row, 0)
+        for j in range(p + 1):
+            for c in range(dim):
+                if not math.isfinite(row[0, j, c]):
+                    finite = False
+        for c in range(dim):
+            v = abs(row[0, 0, c])
+            if v > scale:
+                scale = v
+        _scaled(row, 0, breaks[i + 1] - breaks[i], ds)
+        U[i], nn, f = _piece_first(ds, M, _FRACTIONS)
+        if nn > best:
+            best = nn
+            bi = i
+            bf = f
+    return best, bi, bf, scale, finite
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def bspline_delta_pass(knots, p, spans, ctrl, base, closed, breaks, M, U, lo, hi):
+    """:func:`first_pass` on the pieces ``lo .. hi - 1`` of the difference curve of two
+    B-splines on the same knots (control points ``ctrl - base``), bit for bit as on its whole
+    power form, without that form; the returns of :func:`hermite_delta_pass`. A cubic runs a
+    copy compiled for degree 3 (the same operations, as in ``power_form_kernel``)."""
+    idx = np.empty(0, dtype=np.int64)
+    out = np.empty((0, 1, 1))
+    if p == 3:
+        return _bspline_delta_body(knots, 3, spans, ctrl, base, closed, breaks, M, U, lo, hi,
+                                   idx, out, False)
+    return _bspline_delta_body(knots, p, spans, ctrl, base, closed, breaks, M, U, lo, hi,
+                               idx, out, False)
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def bspline_delta_rows(knots, p, spans, ctrl, base, closed, idx, out):
+    """``out[r]`` = the power coefficients of piece ``idx[r]`` of :func:`bspline_delta_pass`'s
+    difference curve (the same bits)."""
+    U = np.empty(0)
+    M = np.empty((0, 0))
+    breaks = np.empty(0)
+    if p == 3:
+        _bspline_delta_body(knots, 3, spans, ctrl, base, closed, breaks, M, U, 0, 0, idx, out,
+                            True)
+    else:
+        _bspline_delta_body(knots, p, spans, ctrl, base, closed, breaks, M, U, 0, 0, idx, out,
+                            True)
 
 
 @njit(cache=True, nogil=True, error_model="numpy")

@@ -2,8 +2,9 @@
 
 Public: :func:`energy`, :func:`curvature`, :func:`curvature_derivative`, :func:`torsion`,
 :func:`analyze` (-> :class:`Analysis`; :func:`fairness_figures`: its scalar figures only),
-:func:`deviation` (-> :class:`Deviation`; :func:`hermite_delta_deviation`: its figures for two
-Hermite splines on the same parameters, without their difference's power form),
+:func:`deviation` (-> :class:`Deviation`; :func:`hermite_delta_deviation`,
+:func:`bspline_delta_deviation`: its figures for two Hermite splines on the same parameters,
+or two B-splines on the same knots, without their difference's power form),
 :func:`matched_hermite_bound` (a cheap Hausdorff bound of two cubic Hermite curves),
 :func:`geometric_upper_bound` (the same for any two curves, from one dense pass),
 :func:`point_displacement` (the largest move of corresponding data points),
@@ -16,6 +17,7 @@ from ._analyze import Analysis, analyze, derivative_jumps, fairness_figures
 from ._curvature import curvature, curvature_derivative, torsion
 from ._deviation import (
     Deviation,
+    bspline_delta_deviation,
     deviation,
     geometric_upper_bound,
     hermite_delta_deviation,
@@ -43,6 +45,7 @@ __all__ = [
     "Deviation",
     "deviation",
     "hermite_delta_deviation",
+    "bspline_delta_deviation",
     "matched_hermite_bound",
     "geometric_upper_bound",
     "point_displacement",

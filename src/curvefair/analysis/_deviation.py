@@ -16,7 +16,8 @@ from ..curves.piecewise import PiecewiseCurve
 from ..errors import InputError
 from ._core import bernstein_matrix, check_curve, fields_to_dict, taylor_shift, to_bernstein
 
-__all__ = ["Deviation", "deviation", "hermite_delta_deviation", "DEVIATION_RTOL",
+__all__ = ["Deviation", "deviation", "hermite_delta_deviation", "bspline_delta_deviation",
+           "DEVIATION_RTOL",
            "matched_hermite_bound"]
 
 #: Relative accuracy of :attr:`Deviation.max_distance` (see :func:`deviation`).
@@ -245,24 +246,10 @@ def hermite_delta_deviation(curve: Any, points: FloatArray, derivs: tuple[FloatA
     t = np.ascontiguousarray(curve.params, dtype=np.float64)
     sa, sb = (da[1], db[1]) if quintic else (da[0], db[0])
     q = 6 if quintic else 4
-    m = pa.shape[0] - 1
-    U = np.empty(m)
     M = bernstein_matrix(q - 1)
 
-    def run(lo: int, hi: int) -> tuple[float, int, float, float, bool]:
+    def run(U: FloatArray, lo: int, hi: int) -> tuple[float, int, float, float, bool]:
         return _k.hermite_delta_pass(pa, da[0], sa, pb, db[0], sb, t, quintic, M, U, lo, hi)
-
-    # the ranges on two threads, combined in curve order as one pass compares its pieces
-    best_sq, i, f, scale, finite = -1.0, 0, 0.0, 0.0, True
-    for r_best, r_i, r_f, r_scale, r_finite in _threads.ranges(run, 0, m, _threads.THREADS,
-                                                                _PAR_MIN):
-        if r_best > best_sq:
-            best_sq, i, f = r_best, r_i, r_f
-        scale = max(scale, r_scale)
-        finite = finite and r_finite
-    if not finite:
-        return None
-    best = math.sqrt(max(best_sq, 0.0))
 
     def rows(sel: np.ndarray) -> FloatArray:
         out = np.empty((sel.shape[0], q, pa.shape[1]))
@@ -270,10 +257,63 @@ def hermite_delta_deviation(curve: Any, points: FloatArray, derivs: tuple[FloatA
                               np.ascontiguousarray(sel, dtype=np.int64), out)
         return out
 
-    starts, ends = t[:-1], t[1:]
-    best, best_t, ub = _search(U, float(best), float(starts[i] + f * (ends[i] - starts[i])),
-                               rows, starts, ends, 1e-13 * max(float(scale), np.finfo(float).tiny))
-    return best, ub, min(max(best_t, float(t[0])), float(t[-1]))
+    return _delta_figures(run, rows, t)
+
+
+def bspline_delta_deviation(curve: Any, control_points: FloatArray
+                            ) -> tuple[float, float, float] | None:
+    """``(max_distance, upper_bound, param)`` of ``max_t |b(t) - a(t)|``, ``a = curve`` a
+    :class:`~curvefair.BSplineCurve` and ``b`` the B-spline with ``a``'s knots, degree and
+    closedness and the control points ``control_points`` (``a``'s shape): the figures of
+    :func:`deviation` on the difference curve (the power form of the control points'
+    differences against the zero curve), bit for bit, without that form, as
+    :func:`hermite_delta_deviation` does for Hermite splines
+    (:func:`curvefair._kernels.deviation.bspline_delta_pass`). None when a coefficient is not
+    finite."""
+    ca = np.ascontiguousarray(curve.control_points, dtype=np.float64)
+    cb = np.asarray(control_points, dtype=np.float64)
+    if cb.shape != ca.shape:
+        raise InputError("bspline_delta_deviation: control_points must have the curve's shape "
+                         f"{ca.shape}, got {cb.shape}")
+    p = int(curve.degree)
+    knots = np.ascontiguousarray(curve.knots, dtype=np.float64)
+    spans = np.ascontiguousarray(curve.spans, dtype=np.int64)
+    breaks = np.ascontiguousarray(curve.span_breaks, dtype=np.float64)
+    closed = bool(curve.closed)
+    M = bernstein_matrix(p)
+
+    def run(U: FloatArray, lo: int, hi: int) -> tuple[float, int, float, float, bool]:
+        return _k.bspline_delta_pass(knots, p, spans, cb, ca, closed, breaks, M, U, lo, hi)
+
+    def rows(sel: np.ndarray) -> FloatArray:
+        out = np.empty((sel.shape[0], p + 1, ca.shape[1]))
+        _k.bspline_delta_rows(knots, p, spans, cb, ca, closed,
+                              np.ascontiguousarray(sel, dtype=np.int64), out)
+        return out
+
+    return _delta_figures(run, rows, breaks)
+
+
+def _delta_figures(run: Any, rows: Any, breaks: FloatArray) -> tuple[float, float, float] | None:
+    """The piece passes ``run(U, lo, hi)`` over ranges on two threads, combined in curve order
+    as one pass compares its pieces (on the squared samples), then :func:`_search`; None if a
+    coefficient was not finite."""
+    m = breaks.shape[0] - 1
+    U = np.empty(m)
+    best_sq, i, f, scale, finite = -1.0, 0, 0.0, 0.0, True
+    for r_best, r_i, r_f, r_scale, r_finite in _threads.ranges(
+            lambda lo, hi: run(U, lo, hi), 0, m, _threads.THREADS, _PAR_MIN):
+        if r_best > best_sq:
+            best_sq, i, f = r_best, r_i, r_f
+        scale = max(scale, r_scale)
+        finite = finite and r_finite
+    if not finite:
+        return None
+    best = math.sqrt(max(best_sq, 0.0))
+    starts, ends = breaks[:-1], breaks[1:]
+    best, best_t, ub = _search(U, best, float(starts[i] + f * (ends[i] - starts[i])), rows,
+                               starts, ends, 1e-13 * max(float(scale), np.finfo(float).tiny))
+    return best, ub, min(max(best_t, float(breaks[0])), float(breaks[-1]))
 
 
 def deviation(curve_a: object, curve_b: object,

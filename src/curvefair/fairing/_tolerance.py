@@ -243,15 +243,21 @@ def _same_data(x: Any, y: Any) -> bool:
 
 def _difference_deviation(a: PiecewiseCurve, b: PiecewiseCurve,
                           form: PiecewisePolynomial | None) -> tuple[float, float, float]:
-    from ..analysis import deviation, hermite_delta_deviation
+    from ..analysis import bspline_delta_deviation, deviation, hermite_delta_deviation
 
     if form is not None:
         d = _against_zero(form, a.closed)
-    elif _comparable(a, b) and isinstance(a, (CubicHermite, QuinticHermite)) \
-            and (got := hermite_delta_deviation(a, cast(Any, b).points,
-                                                tuple(cast(Any, b)._derivs))) is not None:
-        return got  # the same figures, without the difference curve's power form
     elif _comparable(a, b):
+        # the difference curve one piece at a time (the same figures, without its power form);
+        # its whole form only when a coefficient is not finite (deviation() then reports it)
+        got = None
+        bb = cast(Any, b)
+        if isinstance(a, (CubicHermite, QuinticHermite)):
+            got = hermite_delta_deviation(a, bb.points, tuple(bb._derivs))
+        elif isinstance(a, BSplineCurve):
+            got = bspline_delta_deviation(a, bb.control_points)
+        if got is not None:
+            return got
         fa, fb = curve_fields(a), curve_fields(b)
         assert fa is not None and fb is not None
         d = delta_deviation(a, {k: fb[k] - fa[k] for k in fa})
