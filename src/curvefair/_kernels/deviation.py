@@ -2,8 +2,12 @@
 :func:`curvefair.analysis.matched_hermite_bound` (:mod:`curvefair.analysis._deviation`).
 
 :func:`first_pass` bounds every merged piece of the difference curve by its Bernstein control
-points and samples it; :func:`branch_and_bound` runs the halving levels of the parametric
-search; :func:`matched_bound_kernel` is the per-span bound of two cubic Hermite curves through
+points and samples it; :func:`hermite_delta_pass` and :func:`bspline_delta_pass` do the same
+for the difference of two Hermite splines on the same parameters / two B-splines on the same
+knots, forming each piece's power coefficients as they go (the ``*_rows`` kernels form chosen
+pieces again), and :func:`split_bounds` picks the pieces left to the search;
+:func:`branch_and_bound` runs the halving levels of the parametric search;
+:func:`matched_bound_kernel` is the per-span bound of two cubic Hermite curves through
 the same number of points, and :func:`matched_hermite_bound_reference` the same bound in numpy,
 the plain form the kernel is tested against. :func:`point_distances_kernel` and
 :func:`moved_points_kernel` are the per-point moves of :mod:`curvefair._distance` and of
@@ -72,6 +76,26 @@ def _piece_first(ds, M, fr):  # pragma: no cover - compiled
     return np.sqrt(u), best, bf
 
 
+@njit(cache=True, inline="always")
+def _row_first(row, wi, M, ds):  # pragma: no cover - compiled
+    """:func:`_piece_first` of the piece whose power coefficients are ``row[0]`` (width
+    ``wi``), with ``max_c |row[0, 0, c]|`` (its share of the deviation's rounding scale) and
+    whether every coefficient is finite: ``(bound, squared sample, fraction, c0, finite)``."""
+    finite = True
+    c0 = 0.0
+    for j in range(row.shape[1]):
+        for c in range(row.shape[2]):
+            if not math.isfinite(row[0, j, c]):
+                finite = False
+    for c in range(row.shape[2]):
+        v = abs(row[0, 0, c])
+        if v > c0:
+            c0 = v
+    _scaled(row, 0, wi, ds)
+    u, nn, f = _piece_first(ds, M, _FRACTIONS)
+    return u, nn, f, c0, finite
+
+
 @njit(cache=True, error_model="numpy")
 def first_pass(d, w, M, U):
     """Per piece: ``U[i]`` = max norm of the Bernstein control points of ``d`` on piece ``i``
@@ -133,27 +157,19 @@ def hermite_delta_pass(pa, ma, sa, pb, mb, sb, t, quintic, M, U, lo, hi):
     row = np.empty((1, q, dim))
     ds = np.empty((q, dim))
     best = -1.0
-    bi = 0
+    bi = lo
     bf = 0.0
     scale = 0.0
     finite = True
-    bi = lo
     for i in range(lo, hi):
         _delta_data(pa, ma, sa, pb, mb, sb, t, quintic, i, p2, m2, s2, t2)
         if quintic:
             _quintic_row(p2, m2, s2, t2, 0, row, 0)
         else:
             _cubic_row(p2, m2, t2, 0, row, 0)
-        for j in range(q):
-            for c in range(dim):
-                if not math.isfinite(row[0, j, c]):
-                    finite = False
-        for c in range(dim):
-            v = abs(row[0, 0, c])
-            if v > scale:
-                scale = v
-        _scaled(row, 0, t[i + 1] - t[i], ds)
-        U[i], nn, f = _piece_first(ds, M, _FRACTIONS)
+        U[i], nn, f, c0, ok = _row_first(row, t[i + 1] - t[i], M, ds)
+        scale = max(scale, c0)
+        finite = finite and ok
         if nn > best:
             best = nn
             bi = i
@@ -228,16 +244,9 @@ def _bspline_delta_body(knots, p, spans, ctrl, base, closed, breaks, M, U, lo, h
     for i in range(lo, hi):
         have = _bspline_delta_row(knots, p, spans[i], ctrl, base, closed, prev, have, ndu,
                                   left, right, a, d, fact, row, 0)
-        for j in range(p + 1):
-            for c in range(dim):
-                if not math.isfinite(row[0, j, c]):
-                    finite = False
-        for c in range(dim):
-            v = abs(row[0, 0, c])
-            if v > scale:
-                scale = v
-        _scaled(row, 0, breaks[i + 1] - breaks[i], ds)
-        U[i], nn, f = _piece_first(ds, M, _FRACTIONS)
+        U[i], nn, f, c0, ok = _row_first(row, breaks[i + 1] - breaks[i], M, ds)
+        scale = max(scale, c0)
+        finite = finite and ok
         if nn > best:
             best = nn
             bi = i
