@@ -235,10 +235,13 @@ class _KnotData:
             self.left2[a:b] = left[:, 2, :]
         self.c = c  # (k, p+2)
         # (k, p+2) control point indices, int32 below 2**31 control points: 20 bytes a knot
-        # less at a cubic's ten million knots (the kernels only index with them)
-        self.ctrl = np.ascontiguousarray(
-            curve.control_index(js[:, None] + np.arange(-p - 1, 1)[None, :]),
-            dtype=np.int32 if curve.n_ctrl < 2**31 else np.int64)
+        # less at a cubic's ten million knots (the kernels only index with them); made in the
+        # same blocks of knots (no int64 table of every knot's indices on the way)
+        self.ctrl = np.empty((k, p + 2), dtype=np.int32 if curve.n_ctrl < 2**31 else np.int64)
+        offs = np.arange(-p - 1, 1)[None, :]
+        for a in range(0, k, _KNOT_BLOCK):
+            b = min(a + _KNOT_BLOCK, k)
+            self.ctrl[a:b] = curve.control_index(js[a:b, None] + offs)
 
     def jumps(self, d: FloatArray, k: np.ndarray | slice = slice(None)) -> FloatArray:
         """Sapidis-Farin measure at knots ``js[k]``: :func:`sapidis_measure` of the one-sided
@@ -549,8 +552,14 @@ def _loop_args(curve: BSplineCurve, kd: _KnotData, d: FloatArray, orig: FloatArr
     else:
         h = p // 2
         a1 = np.where(np.abs(C[:, h]) >= np.abs(C[:, h + 1]), h, h + 1).astype(np.int64)
-    rows = np.arange(nk)
-    denom = np.where(ctrl == ctrl[rows, a1][:, None], C, 0.0).sum(axis=1)
+    # (in blocks of knots, as _KnotData's tables: the (nk, p+2) mask and masked copy of C
+    # were 60 bytes a knot of fresh memory at the call's peak; each row's sum is its own)
+    denom = np.empty(nk)
+    for lo in range(0, nk, _KNOT_BLOCK):
+        hi = min(lo + _KNOT_BLOCK, nk)
+        cb = ctrl[lo:hi]
+        mine = cb[np.arange(hi - lo), a1[lo:hi]]
+        denom[lo:hi] = np.where(cb == mine[:, None], C[lo:hi], 0.0).sum(axis=1)
     if variant == "least-squares":
         i = js[:, None] + np.arange(-p, 0)[None, :]  # Boehm ratios (_alphas), i = j-p .. j-1
         alphas = np.ascontiguousarray((t[js][:, None] - t[i]) / (t[i + p + 1] - t[i]))
