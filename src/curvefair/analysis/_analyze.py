@@ -393,10 +393,12 @@ def _analyze(c: PiecewiseCurve, rtol: float, summary: bool, whole: bool = False
                                       kstol * g * g, closed, ell_g, pos_g, 2)
 
     if summary:
-        # the sum of a contiguous copy, as analyze() sums its frozen copy: the same bits
+        # the sum of the column where the pass wrote it: numpy's pairwise summation runs
+        # over a strided column as over analyze()'s frozen contiguous copy (the same bits,
+        # tested on 60,000 segments), without a copy at the analysis' peak
         return {"energy2": e2, "energy3": e3,
                 "max_jump": float(jumps.max()) if jumps.size else 0.0, "max_top_jump": max_top,
-                "sapidis_sum": float(np.sum(np.ascontiguousarray(smp.knots[ks, 2]))),
+                "sapidis_sum": float(np.sum(smp.knots[ks, 2])),
                 "dkds_energy": float(smp.dkds_energy), "inflections": int(n_infl),
                 "extrema": int(n_ext)}
     jidx = np.arange(0 if closed else 1, m, dtype=np.int64)
