@@ -145,6 +145,15 @@ def _span_basis(knots, p, s, prev, have, ndu, left, right, a, d):
 
 
 @njit(cache=True, inline="always")
+def _basis_work(p):  # pragma: no cover - compiled
+    """The work arrays of :func:`_span_basis` for degree ``p`` (``ndu``, ``left``, ``right``,
+    ``a``, the derivatives ``d`` of one parameter), the factorials ``0! .. p!``, the previous
+    span's knot pattern and ``have = False``: what a pass over spans starts from."""
+    return (np.empty((p + 1, p + 1)), np.empty(p + 1), np.empty(p + 1), np.empty((2, p + 1)),
+            np.empty((1, p + 1, p + 1)), _factorials(p), np.empty(2 * p), np.bool_(False))
+
+
+@njit(cache=True, inline="always")
 def _power_form_body(knots, p, spans, ctrl, base, closed, out, out_diff, pair):
     """The loop of :func:`power_form_kernel` (``pair`` False; ``base`` and ``out_diff`` unused)
     and of :func:`power_form_pair_kernel` (``pair`` True). Inlined into both with ``p`` and
@@ -153,14 +162,7 @@ def _power_form_body(knots, p, spans, ctrl, base, closed, out, out_diff, pair):
     the same order as the general one: bitwise the same results."""
     n = ctrl.shape[0]
     dim = ctrl.shape[1]
-    ndu = np.empty((p + 1, p + 1))
-    left = np.empty(p + 1)
-    right = np.empty(p + 1)
-    a = np.empty((2, p + 1))
-    d = np.empty((1, p + 1, p + 1))
-    fact = _factorials(p)
-    prev = np.empty(2 * p)
-    have = np.bool_(False)
+    ndu, left, right, a, d, fact, prev, have = _basis_work(p)
     for m in range(spans.shape[0]):
         s = spans[m]
         have = _span_basis(knots, p, s, prev, have, ndu, left, right, a, d)

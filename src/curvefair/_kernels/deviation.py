@@ -23,7 +23,7 @@ import numpy as np
 
 from .._jit import njit
 from .._typing import FloatArray
-from .bspline import _factorials, _span_basis
+from .bspline import _basis_work, _span_basis
 from .hermite_power import _cubic_row, _quintic_row
 
 #: values at 0, 1/3, 2/3, 1 -> Bernstein control points of a cubic
@@ -77,23 +77,24 @@ def _piece_first(ds, M, fr):  # pragma: no cover - compiled
 
 
 @njit(cache=True, inline="always")
-def _row_first(row, wi, M, ds):  # pragma: no cover - compiled
-    """:func:`_piece_first` of the piece whose power coefficients are ``row[0]`` (width
-    ``wi``), with ``max_c |row[0, 0, c]|`` (its share of the deviation's rounding scale) and
-    whether every coefficient is finite: ``(bound, squared sample, fraction, c0, finite)``."""
-    finite = True
-    c0 = 0.0
+def _row_first(row, wi, M, ds, U, i, best, bi, bf, scale, finite):  # pragma: no cover
+    """:func:`_piece_first` of piece ``i``, whose power coefficients are ``row[0]`` (width
+    ``wi``), into ``U[i]``; the running state of a pass updated: the largest squared sample
+    (the first if tied), its piece and fraction, the rounding scale ``max |c_i0|`` and whether
+    every coefficient is finite. Returns the new ``(best, bi, bf, scale, finite)``."""
     for j in range(row.shape[1]):
         for c in range(row.shape[2]):
             if not math.isfinite(row[0, j, c]):
                 finite = False
     for c in range(row.shape[2]):
         v = abs(row[0, 0, c])
-        if v > c0:
-            c0 = v
+        if v > scale:
+            scale = v
     _scaled(row, 0, wi, ds)
-    u, nn, f = _piece_first(ds, M, _FRACTIONS)
-    return u, nn, f, c0, finite
+    U[i], nn, f = _piece_first(ds, M, _FRACTIONS)
+    if nn > best:
+        return nn, i, f, scale, finite
+    return best, bi, bf, scale, finite
 
 
 @njit(cache=True, error_model="numpy")
@@ -167,13 +168,8 @@ def hermite_delta_pass(pa, ma, sa, pb, mb, sb, t, quintic, M, U, lo, hi):
             _quintic_row(p2, m2, s2, t2, 0, row, 0)
         else:
             _cubic_row(p2, m2, t2, 0, row, 0)
-        U[i], nn, f, c0, ok = _row_first(row, t[i + 1] - t[i], M, ds)
-        scale = max(scale, c0)
-        finite = finite and ok
-        if nn > best:
-            best = nn
-            bi = i
-            bf = f
+        best, bi, bf, scale, finite = _row_first(row, t[i + 1] - t[i], M, ds, U, i, best, bi,
+                                                 bf, scale, finite)
     return best, bi, bf, scale, finite
 
 
@@ -221,14 +217,7 @@ def _bspline_delta_body(knots, p, spans, ctrl, base, closed, breaks, M, U, lo, h
     """The pieces ``lo .. hi - 1`` (``rows`` False: :func:`first_pass` on each, as
     :func:`hermite_delta_pass`) or the rows ``idx`` into ``out`` (``rows`` True)."""
     dim = ctrl.shape[1]
-    ndu = np.empty((p + 1, p + 1))
-    left = np.empty(p + 1)
-    right = np.empty(p + 1)
-    a = np.empty((2, p + 1))
-    d = np.empty((1, p + 1, p + 1))
-    fact = _factorials(p)
-    prev = np.empty(2 * p)
-    have = np.bool_(False)
+    ndu, left, right, a, d, fact, prev, have = _basis_work(p)
     best = -1.0
     bi = lo
     bf = 0.0
@@ -244,13 +233,8 @@ def _bspline_delta_body(knots, p, spans, ctrl, base, closed, breaks, M, U, lo, h
     for i in range(lo, hi):
         have = _bspline_delta_row(knots, p, spans[i], ctrl, base, closed, prev, have, ndu,
                                   left, right, a, d, fact, row, 0)
-        U[i], nn, f, c0, ok = _row_first(row, breaks[i + 1] - breaks[i], M, ds)
-        scale = max(scale, c0)
-        finite = finite and ok
-        if nn > best:
-            best = nn
-            bi = i
-            bf = f
+        best, bi, bf, scale, finite = _row_first(row, breaks[i + 1] - breaks[i], M, ds, U, i,
+                                                 best, bi, bf, scale, finite)
     return best, bi, bf, scale, finite
 
 
