@@ -373,6 +373,10 @@ def quintic_hermite_data(pts: FloatArray, t: FloatArray, left: Any, right: Any,
     res[rp, 1] -= r3r
     res = res.reshape(2 * npt, dim)
     x0 = np.stack([m0, s0], axis=1).reshape(2 * npt, dim)
+    # the one-sided derivatives, the first guess and the chords are in res and x0 now (r5 is
+    # read by a not-a-knot end only): freed before the band (at 1e6 points the band and its
+    # solve ran beside 7 more arrays of the data's size)
+    del r3l, r4l, r3r, r4r, m0, s0, delta
     M = 2 * npt
     if periodic:
         dsc, ab = _banded(h, npt, npt - 1, 3, 3)
@@ -401,8 +405,12 @@ def quintic_hermite_data(pts: FloatArray, t: FloatArray, left: Any, right: Any,
         else:
             lo = 6 if nak[1] else 3
             up = 6 if nak[0] else 3
+            if not (nak[0] or nak[1]):
+                del r5
             dsc, ab = _banded(h, npt, npt - 1, lo, up)
-            F = res * dsc[:, None]
+            F = res  # scaled in place: the same products as res * dsc, no second array
+            F *= dsc[:, None]
+            del res
             for side, cond in enumerate((left, right)):
                 pt = 0 if side == 0 else n - 1
                 # rows of the end point: r'''' (+ left, - right), r''' (- left, + right)
