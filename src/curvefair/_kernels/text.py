@@ -368,6 +368,17 @@ def shortest_length(v, d, kk, nd):
     return n
 
 
+@njit(cache=True, inline="always")
+def _digits_back(out, j, q, count):
+    """The last ``count`` decimal digits of ``q`` written backwards from ``out[j]``; returns
+    the position before them and ``q`` without them."""
+    for _ in range(count):
+        out[j] = 48 + q % 10
+        q //= 10
+        j -= 1
+    return j, q
+
+
 @njit(cache=True)
 def write_shortest(out, w, v, d, kk, nd):
     """Write ``v`` as :func:`curvefair.io._text._shortest` does (``repr`` without a ``.0``
@@ -381,25 +392,16 @@ def write_shortest(out, w, v, d, kk, nd):
     q = d
     if kk >= 0:
         # digits after the point: nd - (kk + 1) of them; zeros to pad the integer part
-        for _ in range(nd - (kk + 1)):
-            out[j] = 48 + q % 10
-            q //= 10
-            j -= 1
+        j, q = _digits_back(out, j, q, nd - (kk + 1))
         if nd > kk + 1:
             out[j] = 46
             j -= 1
         for _ in range(kk + 1 - nd):
             out[j] = 48
             j -= 1
-        while j >= w:
-            out[j] = 48 + q % 10
-            q //= 10
-            j -= 1
+        _digits_back(out, j, q, j - w + 1)
     else:
-        for _ in range(nd):
-            out[j] = 48 + q % 10
-            q //= 10
-            j -= 1
+        j, q = _digits_back(out, j, q, nd)
         while j > w + 1:
             out[j] = 48
             j -= 1

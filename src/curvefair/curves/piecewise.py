@@ -26,24 +26,25 @@ from ..errors import InputError
 __all__ = ["PiecewisePolynomial", "PiecewiseCurve", "horner_rows", "readonly"]
 
 
-def _frozen(arr: np.ndarray) -> bool:
-    """True if ``arr`` is read-only and its memory is an immutable ``bytes`` object."""
+def _frozen_buffer(arr: np.ndarray) -> bytes | None:
+    """The immutable ``bytes`` object whose memory a read-only ``arr`` views, else None."""
     if arr.flags.writeable:
-        return False
+        return None
     base: object = arr
     while isinstance(base, np.ndarray):
         base = base.base
-    return isinstance(base, bytes)
+    return base if isinstance(base, bytes) else None
+
+
+def _frozen(arr: np.ndarray) -> bool:
+    """True if ``arr`` is read-only and its memory is an immutable ``bytes`` object."""
+    return _frozen_buffer(arr) is not None
 
 
 def shares_whole_frozen(arr: np.ndarray) -> bool:
     """True if ``arr`` is frozen (:func:`readonly`) and spans its whole ``bytes`` buffer."""
-    if not _frozen(arr) or not arr.flags.c_contiguous:
-        return False
-    base: object = arr
-    while isinstance(base, np.ndarray):
-        base = base.base
-    return isinstance(base, bytes) and len(base) == arr.nbytes
+    buf = _frozen_buffer(arr)
+    return buf is not None and arr.flags.c_contiguous and len(buf) == arr.nbytes
 
 
 def readonly(arr: np.ndarray) -> np.ndarray:
