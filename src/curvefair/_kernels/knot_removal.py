@@ -94,17 +94,22 @@ def _measure_parts(d, k, p, ctrl, C, right, left2):
         J1 += c * d[q, 1]
         if dim == 3:
             J2 += c * d[q, 2]
+    # r'' (right) enters only a quadratic's or a 3-D curve's measure: a planar curve of
+    # degree >= 3 passes no r'' table (right has one row per knot, see _KnotData)
+    second = p == 2 or dim == 3
     for a in range(p + 1):
         q = ctrl[k, a + 1]
         c = right[k, 0, a]
         a0 += c * d[q, 0]
         a1 += c * d[q, 1]
-        c = right[k, 1, a]
-        b0 += c * d[q, 0]
-        b1 += c * d[q, 1]
         if dim == 3:
-            a2 += right[k, 0, a] * d[q, 2]
-            b2 += c * d[q, 2]
+            a2 += c * d[q, 2]
+        if second:
+            c = right[k, 1, a]
+            b0 += c * d[q, 0]
+            b1 += c * d[q, 1]
+            if dim == 3:
+                b2 += c * d[q, 2]
     if p == 2:
         for a in range(p + 1):
             q = ctrl[k, a]

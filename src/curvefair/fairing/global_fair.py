@@ -609,6 +609,9 @@ def _global_fair(problem: FairingProblem, l: Any, gap: float) -> GlobalResult:  
     act = np.empty(n, dtype=np.bool_)
     rmax, ract = tolv - margin, (1 - 1e-6) * tolv
     _ranges(lambda a, b: _k.finish_points_range(d0, v, mask, rmax, ract, x, act, a, b), 0, n)
+    # the Newton band storage (8x the coordinates' bytes) and work arrays (v is a view of
+    # them) are freed before the result curve is validated and analysed
+    del v, system
     # 2 (G d)_i + lam_i (d_i - o_i) = 0 (in place: no temporaries)
     lam = np.multiply(lam_, E0, out=lam_ if lam_.flags.writeable else None)
     lam /= tolv * tolv

@@ -222,8 +222,12 @@ class _KnotData:
         nder = max(p, 2)
         k = js.size
         c = np.zeros((k, p + 2))  # as _jump_coefficients
-        self.right = np.empty((k, 2, p + 1))  # r', r'' (right limits)
-        self.left2 = np.empty((k, p + 1))  # r'' (left limit)
+        # the measure (sapidis_measure) reads r'' only for a quadratic (both sides) or a 3-D
+        # curve (the right one, for the binormal): a planar curve of degree >= 3 keeps r' alone
+        # (32 bytes a knot instead of 96 for a cubic; the kernel then reads no other row)
+        two = p == 2 or curve.dim == 3
+        self.right = np.empty((k, 2 if two else 1, p + 1))  # r'[, r''] (right limits)
+        self.left2 = np.empty((k if p == 2 else 0, p + 1))  # r'' (left limit)
         for a in range(0, k, _KNOT_BLOCK):
             b = min(a + _KNOT_BLOCK, k)
             jb = js[a:b]
@@ -231,8 +235,9 @@ class _KnotData:
             left = basis_derivatives(t, p, jb - 1, t[jb] - t[jb - 1], nder, local=True)
             c[a:b, 1:] += right[:, p, :]
             c[a:b, :-1] -= left[:, p, :]
-            self.right[a:b] = right[:, 1:3, :]
-            self.left2[a:b] = left[:, 2, :]
+            self.right[a:b] = right[:, 1:3 if two else 2, :]
+            if p == 2:
+                self.left2[a:b] = left[:, 2, :]
         self.c = c  # (k, p+2)
         # (k, p+2) control point indices, int32 below 2**31 control points: 20 bytes a knot
         # less at a cubic's ten million knots (the kernels only index with them); made in the
@@ -541,17 +546,19 @@ def _loop_args(curve: BSplineCurve, kd: _KnotData, d: FloatArray, orig: FloatArr
     js = kd.js
     nk = js.size
     t = np.asarray(curve.knots)
-    pos = np.full(t.size, -1, dtype=np.int64)
+    # knot index -> position in js (-1: not removable); int32 below 2**31 knots
+    pos = np.full(t.size, -1, dtype=np.int32 if nk < 2**31 else np.int64)
     pos[js] = np.arange(nk)
     C = np.ascontiguousarray(kd.c)
     ctrl = np.ascontiguousarray(kd.ctrl)
     # one-point: the moved basis function a (of j-p-1 .. j; _one_point_index) and the sum of
     # the jump coefficients of its control point (a closed curve's wrapped copies add up)
+    # (int16: 8 bytes a knot less than int64 at the loop's peak; a1 <= p + 1)
     if p % 2 == 1:
-        a1 = np.full(nk, p + 1 - (p + 1) // 2, dtype=np.int64)
+        a1 = np.full(nk, p + 1 - (p + 1) // 2, dtype=np.int16)
     else:
         h = p // 2
-        a1 = np.where(np.abs(C[:, h]) >= np.abs(C[:, h + 1]), h, h + 1).astype(np.int64)
+        a1 = np.where(np.abs(C[:, h]) >= np.abs(C[:, h + 1]), h, h + 1).astype(np.int16)
     # (in blocks of knots, as _KnotData's tables: the (nk, p+2) mask and masked copy of C
     # were 60 bytes a knot of fresh memory at the call's peak; each row's sum is its own)
     denom = np.empty(nk)
