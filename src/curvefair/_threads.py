@@ -95,7 +95,6 @@ def ranges_start(fn: Callable[[int, int], Any], lo: int, hi: int, threads: int,
     # them (measured: a Gram band's two work arrays, 5.25x the input's coordinate bytes,
     # stayed alive through the global fairing's set-up)
     state: dict[str, Any] = {"next": 0, "pending": 0, "error": None, "fn": fn}
-    del fn
     idle = threading.Event()
     idle.set()
 

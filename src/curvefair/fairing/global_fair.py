@@ -608,7 +608,7 @@ def _global_fair(problem: FairingProblem, l: Any, gap: float) -> GlobalResult:  
     x = g0 if g0.flags.c_contiguous and not np.shares_memory(g0, v) else np.empty_like(d0)
     act = np.empty(n, dtype=np.bool_)
     rmax, ract = tolv - margin, (1 - 1e-6) * tolv
-    _ranges(lambda a, b: _k.finish_points_range(d0, v, mask, rmax, ract, x, act, a, b), 0, n)
+    _ranges(partial(_k.finish_points_range, d0, v, mask, rmax, ract, x, act), 0, n)
     # the Newton band storage (8x the coordinates' bytes) and work arrays (v is a view of
     # them) are freed before the result curve is validated and analysed
     del v, system
