@@ -203,7 +203,9 @@ class SpanForms:
             # (the stored samples' unit: a power of two near the control points' size)
             self.unit_points = np.asarray(curve.control_points)
         else:
-            self.breaks = np.array(curve.params)  # as HermiteSpline's own power form
+            # the curve's own frozen parameters (the values of its power form's breaks), read
+            # only: no copy (8 bytes a segment at the analysis' peak)
+            self.breaks = np.asarray(curve.params)
             # the segments' start points: the whole form's unit
             self.unit_points = np.asarray(curve.points)[:-1]
         self.shape = (self.breaks.shape[0] - 1, int(curve.degree) + 1, int(curve.dim))

@@ -289,12 +289,19 @@ def _banded(h: FloatArray, npt: int, nseg_band: int, lo: int, up: int
         diag[:-1] += w
         diag[1:] += w
     dsc = diag.reshape(M) ** -0.5
+    del w, diag  # (two arrays of 16 bytes a point, not read again: freed before the band)
     ab = np.zeros((2 * lo + up + 1, M), order="F")[lo:]
     nb = nseg_band
     ds = [dsc[e: e + 2 * nb: 2] for e in range(4)]  # unknown e of every band segment
+    # each entry's products in one work array, in place (the same operations in the same
+    # order as ``_KE[a, b] * hp[.] * ds[a] * ds[b]``, without two temporaries of the band's
+    # length beside the band at a quintic interpolation's peak)
+    val = np.empty(nb)
     for a in range(4):
         for b in range(a, 4):
-            val = _KE[a, b] * hp[int(_KE_POW[a, b])][:nb] * ds[a] * ds[b]
+            np.multiply(_KE[a, b], hp[int(_KE_POW[a, b])][:nb], out=val)
+            val *= ds[a]
+            val *= ds[b]
             ab[up + a - b, b: b + 2 * nb: 2] += val
             if b != a:
                 ab[up + b - a, a: a + 2 * nb: 2] += val
