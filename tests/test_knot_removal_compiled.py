@@ -436,7 +436,7 @@ def test_small_closed_and_multiple_knots_match_reference(p):
 
 def test_pairwise_sum_is_numpys():
     # the tracked sum adds the touched knots' z as numpy's sum does (pairwise), bitwise
-    from curvefair._kernels.knot_removal import _pw_sum_long
+    from curvefair._kernels.pairwise import pw_sum_long as _pw_sum_long
 
     rng = np.random.default_rng(2)
     for m in [*range(0, 140), 255, 256, 1000, 4097]:

@@ -12,51 +12,12 @@ from __future__ import annotations
 import numpy as np
 
 from .._jit import njit
+from .pairwise import pw_sum
 from .ranking import tt_update, tt_update_range
-
 
 # ------------------------------------------------------------------------------------------
 # the compiled loop
 # ------------------------------------------------------------------------------------------
-@njit(cache=True)
-def _pw_sum_long(v, m):
-    """numpy's pairwise summation above 128 values (recursive halves, multiples of 8)."""
-    if m <= 128:
-        return _pw_sum(v, m)
-    m2 = m // 2
-    m2 -= m2 % 8
-    return _pw_sum_long(v[:m2], m2) + _pw_sum_long(v[m2:], m - m2)
-
-
-@njit(cache=True, inline="always")
-def _pw_sum(v, m):
-    """``v[:m].sum()`` in numpy's order (pairwise summation: sequential below 8 values, eight
-    accumulators up to 128), so that the tracked sum is bitwise the vectorised one."""
-    if m < 8:
-        res = 0.0
-        for i in range(m):
-            res += v[i]
-        return res
-    if m > 128:
-        return _pw_sum_long(v, m)
-    r0, r1, r2, r3 = v[0], v[1], v[2], v[3]
-    r4, r5, r6, r7 = v[4], v[5], v[6], v[7]
-    i = 8
-    while i < m - (m % 8):
-        r0 += v[i]
-        r1 += v[i + 1]
-        r2 += v[i + 2]
-        r3 += v[i + 3]
-        r4 += v[i + 4]
-        r5 += v[i + 5]
-        r6 += v[i + 6]
-        r7 += v[i + 7]
-        i += 8
-    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
-    while i < m:
-        res += v[i]
-        i += 1
-    return res
 
 
 @njit(cache=True, inline="always")
@@ -346,7 +307,7 @@ def kr_loop(d, orig, mask, tol, p, n, closed, js, pos, C, right, left2, ctrl, a1
             kk = tk[u]
             zold[u] = z[kk]
             znew[u] = knot_measure(d, kk, p, ctrl, C, right, left2)
-        new_total = total - _pw_sum(zold, m) + _pw_sum(znew, m)
+        new_total = total - pw_sum(zold, m) + pw_sum(znew, m)
         if new_total >= total - floor:
             for r in range(nm - 1, -1, -1):
                 q = idx[r]

@@ -114,7 +114,7 @@ def _frenet_node(r1, r2, r3, sc1, sc2, speed_rtol, cross_rtol):
 @njit(cache=True, nogil=True, fastmath=_FM, error_model="numpy", readonly=('cw', 'h'))
 def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cross_rtol,
                 kap, dks, knots, energies, quad, box, ell, pos, gaps, unit,
-                i_lo, i_hi, scratch, first, endv, ksfl, off):
+                i_lo, i_hi, scratch, first, endv, ksfl, off, k_off, k_scratch):
     """One fused pass over the segments (see
     :func:`curvefair.analysis._sampling.sample_curve`).
 
@@ -147,6 +147,10 @@ def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cr
     ``cw`` holds the rows of segments ``off .. off + len(cw) - 1`` (those the range reads, the
     lead-in segment included): the whole form (``off = 0``) or a range's own rows made for
     it (:class:`curvefair.analysis._sampling.SpanForms`); ``h`` covers every segment.
+
+    ``knots`` and ``energies`` may be a block's own rows: segment ``i``'s are row ``i - k_off``,
+    the lead-in segment's row ``k_scratch`` (``k_off = 0``, ``k_scratch = scratch``: the
+    whole arrays, as the other outputs).
     """
     m = h.shape[0]
     p1 = cw.shape[1]
@@ -185,6 +189,7 @@ def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cr
     ngap = 0
     for i in range(i0, i_hi):
         row = i if i >= i_lo else scratch
+        krow = i - k_off if i >= i_lo else k_scratch
         own = i >= i_lo
         hi = h[i]
         ih = 1.0 / hi
@@ -212,7 +217,7 @@ def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cr
                             dd += e[j + o, d] * e[k + o, d]
                         acc += dd * fall[j + o, o] * fall[k + o, o] * hilb[j + k]
                 acc *= ih2 * ih2 if o == 2 else ih3 * ih3
-            energies[row, o - 2] = acc * hi
+            energies[krow, o - 2] = acc * hi
         # jumps at breakpoint i of the third and the degree-th derivative; then the left
         # limits at this segment's end for breakpoint i + 1
         for slot in range(2):
@@ -232,7 +237,7 @@ def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cr
                     for j in range(nu, p1):
                         acc += fall[j, nu] * e[j, d]
                 endv[slot, d] = acc * ihn
-            knots[row, slot] = np.sqrt(jj) if i > 0 else 0.0
+            knots[krow, slot] = np.sqrt(jj) if i > 0 else 0.0
         if p1 == 4:  # cubic: derivative polynomials in u written out (the common case)
             for d in range(dim):
                 c1[d] = e[1, d] * ih
@@ -338,7 +343,7 @@ def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cr
         quad[row, 1] = ea * sw
         quad[row, 2] = qd * sw
         quad[row, 3] = ed * sw
-        knots[row, 2] = abs(ks_start - ks_prev_end) if i > 0 else 0.0
+        knots[krow, 2] = abs(ks_start - ks_prev_end) if i > 0 else 0.0
         if i == 0:
             ksfl[0] = ks_start
         ks_prev_end = ks_end

@@ -347,7 +347,7 @@ def _analyze(c: PiecewiseCurve, rtol: float, summary: bool, whole: bool = False
             planar = True
             cw = np.ascontiguousarray(coeffs @ E)  # (m, p1, 2): coordinates in the plane
 
-    smp = sample_curve(cw, h, planar, closed, rtol)
+    smp = sample_curve(cw, h, planar, closed, rtol, sums_only=summary)
     if forms is not None and not forms.finite:
         c.piecewise  # noqa: B018 (a form beyond float64 raises the whole form's own message)
         return _analyze(c, rtol, summary, True)
@@ -357,7 +357,11 @@ def _analyze(c: PiecewiseCurve, rtol: float, summary: bool, whole: bool = False
     # analyze() keeps one frozen copy of each per-knot column; the summary reads the values
     # where the pass wrote them
     keep = (lambda a: a) if summary else _ro
-    if cw is coeffs or cw is forms:
+    sums = smp.sums  # (a summary of an open planar curve: summed in the pass, see there)
+    if sums is not None:
+        e2, e3 = sums[0], sums[1]
+        jumps = top = np.zeros(0)
+    elif cw is coeffs or cw is forms:
         # exact energies and jumps from the same compiled pass
         e2 = float(np.sum(smp.energies[:, 0]))
         e3 = float(np.sum(smp.energies[:, 1]))
@@ -369,6 +373,8 @@ def _analyze(c: PiecewiseCurve, rtol: float, summary: bool, whole: bool = False
         jumps = derivative_jumps(c, 3)[1]
         top = derivative_jumps(c, degree)[1]
     max_top = float(top.max()) if top.size else 0.0
+    if sums is not None:
+        max_top = sums[4]
 
     kap, dks = smp.kappa, smp.dkds
     max_k, max_ks = smp.max_kappa, smp.max_dkds
@@ -396,9 +402,13 @@ def _analyze(c: PiecewiseCurve, rtol: float, summary: bool, whole: bool = False
         # the sum of the column where the pass wrote it: numpy's pairwise summation runs
         # over a strided column as over analyze()'s frozen contiguous copy (the same bits,
         # tested on 60,000 segments), without a copy at the analysis' peak
-        return {"energy2": e2, "energy3": e3,
-                "max_jump": float(jumps.max()) if jumps.size else 0.0, "max_top_jump": max_top,
-                "sapidis_sum": float(np.sum(smp.knots[ks, 2])),
+        if sums is not None:
+            max_jump, sap = sums[3], sums[2]
+        else:
+            max_jump = float(jumps.max()) if jumps.size else 0.0
+            sap = float(np.sum(smp.knots[ks, 2]))
+        return {"energy2": e2, "energy3": e3, "max_jump": max_jump, "max_top_jump": max_top,
+                "sapidis_sum": sap,
                 "dkds_energy": float(smp.dkds_energy), "inflections": int(n_infl),
                 "extrema": int(n_ext)}
     jidx = np.arange(0 if closed else 1, m, dtype=np.int64)

@@ -28,6 +28,7 @@ from typing import TYPE_CHECKING, cast
 import numpy as np
 
 from .. import _threads
+from .._kernels import pairwise as _kp
 from .._kernels import sampling as _k
 from .._typing import FloatArray
 from ..curves.bspline import BSplineCurve
@@ -53,6 +54,8 @@ _MAX_LEVELS = 40
 #: Segments: from this many on, the sampling pass runs in ranges on two threads
 #: (:mod:`curvefair._threads`; bitwise the same results as on one).
 PAR_MIN = 50_000
+#: segments per block of a ``sums_only`` pass (:func:`sample_curve`)
+STREAM_BLOCK = 65_536
 
 # Gander & Gautschi (2000): 4-point Gauss-Lobatto and 7-point Kronrod extension on [-1, 1]
 _R23 = float(np.sqrt(2.0 / 3.0))
@@ -181,6 +184,9 @@ class Samples:
     energies: FloatArray  # (m, 2): exact int |r''|^2 and int |r'''|^2 per segment
     extra: tuple[tuple[np.ndarray, FloatArray, FloatArray], ...]  # per quantity: seg, u, value
     unit: float = 1.0  # the power of two near the curve's size that scales kappa and dkds
+    # sums_only: (sum energies[:, 0], sum energies[:, 1], sum of the Sapidis measure, max jump,
+    # max top jump) over the interior breakpoints of an open curve, as np.sum / np.max give
+    sums: tuple[float, float, float, float, float] | None = None
 
 
 class SpanForms:
@@ -315,7 +321,7 @@ def _kernel_tables(degree: int, planar: bool
 
 
 def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed: bool,
-                 rtol: float = QUAD_RTOL) -> Samples:
+                 rtol: float = QUAD_RTOL, sums_only: bool = False) -> Samples:
     """Sample ``kappa`` and ``dkappa/ds`` on every segment; integrate; certify signs.
 
     ``cw`` are power coefficients ``(m, p+1, dim)`` (``dim`` 2 for planar curves, 3 for
@@ -338,6 +344,14 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
     the segments they read; for a B-spline ``unit`` is then the power of two nearest the
     diagonal of the control points (a power of two either way: the counts and figures are the
     same bits).
+
+    ``sums_only`` (what :func:`curvefair.analysis.fairness_figures` needs of an open curve
+    whose segment forms are made range by range): the jumps and energies are not kept per
+    segment (40 bytes a segment at the analysis' peak) but summed block by block as they are
+    made, in numpy's pairwise order (:mod:`curvefair._kernels.pairwise`): ``Samples.sums``
+    then holds ``np.sum`` of each energy column, ``np.sum`` of the Sapidis measure at the
+    interior breakpoints and the largest jumps there, the same bits as those of the arrays
+    (``knots`` and ``energies`` are then empty).
     """
     m, p1, dim = cw.shape
     p = p1 - 1
@@ -351,8 +365,16 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
     dks = np.empty((m + spare, K), dtype=np.float32)
     forms = cw if isinstance(cw, SpanForms) else None
     unit = _unit(cast(FloatArray, cw)) if forms is None else _unit_of(forms.unit_points)
-    knots = np.empty((m + spare, 3))
-    energies = np.empty((m + spare, 2))
+    stream = sums_only and forms is not None and not closed and m >= 2
+    if stream:
+        knots = energies = np.empty((0, 3))  # (summed by blocks in run(), never kept)
+        lbe, lbs = _kp.leaf_bounds(m), _kp.leaf_bounds(m - 1)
+        ls2, ls3 = np.empty(lbe.shape[0] - 1), np.empty(lbe.shape[0] - 1)
+        lss = np.empty(lbs.shape[0] - 1)
+        folds: dict[tuple[int, int], tuple[np.ndarray, ...]] = {}
+    else:
+        knots = np.empty((m + spare, 3))
+        energies = np.empty((m + spare, 2))
     quad = np.empty((m + spare, 4))
     ell = np.empty(m + spare)
     pos = np.empty(m + spare)
@@ -376,17 +398,71 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
             # (an empty range still reads the row of its first segment for the box's start,
             # as it does in the whole form)
             rows = forms.rows(off, max(b, off + 1))
+        if stream:
+            return blocks(a, b, box, endv, fl, gaps, scratch)
         while True:
             nsing, maxk, maxks, ngap = _k.pass_kernel(
                 rows, hc, plan.x, plan.tab, plan.w7, plan.w4, plan.P, fall, fits, nfit, subs,
                 SPEED_RTOL, CROSS_RTOL, kap, dks, knots, energies, quad, box, ell, pos, gaps,
-                unit, a, b, scratch, first, endv, fl, off)
+                unit, a, b, scratch, first, endv, fl, off, 0, scratch)
             if ngap <= gaps.shape[0]:
                 break
             gaps = np.empty((ngap, 3), dtype=np.int64)  # rare: the buffer was too small; redo
         if a == 0 and b > 0:  # (an empty range 0 .. 0 when there are fewer segments than ranges)
             ksfl[0] = fl[0]
         return nsing, maxk, maxks, box, gaps[:ngap], endv, fl
+
+    def blocks(a: int, b: int, box: np.ndarray, endv: np.ndarray, fl: np.ndarray,
+               gaps: np.ndarray, scratch: int) -> tuple[int, float, float, np.ndarray,
+                                                        np.ndarray, np.ndarray, np.ndarray]:
+        """run() of a range in blocks of STREAM_BLOCK segments (sums_only): each block's
+        jumps and energies in the block's own rows, folded into the leaf sums after its pass.
+        Every output is what one pass over the range gives (each block re-runs its lead-in
+        segment, as a range does: the same values; maxima, counts and boxes combine
+        exactly)."""
+        assert forms is not None
+        nb = max(min(STREAM_BLOCK, b - a), 1)
+        kb = np.empty((nb + 1, 3))
+        eb = np.empty((nb + 1, 2))
+        bufs = np.empty((3, 2, _kp.LEAF))
+        ints = np.zeros((3, 3), dtype=np.int64)
+        fe = np.array([a, a, max(a, 1) - 1], dtype=np.int64)  # first element of each tree
+        ints[:2, 2] = max(int(np.searchsorted(lbe, a, side="right")) - 1, 0)
+        ints[2, 2] = max(int(np.searchsorted(lbs, fe[2], side="right")) - 1, 0)
+        mx = np.full(2, -np.inf)
+        nsing, maxk, maxks = 0, 0.0, 0.0
+        bx = np.empty((2, dim))
+        found: list[np.ndarray] = []
+        s0 = a
+        while True:
+            s1 = min(s0 + STREAM_BLOCK, b)
+            off = s0 - 1 if s0 > 0 else 0
+            rows = forms.rows(off, max(s1, off + 1))
+            while True:
+                ns, mk, mks, ngap = _k.pass_kernel(
+                    rows, hc, plan.x, plan.tab, plan.w7, plan.w4, plan.P, fall, fits, nfit,
+                    subs, SPEED_RTOL, CROSS_RTOL, kap, dks, kb, eb, quad, bx, ell, pos, gaps,
+                    unit, s0, s1, scratch, first, endv, fl, off, s0, nb)
+                if ngap <= gaps.shape[0]:
+                    break
+                gaps = np.empty((ngap, 3), dtype=np.int64)  # rare: too small; redo the block
+            _kp.fold_block(kb, eb, s1 - s0, s0, lbe, lbs, ls2, ls3, lss, bufs, ints, fe, mx)
+            nsing += ns
+            maxk = max(maxk, mk)
+            maxks = max(maxks, mks)
+            if s0 == a:
+                box[:] = bx
+            else:
+                np.minimum(box[0], bx[0], out=box[0])
+                np.maximum(box[1], bx[1], out=box[1])
+            found.append(gaps[:ngap].copy())
+            s0 = s1
+            if s0 >= b:
+                break
+        if a == 0 and b > 0:
+            ksfl[0] = fl[0]
+        folds[(a, b)] = (bufs, ints, fe, mx)  # (ranges may be empty: a == b)
+        return nsing, maxk, maxks, box, np.concatenate(found), endv, fl
 
     parts = _threads.ranges(run, 0, m, _threads.THREADS, PAR_MIN)
     nsing = sum(r[0] for r in parts)
@@ -396,7 +472,12 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
                     np.max([r[3][1] for r in parts], axis=0)])
     gaps = parts[0][4] if len(parts) == 1 else np.concatenate([r[4] for r in parts])
     ngap = gaps.shape[0]
-    kap, dks, knots, energies, quad = kap[:m], dks[:m], knots[:m], energies[:m], quad[:m]
+    sums = None
+    if stream:
+        sums = _stream_sums(folds, lbe, lbs, ls2, ls3, lss, m)
+    else:
+        knots, energies = knots[:m], energies[:m]
+    kap, dks, quad = kap[:m], dks[:m], quad[:m]
     ell, pos = ell[:m], pos[:m]
     if closed:
         ksfl[1] = parts[-1][6][1]
@@ -439,7 +520,41 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
                    n_singular=int(nsing), max_kappa=float(maxk),
                    max_dkds=float(maxks), knots=knots, energies=energies,
                    diagonal=float(np.sqrt(np.sum((box[1] - box[0]) ** 2))), ell=ell,
-                   pos=pos, extra=(extra[0], extra[1]), unit=unit)
+                   pos=pos, extra=(extra[0], extra[1]), unit=unit, sums=sums)
+
+
+def _stream_sums(folds: dict[tuple[int, int], tuple[np.ndarray, ...]], lbe: np.ndarray,
+                 lbs: np.ndarray, ls2: FloatArray, ls3: FloatArray, lss: FloatArray, m: int
+                 ) -> tuple[float, float, float, float, float]:
+    """The figures of :func:`sample_curve`'s ``sums_only`` pass from the ranges' fold states
+    (:func:`curvefair._kernels.pairwise.fold_block`): the leaves split between ranges summed
+    from their parts in order (an earlier range's unfinished values, then the heads of the
+    ranges after it, up to the one in which the leaf ends), then each tree combined in
+    numpy's order."""
+    trees = ((lbe, ls2), (lbe, ls3), (lbs, lss))
+    for t, (lb, ls) in enumerate(trees):
+        part: list[FloatArray] = []
+        got = 0
+        leaf = -1
+        for a in sorted(folds):
+            bufs, ints, _, _ = folds[a]
+            nh, nc, cur = int(ints[t, 0]), int(ints[t, 1]), int(ints[t, 2])
+            if nh:
+                part.append(bufs[t, 0, :nh])
+                got += nh
+            if leaf >= 0 and got == lb[leaf + 1] - lb[leaf]:  # the split leaf is whole
+                vals = np.concatenate(part)
+                ls[leaf] = _kp.pw_sum_long(vals, vals.shape[0])
+                part, got, leaf = [], 0, -1
+            if nc:  # this range's last leaf is unfinished: its values so far
+                assert leaf < 0
+                part, got, leaf = [bufs[t, 1, :nc]], nc, cur
+        assert leaf < 0, "a leaf left unfinished after the last range"
+    mx = np.array([f[3] for f in folds.values()])
+    top = mx.max(axis=0)  # (NaN propagates, as np.max)
+    n = m - 1
+    return (float(_kp.tree_sum(ls2, m)), float(_kp.tree_sum(ls3, m)),
+            float(_kp.tree_sum(lss, n)), float(top[0]), float(top[1]))
 
 
 def _unit(cw: FloatArray) -> float:

@@ -1,0 +1,106 @@
+"""numpy's pairwise summation streamed by leaves (curvefair._kernels.pairwise), and the summary
+analysis that sums its jumps and energies block by block instead of keeping them per segment
+(``sample_curve(..., sums_only=True)``): the same bits as ``np.sum`` / ``np.max`` of the
+arrays, whatever the blocks and the threads' ranges."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import curvefair as cf
+from curvefair import _threads
+from curvefair._kernels import pairwise as kp
+from curvefair.analysis import _sampling, fairness_figures
+
+SIZES = [*range(0, 300), 511, 512, 513, 1023, 1024, 1025, 4097, 65_537, 100_003, 1_000_001]
+
+
+def test_leaves_and_tree_sum_are_numpys_sum():
+    # the leaves' sums (each by pw_sum over its own values) combined by tree_sum give
+    # np.sum's bits, for contiguous arrays and strided columns, values over 16 decades
+    rng = np.random.default_rng(0)
+    for n in SIZES:
+        v2 = rng.normal(size=(n, 2)) * 10.0 ** rng.uniform(-8, 8, (n, 2))
+        for v in (v2[:, 0], np.ascontiguousarray(v2[:, 1])):
+            lb = kp.leaf_bounds(n)
+            assert lb[0] == 0 and lb[-1] == n
+            assert np.all(np.diff(lb) >= 1) and np.all(np.diff(lb) <= kp.LEAF)
+            ls = np.array([kp.pw_sum(np.ascontiguousarray(v[a:b]), b - a)
+                           for a, b in zip(lb[:-1], lb[1:], strict=True)])
+            assert kp.tree_sum(ls, n) == np.sum(v)
+            assert kp.pw_sum_long(np.ascontiguousarray(v), n) == np.sum(v)
+
+
+def test_tree_sum_is_not_a_plain_sum():
+    # the check above can fail: a sequential sum of the same values differs from numpy's
+    rng = np.random.default_rng(1)
+    v = rng.normal(size=10_000) * 10.0 ** rng.uniform(-8, 8, 10_000)
+    seq = 0.0
+    for x in v:
+        seq += x
+    assert seq != np.sum(v)
+
+
+def _figures(a: cf.Analysis) -> dict:
+    return {"energy2": a.energy2, "energy3": a.energy3, "max_jump": a.max_jump or 0.0,
+            "max_top_jump": a.max_top_jump, "sapidis_sum": a.sapidis_sum,
+            "dkds_energy": a.dkds_energy, "inflections": a.inflections, "extrema": a.extrema}
+
+
+@pytest.mark.parametrize("block,par_min", [(65_536, 50_000), (7, 4), (100, 4), (129, 300),
+                                           (1000, 300)])
+def test_streamed_summary_is_the_full_analysis(monkeypatch, block, par_min):
+    # open planar cubic, quintic and B-spline curves whose segment forms are made range by
+    # range: fairness_figures sums the jumps and energies by blocks (counted) and gives
+    # analyze()'s figures bit for bit, on one thread and on two (tiny ranges and blocks:
+    # leaves split between blocks and between ranges, ranges inside one leaf)
+    calls = []
+    real = _sampling._stream_sums
+    monkeypatch.setattr(_sampling, "_stream_sums", lambda *a: calls.append(1) or real(*a))
+    monkeypatch.setattr(_sampling, "STREAM_BLOCK", block)
+    monkeypatch.setattr(_sampling, "PAR_MIN", par_min)
+    rng = np.random.default_rng(block + par_min)
+    sizes = (4, 5, 9, 130, 131, 257, 1000, 3000) if block < 1000 else (4, 9, 257, 3000, 70_001)
+    cases = 0
+    for threads in (1, 2):
+        monkeypatch.setattr(_threads, "THREADS", threads)
+        for n in sizes:
+            x = np.linspace(0, 30, n)
+            P = np.c_[x, np.sin(x)] + 1e-3 * rng.normal(size=(n, 2))
+            curves = [cf.interpolate_cubic(P), cf.interpolate_bspline(P)]
+            if n <= 3000:
+                curves.append(cf.interpolate_quintic(P))
+            for c in curves:
+                ref = _figures(cf.analyze(c))
+                got = fairness_figures(c)
+                assert "piecewise" not in c.__dict__  # (both read the segment forms)
+                for key, val in ref.items():
+                    assert got[key] == val, (n, type(c).__name__, key)
+                cases += 1
+    assert len(calls) == cases
+
+
+def test_streamed_summary_keeps_nan_and_closed_curves_are_not_streamed(monkeypatch):
+    # a closed curve's seam row is made after the pass: its summary keeps the arrays
+    calls = []
+    real = _sampling._stream_sums
+    monkeypatch.setattr(_sampling, "_stream_sums", lambda *a: calls.append(1) or real(*a))
+    a = np.linspace(0, 2 * np.pi, 200, endpoint=False)
+    c = cf.interpolate_cubic(np.c_[np.cos(a), 0.5 * np.sin(a)], "chord", "periodic")
+    ref = _figures(cf.analyze(c))
+    got = fairness_figures(c)
+    assert not calls
+    assert all(got[k] == v for k, v in ref.items())
+    # the block fold's maxima: NaN sticks wherever it comes (np.max's rule)
+    kb = np.array([[1.0, 2.0, 0.0], [np.nan, 1.0, 0.0], [3.0, np.nan, 0.0], [5.0, 7.0, 0.0]])
+    eb = np.zeros((4, 2))
+    lb = kp.leaf_bounds(4)
+    ls = np.empty(1)
+    for start in (0, 1):
+        bufs = np.empty((3, 2, kp.LEAF))
+        ints = np.zeros((3, 3), dtype=np.int64)
+        mx = np.full(2, -np.inf)
+        kp.fold_block(kb[start:], eb[start:], 4 - start, start, lb, kp.leaf_bounds(3), ls,
+                      ls.copy(), ls.copy(), bufs, ints, np.zeros(3, dtype=np.int64), mx)
+        assert np.isnan(mx).all()
