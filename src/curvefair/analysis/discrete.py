@@ -191,28 +191,30 @@ def second_curvature_values(ctrl: FloatArray, lw: FloatArray, mw: FloatArray,
     """``K_i`` of eq. (3) for control points ``ctrl`` (n, dim); open ends are 0 (see
     :func:`second_discrete_curvature`)."""
     n = ctrl.shape[0]
+    k = np.zeros(n)
     if closed:
         idx = np.arange(n)
+        prev, cur, nxt = ctrl[(idx - 1) % n], ctrl, ctrl[(idx + 1) % n]
+        lwi, mwi, ki, i0 = lw, mw, k, 0
     else:
-        idx = np.arange(1, n - 1)
-    prev = ctrl[(idx - 1) % n]
-    cur = ctrl[idx]
-    nxt = ctrl[(idx + 1) % n]
+        # interior points 1 .. n-2 as views (no index array, no gathered copies of the
+        # control points: 3.5x the coordinates' bytes less at a million points)
+        prev, cur, nxt = ctrl[:-2], ctrl[1:-1], ctrl[2:]
+        lwi, mwi, ki, i0 = lw[1:-1], mw[1:-1], k[1:-1], 1
     e0 = cur - prev
     e1 = nxt - cur
     area = 0.5 * _cross2(e0, e1)
-    w = lw[idx, None] * e0 + mw[idx, None] * e1
+    w = lwi[:, None] * e0 + mwi[:, None] * e1
     wn = np.linalg.norm(w, axis=1)
-    k = np.zeros(n)
     nz = area != 0.0
     bad = np.flatnonzero(nz & (wn == 0.0))
     if bad.size:
-        i = int(idx[bad[0]])
+        i = int(bad[0]) + i0
         raise InputError(
             f"curve: the second discrete curvature at control point {i} does not exist "
             "(a knot of multiplicity 3 makes a corner there)"
         )
-    k[idx[nz]] = area[nz] / wn[nz] ** 3
+    ki[nz] = area[nz] / wn[nz] ** 3
     return k
 
 
