@@ -373,12 +373,17 @@ def quintic_hermite_data(pts: FloatArray, t: FloatArray, left: Any, right: Any,
     else:
         r3l, r4l, r3r, r4r, r5 = _one_sided(h, delta, m0, s0)
         rp = np.arange(1, npt)
-    res: FloatArray = np.zeros((npt, 2, dim))  # f - K x0 per point: (-jump(r''''), jump(r'''))
+    # f - K x0 per point (-jump(r''''), jump(r''')), filled through an (npt, 2, dim) view of
+    # coordinate-major memory: the right-hand side (2 npt, dim) is then Fortran-ordered and
+    # LAPACK solves it in place (no copy of it beside the band)
+    res_t = np.zeros((dim, npt, 2))
+    res: FloatArray = res_t.transpose(1, 2, 0)
     res[: h.size, 0] -= r4l
     res[rp, 0] += r4r
     res[: h.size, 1] += r3l
     res[rp, 1] -= r3r
-    res = res.reshape(2 * npt, dim)
+    res = res_t.reshape(dim, 2 * npt).T
+    del res_t
     x0 = np.stack([m0, s0], axis=1).reshape(2 * npt, dim)
     # the one-sided derivatives, the first guess and the chords are in res and x0 now (r5 is
     # read by a not-a-knot end only): freed before the band (at 1e6 points the band and its
@@ -445,7 +450,11 @@ def quintic_hermite_data(pts: FloatArray, t: FloatArray, left: Any, right: Any,
                         c, vals, rhs = orig[src]
                         _set_row(ab, F, lo, up, rows[w], c, vals,
                                  rhs + sign * vhat * dsc[rows[src]])
-            x = x0 + _solve(ab, lo, up, F) * dsc[:, None]
+            y = _solve(ab, lo, up, F)
+            del ab, F  # (the band, before the correction is scaled and added)
+            y *= dsc[:, None]
+            x = x0
+            x += y  # x0 + dx in place: the same sums
     return x[0::2] / hbar, x[1::2] / hbar**2
 
 
