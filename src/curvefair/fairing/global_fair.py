@@ -564,9 +564,12 @@ def _global_fair(problem: FairingProblem, l: Any, gap: float) -> GlobalResult:  
 
     E0 = energy(d0)
     lam = np.zeros(n)
-    free = np.flatnonzero(mask)
-    if free.size == 0:
-        return GlobalResult(curve, E0, E0, lam, 0, "no_movable_point", free)
+    # (a count, not an index array of the free points: 8 bytes a point less through the
+    # Newton iteration)
+    n_free = int(np.count_nonzero(mask))
+    if n_free == 0:
+        return GlobalResult(curve, E0, E0, lam, 0, "no_movable_point",
+                            np.zeros(0, dtype=np.int64))
     if E0 <= 0.0:
         return GlobalResult(curve, E0, E0, lam, 0, "zero_energy", np.zeros(0, dtype=np.int64))
     if max_steps == 0:  # no iteration (not even the start or the unconstrained solve)
@@ -579,7 +582,7 @@ def _global_fair(problem: FairingProblem, l: Any, gap: float) -> GlobalResult:  
     eye = np.broadcast_to(np.eye(dim), (n, dim, dim))
 
     if tol is None:
-        if closed and n - free.size < 2:
+        if closed and n - n_free < 2:
             # every closed curve's energy falls to 0 as it shrinks: the limit is one point
             # (at most one control point held), and every figure of it is rounding noise
             raise InputError(
