@@ -141,7 +141,7 @@ def _fold_one(t, e, v, lb, ls, bufs, ints, first):
     ints[t, 1] = c
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def fold_block(kb, eb, count, s0, lbe, lbs, ls2, ls3, lss, bufs, ints, first, mx):
     """The figures a summary analysis keeps of one block of segments ``s0 .. s0 + count - 1``
     of an open curve, whose jumps and energies the sampling pass wrote to the block's own

@@ -391,6 +391,8 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
         fl = np.zeros(2)
         gaps = np.empty((max(1 << 12, (b - a) // 4), 3), dtype=np.int64)
         scratch = m + starts.get(a, 0)
+        if stream:  # (each block makes its own rows)
+            return blocks(a, b, box, endv, fl, gaps, scratch)
         if forms is None:
             rows, off = cwc, 0
         else:  # the range's own rows, its lead-in segment first
@@ -398,8 +400,6 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
             # (an empty range still reads the row of its first segment for the box's start,
             # as it does in the whole form)
             rows = forms.rows(off, max(b, off + 1))
-        if stream:
-            return blocks(a, b, box, endv, fl, gaps, scratch)
         while True:
             nsing, maxk, maxks, ngap = _k.pass_kernel(
                 rows, hc, plan.x, plan.tab, plan.w7, plan.w4, plan.P, fall, fits, nfit, subs,
