@@ -553,7 +553,7 @@ def _loop_args(curve: BSplineCurve, kd: _KnotData, d: FloatArray, orig: FloatArr
     ctrl = np.ascontiguousarray(kd.ctrl)
     # one-point: the moved basis function a (of j-p-1 .. j; _one_point_index) and the sum of
     # the jump coefficients of its control point (a closed curve's wrapped copies add up)
-    # (int16: 8 bytes a knot less than int64 at the loop's peak; a1 <= p + 1)
+    # (int16: 6 bytes a knot less than int64 at the loop's peak; a1 <= p + 1)
     if p % 2 == 1:
         a1 = np.full(nk, p + 1 - (p + 1) // 2, dtype=np.int16)
     else:
