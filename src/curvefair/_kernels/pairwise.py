@@ -121,24 +121,34 @@ def tree_sum(ls, n):
     return 0.0 + _tree(ls, k, n)
 
 
-@njit(cache=True, inline="always")
-def _fold_one(t, e, v, lb, ls, bufs, ints, first):
-    """Value ``v`` of element ``e`` into tree ``t``'s state (see :func:`fold_block`)."""
-    L = ints[t, 2]
-    while lb[L + 1] <= e:
-        L += 1
-    ints[t, 2] = L
-    if lb[L] < first[t]:  # the leaf began before this range: its head, finished later
-        bufs[t, 0, ints[t, 0]] = v
-        ints[t, 0] += 1
-        return
-    c = ints[t, 1]
-    bufs[t, 1, c] = v
-    c += 1
-    if e == lb[L + 1] - 1:  # the leaf is complete
-        ls[L] = pw_sum(bufs[t, 1], c)
-        c = 0
-    ints[t, 1] = c
+@njit(cache=True, nogil=True)
+def _fold_tree(v, n, e0, lb, ls, head, cur, st, first):
+    """Values ``v[:n]`` of elements ``e0 .. e0 + n - 1`` into one tree's state (see
+    :func:`fold_block`): ``head``/``cur`` the two value buffers, ``st = (head count, current
+    count, current leaf)`` (kept in locals through the loop), ``first`` the range's first
+    element."""
+    nh = st[0]
+    nc = st[1]
+    L = st[2]
+    end = lb[L + 1]
+    for r in range(n):
+        e = e0 + r
+        while end <= e:
+            L += 1
+            end = lb[L + 1]
+        x = v[r]
+        if lb[L] < first:  # the leaf began before this range: its head, finished later
+            head[nh] = x
+            nh += 1
+        else:
+            cur[nc] = x
+            nc += 1
+            if e == end - 1:  # the leaf is complete
+                ls[L] = pw_sum(cur, nc)
+                nc = 0
+    st[0] = nh
+    st[1] = nc
+    st[2] = L
 
 
 @njit(cache=True, nogil=True)
@@ -156,13 +166,16 @@ def fold_block(kb, eb, count, s0, lbe, lbs, ls2, ls3, lss, bufs, ints, first, mx
     leaf; ``ints[t] = (head count, current count, current leaf)``; ``first[t]`` the range's
     first element of tree ``t``. A leaf split between ranges is summed afterwards from the
     earlier range's unfinished values and the later one's head."""
-    for r in range(count):
-        i = s0 + r
-        _fold_one(0, i, eb[r, 0], lbe, ls2, bufs, ints, first)
-        _fold_one(1, i, eb[r, 1], lbe, ls3, bufs, ints, first)
-        if i >= 1:
-            _fold_one(2, i - 1, kb[r, 2], lbs, lss, bufs, ints, first)
-            for q in range(2):
-                v = kb[r, q]
-                if not (v <= mx[q]) and mx[q] == mx[q]:
-                    mx[q] = v
+    _fold_tree(eb[:, 0], count, s0, lbe, ls2, bufs[0, 0], bufs[0, 1], ints[0], first[0])
+    _fold_tree(eb[:, 1], count, s0, lbe, ls3, bufs[1, 0], bufs[1, 1], ints[1], first[1])
+    r0 = 1 if s0 == 0 else 0  # (segment 0 has no interior breakpoint)
+    if count > r0:
+        _fold_tree(kb[r0:, 2], count - r0, s0 + r0 - 1, lbs, lss, bufs[2, 0], bufs[2, 1],
+                   ints[2], first[2])
+    for q in range(2):
+        m = mx[q]
+        for r in range(r0, count):
+            v = kb[r, q]
+            if not (v <= m) and m == m:
+                m = v
+        mx[q] = m
