@@ -59,6 +59,7 @@ COMPILED_FILES = frozenset({
     "test_io_text_layout.py",
     "test_reader_scans.py",
     "test_hermite_delta_deviation.py",
+    "test_pairwise_sums.py",
 })
 
 #: test files whose tests each take more than ~20 s (marked ``slow``); measured with
