@@ -119,7 +119,6 @@ def ranges_start(fn: Callable[[int, int], Any], lo: int, hi: int, threads: int,
             except BaseException as exc:  # re-raised by the calling thread
                 state["error"] = exc
             finally:
-                f = None
                 if worker:
                     with lock:
                         state["pending"] -= 1

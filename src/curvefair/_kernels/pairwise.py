@@ -21,13 +21,20 @@ from .._jit import njit
 LEAF = 128  # numpy's PW_BLOCKSIZE
 
 
+@njit(cache=True, inline="always")
+def _half(n):
+    """The size of the left half of numpy's pairwise recursion over ``n > 128`` values: half,
+    rounded down to a multiple of 8 (its unroll factor)."""
+    n2 = n // 2
+    return n2 - n2 % 8
+
+
 @njit(cache=True)
 def pw_sum_long(v, m):
     """numpy's pairwise summation above 128 values (recursive halves, multiples of 8)."""
     if m <= LEAF:
         return pw_sum(v, m)
-    m2 = m // 2
-    m2 -= m2 % 8
+    m2 = _half(m)
     return pw_sum_long(v[:m2], m2) + pw_sum_long(v[m2:], m - m2)
 
 
@@ -73,7 +80,6 @@ def leaf_bounds(n):
     out = np.empty(cap + 1, dtype=np.int64)
     stack_lo = np.empty(128, dtype=np.int64)
     stack_n = np.empty(128, dtype=np.int64)
-    top = 0
     stack_lo[0] = 0
     stack_n[0] = n
     top = 1
@@ -86,8 +92,7 @@ def leaf_bounds(n):
             out[k] = lo
             k += 1
             continue
-        c2 = c // 2
-        c2 -= c2 % 8
+        c2 = _half(c)
         stack_lo[top] = lo + c2  # right half below the left one
         stack_n[top] = c - c2
         stack_lo[top + 1] = lo
@@ -105,8 +110,7 @@ def _tree(ls, k, n):
         v = ls[k[0]]
         k[0] += 1
         return v
-    n2 = n // 2
-    n2 -= n2 % 8
+    n2 = _half(n)
     a = _tree(ls, k, n2)
     return a + _tree(ls, k, n - n2)
 

@@ -359,8 +359,7 @@ def _analyze(c: PiecewiseCurve, rtol: float, summary: bool, whole: bool = False
     keep = (lambda a: a) if summary else _ro
     sums = smp.sums  # (a summary of an open planar curve: summed in the pass, see there)
     if sums is not None:
-        e2, e3 = sums[0], sums[1]
-        jumps = top = np.zeros(0)
+        e2, e3, sap, max_jump, max_top = sums
     elif cw is coeffs or cw is forms:
         # exact energies and jumps from the same compiled pass
         e2 = float(np.sum(smp.energies[:, 0]))
@@ -372,9 +371,8 @@ def _analyze(c: PiecewiseCurve, rtol: float, summary: bool, whole: bool = False
         e3 = float(np.sum(segment_energies(c, 3))) if degree >= 3 else 0.0
         jumps = derivative_jumps(c, 3)[1]
         top = derivative_jumps(c, degree)[1]
-    max_top = float(top.max()) if top.size else 0.0
-    if sums is not None:
-        max_top = sums[4]
+    if sums is None:
+        max_top = float(top.max()) if top.size else 0.0
 
     kap, dks = smp.kappa, smp.dkds
     max_k, max_ks = smp.max_kappa, smp.max_dkds
@@ -402,9 +400,7 @@ def _analyze(c: PiecewiseCurve, rtol: float, summary: bool, whole: bool = False
         # the sum of the column where the pass wrote it: numpy's pairwise summation runs
         # over a strided column as over analyze()'s frozen contiguous copy (the same bits,
         # tested on 60,000 segments), without a copy at the analysis' peak
-        if sums is not None:
-            max_jump, sap = sums[3], sums[2]
-        else:
+        if sums is None:
             max_jump = float(jumps.max()) if jumps.size else 0.0
             sap = float(np.sum(smp.knots[ks, 2]))
         return {"energy2": e2, "energy3": e3, "max_jump": max_jump, "max_top_jump": max_top,
