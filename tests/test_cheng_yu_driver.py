@@ -240,6 +240,10 @@ def test_registered_and_runs_through_fair():
     np.testing.assert_array_equal(res.curve.control_points, direct.curve.control_points)
     closed = fair(noisy_closed(12), "cheng-yu", tol=0.02)  # clamp ignored on closed curves
     assert closed.report["steps"] > 0
+    # the report's counts are the lengths of the public per-point lists
+    for r, before in ((res, c0), (closed, noisy_closed(12))):
+        assert r.report["bad_points_before"] == len(bad_points(before)) > 0
+        assert r.report["bad_points_after"] == len(bad_points(r.curve))
 
 
 @pytest.mark.parametrize("closed", [False, True])

@@ -20,6 +20,7 @@ from curvefair import (
     interpolate_bspline,
     second_discrete_curvature,
 )
+from curvefair.analysis.discrete import bad_point_count
 
 
 def random_open(rng, n=10, dim=2, uniform=False):
@@ -238,6 +239,7 @@ def test_bad_points_against_slow_reference(seed, closed):
     np.testing.assert_allclose([b.value for b in got], [r[2] for r in ref], rtol=1e-12)
     assert all(b.kind == b.kinds[0] for b in got)
     assert all(got[j].value >= got[j + 1].value for j in range(len(got) - 1))
+    assert bad_point_count(c) == len(ref)
 
 
 def test_bad_point_kinds_on_constructed_curves():

@@ -446,9 +446,17 @@ def bad_points(curve: Any) -> list[BadPoint]:
     idx = np.flatnonzero(flags.any(axis=0))
     z = sdc.second_difference[idx] ** 2
     order = np.lexsort((idx, -z))
-    out = []
-    for j in order:
-        i = int(idx[j])
-        kinds = tuple(int(k) + 1 for k in np.flatnonzero(flags[:, i]))
-        out.append(BadPoint(index=i, kind=kinds[0], value=float(z[j]), kinds=kinds))
-    return out
+    idx, z = idx[order], z[order]
+    # the kinds of a point as a 3-bit code (bit k-1: kind k), one tuple per code
+    code = flags[0, idx] + 2 * flags[1, idx].astype(np.int8) + 4 * flags[2, idx].astype(np.int8)
+    table = [tuple(k + 1 for k in range(3) if c >> k & 1) for c in range(8)]
+    return [BadPoint(index=i, kind=table[c][0], value=v, kinds=table[c])
+            for i, c, v in zip(idx.tolist(), code.tolist(), z.tolist(), strict=True)]
+
+
+def bad_point_count(curve: Any) -> int:
+    """The number of bad control points of a cubic B-spline: ``len(bad_points(curve))``
+    without a Python object per point (what a fairing report states)."""
+    sdc = second_discrete_curvature(curve)
+    flags = bad_point_kinds(sdc.K, sdc.first_difference, sdc.weights, sdc.valid, sdc.closed)
+    return int(np.count_nonzero(flags.any(axis=0)))

@@ -23,6 +23,7 @@ from .._kernels import cheng_yu as _k
 from .._typing import FloatArray
 from .._validate import as_nonnegative, as_step_count
 from ..analysis.discrete import (
+    bad_point_count,
     check_cubic_bspline,
     corner_cut_ratios,
     second_discrete_curvature,
@@ -351,7 +352,6 @@ def solve(problem: FairingProblem, *, pair: bool = True, relative: bool = True) 
     ``eps`` is relative to the input's fairing indicator ``x = sum D_i**2`` (default ``1e-8``);
     ``relative=False`` makes it an absolute threshold on ``z_i = D_i**2`` (default 0).
     """
-    from ..analysis.discrete import bad_points
     from .problem import FairingHistory, Outcome
 
     res = _solve(problem, pair=bool(pair), relative=bool(relative))
@@ -362,8 +362,8 @@ def solve(problem: FairingProblem, *, pair: bool = True, relative: bool = True) 
         "indicator_before": res.indicator_before,
         "indicator_after": res.indicator_after,
         "pair_steps": int(np.sum(h["n_moved"] == 2)),
-        "bad_points_before": len(bad_points(problem.curve)),
-        "bad_points_after": len(bad_points(res.curve)),
+        "bad_points_before": bad_point_count(problem.curve),
+        "bad_points_after": bad_point_count(res.curve),
     }
     epsv = (1e-8 if relative else 0.0) if problem.eps is None else problem.eps
     n = problem.curve.n_ctrl  # type: ignore[attr-defined]
