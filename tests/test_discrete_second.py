@@ -20,7 +20,7 @@ from curvefair import (
     interpolate_bspline,
     second_discrete_curvature,
 )
-from curvefair.analysis.discrete import bad_point_count
+from curvefair.analysis.discrete import bad_point_count, fairing_indicator
 
 
 def random_open(rng, n=10, dim=2, uniform=False):
@@ -280,3 +280,27 @@ def test_bad_input():
     P = np.array([[0, 0], [1, 0], [2, 0], [3, 0], [3, 1], [3, 2], [3, 3.0]])
     with pytest.raises(InputError, match="multiplicity 3"):
         second_discrete_curvature(BSplineCurve(P, knots, 3))
+    with pytest.raises(InputError, match="control point 3 does not exist"):
+        bad_point_count(BSplineCurve(P, knots, 3))
+    with pytest.raises(InputError, match="control point 3 does not exist"):
+        fairing_indicator(BSplineCurve(P, knots, 3))
+
+
+@pytest.mark.parametrize("block", [1, 2, 3, 7, 65_536])
+def test_counts_and_indicator_in_blocks_are_the_whole_curves(monkeypatch, block):
+    # an open curve is counted block by block (each point's kinds depend on control points
+    # i-2 .. i+2 only): every block size gives the length of bad_points(), whose list is
+    # checked against the slow one-index-at-a-time reference above
+    from curvefair.analysis import discrete
+
+    monkeypatch.setattr(discrete, "COUNT_BLOCK", block)
+    rng = np.random.default_rng(block)
+    curves = [random_open(rng, n, dim) for n in (4, 5, 6, 9, 17, 40) for dim in (2, 3)]
+    x = np.linspace(0, 60, 3000)
+    noisy = np.c_[x, np.sin(x)] + 0.01 * rng.normal(size=(3000, 2))
+    curves += [interpolate_bspline(noisy), random_closed(rng, 30), random_closed(rng, 7, 3)]
+    for c in curves:
+        assert bad_point_count(c) == len(bad_points(c))
+        # the indicator summed from blocks: the same bits as from the whole arrays
+        assert fairing_indicator(c) == second_discrete_curvature(c).indicator
+    assert bad_point_count(curves[-3]) > 500

@@ -12,6 +12,7 @@ curve lives on ``[u_3, u_{n+1}]``).
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any
 
@@ -454,9 +455,71 @@ def bad_points(curve: Any) -> list[BadPoint]:
             for i, c, v in zip(idx.tolist(), code.tolist(), z.tolist(), strict=True)]
 
 
+#: control points per block of :func:`bad_point_count` and :func:`fairing_indicator` on open
+#: curves
+COUNT_BLOCK = 65_536
+
+
+def _open_blocks(curve: Any) -> Iterator[tuple[FloatArray, FloatArray]]:
+    """``(K, t)`` of an open cubic B-spline block by block, for the points ``a .. b-1`` of each
+    block of the valid range ``2 .. n-3`` with one point either side (``K`` and ``t`` of the
+    points ``a-1 .. b``): the kinds and ``D_i`` of point ``i`` depend on control points
+    ``i-2 .. i+2`` only, and each value is computed elementwise by the same functions as for the
+    whole curve (the same bits). A corner raises the whole curve's error (naming the control
+    point)."""
+    n = curve.n_ctrl
+    ctrl = np.asarray(curve.control_points, dtype=float)
+    lw, mw = corner_cut_ratios(np.asarray(curve.knots, dtype=float), n, False)
+    try:
+        for a in range(2, n - 2, COUNT_BLOCK):
+            b = min(a + COUNT_BLOCK, n - 2)
+            # the interior of control points a-2 .. b+1: points a-1 .. b
+            K = second_curvature_values(ctrl[a - 2:b + 2], lw[a - 2:b + 2], mw[a - 2:b + 2],
+                                        False)[1:-1]
+            yield K, _difference_weights(ctrl[a - 2:b + 2], False)[1:-1]
+    except InputError:  # a corner: the whole curve's message (with the control point)
+        second_discrete_curvature(curve)
+        raise
+
+
 def bad_point_count(curve: Any) -> int:
     """The number of bad control points of a cubic B-spline: ``len(bad_points(curve))``
-    without a Python object per point (what a fairing report states)."""
-    sdc = second_discrete_curvature(curve)
-    flags = bad_point_kinds(sdc.K, sdc.first_difference, sdc.weights, sdc.valid, sdc.closed)
-    return int(np.count_nonzero(flags.any(axis=0)))
+    without a Python object per point (what a fairing report states). An open curve is counted
+    block by block (the temporaries of one block instead of several times the coordinates'
+    bytes), a closed one on the whole curve."""
+    curve = check_cubic_bspline(curve, "bad_point_count")
+    if curve.closed or curve.n_ctrl < 5:
+        sdc = second_discrete_curvature(curve)
+        flags = bad_point_kinds(sdc.K, sdc.first_difference, sdc.weights, sdc.valid, True)
+        return int(np.count_nonzero(flags.any(axis=0)))
+    count = 0
+    for K, t in _open_blocks(curve):
+        dK = np.zeros_like(K)
+        dK[1:] = np.diff(K)
+        valid = np.ones(K.shape[0], dtype=bool)
+        valid[0] = valid[-1] = False
+        flags = bad_point_kinds(K, dK, t, valid, False)
+        count += int(np.count_nonzero(flags.any(axis=0)))
+    return count
+
+
+def fairing_indicator(curve: Any) -> float:
+    """Cheng & Yu's fairing indicator ``x = sum D_i**2`` of a cubic B-spline: bit for bit
+    ``second_discrete_curvature(curve).indicator``, without its per-point arrays. An open
+    curve's ``D_i**2`` are written block by block into one array, summed as that attribute
+    sums them (numpy's pairwise sum of the same values in the same order)."""
+    curve = check_cubic_bspline(curve, "fairing_indicator")
+    if curve.closed or curve.n_ctrl < 5:  # (no block: the whole curve's checks)
+        return second_discrete_curvature(curve).indicator
+    n = curve.n_ctrl
+    z = np.empty(max(n - 4, 0))
+    j = 0
+    for K, t in _open_blocks(curve):
+        m = K.shape[0] - 2
+        D = z[j:j + m]
+        np.multiply(t[1:-1], K[:-2], out=D)
+        D += (1.0 - t[1:-1]) * K[2:]
+        D -= K[1:-1]
+        np.multiply(D, D, out=D)
+        j += m
+    return float(np.sum(z))

@@ -26,7 +26,7 @@ from ..analysis.discrete import (
     bad_point_count,
     check_cubic_bspline,
     corner_cut_ratios,
-    second_discrete_curvature,
+    fairing_indicator,
 )
 from ..errors import InputError
 from .stop import StopReason
@@ -306,7 +306,9 @@ def _solve(problem: FairingProblem, *, pair: bool, relative: bool) -> CYResult:
     e = problem.tol
     max_steps = as_step_count(problem.max_steps, default=100 * n)
     mask = problem.movable
-    sdc = second_discrete_curvature(curve)  # validates (raises at a true corner)
+    # validates (raises at a true corner); the indicator alone (second_discrete_curvature's
+    # per-point arrays are 2.5x the coordinates' bytes, its temporaries more)
+    x0 = fairing_indicator(curve)
     knots = np.asarray(curve.knots, dtype=float)
     lw, mw = corner_cut_ratios(knots, n, closed)
     corner = np.flatnonzero((lw == 0.0) & (mw == 0.0))
@@ -315,9 +317,9 @@ def _solve(problem: FairingProblem, *, pair: bool, relative: bool) -> CYResult:
     for i in corner:  # K_i undefined once Q_{i-1}, Q_i, Q_{i+1} stop being collinear
         mask[np.arange(i - 1, i + 2) % n] = False
     Q = np.array(curve.control_points, dtype=float, order="C")
-    Q0 = Q.copy()
+    # the original points: the input curve's own (read-only, never written), no copy
+    Q0 = np.ascontiguousarray(curve.control_points, dtype=float)
     W = np.ascontiguousarray(curve.gram_band(2), dtype=float)
-    x0 = sdc.indicator
     if relative:
         _, eps_abs = eps_threshold(problem.eps, x0, 1e-8)
     else:
@@ -330,8 +332,10 @@ def _solve(problem: FairingProblem, *, pair: bool, relative: bool) -> CYResult:
     steps, code, hist, moves = _k.cy_loop(Q, Q0, W, lw, mw, closed, planar, mask, e, eps_abs,
                                           int(max_steps), bool(pair), hist, moves)
     steps = int(steps)
-    out = curve.replace(control_points=Q)
-    x1 = second_discrete_curvature(out).indicator
+    del Q0, W, lw, mw, mask
+    out = curve.replace(control_points=Q)  # (a copy: Q is freed before the measure)
+    del Q
+    x1 = fairing_indicator(out)
     history = {
         "step": np.arange(steps + 1),
         "x": hist[: steps + 1].copy(),
