@@ -347,6 +347,10 @@ def _solve(ab: FloatArray, lo: int, up: int, rhs: FloatArray) -> FloatArray:
     return y
 
 
+#: segments per block of the one-sided derivatives in :func:`quintic_hermite_data`
+ONE_SIDED_BLOCK = 65_536
+
+
 def quintic_hermite_data(pts: FloatArray, t: FloatArray, left: Any, right: Any,
                           periodic: bool) -> tuple[FloatArray, FloatArray]:
     """First and second derivatives at ``t`` of the C4 quintic spline through ``pts``.
@@ -363,33 +367,46 @@ def quintic_hermite_data(pts: FloatArray, t: FloatArray, left: Any, right: Any,
     n, dim = pts.shape
     hbar = (t[-1] - t[0]) / (n - 1)  # solve in t / hbar: no over/underflow of h**-5
     h = np.diff(t) / hbar
-    delta = np.diff(pts, axis=0)
-    m0, s0 = _first_guess(h, delta, periodic)
-    npt = m0.shape[0]
-    if periodic:
-        r3l, r4l, r3r, r4r, _ = _one_sided(h, delta, np.vstack([m0, m0[:1]]),
-                                           np.vstack([s0, s0[:1]]))
-        rp = np.r_[1:npt, 0]
-    else:
-        r3l, r4l, r3r, r4r, r5 = _one_sided(h, delta, m0, s0)
-        rp = np.arange(1, npt)
+    nak_any = not periodic and (left == "not-a-knot" or right == "not-a-knot")
+
+    def first_guess() -> FloatArray:
+        """The first guess ``x0`` (``m``, ``s`` interleaved, shape ``(2 npt, dim)``)."""
+        m0, s0 = _first_guess(h, np.diff(pts, axis=0), periodic)
+        return np.stack([m0, s0], axis=1).reshape(2 * m0.shape[0], dim)
+
+    x0 = first_guess()
+    npt = x0.shape[0] // 2
+    M = 2 * npt
+    rp = np.r_[1:npt, 0] if periodic else np.arange(1, npt)
     # f - K x0 per point (-jump(r''''), jump(r''')), filled through an (npt, 2, dim) view of
     # coordinate-major memory: the right-hand side (2 npt, dim) is then Fortran-ordered and
-    # LAPACK solves it in place (no copy of it beside the band)
+    # LAPACK solves it in place (no copy of it beside the band). The one-sided derivatives are
+    # made for a block of segments at a time (elementwise: the same values; an entry's two
+    # terms added to 0 in either order give the same sum); r^(5) is kept for a not-a-knot end
+    # only
     res_t = np.zeros((dim, npt, 2))
     res: FloatArray = res_t.transpose(1, 2, 0)
-    res[: h.size, 0] -= r4l
-    res[rp, 0] += r4r
-    res[: h.size, 1] += r3l
-    res[rp, 1] -= r3r
+    m0, s0 = x0[0::2], x0[1::2]
+    if periodic:
+        m0, s0 = np.vstack([m0, m0[:1]]), np.vstack([s0, s0[:1]])
+    r5 = np.empty((h.size, dim)) if nak_any else None
+    for a in range(0, h.size, ONE_SIDED_BLOCK):
+        b = min(a + ONE_SIDED_BLOCK, h.size)
+        delta = pts[a + 1:b + 1] - pts[a:b]  # (np.diff's rows a .. b-1)
+        r3l, r4l, r3r, r4r, r5b = _one_sided(h[a:b], delta, m0[a:b + 1], s0[a:b + 1])
+        res[a:b, 0] -= r4l
+        res[rp[a:b], 0] += r4r
+        res[a:b, 1] += r3l
+        res[rp[a:b], 1] -= r3r
+        if r5 is not None:
+            r5[a:b] = r5b
+    del m0, s0, r3l, r4l, r3r, r4r, r5b, delta
     res = res_t.reshape(dim, 2 * npt).T
     del res_t
-    x0 = np.stack([m0, s0], axis=1).reshape(2 * npt, dim)
-    # the one-sided derivatives, the first guess and the chords are in res and x0 now (r5 is
-    # read by a not-a-knot end only): freed before the band (at 1e6 points the band and its
-    # solve ran beside 7 more arrays of the data's size)
-    del r3l, r4l, r3r, r4r, m0, s0, delta
-    M = 2 * npt
+    # the first guess is made again after the solve: only its end rows (read for given end
+    # derivatives) stay beside the band
+    x0_ends = {u: x0[u].copy() for u in (0, 1, M - 2, M - 1)}
+    del x0
     if periodic:
         dsc, ab = _banded(h, npt, npt - 1, 3, 3)
         # A = B + E Ks E^T, B: the open chain without the seam segment (SPD for npt >= 3),
@@ -402,7 +419,7 @@ def quintic_hermite_data(pts: FloatArray, t: FloatArray, left: Any, right: Any,
         y0, Z = Y[:, :dim], Y[:, dim:]
         # Woodbury: A^-1 f = y0 - Z (I + Ks E^T Z)^-1 Ks E^T y0
         y = y0 - Z @ np.linalg.solve(np.eye(4) + Ks @ Z[idx], Ks @ y0[idx])
-        x = x0 + y * dsc[:, None]
+        x = first_guess() + y * dsc[:, None]
         x = np.vstack([x, x[:2]])
     else:
         nak = (left == "not-a-knot", right == "not-a-knot")
@@ -413,12 +430,10 @@ def quintic_hermite_data(pts: FloatArray, t: FloatArray, left: Any, right: Any,
             if any(np.any(np.asarray(v) != 0) for _, v in [*left, *right]):
                 raise InputError("two points with r''' and r'''' given at both ends do not "
                                  "determine a quintic")
-            x = x0
+            x = first_guess()
         else:
             lo = 6 if nak[1] else 3
             up = 6 if nak[0] else 3
-            if not (nak[0] or nak[1]):
-                del r5
             dsc, ab = _banded(h, npt, npt - 1, lo, up)
             F = res  # scaled in place: the same products as res * dsc, no second array
             F *= dsc[:, None]
@@ -443,7 +458,7 @@ def quintic_hermite_data(pts: FloatArray, t: FloatArray, left: Any, right: Any,
                     if o in (1, 2):
                         u = 2 * pt + o - 1
                         _set_row(ab, F, lo, up, rows[w], np.array([u]), np.array([dsc[u]]),
-                                 vhat - x0[u])
+                                 vhat - x0_ends[u])
                     else:
                         src = 0 if o == 4 else 1
                         sign = (1.0 if o == 4 else -1.0) * (1.0 if side == 0 else -1.0)
@@ -453,7 +468,7 @@ def quintic_hermite_data(pts: FloatArray, t: FloatArray, left: Any, right: Any,
             y = _solve(ab, lo, up, F)
             del ab, F  # (the band, before the correction is scaled and added)
             y *= dsc[:, None]
-            x = x0
+            x = first_guess()
             x += y  # x0 + dx in place: the same sums
     return x[0::2] / hbar, x[1::2] / hbar**2
 

@@ -7,7 +7,25 @@ import numpy as np
 from .._typing import FloatArray
 from ..curves.hermite import CubicHermite, HermiteSpline, QuinticHermite
 
-__all__ = ["distinct_data", "full_data", "rebuild", "uniform_spacing"]
+__all__ = ["distinct_data", "distinct_derivatives", "distinct_points", "full_data", "rebuild",
+           "uniform_spacing"]
+
+
+def distinct_points(curve: HermiteSpline) -> tuple[FloatArray, FloatArray]:
+    """``(P, h)`` of :func:`distinct_data`: the distinct points (a fresh writable copy) and
+    the segment widths."""
+    pts = np.array(curve.points, dtype=np.float64)
+    h = np.diff(np.asarray(curve.params, dtype=np.float64))
+    if curve.closed:
+        pts = pts[:-1]
+    return np.ascontiguousarray(pts), np.ascontiguousarray(h)
+
+
+def distinct_derivatives(curve: HermiteSpline) -> list[FloatArray]:
+    """The derivative data of the distinct points, one ``(nd, dim)`` array per order: views of
+    the curve's own (read-only) arrays, no copy."""
+    ders = [np.asarray(d) for d in curve._derivs]
+    return [d[:-1] for d in ders] if curve.closed else ders
 
 
 def distinct_data(curve: HermiteSpline) -> tuple[FloatArray, FloatArray, FloatArray]:
@@ -16,14 +34,9 @@ def distinct_data(curve: HermiteSpline) -> tuple[FloatArray, FloatArray, FloatAr
     A closed curve drops its repeated last point; its segment widths include the closing one.
     Arrays are fresh writable copies.
     """
-    pts = np.array(curve.points, dtype=np.float64)
-    ders = [np.asarray(d) for d in curve._derivs]
-    h = np.diff(np.asarray(curve.params, dtype=np.float64))
-    if curve.closed:
-        pts = pts[:-1]
-        ders = [d[:-1] for d in ders]
-    D = np.ascontiguousarray(np.stack(ders, axis=1), dtype=np.float64)
-    return np.ascontiguousarray(pts), D, np.ascontiguousarray(h)
+    P, h = distinct_points(curve)
+    D = np.ascontiguousarray(np.stack(distinct_derivatives(curve), axis=1), dtype=np.float64)
+    return P, D, h
 
 
 def full_data(curve: HermiteSpline, P: FloatArray, D: FloatArray

@@ -119,7 +119,14 @@ from ..curves.interpolate import cubic_slopes, quintic_hermite_data
 from ..curves.piecewise import horner_rows
 from ..errors import InputError
 from .fair import MethodSpec, register_method
-from .hermite_data import distinct_data, full_data, rebuild, uniform_spacing
+from .hermite_data import (
+    distinct_data,
+    distinct_derivatives,
+    distinct_points,
+    full_data,
+    rebuild,
+    uniform_spacing,
+)
 from .problem import FairingHistory, FairingProblem, Outcome, eps_threshold
 from .stop import StopReason
 
@@ -304,9 +311,14 @@ def prepare(curve: HermiteSpline, *, method: str, tol: float | None, eps: float 
     code = _METHOD_CODE[method]
     mname, mcode = measure_code(measure, degree, method)
     spline = mode == "spline"
-    P, D, h = distinct_data(curve)
+    # spline mode replaces the derivative data by the re-interpolation's (step 1): the input's
+    # are read in place there, not copied beside the re-interpolation (2x the coordinates'
+    # bytes of a quintic at its peak)
+    P, h = distinct_points(curve)
+    D: FloatArray | None = None if spline else np.ascontiguousarray(
+        np.stack(distinct_derivatives(curve), axis=1), dtype=np.float64)
     nd, dim = P.shape
-    nb = D.shape[1]
+    nb = len(curve._derivs)
     closed = curve.closed
     if closed and nd < 3:
         raise InputError(f"method {method!r} needs at least 3 distinct points on a closed "
@@ -369,19 +381,22 @@ def prepare(curve: HermiteSpline, *, method: str, tol: float | None, eps: float 
     # -- step 1: (re-)interpolate (derivatives given by the end conditions stay bit-identical)
     if spline:
         D_new = spline_derivatives(curve, P, clamp, (g2_segment[0], g2_segment[1]))
-        D_new[fixed] = D[fixed]
+        ders = distinct_derivatives(curve)
+        for b in range(nb):
+            D_new[fixed[:, b], b] = ders[b][fixed[:, b]]
         # max |.| per derivative as max(max, -min) of each coordinate's column (exact, as the
         # reduction of |.| over axes (0, 2) is, without its temporaries of the data's size)
         change = 0.0
-        for b in range(D.shape[1]):
+        for b in range(nb):
             big = sml = 0.0
-            for c in range(D.shape[2]):
-                col, dif = D[:, b, c], D_new[:, b, c] - D[:, b, c]
+            for c in range(dim):
+                col, dif = ders[b][:, c], D_new[:, b, c] - ders[b][:, c]
                 big = max(big, float(col.max()), -float(col.min()))
                 sml = max(sml, float(dif.max()), -float(dif.min()))
             change = max(change, sml / (big + 1e-300))
         extra["input_reinterpolation_change"] = change
         D = D_new
+    assert D is not None
 
     # -- ranking and defaults
     meas, values, tv, ti, blocked, block_measure = _k.drive_setup(
