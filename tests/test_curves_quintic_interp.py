@@ -502,3 +502,50 @@ def test_band_solve_in_place_and_on_a_copy(own):
     np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12 * np.abs(want).max())
     # in place: _banded's band was factored (overwritten); a copy leaves the argument alone
     assert np.array_equal(band, before) != own
+
+
+def test_natural_and_periodic_ends_solve_by_banded_cholesky_else_lu(monkeypatch):
+    """r''' and r'''' given at both ends (natural ends; wang-quintic re-interpolates with the
+    input's own values) and the periodic chain are symmetric positive definite: solved by
+    LAPACK's banded Cholesky on the 4-row lower band. Every other end condition, or a failed
+    Cholesky, goes to the general band LU, which gives the same spline to rounding (the
+    exact-arithmetic comparison above checks the Cholesky path to 1e-13)."""
+    from curvefair.curves import interpolate as ip
+
+    spd: list[tuple[int, int]] = []
+    lu: list[tuple[int, int]] = []
+    real_spd, real_lu = ip._solve_spd, ip._solve
+
+    def spy_spd(ab, rhs):
+        spd.append(ab.shape)
+        return real_spd(ab, rhs)
+
+    def spy_lu(ab, lo, up, rhs):
+        lu.append(ab.shape)
+        return real_lu(ab, lo, up, rhs)
+
+    monkeypatch.setattr(ip, "_solve_spd", spy_spd)
+    monkeypatch.setattr(ip, "_solve", spy_lu)
+    rng = np.random.default_rng(21)
+    pts = _walk(rng, 40, 3)
+    t = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))]
+    ring = np.c_[np.cos(np.linspace(0, 6, 30)), np.sin(np.linspace(0, 6, 30))]
+    ring += 0.01 * rng.normal(size=ring.shape)
+    given = ([(3, rng.normal(size=3)), (4, rng.normal(size=3))],
+             [(4, rng.normal(size=3)), (3, rng.normal(size=3))])
+    def dd(q):
+        return q.d1, q.d2
+
+    runs = [lambda: dd(cf.interpolate_quintic(pts)),
+            lambda: dd(cf.interpolate_quintic(ring, bc="periodic")),
+            lambda: quintic_hermite_data(pts, t, *given, False)]
+    first = [r() for r in runs]
+    assert spd == [(4, 80), (4, 60), (4, 80)] and lu == []
+    cf.interpolate_quintic(pts, bc="not-a-knot")
+    cf.interpolate_quintic(pts, bc=((1, np.ones(3)), "natural"))
+    assert len(spd) == 3 and len(lu) == 2
+    monkeypatch.setattr(ip, "_solve_spd", lambda ab, rhs: None)  # as if Cholesky failed
+    for run, (d1, d2) in zip(runs, first, strict=True):
+        e1, e2 = run()
+        assert _rel(d1, e1) < 1e-13 and _rel(d2, e2) < 1e-13
+    assert len(lu) == 5

@@ -10,7 +10,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from scipy.linalg.lapack import dgbsv
+from scipy.linalg.lapack import dgbsv, dpbsv
 
 from .._kernels.cubic_spline import cubic_slopes_kernel, periodic_slopes_kernel
 from .._typing import ArrayLike, FloatArray
@@ -268,7 +268,7 @@ def _first_guess(h: FloatArray, delta: FloatArray, periodic: bool
     return m, s
 
 
-def _banded(h: FloatArray, npt: int, nseg_band: int, lo: int, up: int
+def _banded(h: FloatArray, npt: int, nseg_band: int, lo: int, up: int, sym: bool = False
             ) -> tuple[FloatArray, FloatArray]:
     """Jacobi scale ``dsc = diag(K)**-1/2`` (shape ``(2 npt,)``, all ``h.size`` segments; a
     periodic seam segment joins point ``npt-1`` to 0) and the scaled stiffness
@@ -276,7 +276,9 @@ def _banded(h: FloatArray, npt: int, nseg_band: int, lo: int, up: int
     (``ab[up + r - c, c] = K[r, c]``). ``ab`` is the view ``full[lo:]`` of a Fortran array
     ``full`` with ``lo`` zero rows on top: the layout LAPACK's ``dgbsv`` factors in place, so
     that :func:`_solve` hands it over without a copy (the copy was 80 bytes a point for every
-    row of the band, at the peak of a quintic interpolation)."""
+    row of the band, at the peak of a quintic interpolation). ``sym``: the lower band alone,
+    shape ``(4, 2 npt)`` (``ab[r - c, c] = K[r, c]``, ``r >= c``; ``lo = up = 3``), for
+    :func:`_solve_spd`."""
     M = 2 * npt
     ih = 1.0 / h
     hp = {1: ih, 2: ih * ih}
@@ -290,7 +292,10 @@ def _banded(h: FloatArray, npt: int, nseg_band: int, lo: int, up: int
         diag[1:] += w
     dsc = diag.reshape(M) ** -0.5
     del w, diag  # (two arrays of 16 bytes a point, not read again: freed before the band)
-    ab = np.zeros((2 * lo + up + 1, M), order="F")[lo:]
+    if sym:  # the lower band (LAPACK's dpbsv layout, kd = 3): ab[r - c, c] = K[r, c], r >= c
+        ab = np.zeros((4, M), order="F")
+    else:
+        ab = np.zeros((2 * lo + up + 1, M), order="F")[lo:]
     nb = nseg_band
     ds = [dsc[e: e + 2 * nb: 2] for e in range(4)]  # unknown e of every band segment
     # each entry's products in one work array, in place (the same operations in the same
@@ -302,6 +307,9 @@ def _banded(h: FloatArray, npt: int, nseg_band: int, lo: int, up: int
             np.multiply(_KE[a, b], hp[int(_KE_POW[a, b])][:nb], out=val)
             val *= ds[a]
             val *= ds[b]
+            if sym:  # (the same sums as the general band's entries below the diagonal)
+                ab[b - a, a: a + 2 * nb: 2] += val
+                continue
             ab[up + a - b, b: b + 2 * nb: 2] += val
             if b != a:
                 ab[up + b - a, a: a + 2 * nb: 2] += val
@@ -326,6 +334,18 @@ def _nak_row(k: int, h: FloatArray, dsc: FloatArray) -> tuple[np.ndarray, FloatA
     vals = np.array([-360.0 / a**4, -60.0 / a**3, 360.0 / b**4 - 360.0 / a**4,
                      60.0 / a**3 + 60.0 / b**3, 360.0 / b**4, -60.0 / b**3]) * dsc[cols]
     return cols, vals
+
+
+def _solve_spd(ab: FloatArray, rhs: FloatArray) -> FloatArray | None:
+    """The solution of ``A y = rhs`` for the symmetric positive definite band ``A`` given by its
+    lower band ``ab`` (:func:`_banded` with ``sym=True``), by LAPACK's banded Cholesky
+    ``dpbsv``; ``ab`` and a Fortran-ordered ``rhs`` are overwritten (no copy). None if the
+    factorisation fails (``A`` not positive definite in floating point): the caller then
+    solves the general system (:func:`_solve`)."""
+    _, y, info = dpbsv(ab, np.asfortranarray(rhs), lower=1, overwrite_ab=1, overwrite_b=1)
+    if info != 0 or not np.isfinite(y).all():
+        return None
+    return y
 
 
 def _solve(ab: FloatArray, lo: int, up: int, rhs: FloatArray) -> FloatArray:
@@ -374,102 +394,138 @@ def quintic_hermite_data(pts: FloatArray, t: FloatArray, left: Any, right: Any,
         m0, s0 = _first_guess(h, np.diff(pts, axis=0), periodic)
         return np.stack([m0, s0], axis=1).reshape(2 * m0.shape[0], dim)
 
-    x0 = first_guess()
-    npt = x0.shape[0] // 2
+    npt = n if not periodic else n - 1
     M = 2 * npt
     rp = np.r_[1:npt, 0] if periodic else np.arange(1, npt)
-    # f - K x0 per point (-jump(r''''), jump(r''')), filled through an (npt, 2, dim) view of
-    # coordinate-major memory: the right-hand side (2 npt, dim) is then Fortran-ordered and
-    # LAPACK solves it in place (no copy of it beside the band). The one-sided derivatives are
-    # made for a block of segments at a time (elementwise: the same values; an entry's two
-    # terms added to 0 in either order give the same sum); r^(5) is kept for a not-a-knot end
-    # only
-    res_t = np.zeros((dim, npt, 2))
-    res: FloatArray = res_t.transpose(1, 2, 0)
-    m0, s0 = x0[0::2], x0[1::2]
-    if periodic:
-        m0, s0 = np.vstack([m0, m0[:1]]), np.vstack([s0, s0[:1]])
     r5 = np.empty((h.size, dim)) if nak_any else None
-    for a in range(0, h.size, ONE_SIDED_BLOCK):
-        b = min(a + ONE_SIDED_BLOCK, h.size)
-        delta = pts[a + 1:b + 1] - pts[a:b]  # (np.diff's rows a .. b-1)
-        r3l, r4l, r3r, r4r, r5b = _one_sided(h[a:b], delta, m0[a:b + 1], s0[a:b + 1])
-        res[a:b, 0] -= r4l
-        res[rp[a:b], 0] += r4r
-        res[a:b, 1] += r3l
-        res[rp[a:b], 1] -= r3r
-        if r5 is not None:
-            r5[a:b] = r5b
-    del m0, s0, r3l, r4l, r3r, r4r, r5b, delta
-    res = res_t.reshape(dim, 2 * npt).T
-    del res_t
-    # the first guess is made again after the solve: only its end rows (read for given end
-    # derivatives) stay beside the band
-    x0_ends = {u: x0[u].copy() for u in (0, 1, M - 2, M - 1)}
-    del x0
+    x0_ends: dict[int, FloatArray] = {}
+
+    def residual() -> FloatArray:
+        """``f - K x0`` per point (-jump(r''''), jump(r''')), shape ``(2 npt, dim)``,
+        Fortran-ordered (filled through an ``(npt, 2, dim)`` view of coordinate-major memory):
+        LAPACK solves it in place, no copy of it beside the band. The one-sided derivatives
+        are made for a block of segments at a time (elementwise: the same values; an entry's
+        two terms added to 0 in either order give the same sum); ``r^(5)`` (into ``r5``) for
+        a not-a-knot end only; the first guess's end rows into ``x0_ends``. The first guess
+        itself is not kept: it is made again after the solve."""
+        x0 = first_guess()
+        x0_ends.update({u: x0[u].copy() for u in (0, 1, M - 2, M - 1)})
+        res_t = np.zeros((dim, npt, 2))
+        res: FloatArray = res_t.transpose(1, 2, 0)
+        m0, s0 = x0[0::2], x0[1::2]
+        if periodic:
+            m0, s0 = np.vstack([m0, m0[:1]]), np.vstack([s0, s0[:1]])
+        for a in range(0, h.size, ONE_SIDED_BLOCK):
+            b = min(a + ONE_SIDED_BLOCK, h.size)
+            delta = pts[a + 1:b + 1] - pts[a:b]  # (np.diff's rows a .. b-1)
+            r3l, r4l, r3r, r4r, r5b = _one_sided(h[a:b], delta, m0[a:b + 1], s0[a:b + 1])
+            res[a:b, 0] -= r4l
+            res[rp[a:b], 0] += r4r
+            res[a:b, 1] += r3l
+            res[rp[a:b], 1] -= r3r
+            if r5 is not None:
+                r5[a:b] = r5b
+        return res_t.reshape(dim, M).T
+
     if periodic:
-        dsc, ab = _banded(h, npt, npt - 1, 3, 3)
-        # A = B + E Ks E^T, B: the open chain without the seam segment (SPD for npt >= 3),
-        # Ks: the seam's scaled 4x4 stiffness on the unknowns E = (m, s at npt-1; m, s at 0).
+        # A = B + E Ks E^T, B: the open chain without the seam segment (symmetric positive
+        # definite for npt >= 3: banded Cholesky), Ks: the seam's scaled 4x4 stiffness on the
+        # unknowns E = (m, s at npt-1; m, s at 0)
+        res = residual()
         idx = np.array([M - 2, M - 1, 0, 1])
+
+        def rhs(dsc: FloatArray) -> FloatArray:
+            E = np.zeros((M, 4))
+            E[idx, np.arange(4)] = 1.0
+            return np.asfortranarray(np.hstack([res * dsc[:, None], E]))
+
+        dsc, ab = _banded(h, npt, npt - 1, 3, 3, sym=True)
+        Y = _solve_spd(ab, rhs(dsc))
+        del ab
+        if Y is None:
+            dsc, ab = _banded(h, npt, npt - 1, 3, 3)
+            Y = _solve(ab, 3, 3, rhs(dsc))
+            del ab
+        del res
         Ks = _KE / h[-1] ** _KE_POW * dsc[idx][:, None] * dsc[idx][None, :]
-        E = np.zeros((M, 4))
-        E[idx, np.arange(4)] = 1.0
-        Y = _solve(ab, 3, 3, np.hstack([res * dsc[:, None], E]))
         y0, Z = Y[:, :dim], Y[:, dim:]
         # Woodbury: A^-1 f = y0 - Z (I + Ks E^T Z)^-1 Ks E^T y0
         y = y0 - Z @ np.linalg.solve(np.eye(4) + Ks @ Z[idx], Ks @ y0[idx])
-        x = first_guess() + y * dsc[:, None]
+        del Y, y0, Z
+        x = first_guess()
+        x += y * dsc[:, None]
         x = np.vstack([x, x[:2]])
-    else:
-        nak = (left == "not-a-knot", right == "not-a-knot")
-        if n == 2 and not (nak[0] or nak[1]) and all(o in (3, 4) for o, _ in [*left, *right]):
-            # r''' and r'''' given at both ends of one segment never determine it: with r(t)
-            # any r + c (t - t0)(t - t1) satisfies them. Natural ends (zeros): the line, c = 0
-            # (the first guess), the member that also minimises int |r''|^2.
-            if any(np.any(np.asarray(v) != 0) for _, v in [*left, *right]):
-                raise InputError("two points with r''' and r'''' given at both ends do not "
-                                 "determine a quintic")
-            x = first_guess()
-        else:
-            lo = 6 if nak[1] else 3
-            up = 6 if nak[0] else 3
-            dsc, ab = _banded(h, npt, npt - 1, lo, up)
-            F = res  # scaled in place: the same products as res * dsc, no second array
-            F *= dsc[:, None]
-            del res
-            for side, cond in enumerate((left, right)):
-                pt = 0 if side == 0 else n - 1
-                # rows of the end point: r'''' (+ left, - right), r''' (- left, + right)
-                rows = (2 * pt, 2 * pt + 1)
-                if nak[side]:
-                    ks = (1, 2) if side == 0 else (n - 3, n - 2)
-                    for r, k in zip(rows, ks, strict=True):
-                        _set_row(ab, F, lo, up, r, *_nak_row(k, h, dsc), r5[k] - r5[k - 1])
-                    continue
-                c = np.arange(4) if side == 0 else np.arange(M - 4, M)  # the end segment's
-                orig = [(c, ab[up + r - c, c].copy(), F[r].copy()) for r in rows]
-                # a given r' or r'''' takes the r'''' row, r'' or r''' the r''' row
-                target = [0 if o in (1, 4) else 1 for o, _ in cond]
-                if target[0] == target[1]:
-                    target[1] = 1 - target[0]
-                for (o, v), w in zip(cond, target, strict=True):
-                    vhat = np.asarray(v, dtype=float) * hbar**o
-                    if o in (1, 2):
-                        u = 2 * pt + o - 1
-                        _set_row(ab, F, lo, up, rows[w], np.array([u]), np.array([dsc[u]]),
-                                 vhat - x0_ends[u])
-                    else:
-                        src = 0 if o == 4 else 1
-                        sign = (1.0 if o == 4 else -1.0) * (1.0 if side == 0 else -1.0)
-                        c, vals, rhs = orig[src]
-                        _set_row(ab, F, lo, up, rows[w], c, vals,
-                                 rhs + sign * vhat * dsc[rows[src]])
-            y = _solve(ab, lo, up, F)
-            del ab, F  # (the band, before the correction is scaled and added)
-            y *= dsc[:, None]
-            x = first_guess()
-            x += y  # x0 + dx in place: the same sums
+        return x[0::2] / hbar, x[1::2] / hbar**2
+    nak = (left == "not-a-knot", right == "not-a-knot")
+    if n == 2 and not (nak[0] or nak[1]) and all(o in (3, 4) for o, _ in [*left, *right]):
+        # r''' and r'''' given at both ends of one segment never determine it: with r(t)
+        # any r + c (t - t0)(t - t1) satisfies them. Natural ends (zeros): the line, c = 0
+        # (the first guess), the member that also minimises int |r''|^2.
+        if any(np.any(np.asarray(v) != 0) for _, v in [*left, *right]):
+            raise InputError("two points with r''' and r'''' given at both ends do not "
+                             "determine a quintic")
+        x = first_guess()
+        return x[0::2] / hbar, x[1::2] / hbar**2
+    lo = 6 if nak[1] else 3
+    up = 6 if nak[0] else 3
+
+    def system(sym: bool) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """``(dsc, ab, F)``: the scaled band (the lower band if ``sym``) and right-hand side
+        with the end conditions in the end points' rows."""
+        dsc, ab = _banded(h, npt, npt - 1, lo, up, sym=sym)
+        F = residual()
+        F *= dsc[:, None]  # scaled in place: the same products as res * dsc
+        for side, cond in enumerate((left, right)):
+            pt = 0 if side == 0 else n - 1
+            # rows of the end point: r'''' (+ left, - right), r''' (- left, + right)
+            rows = (2 * pt, 2 * pt + 1)
+            if nak[side]:
+                assert r5 is not None
+                ks = (1, 2) if side == 0 else (n - 3, n - 2)
+                for r, k in zip(rows, ks, strict=True):
+                    _set_row(ab, F, lo, up, r, *_nak_row(k, h, dsc), r5[k] - r5[k - 1])
+                continue
+            if sym:  # r''' and r'''' given: each keeps its own (symmetric) row
+                for o, v in cond:
+                    r = rows[0 if o == 4 else 1]
+                    sign = (1.0 if o == 4 else -1.0) * (1.0 if side == 0 else -1.0)
+                    F[r] += sign * (np.asarray(v, dtype=float) * hbar**o) * dsc[r]
+                continue
+            c = np.arange(4) if side == 0 else np.arange(M - 4, M)  # the end segment's
+            orig = [(c, ab[up + r - c, c].copy(), F[r].copy()) for r in rows]
+            # a given r' or r'''' takes the r'''' row, r'' or r''' the r''' row
+            target = [0 if o in (1, 4) else 1 for o, _ in cond]
+            if target[0] == target[1]:
+                target[1] = 1 - target[0]
+            for (o, v), w in zip(cond, target, strict=True):
+                vhat = np.asarray(v, dtype=float) * hbar**o
+                if o in (1, 2):
+                    u = 2 * pt + o - 1
+                    _set_row(ab, F, lo, up, rows[w], np.array([u]), np.array([dsc[u]]),
+                             vhat - x0_ends[u])
+                else:
+                    src = 0 if o == 4 else 1
+                    sign = (1.0 if o == 4 else -1.0) * (1.0 if side == 0 else -1.0)
+                    c, vals, rhs = orig[src]
+                    _set_row(ab, F, lo, up, rows[w], c, vals,
+                             rhs + sign * vhat * dsc[rows[src]])
+        return dsc, ab, F
+
+    # r''' and r'''' given at both ends (natural ends): the matrix is the jerk energy's
+    # stiffness, symmetric positive definite (n >= 3): banded Cholesky on its lower band (4
+    # rows instead of the LU's 10); the general LU otherwise, or if Cholesky fails
+    dx: FloatArray | None = None
+    if not (nak[0] or nak[1]) and all(o in (3, 4) for o, _ in [*left, *right]):
+        dsc, ab, F = system(True)
+        dx = _solve_spd(ab, F)
+        del ab, F
+    if dx is None:
+        dsc, ab, F = system(False)
+        dx = _solve(ab, lo, up, F)
+        del ab, F  # (the band, before the correction is scaled and added)
+    dx *= dsc[:, None]
+    x = first_guess()
+    x += dx  # x0 + dx in place: the same sums
     return x[0::2] / hbar, x[1::2] / hbar**2
 
 
