@@ -435,9 +435,11 @@ def quintic_hermite_data(pts: FloatArray, t: FloatArray, left: Any, right: Any,
         idx = np.array([M - 2, M - 1, 0, 1])
 
         def rhs(dsc: FloatArray) -> FloatArray:
-            E = np.zeros((M, 4))
-            E[idx, np.arange(4)] = 1.0
-            return np.asfortranarray(np.hstack([res * dsc[:, None], E]))
+            """``[res * dsc, E]``, made Fortran-ordered (LAPACK solves it in place)."""
+            out = np.zeros((M, dim + 4), order="F")
+            np.multiply(res, dsc[:, None], out=out[:, :dim])
+            out[idx, dim + np.arange(4)] = 1.0
+            return out
 
         dsc, ab = _banded(h, npt, npt - 1, 3, 3, sym=True)
         Y = _solve_spd(ab, rhs(dsc))
