@@ -470,3 +470,19 @@ def test_gram_band_in_two_halves_is_bitwise_one_pass(monkeypatch, knots, degree,
     assert len(calls) == 2 and calls[1] > 0  # the second half starts at a later row
     assert one.tobytes() == two.tobytes()
     assert np.abs(one).max() > 0
+
+
+def test_gauss_nodes_made_once_and_handed_out_as_copies():
+    # the Gram band's quadrature (made once per node count): numpy's leggauss mapped to [0, 1],
+    # bit for bit; a caller writing into its arrays leaves the next caller's intact
+    from curvefair.curves.bspline import _gauss
+
+    for nq in (1, 2, 3, 4, 6):
+        x, w = np.polynomial.legendre.leggauss(nq)
+        a, b = _gauss(nq)
+        assert np.array_equal(a, 0.5 * (x + 1.0)) and np.array_equal(b, 0.5 * w)
+        a[:] = 7.0
+        b[:] = 7.0
+        c, d = _gauss(nq)
+        assert np.array_equal(c, 0.5 * (x + 1.0)) and np.array_equal(d, 0.5 * w)
+        assert abs(d.sum() - 1.0) < 4e-15  # the weights integrate 1 over [0, 1]

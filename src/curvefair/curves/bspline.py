@@ -94,9 +94,18 @@ def basis_derivatives(knots: FloatArray, degree: int, span: np.ndarray, x: Float
     return out
 
 
+_GAUSS: dict[int, tuple[FloatArray, FloatArray]] = {}
+
+
 def _gauss(nq: int) -> tuple[FloatArray, FloatArray]:
-    x, w = np.polynomial.legendre.leggauss(nq)
-    return 0.5 * (x + 1.0), 0.5 * w
+    """Gauss-Legendre nodes and weights of ``nq`` points on ``[0, 1]``: numpy's ``leggauss``
+    (an eigenproblem and a Newton polish, about 0.2 ms: a tenth of a small curve's whole
+    ``fair()`` call) made once per ``nq``; fresh copies returned."""
+    got = _GAUSS.get(nq)
+    if got is None:
+        x, w = np.polynomial.legendre.leggauss(nq)
+        got = _GAUSS[nq] = (0.5 * (x + 1.0), 0.5 * w)
+    return got[0].copy(), got[1].copy()
 
 
 # ------------------------------------------------------------------------------------------
