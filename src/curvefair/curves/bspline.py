@@ -99,8 +99,9 @@ _GAUSS: dict[int, tuple[FloatArray, FloatArray]] = {}
 
 def _gauss(nq: int) -> tuple[FloatArray, FloatArray]:
     """Gauss-Legendre nodes and weights of ``nq`` points on ``[0, 1]``: numpy's ``leggauss``
-    (an eigenproblem and a Newton polish, about 0.2 ms: a tenth of a small curve's whole
-    ``fair()`` call) made once per ``nq``; fresh copies returned."""
+    (an eigenproblem and a Newton polish, tens of microseconds: felt by small curves, whose
+    whole ``fair()`` call is a millisecond or two) made once per ``nq``; fresh copies
+    returned."""
     got = _GAUSS.get(nq)
     if got is None:
         x, w = np.polynomial.legendre.leggauss(nq)
