@@ -875,7 +875,7 @@ def _prefetch_rows(arr, lo, hi, cols):
     prefetch(arr, (hi + 1) * cols - 1)
 
 
-@njit(cache=True)
+@njit(cache=True, readonly=('orig',))
 def drive(P, D, h, orig, closed, degree, method, spline, hstep, eligible, tol, eps,
           max_steps, move_floor, K0, pe, q, fixed, Hinv, w0, wmax, thr,
           measure, values, tv, ti, blocked, block_measure, mcode=M_DEFAULT):

@@ -419,7 +419,9 @@ def prepare(curve: HermiteSpline, *, method: str, tol: float | None, eps: float 
     Hinv = np.zeros((0, 0))
     if spline and closed and nd * nb <= _DENSE_MAX:
         Hinv = _dense_inverse(nd, nb, h, degree)
-    orig = P.copy()  # the loop's tolerance centres, and the start of a re-run
+    # the loop's tolerance centres and the start of a re-run: the input's own distinct points
+    # (read only, never written; P's values before the loop), not a copy
+    orig = np.asarray(curve.points, dtype=np.float64)[:nd]
     args = (P, D, h, orig, closed, degree, code, spline, hstep, eligible,
             np.inf if tol is None else float(tol), eps_eff, max_eff, floor,
             K0, pe, q, fixed, Hinv, _W0[degree], _WMAX, _THR, meas, values, tv, ti,
