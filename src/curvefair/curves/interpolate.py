@@ -336,6 +336,12 @@ def _nak_row(k: int, h: FloatArray, dsc: FloatArray) -> tuple[np.ndarray, FloatA
     return cols, vals
 
 
+def _end_sign(order: int, side: int) -> float:
+    """Sign of a given ``r''''`` (``order`` 4) or ``r'''`` (3) in its end row's right-hand side:
+    the rows hold ``+r''''``, ``-r'''`` at the left end (0) and the opposite at the right."""
+    return (1.0 if order == 4 else -1.0) * (1.0 if side == 0 else -1.0)
+
+
 def _solve_spd(ab: FloatArray, rhs: FloatArray) -> FloatArray | None:
     """The solution of ``A y = rhs`` for the symmetric positive definite band ``A`` given by its
     lower band ``ab`` (:func:`_banded` with ``sym=True``), by LAPACK's banded Cholesky
@@ -459,7 +465,9 @@ def quintic_hermite_data(pts: FloatArray, t: FloatArray, left: Any, right: Any,
         x = np.vstack([x, x[:2]])
         return x[0::2] / hbar, x[1::2] / hbar**2
     nak = (left == "not-a-knot", right == "not-a-knot")
-    if n == 2 and not (nak[0] or nak[1]) and all(o in (3, 4) for o, _ in [*left, *right]):
+    # r''' and r'''' given at both ends (natural-type ends)
+    natural = not (nak[0] or nak[1]) and all(o in (3, 4) for o, _ in [*left, *right])
+    if n == 2 and natural:
         # r''' and r'''' given at both ends of one segment never determine it: with r(t)
         # any r + c (t - t0)(t - t1) satisfies them. Natural ends (zeros): the line, c = 0
         # (the first guess), the member that also minimises int |r''|^2.
@@ -490,8 +498,7 @@ def quintic_hermite_data(pts: FloatArray, t: FloatArray, left: Any, right: Any,
             if sym:  # r''' and r'''' given: each keeps its own (symmetric) row
                 for o, v in cond:
                     r = rows[0 if o == 4 else 1]
-                    sign = (1.0 if o == 4 else -1.0) * (1.0 if side == 0 else -1.0)
-                    F[r] += sign * (np.asarray(v, dtype=float) * hbar**o) * dsc[r]
+                    F[r] += _end_sign(o, side) * (np.asarray(v, dtype=float) * hbar**o) * dsc[r]
                 continue
             c = np.arange(4) if side == 0 else np.arange(M - 4, M)  # the end segment's
             orig = [(c, ab[up + r - c, c].copy(), F[r].copy()) for r in rows]
@@ -507,17 +514,16 @@ def quintic_hermite_data(pts: FloatArray, t: FloatArray, left: Any, right: Any,
                              vhat - x0_ends[u])
                 else:
                     src = 0 if o == 4 else 1
-                    sign = (1.0 if o == 4 else -1.0) * (1.0 if side == 0 else -1.0)
                     c, vals, rhs = orig[src]
                     _set_row(ab, F, lo, up, rows[w], c, vals,
-                             rhs + sign * vhat * dsc[rows[src]])
+                             rhs + _end_sign(o, side) * vhat * dsc[rows[src]])
         return dsc, ab, F
 
-    # r''' and r'''' given at both ends (natural ends): the matrix is the jerk energy's
-    # stiffness, symmetric positive definite (n >= 3): banded Cholesky on its lower band (4
-    # rows instead of the LU's 10); the general LU otherwise, or if Cholesky fails
+    # natural-type ends: the matrix is the jerk energy's stiffness, symmetric positive
+    # definite (n >= 3): banded Cholesky on its lower band (4 rows instead of the LU's 10);
+    # the general LU otherwise, or if Cholesky fails
     dx: FloatArray | None = None
-    if not (nak[0] or nak[1]) and all(o in (3, 4) for o, _ in [*left, *right]):
+    if natural:
         dsc, ab, F = system(True)
         dx = _solve_spd(ab, F)
         del ab, F

@@ -314,9 +314,12 @@ def prepare(curve: HermiteSpline, *, method: str, tol: float | None, eps: float 
     # spline mode replaces the derivative data by the re-interpolation's (step 1): the input's
     # are read in place there, not copied beside the re-interpolation (2x the coordinates'
     # bytes of a quintic at its peak)
-    P, h = distinct_points(curve)
-    D: FloatArray | None = None if spline else np.ascontiguousarray(
-        np.stack(distinct_derivatives(curve), axis=1), dtype=np.float64)
+    D: FloatArray | None
+    if spline:
+        P, h = distinct_points(curve)
+        D = None
+    else:
+        P, D, h = distinct_data(curve)
     nd, dim = P.shape
     nb = len(curve._derivs)
     closed = curve.closed
