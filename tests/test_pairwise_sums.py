@@ -11,6 +11,7 @@ import pytest
 import curvefair as cf
 from curvefair import _threads
 from curvefair._kernels import pairwise as kp
+from curvefair.analysis import _analyze as _analyze_mod
 from curvefair.analysis import _sampling, fairness_figures
 
 SIZES = [*range(0, 300), 511, 512, 513, 1023, 1024, 1025, 4097, 65_537, 100_003, 1_000_001]
@@ -104,3 +105,43 @@ def test_streamed_summary_keeps_nan_and_closed_curves_are_not_streamed(monkeypat
         kp.fold_block(kb[start:], eb[start:], 4 - start, start, lb, kp.leaf_bounds(3), ls,
                       ls.copy(), ls.copy(), bufs, ints, np.zeros(3, dtype=np.int64), mx)
         assert np.isnan(mx).all()
+
+
+def _wiggly(n: int, rng: np.random.Generator, scale: float) -> np.ndarray:
+    # straight stretches (curvature at the rounding level: the zero bands decide) between
+    # noisy ones (many sign changes, some across every block boundary)
+    x = np.linspace(0, 30, n)
+    y = np.where((x > 10) & (x < 20), 0.0, np.sin(x) + 1e-3 * rng.normal(size=n))
+    return scale * np.c_[x, y] + np.array([3.0 * scale, -7.0 * scale])
+
+
+@pytest.mark.parametrize("block,par_min", [(1, 4), (2, 4), (7, 300), (65_536, 50_000)])
+def test_long_summary_rescans_the_signs_block_by_block(monkeypatch, block, par_min):
+    # from RESCAN_MIN segments on (forced to 2 here) the summary keeps no samples: the sign
+    # counts come from a second pass, scanned block by block (blocks of one segment: every
+    # change between two segments is one between blocks) on one thread and on two. The
+    # counts are analyze()'s (which scans the kept samples), for curves of size 1, 1e-15 and
+    # 1e25 (the samples' unit scales the zero bands), and the other figures unchanged
+    calls = []
+    real = _sampling.rescan_sign_counts
+    monkeypatch.setattr(_analyze_mod, "rescan_sign_counts",
+                        lambda *a: calls.append(1) or real(*a))
+    monkeypatch.setattr(_sampling, "STREAM_BLOCK", block)
+    monkeypatch.setattr(_sampling, "PAR_MIN", par_min)
+    monkeypatch.setattr(_sampling, "RESCAN_MIN", 2)
+    rng = np.random.default_rng(block)
+    cases = changes = 0
+    for threads in (1, 2):
+        monkeypatch.setattr(_threads, "THREADS", threads)
+        for n in (4, 5, 60, 301, 2000):
+            for scale in (1.0, 1e-15, 1e25):
+                P = _wiggly(n, rng, scale)
+                for c in (cf.interpolate_cubic(P), cf.interpolate_quintic(P),
+                          cf.interpolate_bspline(P)):
+                    ref = _figures(cf.analyze(c))
+                    got = fairness_figures(c)
+                    assert got == ref, (n, scale, type(c).__name__)
+                    cases += 1
+                    changes += ref["inflections"] + ref["extrema"]
+    assert len(calls) == cases
+    assert changes > 1000

@@ -114,7 +114,7 @@ def _frenet_node(r1, r2, r3, sc1, sc2, speed_rtol, cross_rtol):
 @njit(cache=True, nogil=True, fastmath=_FM, error_model="numpy", readonly=('cw', 'h'))
 def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cross_rtol,
                 kap, dks, knots, energies, quad, box, ell, pos, gaps, unit,
-                i_lo, i_hi, scratch, first, endv, ksfl, off, k_off, k_scratch):
+                i_lo, i_hi, at, first, endv, ksfl, off):
     """One fused pass over the segments (see
     :func:`curvefair.analysis._sampling.sample_curve`).
 
@@ -137,20 +137,23 @@ def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cr
     outputs, their gaps, their bounding box and counts), so that ranges can run on several
     threads. A range starting after segment 0 first runs the whole pass over segment
     ``i_lo - 1`` (the limits at its end are what the jumps at breakpoint ``i_lo`` need),
-    writing that segment's rows to row ``scratch`` (a spare row past ``m``): every value is
-    computed by the same code from the same inputs however the segments are split, so the
-    results are bitwise the same on one thread or several. ``first`` gets the right limits of
-    the third and ``degree``-th derivative at the start of segment 0 (range with ``i_lo ==
-    0``), ``endv`` the left limits at the end of segment ``i_hi - 1``, ``ksfl`` ``dkappa/ds``
-    at those two places: :func:`seam_jumps` makes the closed curve's seam row from them.
+    writing that segment's rows to the spare rows named in ``at``: every value is computed by
+    the same code from the same inputs however the segments are split, so the results are
+    bitwise the same on one thread or several. ``first`` gets the right limits of the third
+    and ``degree``-th derivative at the start of segment 0 (range with ``i_lo == 0``),
+    ``endv`` the left limits at the end of segment ``i_hi - 1``, ``ksfl`` ``dkappa/ds`` at
+    those two places: :func:`seam_jumps` makes the closed curve's seam row from them.
 
     ``cw`` holds the rows of segments ``off .. off + len(cw) - 1`` (those the range reads, the
     lead-in segment included): the whole form (``off = 0``) or a range's own rows made for
     it (:class:`curvefair.analysis._sampling.SpanForms`); ``h`` covers every segment.
 
-    ``knots`` and ``energies`` may be a block's own rows: segment ``i``'s are row ``i - k_off``,
-    the lead-in segment's row ``k_scratch`` (``k_off = 0``, ``k_scratch = scratch``: the
-    whole arrays, as the other outputs).
+    **Rows.** ``at`` (3, 2) int64 places the per-segment outputs, as three groups: ``quad``
+    (``at[0]``), ``knots`` and ``energies`` (``at[1]``), ``kap``, ``dks``, ``ell`` and ``pos``
+    (``at[2]``). Segment ``i``'s row of a group is ``i - at[g, 0]``, the lead-in segment's
+    row ``at[g, 1]``: ``(0, scratch)`` writes the whole arrays (a spare row ``scratch`` past
+    ``m`` per range), ``(s0, nb)`` a block's own ``nb + 1`` rows for a block starting at
+    segment ``s0``.
     """
     m = h.shape[0]
     p1 = cw.shape[1]
@@ -188,15 +191,16 @@ def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cr
     maxks = 0.0
     ngap = 0
     for i in range(i0, i_hi):
-        row = i if i >= i_lo else scratch
-        krow = i - k_off if i >= i_lo else k_scratch
         own = i >= i_lo
+        row = i - at[0, 0] if own else at[0, 1]  # quad
+        krow = i - at[1, 0] if own else at[1, 1]  # knots, energies
+        srow = i - at[2, 0] if own else at[2, 1]  # kap, dks, ell, pos
         hi = h[i]
         ih = 1.0 / hi
         ih2 = ih * ih
         ih3 = ih2 * ih
         sc1, sc2 = _setup(cw, i - off, hi, fall, e)
-        ell[row] = sc1 * hi
+        ell[srow] = sc1 * hi
         c0n = 0.0
         for d in range(dim):
             v = cw[i - off, 0, d]
@@ -205,7 +209,7 @@ def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cr
                 box[0, d] = v
             if v > box[1, d]:
                 box[1, d] = v
-        pos[row] = np.sqrt(c0n)
+        pos[srow] = np.sqrt(c0n)
         # exact energies: h int_0^1 |sum_j g_j u^j|^2 du with g_j = fall[j+o, o] e_{j+o} / h^o
         for o in range(2, 4):
             acc = 0.0
@@ -273,8 +277,8 @@ def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cr
                 k_ = k_ if good else 0.0
                 ks = ks if good else 0.0
                 nsing += (not good) & own
-                kap[row, qn] = min(max(k_ * unit, -_F32_MAX), _F32_MAX)
-                dks[row, qn] = min(max(ks * unit2, -_F32_MAX), _F32_MAX)
+                kap[srow, qn] = min(max(k_ * unit, -_F32_MAX), _F32_MAX)
+                dks[srow, qn] = min(max(ks * unit2, -_F32_MAX), _F32_MAX)
                 maxk = max(maxk, abs(k_))
                 maxks = max(maxks, abs(ks))
                 ksa[qn] = ks
@@ -306,8 +310,8 @@ def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cr
                 vals[1, qn] = enum
                 nsing += sing & own
                 # stored in float32 (sign and rough size are all the counts need), clamped
-                kap[row, qn] = min(max(k_ * unit, -_F32_MAX), _F32_MAX)
-                dks[row, qn] = min(max(ks * unit2, -_F32_MAX), _F32_MAX)
+                kap[srow, qn] = min(max(k_ * unit, -_F32_MAX), _F32_MAX)
+                dks[srow, qn] = min(max(ks * unit2, -_F32_MAX), _F32_MAX)
                 if qn == 0:
                     ks_start = ks
                 ks_end = ks

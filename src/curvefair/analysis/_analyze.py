@@ -15,7 +15,7 @@ from ..curves.piecewise import PiecewiseCurve, readonly
 from ..interop import as_curve
 from ._core import bounding_diagonal, check_curve, falling, fields_to_dict
 from ._energy import segment_energies
-from ._sampling import QUAD_RTOL, SpanForms, sample_curve, scan_sign_changes
+from ._sampling import QUAD_RTOL, SpanForms, rescan_sign_counts, sample_curve, scan_sign_changes
 
 __all__ = ["Analysis", "analyze", "fairness_figures", "derivative_jumps", "ZERO_RTOL",
            "PLANAR_RTOL"]
@@ -388,6 +388,12 @@ def _analyze(c: PiecewiseCurve, rtol: float, summary: bool, whole: bool = False
     g = smp.unit
     ell_g, pos_g = smp.ell / g, smp.pos / g
     ex_k, ex_ks = smp.extra
+    if smp.rescan:  # (a summary of a long open curve: no samples kept, see sample_curve)
+        assert summary and forms is not None and sums is not None
+        n_infl, n_ext = rescan_sign_counts(forms, h, planar, smp, ktol, kstol)
+        return {"energy2": e2, "energy3": e3, "max_jump": max_jump, "max_top_jump": max_top,
+                "sapidis_sum": sap, "dkds_energy": float(smp.dkds_energy),
+                "inflections": int(n_infl), "extrema": int(n_ext)}
     if planar:
         n_infl, infl_at = scan_sign_changes(kap, smp.x, breaks, (ex_k[0], ex_k[1], ex_k[2] * g),
                                             ktol * g, closed, ell_g, pos_g, 1)

@@ -37,7 +37,7 @@ from ._core import CROSS_RTOL, SPEED_RTOL, derivs_at, falling, frenet
 if TYPE_CHECKING:
     from ..curves.hermite import HermiteSpline
 
-__all__ = ["Samples", "sample_curve", "scan_sign_changes", "QUAD_RTOL"]
+__all__ = ["Samples", "sample_curve", "scan_sign_changes", "rescan_sign_counts", "QUAD_RTOL"]
 
 #: Rounding level of curvature-type quantities computed from floating-point spline data: on a
 #: segment of length scale ``ell`` starting at distance ``pos`` from the origin, the
@@ -56,6 +56,10 @@ _MAX_LEVELS = 40
 PAR_MIN = 50_000
 #: segments per block of a ``sums_only`` pass (:func:`sample_curve`)
 STREAM_BLOCK = 65_536
+#: Segments: from this many on, a ``sums_only`` pass of an open curve whose forms are made
+#: range by range keeps no samples; the sign counts sample it again
+#: (:func:`rescan_sign_counts`).
+RESCAN_MIN = 1 << 21
 
 # Gander & Gautschi (2000): 4-point Gauss-Lobatto and 7-point Kronrod extension on [-1, 1]
 _R23 = float(np.sqrt(2.0 / 3.0))
@@ -187,6 +191,8 @@ class Samples:
     # sums_only: (sum energies[:, 0], sum energies[:, 1], sum of the Sapidis measure, max jump,
     # max top jump) over the interior breakpoints of an open curve, as np.sum / np.max give
     sums: tuple[float, float, float, float, float] | None = None
+    # no samples kept (kappa, dkds, ell, pos empty): count the signs by rescan_sign_counts
+    rescan: bool = False
 
 
 class SpanForms:
@@ -351,7 +357,12 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
     made, in numpy's pairwise order (:mod:`curvefair._kernels.pairwise`): ``Samples.sums``
     then holds ``np.sum`` of each energy column, ``np.sum`` of the Sapidis measure at the
     interior breakpoints and the largest jumps there, the same bits as those of the arrays
-    (``knots`` and ``energies`` are then empty).
+    (``knots`` and ``energies`` are then empty). From :data:`RESCAN_MIN` segments on, such a
+    pass keeps no samples either (``kappa``, ``dkds``, ``ell`` and ``pos``: 2 K float32 and
+    two float64 a segment, 9.5 times the coordinates' bytes for a planar quintic, the
+    analysis' peak at ten million segments): each block writes them in its own rows, and
+    :func:`rescan_sign_counts` makes them again block by block once the zero bands (which
+    need the whole curve's largest values and size) are known. ``Samples.rescan`` says so.
     """
     m, p1, dim = cw.shape
     p = p1 - 1
@@ -361,11 +372,18 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
     # one spare row per range (the lead-in segment of a range, see pass_kernel); the views of
     # the first m rows are what the analysis keeps
     spare = _threads.CHUNKS
-    kap = np.empty((m + spare, K), dtype=np.float32)
-    dks = np.empty((m + spare, K), dtype=np.float32)
     forms = cw if isinstance(cw, SpanForms) else None
     unit = _unit(cast(FloatArray, cw)) if forms is None else _unit_of(forms.unit_points)
     stream = sums_only and forms is not None and not closed and m >= 2
+    lean = stream and m >= RESCAN_MIN
+    if lean:  # (each block's own rows, see blocks())
+        kap = dks = np.empty((0, K), dtype=np.float32)
+        ell = pos = np.empty(0)
+    else:
+        kap = np.empty((m + spare, K), dtype=np.float32)
+        dks = np.empty((m + spare, K), dtype=np.float32)
+        ell = np.empty(m + spare)
+        pos = np.empty(m + spare)
     if stream:
         knots = energies = np.empty((0, 3))  # (summed by blocks in run(), never kept)
         lbe, lbs = _kp.leaf_bounds(m), _kp.leaf_bounds(m - 1)
@@ -376,8 +394,6 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
         knots = np.empty((m + spare, 3))
         energies = np.empty((m + spare, 2))
     quad = np.empty((m + spare, 4))
-    ell = np.empty(m + spare)
-    pos = np.empty(m + spare)
     cwc = np.ascontiguousarray(cw, dtype=np.float64) if forms is None else None
     hc = np.ascontiguousarray(h, dtype=np.float64)
     first = np.zeros((2, dim))  # limits at the start of segment 0 (range 0 writes them)
@@ -391,6 +407,8 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
         fl = np.zeros(2)
         gaps = np.empty((max(1 << 12, (b - a) // 4), 3), dtype=np.int64)
         scratch = m + starts.get(a, 0)
+        at = np.full((3, 2), scratch, dtype=np.int64)
+        at[:, 0] = 0  # the whole arrays' rows
         if stream:  # (each block makes its own rows)
             return blocks(a, b, box, endv, fl, gaps, scratch)
         if forms is None:
@@ -404,7 +422,7 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
             nsing, maxk, maxks, ngap = _k.pass_kernel(
                 rows, hc, plan.x, plan.tab, plan.w7, plan.w4, plan.P, fall, fits, nfit, subs,
                 SPEED_RTOL, CROSS_RTOL, kap, dks, knots, energies, quad, box, ell, pos, gaps,
-                unit, a, b, scratch, first, endv, fl, off, 0, scratch)
+                unit, a, b, at, first, endv, fl, off)
             if ngap <= gaps.shape[0]:
                 break
             gaps = np.empty((ngap, 3), dtype=np.int64)  # rare: the buffer was too small; redo
@@ -424,6 +442,15 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
         nb = max(min(STREAM_BLOCK, b - a), 1)
         kb = np.empty((nb + 1, 3))
         eb = np.empty((nb + 1, 2))
+        at = np.array([[0, scratch], [0, nb], [0, scratch]], dtype=np.int64)
+        if lean:  # the samples in the block's own rows too
+            kap_b = np.empty((nb + 1, K), dtype=np.float32)
+            dks_b = np.empty((nb + 1, K), dtype=np.float32)
+            ell_b = np.empty(nb + 1)
+            pos_b = np.empty(nb + 1)
+            at[2, 1] = nb
+        else:
+            kap_b, dks_b, ell_b, pos_b = kap, dks, ell, pos
         bufs = np.empty((3, 2, _kp.LEAF))
         ints = np.zeros((3, 3), dtype=np.int64)
         fe = np.array([a, a, max(a, 1) - 1], dtype=np.int64)  # first element of each tree
@@ -438,11 +465,14 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
             s1 = min(s0 + STREAM_BLOCK, b)
             off = s0 - 1 if s0 > 0 else 0
             rows = forms.rows(off, max(s1, off + 1))
+            at[1, 0] = s0
+            if lean:
+                at[2, 0] = s0
             while True:
                 ns, mk, mks, ngap = _k.pass_kernel(
                     rows, hc, plan.x, plan.tab, plan.w7, plan.w4, plan.P, fall, fits, nfit,
-                    subs, SPEED_RTOL, CROSS_RTOL, kap, dks, kb, eb, quad, bx, ell, pos, gaps,
-                    unit, s0, s1, scratch, first, endv, fl, off, s0, nb)
+                    subs, SPEED_RTOL, CROSS_RTOL, kap_b, dks_b, kb, eb, quad, bx, ell_b, pos_b,
+                    gaps, unit, s0, s1, at, first, endv, fl, off)
                 if ngap <= gaps.shape[0]:
                     break
                 gaps = np.empty((ngap, 3), dtype=np.int64)  # rare: too small; redo the block
@@ -520,7 +550,7 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
                    n_singular=int(nsing), max_kappa=float(maxk),
                    max_dkds=float(maxks), knots=knots, energies=energies,
                    diagonal=float(np.sqrt(np.sum((box[1] - box[0]) ** 2))), ell=ell,
-                   pos=pos, extra=(extra[0], extra[1]), unit=unit, sums=sums)
+                   pos=pos, extra=(extra[0], extra[1]), unit=unit, sums=sums, rescan=lean)
 
 
 def _stream_sums(folds: dict[tuple[int, int], tuple[np.ndarray, ...]], lbe: np.ndarray,
@@ -555,6 +585,103 @@ def _stream_sums(folds: dict[tuple[int, int], tuple[np.ndarray, ...]], lbe: np.n
     n = m - 1
     return (float(_kp.tree_sum(ls2, m)), float(_kp.tree_sum(ls3, m)),
             float(_kp.tree_sum(lss, n)), float(top[0]), float(top[1]))
+
+
+def rescan_sign_counts(forms: SpanForms, h: FloatArray, planar: bool, smp: Samples,
+                       ktol: float, kstol: float) -> tuple[int, int]:
+    """The sign changes of ``kappa`` and ``dkappa/ds`` (:func:`scan_sign_changes`' counts) of
+    an open curve whose :func:`sample_curve` pass kept no samples (``smp.rescan``): the pass
+    runs again block by block (``STREAM_BLOCK`` segments, on the sampling's threads), each
+    block's samples scanned as they are made with the zero bands ``ktol`` and ``kstol`` and
+    the extra samples ``smp.extra`` of the block's segments (all scaled by ``smp.unit`` as
+    :func:`curvefair.analyze` scales them for :func:`scan_sign_changes`); then dropped.
+
+    The counts are exactly the whole scan's: the samples are the first pass's bits (the same
+    compiled pass over the same rows, a block re-running its lead-in segment as a range
+    does), a change is counted between two consecutive nonzero samples of opposite sign, and a
+    block's scan starts with no sign, so the blocks' counts plus the changes between one
+    block's last nonzero sample and the next one's first add up to the whole sequence's.
+    Costs one more sampling pass; keeps ``4 K + 16`` bytes a segment of a block instead of the
+    whole curve's.
+    """
+    m, p1, dim = forms.shape
+    p = p1 - 1
+    plan = _plan(p, planar)
+    K = plan.K
+    fits, subs, nfit, fall = _kernel_tables(p, planar)
+    hc = np.ascontiguousarray(h, dtype=np.float64)
+    breaks = np.ascontiguousarray(forms.breaks, dtype=np.float64)
+    g = smp.unit
+    # per quantity: samples' slot, extra samples (segment, u, value scaled as the samples),
+    # zero band, power of the rounding band (see scan_sign_changes)
+    quantities = []
+    for which, (ex, tol, power) in enumerate(((smp.extra[0], ktol * g, 1),
+                                              (smp.extra[1], kstol * g * g, 2))):
+        if which == 0 and not planar:
+            continue
+        scale = g if power == 1 else g * g
+        quantities.append((which, np.ascontiguousarray(ex[0], dtype=np.int64),
+                           np.ascontiguousarray(ex[1]), np.ascontiguousarray(ex[2] * scale),
+                           float(tol), power))
+
+    def run(a: int, b: int) -> np.ndarray:
+        """(n, first sign, last sign) per quantity of segments ``a .. b-1``."""
+        state = np.zeros((2, 3), dtype=np.int64)
+        if a >= b:
+            return state
+        nb = min(STREAM_BLOCK, b - a)
+        vals = np.empty((2, nb + 1, K), dtype=np.float32)
+        kb = np.empty((nb + 1, 3))
+        eb = np.empty((nb + 1, 2))
+        quad = np.empty((nb + 1, 4))
+        ell = np.empty(nb + 1)
+        pos = np.empty(nb + 1)
+        box = np.empty((2, dim))
+        endv = np.empty((2, dim))
+        first = np.zeros((2, dim))
+        fl = np.zeros(2)
+        gaps = np.empty((1 << 12, 3), dtype=np.int64)  # (not read: the first pass has them)
+        at = np.full((3, 2), nb, dtype=np.int64)
+        out = np.empty(nb * K + 1)
+        s0 = a
+        while s0 < b:
+            s1 = min(s0 + STREAM_BLOCK, b)
+            off = s0 - 1 if s0 > 0 else 0
+            rows = forms.rows(off, s1)
+            at[:, 0] = s0
+            _k.pass_kernel(rows, hc, plan.x, plan.tab, plan.w7, plan.w4, plan.P, fall, fits,
+                           nfit, subs, SPEED_RTOL, CROSS_RTOL, vals[0], vals[1], kb, eb, quad,
+                           box, ell, pos, gaps, g, s0, s1, at, first, endv, fl, off)
+            ns = s1 - s0
+            for which, ex_seg, ex_u, ex_val, tol, power in quantities:
+                lo, hi = np.searchsorted(ex_seg, (s0, s1))
+                if out.shape[0] < ns * K + (hi - lo) + 1:
+                    out = np.empty(ns * K + (hi - lo) + 1)
+                n, fs, _, _, ls, _, _ = _k.scan_kernel(
+                    vals[which, :ns], plan.x, breaks[s0:s1 + 1], ex_seg[lo:hi] - s0,
+                    ex_u[lo:hi], ex_val[lo:hi], tol, ell[:ns] / g, pos[:ns] / g,
+                    ROUNDING_FLOOR, power, out)
+                _join(state[which], n, fs, ls)
+            s0 = s1
+        return state
+
+    total = np.zeros((2, 3), dtype=np.int64)
+    for part in _threads.ranges(run, 0, m, _threads.THREADS, PAR_MIN):
+        for which in (0, 1):
+            _join(total[which], *part[which])
+    return int(total[0, 0]), int(total[1, 0])
+
+
+def _join(state: np.ndarray, n: int, fs: int, ls: int) -> None:
+    """Append a scanned stretch (``n`` changes, its first and last nonzero sign; 0: none) to
+    ``state`` = (changes, first sign, last sign) of the stretches before it."""
+    state[0] += n
+    if fs != 0:
+        if state[2] != 0 and state[2] != fs:
+            state[0] += 1
+        if state[1] == 0:
+            state[1] = fs
+        state[2] = ls
 
 
 def _unit(cw: FloatArray) -> float:
