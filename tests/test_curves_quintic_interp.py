@@ -549,3 +549,64 @@ def test_natural_and_periodic_ends_solve_by_banded_cholesky_else_lu(monkeypatch)
         e1, e2 = run()
         assert _rel(d1, e1) < 1e-13 and _rel(d2, e2) < 1e-13
     assert len(lu) == 5
+
+
+def _whole_first_guess(h, delta, periodic):
+    # the first guess as one whole-array computation (how it was made before it was made by
+    # blocks): np.roll for the periodic neighbours, slices for the open interior
+    sig = delta / h[:, None]
+    if periodic:
+        a, b = np.roll(h, 1)[:, None], h[:, None]
+        sa, sb = np.roll(sig, 1, axis=0), sig
+        return (b * sa + a * sb) / (a + b), 2.0 * (sb - sa) / (a + b)
+    n = h.size + 1
+    m = np.empty((n, sig.shape[1]))
+    s = np.zeros_like(m)
+    if n == 2:
+        m[:] = sig[0]
+        return m, s
+    a, b = h[:-1, None], h[1:, None]
+    m[1:-1] = (b * sig[:-1] + a * sig[1:]) / (a + b)
+    s[1:-1] = 2.0 * (sig[1:] - sig[:-1]) / (a + b)
+    s[0], s[-1] = s[1], s[-2]
+    m[0] = sig[0] - 0.5 * h[0] * s[0]
+    m[-1] = sig[-1] + 0.5 * h[-1] * s[-1]
+    return m, s
+
+
+def test_first_guess_by_blocks_is_the_whole_one_and_fits_quadratics():
+    """The solver's first guess is made a block of points at a time (``_guess_rows``): every
+    block of 1, 2, 3, 7 or 1000 points, open and periodic, 2-50 points over six decades, is
+    bit for bit the whole-array computation's rows (a periodic curve's row ``npt`` is row 0).
+    Independently, the three-point estimates are exact for data from a quadratic."""
+    from curvefair.curves import interpolate as ip
+
+    rng = np.random.default_rng(31)
+    blocks = 0
+    for n in (2, 3, 4, 5, 8, 50):
+        for periodic in (False, True):
+            if periodic and n < 4:
+                continue
+            pts = rng.normal(size=(n, 3)) * 10.0 ** rng.uniform(-3, 3, (n, 1))
+            if periodic:
+                pts[-1] = pts[0]
+            h = rng.uniform(0.01, 5.0, n - 1)
+            m, s = _whole_first_guess(h, np.diff(pts, axis=0), periodic)
+            npt = n - 1 if periodic else n
+            for size in (1, 2, 3, 7, 1000):
+                for a in range(0, npt, size):
+                    b = min(a + size, npt)
+                    mb, sb = ip._guess_rows(h, pts, a, b, periodic)
+                    assert mb.tobytes() == m[a:b].tobytes() and sb.tobytes() == s[a:b].tobytes()
+                    blocks += 1
+            if periodic:
+                mb, sb = ip._guess_rows(h, pts, npt, npt + 1, True)
+                assert mb.tobytes() == m[:1].tobytes() and sb.tobytes() == s[:1].tobytes()
+    assert blocks > 250
+    # a quadratic r(t) = c0 + c1 t + c2 t^2 at uneven t: m = r'(t_i), s = r''(t_i) = 2 c2
+    t = np.cumsum(rng.uniform(0.2, 2.0, 12))
+    c = rng.normal(size=(3, 2))
+    pts = c[0] + t[:, None] * c[1] + t[:, None] ** 2 * c[2]
+    m, s = ip._guess_rows(np.diff(t), pts, 0, 12, False)
+    np.testing.assert_allclose(m, c[1] + 2.0 * t[:, None] * c[2], rtol=1e-11, atol=1e-11)
+    np.testing.assert_allclose(s, np.broadcast_to(2.0 * c[2], s.shape), rtol=1e-11, atol=1e-11)

@@ -244,27 +244,55 @@ def _one_sided(h: FloatArray, delta: FloatArray, m: FloatArray, s: FloatArray
     return r3l, r4l, r3r, r4r, 120.0 * a5 * (ih2 * ih2)
 
 
-def _first_guess(h: FloatArray, delta: FloatArray, periodic: bool
-                 ) -> tuple[FloatArray, FloatArray]:
-    """Three-point (parabola) estimates of ``r'`` and ``r''`` at every distinct point: exact
-    for data from a quadratic, in particular on a straight line."""
-    sig = delta / h[:, None]
+def _guess_rows(h: FloatArray, pts: FloatArray, a: int, b: int, periodic: bool
+                ) -> tuple[FloatArray, FloatArray]:
+    """Three-point (parabola) estimates ``m`` of ``r'`` and ``s`` of ``r''`` at points ``a ..
+    b-1``: exact for data from a quadratic, in particular on a straight line. With ``sig_j =
+    (p_{j+1} - p_j) / h_j``: ``m_i = (h_i sig_{i-1} + h_{i-1} sig_i) / (h_{i-1} + h_i)``,
+    ``s_i = 2 (sig_i - sig_{i-1}) / (h_{i-1} + h_i)`` (indices mod ``npt`` on a periodic
+    curve); an open curve's end points take their neighbour's ``s`` and ``m = sig -+ h s /
+    2`` of their segment (two points: the chord's slope, ``s = 0``).
+
+    Made a block of points at a time from the segments the block reads (every value one
+    elementwise expression of its own operands: the same bits however the points are cut),
+    so that the whole first guess and its temporaries, several arrays of the points' size,
+    are never made at once. ``pts`` are the ``h.size + 1`` points (a periodic curve's last
+    repeating the first: its point ``npt`` is point 0 again)."""
+    dim = pts.shape[1]
     if periodic:
-        a, b = np.roll(h, 1)[:, None], h[:, None]
-        sa, sb = np.roll(sig, 1, axis=0), sig
-        return (b * sa + a * sb) / (a + b), 2.0 * (sb - sa) / (a + b)
+        nseg = h.size
+        seg = np.arange(a - 1, b) % nseg  # segments i-1 and i of every point i (mod npt)
+        hh = h[seg]
+        sig = (pts[seg + 1] - pts[seg]) / hh[:, None]
+        ha, hb = hh[:-1, None], hh[1:, None]
+        sa, sb = sig[:-1], sig[1:]
+        return (hb * sa + ha * sb) / (ha + hb), 2.0 * (sb - sa) / (ha + hb)
     n = h.size + 1
-    m = np.empty((n, sig.shape[1]))
+    m = np.empty((b - a, dim))
     s = np.zeros_like(m)
     if n == 2:
-        m[:] = sig[0]
+        m[:] = (pts[1] - pts[0]) / h[0]
         return m, s
-    a, b = h[:-1, None], h[1:, None]
-    m[1:-1] = (b * sig[:-1] + a * sig[1:]) / (a + b)
-    s[1:-1] = 2.0 * (sig[1:] - sig[:-1]) / (a + b)
-    s[0], s[-1] = s[1], s[-2]
-    m[0] = sig[0] - 0.5 * h[0] * s[0]
-    m[-1] = sig[-1] + 0.5 * h[-1] * s[-1]
+
+    def inner(lo: int, hi: int) -> tuple[FloatArray, FloatArray]:
+        """``m``, ``s`` of the interior points ``lo .. hi-1`` (``1 <= lo < hi <= n-1``)."""
+        hh = h[lo - 1:hi]
+        sig = (pts[lo:hi + 1] - pts[lo - 1:hi]) / hh[:, None]
+        ha, hb = hh[:-1, None], hh[1:, None]
+        return ((hb * sig[:-1] + ha * sig[1:]) / (ha + hb),
+                2.0 * (sig[1:] - sig[:-1]) / (ha + hb))
+
+    lo, hi = max(a, 1), min(b, n - 1)
+    if hi > lo:
+        m[lo - a:hi - a], s[lo - a:hi - a] = inner(lo, hi)
+    if a == 0:  # s[0] = s[1], m[0] = sig[0] - h[0] s[0] / 2
+        s1 = inner(1, 2)[1][0]
+        s[0] = s1
+        m[0] = (pts[1] - pts[0]) / h[0] - 0.5 * h[0] * s1
+    if b == n:  # s[-1] = s[-2], m[-1] = sig[-1] + h[-1] s[-1] / 2
+        s2 = inner(n - 2, n - 1)[1][0]
+        s[-1] = s2
+        m[-1] = (pts[n - 1] - pts[n - 2]) / h[-1] + 0.5 * h[-1] * s2
     return m, s
 
 
@@ -395,36 +423,44 @@ def quintic_hermite_data(pts: FloatArray, t: FloatArray, left: Any, right: Any,
     h = np.diff(t) / hbar
     nak_any = not periodic and (left == "not-a-knot" or right == "not-a-knot")
 
-    def first_guess() -> FloatArray:
-        """The first guess ``x0`` (``m``, ``s`` interleaved, shape ``(2 npt, dim)``)."""
-        m0, s0 = _first_guess(h, np.diff(pts, axis=0), periodic)
-        return np.stack([m0, s0], axis=1).reshape(2 * m0.shape[0], dim)
-
     npt = n if not periodic else n - 1
     M = 2 * npt
+
+    def add_first_guess(x: FloatArray) -> FloatArray:
+        """``x + x0`` in place (``x`` with ``m``, ``s`` interleaved, shape ``(2 npt, dim)``),
+        the first guess made a block of points at a time (:func:`_guess_rows`; ``x + x0``
+        and ``x0 + x`` are the same sums)."""
+        for a in range(0, npt, ONE_SIDED_BLOCK):
+            b = min(a + ONE_SIDED_BLOCK, npt)
+            m0, s0 = _guess_rows(h, pts, a, b, periodic)
+            x[2 * a:2 * b:2] += m0
+            x[2 * a + 1:2 * b:2] += s0
+        return x
+
     rp = np.r_[1:npt, 0] if periodic else np.arange(1, npt)
     r5 = np.empty((h.size, dim)) if nak_any else None
-    x0_ends: dict[int, FloatArray] = {}
+    # the first guess's end rows (m, s at the first and the last distinct point)
+    (m_a, s_a), (m_b, s_b) = (_guess_rows(h, pts, 0, 1, periodic),
+                              _guess_rows(h, pts, npt - 1, npt, periodic))
+    x0_ends = {0: m_a[0], 1: s_a[0], M - 2: m_b[0], M - 1: s_b[0]}
 
     def residual() -> FloatArray:
         """``f - K x0`` per point (-jump(r''''), jump(r''')), shape ``(2 npt, dim)``,
         Fortran-ordered (filled through an ``(npt, 2, dim)`` view of coordinate-major memory):
         LAPACK solves it in place, no copy of it beside the band. The one-sided derivatives
         are made for a block of segments at a time (elementwise: the same values; an entry's
-        two terms added to 0 in either order give the same sum); ``r^(5)`` (into ``r5``) for
-        a not-a-knot end only; the first guess's end rows into ``x0_ends``. The first guess
-        itself is not kept: it is made again after the solve."""
-        x0 = first_guess()
-        x0_ends.update({u: x0[u].copy() for u in (0, 1, M - 2, M - 1)})
+        two terms added to 0 in either order give the same sum), and so is the first guess
+        of the block's points (:func:`_guess_rows`); ``r^(5)`` (into ``r5``) for a
+        not-a-knot end only. The first guess is never whole: it is made again, block by
+        block, after the solve."""
         res_t = np.zeros((dim, npt, 2))
         res: FloatArray = res_t.transpose(1, 2, 0)
-        m0, s0 = x0[0::2], x0[1::2]
-        if periodic:
-            m0, s0 = np.vstack([m0, m0[:1]]), np.vstack([s0, s0[:1]])
         for a in range(0, h.size, ONE_SIDED_BLOCK):
             b = min(a + ONE_SIDED_BLOCK, h.size)
             delta = pts[a + 1:b + 1] - pts[a:b]  # (np.diff's rows a .. b-1)
-            r3l, r4l, r3r, r4r, r5b = _one_sided(h[a:b], delta, m0[a:b + 1], s0[a:b + 1])
+            # points a .. b (a periodic curve's point npt is point 0)
+            m0, s0 = _guess_rows(h, pts, a, b + 1, periodic)
+            r3l, r4l, r3r, r4r, r5b = _one_sided(h[a:b], delta, m0, s0)
             res[a:b, 0] -= r4l
             res[rp[a:b], 0] += r4r
             res[a:b, 1] += r3l
@@ -460,10 +496,13 @@ def quintic_hermite_data(pts: FloatArray, t: FloatArray, left: Any, right: Any,
         # Woodbury: A^-1 f = y0 - Z (I + Ks E^T Z)^-1 Ks E^T y0
         y = y0 - Z @ np.linalg.solve(np.eye(4) + Ks @ Z[idx], Ks @ y0[idx])
         del Y, y0, Z
-        x = first_guess()
-        x += y * dsc[:, None]
-        x = np.vstack([x, x[:2]])
-        return x[0::2] / hbar, x[1::2] / hbar**2
+        y *= dsc[:, None]
+        x = add_first_guess(y)
+        d1, d2 = np.empty((n, dim)), np.empty((n, dim))  # the last point repeats the first
+        d1[:npt] = x[0::2] / hbar
+        d2[:npt] = x[1::2] / hbar**2
+        d1[npt], d2[npt] = d1[0], d2[0]
+        return d1, d2
     nak = (left == "not-a-knot", right == "not-a-knot")
     # r''' and r'''' given at both ends (natural-type ends)
     natural = not (nak[0] or nak[1]) and all(o in (3, 4) for o, _ in [*left, *right])
@@ -474,8 +513,8 @@ def quintic_hermite_data(pts: FloatArray, t: FloatArray, left: Any, right: Any,
         if any(np.any(np.asarray(v) != 0) for _, v in [*left, *right]):
             raise InputError("two points with r''' and r'''' given at both ends do not "
                              "determine a quintic")
-        x = first_guess()
-        return x[0::2] / hbar, x[1::2] / hbar**2
+        m0, s0 = _guess_rows(h, pts, 0, 2, False)
+        return m0 / hbar, s0 / hbar**2
     lo = 6 if nak[1] else 3
     up = 6 if nak[0] else 3
 
@@ -532,8 +571,7 @@ def quintic_hermite_data(pts: FloatArray, t: FloatArray, left: Any, right: Any,
         dx = _solve(ab, lo, up, F)
         del ab, F  # (the band, before the correction is scaled and added)
     dx *= dsc[:, None]
-    x = first_guess()
-    x += dx  # x0 + dx in place: the same sums
+    x = add_first_guess(dx)  # x0 + dx in place: the same sums
     return x[0::2] / hbar, x[1::2] / hbar**2
 
 
