@@ -120,8 +120,10 @@ def test_long_summary_rescans_the_signs_block_by_block(monkeypatch, block, par_m
     # from RESCAN_MIN segments on (forced to 2 here) the summary keeps no samples: the sign
     # counts come from a second pass, scanned block by block (blocks of one segment: every
     # change between two segments is one between blocks) on one thread and on two. The
-    # counts are analyze()'s (which scans the kept samples), for curves of size 1, 1e-15 and
-    # 1e25 (the samples' unit scales the zero bands), and the other figures unchanged
+    # counts are analyze()'s (which scans the kept samples), for open planar curves whose
+    # segment forms are made block by block, closed ones (the seam counted once) and twisted
+    # 3-D ones (the whole power form), of size 1, 1e-15 and 1e25 (the samples' unit scales
+    # the zero bands), and the other figures unchanged
     calls = []
     real = _sampling.rescan_sign_counts
     monkeypatch.setattr(_analyze_mod, "rescan_sign_counts",
@@ -136,12 +138,20 @@ def test_long_summary_rescans_the_signs_block_by_block(monkeypatch, block, par_m
         for n in (4, 5, 60, 301, 2000):
             for scale in (1.0, 1e-15, 1e25):
                 P = _wiggly(n, rng, scale)
+                a = np.linspace(0.0, 2.0 * np.pi, n + 1)
+                ring = scale * np.c_[np.cos(a), 0.5 * np.sin(a)]
+                ring[:-1] += 1e-4 * scale * rng.normal(size=(n, 2))
+                ring[-1] = ring[0]
+                space = np.c_[P, scale * np.sin(np.linspace(0.0, 9.0, n))]
                 for c in (cf.interpolate_cubic(P), cf.interpolate_quintic(P),
-                          cf.interpolate_bspline(P)):
+                          cf.interpolate_bspline(P),
+                          cf.interpolate_cubic(ring, "chord", "periodic"),
+                          cf.interpolate_bspline(ring[:-1], closed=True),
+                          cf.interpolate_cubic(space), cf.interpolate_quintic(space)):
                     ref = _figures(cf.analyze(c))
                     got = fairness_figures(c)
                     assert got == ref, (n, scale, type(c).__name__)
                     cases += 1
                     changes += ref["inflections"] + ref["extrema"]
     assert len(calls) == cases
-    assert changes > 1000
+    assert changes > 3000

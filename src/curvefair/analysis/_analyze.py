@@ -388,19 +388,20 @@ def _analyze(c: PiecewiseCurve, rtol: float, summary: bool, whole: bool = False
     g = smp.unit
     ell_g, pos_g = smp.ell / g, smp.pos / g
     ex_k, ex_ks = smp.extra
-    if smp.rescan:  # (a summary of a long open curve: no samples kept, see sample_curve)
-        assert summary and forms is not None and sums is not None
-        n_infl, n_ext = rescan_sign_counts(forms, h, planar, smp, ktol, kstol)
-        return {"energy2": e2, "energy3": e3, "max_jump": max_jump, "max_top_jump": max_top,
-                "sapidis_sum": sap, "dkds_energy": float(smp.dkds_energy),
-                "inflections": int(n_infl), "extrema": int(n_ext)}
-    if planar:
-        n_infl, infl_at = scan_sign_changes(kap, smp.x, breaks, (ex_k[0], ex_k[1], ex_k[2] * g),
-                                            ktol * g, closed, ell_g, pos_g, 1)
+    if smp.rescan:  # (a long curve's summary: no samples kept, see sample_curve)
+        assert summary
+        n_infl, n_ext = rescan_sign_counts(cw, h, breaks, planar, closed, smp, ktol, kstol)
+        infl_at = ext_at = np.zeros(0)
     else:
-        n_infl, infl_at = 0, np.zeros(0)
-    n_ext, ext_at = scan_sign_changes(dks, smp.x, breaks, (ex_ks[0], ex_ks[1], ex_ks[2] * g * g),
-                                      kstol * g * g, closed, ell_g, pos_g, 2)
+        if planar:
+            n_infl, infl_at = scan_sign_changes(kap, smp.x, breaks,
+                                                (ex_k[0], ex_k[1], ex_k[2] * g), ktol * g,
+                                                closed, ell_g, pos_g, 1)
+        else:
+            n_infl, infl_at = 0, np.zeros(0)
+        n_ext, ext_at = scan_sign_changes(dks, smp.x, breaks,
+                                          (ex_ks[0], ex_ks[1], ex_ks[2] * g * g),
+                                          kstol * g * g, closed, ell_g, pos_g, 2)
 
     if summary:
         # the sum of the column where the pass wrote it: numpy's pairwise summation runs

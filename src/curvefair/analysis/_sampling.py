@@ -56,9 +56,8 @@ _MAX_LEVELS = 40
 PAR_MIN = 50_000
 #: segments per block of a ``sums_only`` pass (:func:`sample_curve`)
 STREAM_BLOCK = 65_536
-#: Segments: from this many on, a ``sums_only`` pass of an open curve whose forms are made
-#: range by range keeps no samples; the sign counts sample it again
-#: (:func:`rescan_sign_counts`).
+#: Segments: from this many on, a ``sums_only`` pass keeps no samples; the sign counts sample
+#: the curve again (:func:`rescan_sign_counts`).
 RESCAN_MIN = 1 << 21
 
 # Gander & Gautschi (2000): 4-point Gauss-Lobatto and 7-point Kronrod extension on [-1, 1]
@@ -357,10 +356,11 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
     made, in numpy's pairwise order (:mod:`curvefair._kernels.pairwise`): ``Samples.sums``
     then holds ``np.sum`` of each energy column, ``np.sum`` of the Sapidis measure at the
     interior breakpoints and the largest jumps there, the same bits as those of the arrays
-    (``knots`` and ``energies`` are then empty). From :data:`RESCAN_MIN` segments on, such a
-    pass keeps no samples either (``kappa``, ``dkds``, ``ell`` and ``pos``: 2 K float32 and
-    two float64 a segment, 9.5 times the coordinates' bytes for a planar quintic, the
-    analysis' peak at ten million segments): each block writes them in its own rows, and
+    (``knots`` and ``energies`` are then empty). From :data:`RESCAN_MIN` segments on, a
+    ``sums_only`` pass of any curve keeps no samples (``kappa``, ``dkds``, ``ell`` and
+    ``pos``: 2 K float32 and two float64 a segment, 9.5 times the coordinates' bytes for a
+    planar quintic, the analysis' peak at ten million segments): it runs in blocks of
+    ``STREAM_BLOCK`` segments, each writing them in its own rows, and
     :func:`rescan_sign_counts` makes them again block by block once the zero bands (which
     need the whole curve's largest values and size) are known. ``Samples.rescan`` says so.
     """
@@ -375,7 +375,7 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
     forms = cw if isinstance(cw, SpanForms) else None
     unit = _unit(cast(FloatArray, cw)) if forms is None else _unit_of(forms.unit_points)
     stream = sums_only and forms is not None and not closed and m >= 2
-    lean = stream and m >= RESCAN_MIN
+    lean = sums_only and m >= RESCAN_MIN
     if lean:  # (each block's own rows, see blocks())
         kap = dks = np.empty((0, K), dtype=np.float32)
         ell = pos = np.empty(0)
@@ -409,7 +409,7 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
         scratch = m + starts.get(a, 0)
         at = np.full((3, 2), scratch, dtype=np.int64)
         at[:, 0] = 0  # the whole arrays' rows
-        if stream:  # (each block makes its own rows)
+        if stream or lean:  # (each block makes its own rows)
             return blocks(a, b, box, endv, fl, gaps, scratch)
         if forms is None:
             rows, off = cwc, 0
@@ -433,16 +433,20 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
     def blocks(a: int, b: int, box: np.ndarray, endv: np.ndarray, fl: np.ndarray,
                gaps: np.ndarray, scratch: int) -> tuple[int, float, float, np.ndarray,
                                                         np.ndarray, np.ndarray, np.ndarray]:
-        """run() of a range in blocks of STREAM_BLOCK segments (sums_only): each block's
-        jumps and energies in the block's own rows, folded into the leaf sums after its pass.
+        """run() of a range in blocks of STREAM_BLOCK segments (sums_only): if ``stream``,
+        each block's jumps and energies in the block's own rows, folded into the leaf sums
+        after its pass (else in the whole arrays); if ``lean``, its samples in its own rows.
         Every output is what one pass over the range gives (each block re-runs its lead-in
         segment, as a range does: the same values; maxima, counts and boxes combine
         exactly)."""
-        assert forms is not None
         nb = max(min(STREAM_BLOCK, b - a), 1)
-        kb = np.empty((nb + 1, 3))
-        eb = np.empty((nb + 1, 2))
-        at = np.array([[0, scratch], [0, nb], [0, scratch]], dtype=np.int64)
+        if stream:
+            kb = np.empty((nb + 1, 3))
+            eb = np.empty((nb + 1, 2))
+        else:
+            kb, eb = knots, energies
+        at = np.array([[0, scratch], [0, nb if stream else scratch], [0, scratch]],
+                      dtype=np.int64)
         if lean:  # the samples in the block's own rows too
             kap_b = np.empty((nb + 1, K), dtype=np.float32)
             dks_b = np.empty((nb + 1, K), dtype=np.float32)
@@ -451,21 +455,26 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
             at[2, 1] = nb
         else:
             kap_b, dks_b, ell_b, pos_b = kap, dks, ell, pos
-        bufs = np.empty((3, 2, _kp.LEAF))
-        ints = np.zeros((3, 3), dtype=np.int64)
-        fe = np.array([a, a, max(a, 1) - 1], dtype=np.int64)  # first element of each tree
-        ints[:2, 2] = max(int(np.searchsorted(lbe, a, side="right")) - 1, 0)
-        ints[2, 2] = max(int(np.searchsorted(lbs, fe[2], side="right")) - 1, 0)
-        mx = np.full(2, -np.inf)
+        if stream:  # the fold state (see _kp.fold_block)
+            bufs = np.empty((3, 2, _kp.LEAF))
+            ints = np.zeros((3, 3), dtype=np.int64)
+            fe = np.array([a, a, max(a, 1) - 1], dtype=np.int64)  # first element of each tree
+            ints[:2, 2] = max(int(np.searchsorted(lbe, a, side="right")) - 1, 0)
+            ints[2, 2] = max(int(np.searchsorted(lbs, fe[2], side="right")) - 1, 0)
+            mx = np.full(2, -np.inf)
         nsing, maxk, maxks = 0, 0.0, 0.0
         bx = np.empty((2, dim))
         found: list[np.ndarray] = []
         s0 = a
         while True:
             s1 = min(s0 + STREAM_BLOCK, b)
-            off = s0 - 1 if s0 > 0 else 0
-            rows = forms.rows(off, max(s1, off + 1))
-            at[1, 0] = s0
+            if forms is None:
+                rows, off = cast(FloatArray, cwc), 0
+            else:
+                off = s0 - 1 if s0 > 0 else 0
+                rows = forms.rows(off, max(s1, off + 1))
+            if stream:
+                at[1, 0] = s0
             if lean:
                 at[2, 0] = s0
             while True:
@@ -476,7 +485,9 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
                 if ngap <= gaps.shape[0]:
                     break
                 gaps = np.empty((ngap, 3), dtype=np.int64)  # rare: too small; redo the block
-            _kp.fold_block(kb, eb, s1 - s0, s0, lbe, lbs, ls2, ls3, lss, bufs, ints, fe, mx)
+            if stream:
+                _kp.fold_block(kb, eb, s1 - s0, s0, lbe, lbs, ls2, ls3, lss, bufs, ints, fe,
+                               mx)
             nsing += ns
             maxk = max(maxk, mk)
             maxks = max(maxks, mks)
@@ -491,7 +502,8 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
                 break
         if a == 0 and b > 0:
             ksfl[0] = fl[0]
-        folds[(a, b)] = (bufs, ints, fe, mx)  # (ranges may be empty: a == b)
+        if stream:
+            folds[(a, b)] = (bufs, ints, fe, mx)  # (ranges may be empty: a == b)
         return nsing, maxk, maxks, box, np.concatenate(found), endv, fl
 
     parts = _threads.ranges(run, 0, m, _threads.THREADS, PAR_MIN)
@@ -587,10 +599,12 @@ def _stream_sums(folds: dict[tuple[int, int], tuple[np.ndarray, ...]], lbe: np.n
             float(_kp.tree_sum(lss, n)), float(top[0]), float(top[1]))
 
 
-def rescan_sign_counts(forms: SpanForms, h: FloatArray, planar: bool, smp: Samples,
-                       ktol: float, kstol: float) -> tuple[int, int]:
+def rescan_sign_counts(cw: FloatArray | SpanForms, h: FloatArray, breaks: FloatArray,
+                       planar: bool, closed: bool, smp: Samples, ktol: float, kstol: float
+                       ) -> tuple[int, int]:
     """The sign changes of ``kappa`` and ``dkappa/ds`` (:func:`scan_sign_changes`' counts) of
-    an open curve whose :func:`sample_curve` pass kept no samples (``smp.rescan``): the pass
+    a curve whose :func:`sample_curve` pass kept no samples (``smp.rescan``; ``cw``, ``h``,
+    ``breaks`` and ``planar`` as that pass and :func:`scan_sign_changes` had them): the pass
     runs again block by block (``STREAM_BLOCK`` segments, on the sampling's threads), each
     block's samples scanned as they are made with the zero bands ``ktol`` and ``kstol`` and
     the extra samples ``smp.extra`` of the block's segments (all scaled by ``smp.unit`` as
@@ -600,17 +614,20 @@ def rescan_sign_counts(forms: SpanForms, h: FloatArray, planar: bool, smp: Sampl
     compiled pass over the same rows, a block re-running its lead-in segment as a range
     does), a change is counted between two consecutive nonzero samples of opposite sign, and a
     block's scan starts with no sign, so the blocks' counts plus the changes between one
-    block's last nonzero sample and the next one's first add up to the whole sequence's.
-    Costs one more sampling pass; keeps ``4 K + 16`` bytes a segment of a block instead of the
-    whole curve's.
+    block's last nonzero sample and the next one's first add up to the whole sequence's (and
+    on a closed curve one more where the last nonzero sample's sign is not the first's, as
+    :func:`scan_sign_changes` counts the seam). Costs one more sampling pass; keeps the
+    samples (``8 K + 16`` bytes a segment) of a block instead of the whole curve's.
     """
-    m, p1, dim = forms.shape
+    m, p1, dim = cw.shape
     p = p1 - 1
     plan = _plan(p, planar)
     K = plan.K
     fits, subs, nfit, fall = _kernel_tables(p, planar)
     hc = np.ascontiguousarray(h, dtype=np.float64)
-    breaks = np.ascontiguousarray(forms.breaks, dtype=np.float64)
+    bk = np.ascontiguousarray(breaks, dtype=np.float64)
+    forms = cw if isinstance(cw, SpanForms) else None
+    cwc = np.ascontiguousarray(cw, dtype=np.float64) if forms is None else None
     g = smp.unit
     # per quantity: samples' slot, extra samples (segment, u, value scaled as the samples),
     # zero band, power of the rounding band (see scan_sign_changes)
@@ -646,8 +663,11 @@ def rescan_sign_counts(forms: SpanForms, h: FloatArray, planar: bool, smp: Sampl
         s0 = a
         while s0 < b:
             s1 = min(s0 + STREAM_BLOCK, b)
-            off = s0 - 1 if s0 > 0 else 0
-            rows = forms.rows(off, s1)
+            if forms is None:
+                rows, off = cast(FloatArray, cwc), 0
+            else:
+                off = s0 - 1 if s0 > 0 else 0
+                rows = forms.rows(off, s1)
             at[:, 0] = s0
             _k.pass_kernel(rows, hc, plan.x, plan.tab, plan.w7, plan.w4, plan.P, fall, fits,
                            nfit, subs, SPEED_RTOL, CROSS_RTOL, vals[0], vals[1], kb, eb, quad,
@@ -658,7 +678,7 @@ def rescan_sign_counts(forms: SpanForms, h: FloatArray, planar: bool, smp: Sampl
                 if out.shape[0] < ns * K + (hi - lo) + 1:
                     out = np.empty(ns * K + (hi - lo) + 1)
                 n, fs, _, _, ls, _, _ = _k.scan_kernel(
-                    vals[which, :ns], plan.x, breaks[s0:s1 + 1], ex_seg[lo:hi] - s0,
+                    vals[which, :ns], plan.x, bk[s0:s1 + 1], ex_seg[lo:hi] - s0,
                     ex_u[lo:hi], ex_val[lo:hi], tol, ell[:ns] / g, pos[:ns] / g,
                     ROUNDING_FLOOR, power, out)
                 _join(state[which], n, fs, ls)
@@ -669,6 +689,8 @@ def rescan_sign_counts(forms: SpanForms, h: FloatArray, planar: bool, smp: Sampl
     for part in _threads.ranges(run, 0, m, _threads.THREADS, PAR_MIN):
         for which in (0, 1):
             _join(total[which], *part[which])
+    if closed:  # the seam: from the last nonzero sample round to the first
+        total[:, 0] += (total[:, 1] != 0) & (total[:, 2] != total[:, 1])
     return int(total[0, 0]), int(total[1, 0])
 
 
