@@ -114,7 +114,7 @@ def _frenet_node(r1, r2, r3, sc1, sc2, speed_rtol, cross_rtol):
 @njit(cache=True, nogil=True, fastmath=_FM, error_model="numpy", readonly=('cw', 'h'))
 def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cross_rtol,
                 kap, dks, knots, energies, quad, box, ell, pos, gaps, unit,
-                i_lo, i_hi, at, first, endv, ksfl, off):
+                i_lo, i_hi, at, first, endv, ksfl, off, full):
     """One fused pass over the segments (see
     :func:`curvefair.analysis._sampling.sample_curve`).
 
@@ -154,6 +154,11 @@ def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cr
     row ``at[g, 1]``: ``(0, scratch)`` writes the whole arrays (a spare row ``scratch`` past
     ``m`` per range), ``(s0, nb)`` a block's own ``nb + 1`` rows for a block starting at
     segment ``s0``.
+
+    ``full`` False: the samples alone (``kap``, ``dks``, ``ell``, ``pos``, the box and the
+    maxima; for :func:`curvefair.analysis._sampling.rescan_sign_counts`): no energies, jumps,
+    quadratures or gaps. The samples are computed by the same code either way (the parts
+    skipped only read them).
     """
     m = h.shape[0]
     p1 = cw.shape[1]
@@ -210,38 +215,39 @@ def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cr
             if v > box[1, d]:
                 box[1, d] = v
         pos[srow] = np.sqrt(c0n)
-        # exact energies: h int_0^1 |sum_j g_j u^j|^2 du with g_j = fall[j+o, o] e_{j+o} / h^o
-        for o in range(2, 4):
-            acc = 0.0
-            if o <= p:
-                for j in range(p1 - o):
-                    for k in range(p1 - o):
-                        dd = 0.0
-                        for d in range(dim):
-                            dd += e[j + o, d] * e[k + o, d]
-                        acc += dd * fall[j + o, o] * fall[k + o, o] * hilb[j + k]
-                acc *= ih2 * ih2 if o == 2 else ih3 * ih3
-            energies[krow, o - 2] = acc * hi
-        # jumps at breakpoint i of the third and the degree-th derivative; then the left
-        # limits at this segment's end for breakpoint i + 1
-        for slot in range(2):
-            nu = 3 if slot == 0 else p
-            ihn = 1.0
-            for _ in range(nu):
-                ihn *= ih
-            jj = 0.0
-            for d in range(dim):
-                right = fall[nu, nu] * cw[i - off, nu, d] if nu <= p else 0.0
-                if i == 0:
-                    first[slot, d] = right
-                diff = right - endv[slot, d]
-                jj += diff * diff
+        if full:  # (not read by the samples)
+            # exact energies: h int_0^1 |sum_j g_j u^j|^2 du with g_j = fall[j+o, o] e_{j+o} / h^o
+            for o in range(2, 4):
                 acc = 0.0
-                if nu <= p:
-                    for j in range(nu, p1):
-                        acc += fall[j, nu] * e[j, d]
-                endv[slot, d] = acc * ihn
-            knots[krow, slot] = np.sqrt(jj) if i > 0 else 0.0
+                if o <= p:
+                    for j in range(p1 - o):
+                        for k in range(p1 - o):
+                            dd = 0.0
+                            for d in range(dim):
+                                dd += e[j + o, d] * e[k + o, d]
+                            acc += dd * fall[j + o, o] * fall[k + o, o] * hilb[j + k]
+                    acc *= ih2 * ih2 if o == 2 else ih3 * ih3
+                energies[krow, o - 2] = acc * hi
+            # jumps at breakpoint i of the third and the degree-th derivative; then the left
+            # limits at this segment's end for breakpoint i + 1
+            for slot in range(2):
+                nu = 3 if slot == 0 else p
+                ihn = 1.0
+                for _ in range(nu):
+                    ihn *= ih
+                jj = 0.0
+                for d in range(dim):
+                    right = fall[nu, nu] * cw[i - off, nu, d] if nu <= p else 0.0
+                    if i == 0:
+                        first[slot, d] = right
+                    diff = right - endv[slot, d]
+                    jj += diff * diff
+                    acc = 0.0
+                    if nu <= p:
+                        for j in range(nu, p1):
+                            acc += fall[j, nu] * e[j, d]
+                    endv[slot, d] = acc * ihn
+                knots[krow, slot] = np.sqrt(jj) if i > 0 else 0.0
         if p1 == 4:  # cubic: derivative polynomials in u written out (the common case)
             for d in range(dim):
                 c1[d] = e[1, d] * ih
@@ -323,35 +329,36 @@ def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cr
                     maxks = aks
                 fa[qn] = sp
                 fd[qn] = ks * ks * sp
-        # 7-point Kronrod and 4-point Lobatto on each of the P pieces
-        qa = 0.0
-        ea = 0.0
-        qd = 0.0
-        ed = 0.0
-        for k in range(P):
-            a7 = 0.0
-            a4 = 0.0
-            d7 = 0.0
-            d4 = 0.0
-            for j in range(7):
-                a7 += w7[j] * fa[6 * k + j]
-                a4 += w4[j] * fa[6 * k + j]
-                d7 += w7[j] * fd[6 * k + j]
-                d4 += w4[j] * fd[6 * k + j]
-            qa += a7
-            ea += abs(a7 - a4)
-            qd += d7
-            ed += abs(d7 - d4)
-        sw = hi / P
-        quad[row, 0] = qa * sw
-        quad[row, 1] = ea * sw
-        quad[row, 2] = qd * sw
-        quad[row, 3] = ed * sw
-        knots[krow, 2] = abs(ks_start - ks_prev_end) if i > 0 else 0.0
-        if i == 0:
-            ksfl[0] = ks_start
+        if full:
+            # 7-point Kronrod and 4-point Lobatto on each of the P pieces
+            qa = 0.0
+            ea = 0.0
+            qd = 0.0
+            ed = 0.0
+            for k in range(P):
+                a7 = 0.0
+                a4 = 0.0
+                d7 = 0.0
+                d4 = 0.0
+                for j in range(7):
+                    a7 += w7[j] * fa[6 * k + j]
+                    a4 += w4[j] * fa[6 * k + j]
+                    d7 += w7[j] * fd[6 * k + j]
+                    d4 += w4[j] * fd[6 * k + j]
+                qa += a7
+                ea += abs(a7 - a4)
+                qd += d7
+                ed += abs(d7 - d4)
+            sw = hi / P
+            quad[row, 0] = qa * sw
+            quad[row, 1] = ea * sw
+            quad[row, 2] = qd * sw
+            quad[row, 3] = ed * sw
+            knots[krow, 2] = abs(ks_start - ks_prev_end) if i > 0 else 0.0
+            if i == 0:
+                ksfl[0] = ks_start
         ks_prev_end = ks_end
-        if not own:
+        if not own or not full:
             continue  # the range's lead-in segment: its gaps belong to the range before
         # certificate: can a sign change of N (E) hide between two samples?
         for which in range(2):

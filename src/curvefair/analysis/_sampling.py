@@ -422,7 +422,7 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
             nsing, maxk, maxks, ngap = _k.pass_kernel(
                 rows, hc, plan.x, plan.tab, plan.w7, plan.w4, plan.P, fall, fits, nfit, subs,
                 SPEED_RTOL, CROSS_RTOL, kap, dks, knots, energies, quad, box, ell, pos, gaps,
-                unit, a, b, at, first, endv, fl, off)
+                unit, a, b, at, first, endv, fl, off, True)
             if ngap <= gaps.shape[0]:
                 break
             gaps = np.empty((ngap, 3), dtype=np.int64)  # rare: the buffer was too small; redo
@@ -481,7 +481,7 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
                 ns, mk, mks, ngap = _k.pass_kernel(
                     rows, hc, plan.x, plan.tab, plan.w7, plan.w4, plan.P, fall, fits, nfit,
                     subs, SPEED_RTOL, CROSS_RTOL, kap_b, dks_b, kb, eb, quad, bx, ell_b, pos_b,
-                    gaps, unit, s0, s1, at, first, endv, fl, off)
+                    gaps, unit, s0, s1, at, first, endv, fl, off, True)
                 if ngap <= gaps.shape[0]:
                     break
                 gaps = np.empty((ngap, 3), dtype=np.int64)  # rare: too small; redo the block
@@ -616,8 +616,10 @@ def rescan_sign_counts(cw: FloatArray | SpanForms, h: FloatArray, breaks: FloatA
     block's scan starts with no sign, so the blocks' counts plus the changes between one
     block's last nonzero sample and the next one's first add up to the whole sequence's (and
     on a closed curve one more where the last nonzero sample's sign is not the first's, as
-    :func:`scan_sign_changes` counts the seam). Costs one more sampling pass; keeps the
-    samples (``8 K + 16`` bytes a segment) of a block instead of the whole curve's.
+    :func:`scan_sign_changes` counts the seam). Costs one more pass over the segments' forms
+    and samples (without the energies, jumps, quadratures and gap certificates: ``full``
+    off); keeps the samples (``8 K + 16`` bytes a segment) of a block instead of the whole
+    curve's.
     """
     m, p1, dim = cw.shape
     p = p1 - 1
@@ -657,7 +659,7 @@ def rescan_sign_counts(cw: FloatArray | SpanForms, h: FloatArray, breaks: FloatA
         endv = np.empty((2, dim))
         first = np.zeros((2, dim))
         fl = np.zeros(2)
-        gaps = np.empty((1 << 12, 3), dtype=np.int64)  # (not read: the first pass has them)
+        gaps = np.empty((0, 3), dtype=np.int64)  # (none found: the first pass has them)
         at = np.full((3, 2), nb, dtype=np.int64)
         out = np.empty(nb * K + 1)
         s0 = a
@@ -671,7 +673,7 @@ def rescan_sign_counts(cw: FloatArray | SpanForms, h: FloatArray, breaks: FloatA
             at[:, 0] = s0
             _k.pass_kernel(rows, hc, plan.x, plan.tab, plan.w7, plan.w4, plan.P, fall, fits,
                            nfit, subs, SPEED_RTOL, CROSS_RTOL, vals[0], vals[1], kb, eb, quad,
-                           box, ell, pos, gaps, g, s0, s1, at, first, endv, fl, off)
+                           box, ell, pos, gaps, g, s0, s1, at, first, endv, fl, off, False)
             ns = s1 - s0
             for which, ex_seg, ex_u, ex_val, tol, power in quantities:
                 lo, hi = np.searchsorted(ex_seg, (s0, s1))
