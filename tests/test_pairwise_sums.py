@@ -155,3 +155,36 @@ def test_long_summary_rescans_the_signs_block_by_block(monkeypatch, block, par_m
                     changes += ref["inflections"] + ref["extrema"]
     assert len(calls) == cases
     assert changes > 3000
+
+
+@pytest.mark.parametrize("par_min", [2, 7, 50_000])
+def test_summary_counts_in_ranges_are_the_scans(monkeypatch, par_min):
+    # below RESCAN_MIN the summary counts the kept samples' sign changes in ranges on two
+    # threads, joined at the ranges' ends (and a closed curve's seam): analyze()'s counts,
+    # which one sequential scan makes, for open, closed, planar and twisted curves of
+    # 4-3000 points (ranges of a few segments: changes between every two ranges)
+    monkeypatch.setattr(_sampling, "PAR_MIN", par_min)
+    calls = []
+    real = _sampling.count_sign_changes
+    monkeypatch.setattr(_analyze_mod, "count_sign_changes",
+                        lambda *a: calls.append(1) or real(*a))
+    rng = np.random.default_rng(par_min)
+    changes = 0
+    for threads in (1, 2):
+        monkeypatch.setattr(_threads, "THREADS", threads)
+        for n in (4, 9, 40, 3000):
+            P = _wiggly(n, rng, 1.0)
+            a = np.linspace(0.0, 2.0 * np.pi, n + 1)
+            ring = np.c_[np.cos(a), 0.5 * np.sin(a)]
+            ring[:-1] += 1e-3 * rng.normal(size=(n, 2))
+            ring[-1] = ring[0]
+            space = np.c_[P, np.sin(np.linspace(0.0, 9.0, n))]
+            for c in (cf.interpolate_cubic(P), cf.interpolate_quintic(P),
+                      cf.interpolate_bspline(P), cf.interpolate_cubic(ring, "chord", "periodic"),
+                      cf.interpolate_bspline(ring[:-1], closed=True),
+                      cf.interpolate_quintic(space)):
+                ref = cf.analyze(c)
+                got = fairness_figures(c)
+                assert (got["inflections"], got["extrema"]) == (ref.inflections, ref.extrema)
+                changes += ref.inflections + ref.extrema
+    assert changes > 1000 and len(calls) > 40

@@ -657,7 +657,7 @@ def refine_kernel(cw, seg, h, quad, rtol, tot, thresh, P, xk, w7, fall, speed_rt
     return used
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, nogil=True, error_model="numpy")
 def scan_kernel(vals, x, breaks, ex_seg, ex_u, ex_val, tol, ell, pos, floor, power,
                 out):
     """The sign changes of :func:`curvefair.analysis._sampling.scan_sign_changes` in one pass:

@@ -15,7 +15,14 @@ from ..curves.piecewise import PiecewiseCurve, readonly
 from ..interop import as_curve
 from ._core import bounding_diagonal, check_curve, falling, fields_to_dict
 from ._energy import segment_energies
-from ._sampling import QUAD_RTOL, SpanForms, rescan_sign_counts, sample_curve, scan_sign_changes
+from ._sampling import (
+    QUAD_RTOL,
+    SpanForms,
+    count_sign_changes,
+    rescan_sign_counts,
+    sample_curve,
+    scan_sign_changes,
+)
 
 __all__ = ["Analysis", "analyze", "fairness_figures", "derivative_jumps", "ZERO_RTOL",
            "PLANAR_RTOL"]
@@ -391,6 +398,12 @@ def _analyze(c: PiecewiseCurve, rtol: float, summary: bool, whole: bool = False
     if smp.rescan:  # (a long curve's summary: no samples kept, see sample_curve)
         assert summary
         n_infl, n_ext = rescan_sign_counts(cw, h, breaks, planar, closed, smp, ktol, kstol)
+        infl_at = ext_at = np.zeros(0)
+    elif summary:  # the counts alone (in ranges on the sampling's threads)
+        n_infl = count_sign_changes(kap, smp.x, breaks, (ex_k[0], ex_k[1], ex_k[2] * g),
+                                    ktol * g, closed, ell_g, pos_g, 1) if planar else 0
+        n_ext = count_sign_changes(dks, smp.x, breaks, (ex_ks[0], ex_ks[1], ex_ks[2] * g * g),
+                                   kstol * g * g, closed, ell_g, pos_g, 2)
         infl_at = ext_at = np.zeros(0)
     else:
         if planar:

@@ -37,7 +37,8 @@ from ._core import CROSS_RTOL, SPEED_RTOL, derivs_at, falling, frenet
 if TYPE_CHECKING:
     from ..curves.hermite import HermiteSpline
 
-__all__ = ["Samples", "sample_curve", "scan_sign_changes", "rescan_sign_counts", "QUAD_RTOL"]
+__all__ = ["Samples", "sample_curve", "scan_sign_changes", "count_sign_changes",
+           "rescan_sign_counts", "QUAD_RTOL"]
 
 #: Rounding level of curvature-type quantities computed from floating-point spline data: on a
 #: segment of length scale ``ell`` starting at distance ``pos`` from the origin, the
@@ -694,6 +695,43 @@ def rescan_sign_counts(cw: FloatArray | SpanForms, h: FloatArray, breaks: FloatA
     if closed:  # the seam: from the last nonzero sample round to the first
         total[:, 0] += (total[:, 1] != 0) & (total[:, 2] != total[:, 1])
     return int(total[0, 0]), int(total[1, 0])
+
+
+def count_sign_changes(vals: np.ndarray, x: FloatArray, breaks: FloatArray,
+                       extra: tuple[np.ndarray, FloatArray, FloatArray], tol: float,
+                       closed: bool, ell: FloatArray, pos: FloatArray, power: int) -> int:
+    """The count of :func:`scan_sign_changes` alone (the same arguments), its segments
+    scanned in ranges on the sampling's threads (from ``PAR_MIN`` segments) and joined as
+    :func:`rescan_sign_counts` joins its blocks: the same count (a change is counted between
+    two consecutive nonzero samples of opposite sign, whichever range they are in)."""
+    m = vals.shape[0]
+    K = vals.shape[1]
+    ex_seg = np.ascontiguousarray(extra[0], dtype=np.int64)
+    ex_u = np.ascontiguousarray(extra[1])
+    ex_val = np.ascontiguousarray(extra[2])
+    bk = np.ascontiguousarray(breaks, dtype=np.float64)
+    v = np.ascontiguousarray(vals)
+    el = np.ascontiguousarray(ell)
+    ps = np.ascontiguousarray(pos)
+
+    def run(a: int, b: int) -> np.ndarray:
+        state = np.zeros(3, dtype=np.int64)
+        if a >= b:
+            return state
+        lo, hi = np.searchsorted(ex_seg, (a, b))
+        out = np.empty((b - a) * K + (hi - lo) + 1)  # (pages written only at changes)
+        n, fs, _, _, ls, _, _ = _k.scan_kernel(
+            v[a:b], x, bk[a:b + 1], ex_seg[lo:hi] - a, ex_u[lo:hi], ex_val[lo:hi],
+            float(tol), el[a:b], ps[a:b], ROUNDING_FLOOR, int(power), out)
+        _join(state, n, fs, ls)
+        return state
+
+    total = np.zeros(3, dtype=np.int64)
+    for part in _threads.ranges(run, 0, m, _threads.THREADS, PAR_MIN):
+        _join(total, *part)
+    if closed and total[1] != 0 and total[2] != total[1]:  # the seam
+        total[0] += 1
+    return int(total[0])
 
 
 def _join(state: np.ndarray, n: int, fs: int, ls: int) -> None:
