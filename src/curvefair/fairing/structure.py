@@ -108,17 +108,17 @@ def fair_new_structure(curve: BSplineCurve, method: str | None, tol: float | Non
         res = fair_fn(curve, method, tol=tol, **kw)
         removed, dev = 0, float(res.report["max_deviation"])
     rep = dict(res.report)
-    from ..analysis import analyze
+    from ..analysis import fairness_figures
 
-    a = analyze(curve)
+    a = fairness_figures(curve)  # (the counts alone: analyze()'s, without its arrays)
     rep["structure"] = {
         "kept": removed == 0, "knots_removed": int(removed),
         "n_ctrl_before": int(curve.n_ctrl), "n_ctrl_after": int(res.curve.n_ctrl),
         "reduction_deviation": d_a, "deviation_upper_bound": dev,
         "note": "moved/max_point_displacement compare with the reduced curve; "
                 "extrema/inflections before are the input's"}
-    rep["extrema_before"] = int(a.extrema)
-    rep["inflections_before"] = int(a.inflections)
+    rep["extrema_before"] = int(a["extrema"])
+    rep["inflections_before"] = int(a["inflections"])
     rep["max_deviation_upper_bound"] = dev
     rep["tol"] = tol
     return FairingResult(res.curve, FairingReport(rep), res.history, curve)
