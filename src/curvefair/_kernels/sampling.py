@@ -359,7 +359,8 @@ def pass_kernel(cw, h, x, tab, w7, w4, P, fall, fits, nfit, subs, speed_rtol, cr
                 ksfl[0] = ks_start
         ks_prev_end = ks_end
         if not own or not full:
-            continue  # the range's lead-in segment: its gaps belong to the range before
+            continue  # a range's lead-in segment (its gaps belong to the range before), or
+            # the samples alone
         # certificate: can a sign change of N (E) hide between two samples?
         for which in range(2):
             nb = nfit[which]

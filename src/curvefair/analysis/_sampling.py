@@ -408,10 +408,10 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
         fl = np.zeros(2)
         gaps = np.empty((max(1 << 12, (b - a) // 4), 3), dtype=np.int64)
         scratch = m + starts.get(a, 0)
-        at = np.full((3, 2), scratch, dtype=np.int64)
-        at[:, 0] = 0  # the whole arrays' rows
         if stream or lean:  # (each block makes its own rows)
             return blocks(a, b, box, endv, fl, gaps, scratch)
+        at = np.full((3, 2), scratch, dtype=np.int64)
+        at[:, 0] = 0  # the whole arrays' rows
         if forms is None:
             rows, off = cwc, 0
         else:  # the range's own rows, its lead-in segment first
@@ -662,7 +662,6 @@ def rescan_sign_counts(cw: FloatArray | SpanForms, h: FloatArray, breaks: FloatA
         fl = np.zeros(2)
         gaps = np.empty((0, 3), dtype=np.int64)  # (none found: the first pass has them)
         at = np.full((3, 2), nb, dtype=np.int64)
-        out = np.empty(nb * K + 1)
         s0 = a
         while s0 < b:
             s1 = min(s0 + STREAM_BLOCK, b)
@@ -677,14 +676,8 @@ def rescan_sign_counts(cw: FloatArray | SpanForms, h: FloatArray, breaks: FloatA
                            box, ell, pos, gaps, g, s0, s1, at, first, endv, fl, off, False)
             ns = s1 - s0
             for which, ex_seg, ex_u, ex_val, tol, power in quantities:
-                lo, hi = np.searchsorted(ex_seg, (s0, s1))
-                if out.shape[0] < ns * K + (hi - lo) + 1:
-                    out = np.empty(ns * K + (hi - lo) + 1)
-                n, fs, _, _, ls, _, _ = _k.scan_kernel(
-                    vals[which, :ns], plan.x, bk[s0:s1 + 1], ex_seg[lo:hi] - s0,
-                    ex_u[lo:hi], ex_val[lo:hi], tol, ell[:ns] / g, pos[:ns] / g,
-                    ROUNDING_FLOOR, power, out)
-                _join(state[which], n, fs, ls)
+                _scan_stretch(state[which], vals[which, :ns], plan.x, bk[s0:s1 + 1], s0,
+                              (ex_seg, ex_u, ex_val), tol, ell[:ns] / g, pos[:ns] / g, power)
             s0 = s1
         return state
 
@@ -692,8 +685,8 @@ def rescan_sign_counts(cw: FloatArray | SpanForms, h: FloatArray, breaks: FloatA
     for part in _threads.ranges(run, 0, m, _threads.THREADS, PAR_MIN):
         for which in (0, 1):
             _join(total[which], *part[which])
-    if closed:  # the seam: from the last nonzero sample round to the first
-        total[:, 0] += (total[:, 1] != 0) & (total[:, 2] != total[:, 1])
+    if closed:
+        _join_seam(total)
     return int(total[0, 0]), int(total[1, 0])
 
 
@@ -704,11 +697,8 @@ def count_sign_changes(vals: np.ndarray, x: FloatArray, breaks: FloatArray,
     scanned in ranges on the sampling's threads (from ``PAR_MIN`` segments) and joined as
     :func:`rescan_sign_counts` joins its blocks: the same count (a change is counted between
     two consecutive nonzero samples of opposite sign, whichever range they are in)."""
-    m = vals.shape[0]
-    K = vals.shape[1]
-    ex_seg = np.ascontiguousarray(extra[0], dtype=np.int64)
-    ex_u = np.ascontiguousarray(extra[1])
-    ex_val = np.ascontiguousarray(extra[2])
+    ex = (np.ascontiguousarray(extra[0], dtype=np.int64), np.ascontiguousarray(extra[1]),
+          np.ascontiguousarray(extra[2]))
     bk = np.ascontiguousarray(breaks, dtype=np.float64)
     v = np.ascontiguousarray(vals)
     el = np.ascontiguousarray(ell)
@@ -716,22 +706,40 @@ def count_sign_changes(vals: np.ndarray, x: FloatArray, breaks: FloatArray,
 
     def run(a: int, b: int) -> np.ndarray:
         state = np.zeros(3, dtype=np.int64)
-        if a >= b:
-            return state
-        lo, hi = np.searchsorted(ex_seg, (a, b))
-        out = np.empty((b - a) * K + (hi - lo) + 1)  # (pages written only at changes)
-        n, fs, _, _, ls, _, _ = _k.scan_kernel(
-            v[a:b], x, bk[a:b + 1], ex_seg[lo:hi] - a, ex_u[lo:hi], ex_val[lo:hi],
-            float(tol), el[a:b], ps[a:b], ROUNDING_FLOOR, int(power), out)
-        _join(state, n, fs, ls)
+        if a < b:
+            _scan_stretch(state, v[a:b], x, bk[a:b + 1], a, ex, float(tol), el[a:b], ps[a:b],
+                          int(power))
         return state
 
     total = np.zeros(3, dtype=np.int64)
-    for part in _threads.ranges(run, 0, m, _threads.THREADS, PAR_MIN):
+    for part in _threads.ranges(run, 0, v.shape[0], _threads.THREADS, PAR_MIN):
         _join(total, *part)
-    if closed and total[1] != 0 and total[2] != total[1]:  # the seam
-        total[0] += 1
+    if closed:
+        _join_seam(total)
     return int(total[0])
+
+
+def _scan_stretch(state: np.ndarray, vals: np.ndarray, x: FloatArray, breaks: FloatArray,
+                  a: int, extra: tuple[np.ndarray, FloatArray, FloatArray], tol: float,
+                  ell: FloatArray, pos: FloatArray, power: int) -> None:
+    """Scan segments ``a .. a + len(vals) - 1`` (``vals``, ``ell``, ``pos`` their rows,
+    ``breaks`` their ``len(vals) + 1`` breaks; ``extra`` the whole curve's sorted extra
+    samples, of which theirs are taken) with :func:`scan_sign_changes`' compiled scan, and
+    append the stretch to ``state`` (:func:`_join`)."""
+    ex_seg, ex_u, ex_val = extra
+    lo, hi = np.searchsorted(ex_seg, (a, a + vals.shape[0]))
+    out = np.empty(vals.size + (hi - lo) + 1)  # (its pages written only at changes)
+    n, fs, _, _, ls, _, _ = _k.scan_kernel(vals, x, breaks, ex_seg[lo:hi] - a, ex_u[lo:hi],
+                                           ex_val[lo:hi], tol, ell, pos, ROUNDING_FLOOR,
+                                           power, out)
+    _join(state, n, fs, ls)
+
+
+def _join_seam(state: np.ndarray) -> None:
+    """A closed curve's seam, in place on the joined ``state`` (``(..., 3)``: changes, first
+    and last nonzero sign): one more change where the last sign is not the first's, as
+    :func:`scan_sign_changes` counts it."""
+    state[..., 0] += (state[..., 1] != 0) & (state[..., 2] != state[..., 1])
 
 
 def _join(state: np.ndarray, n: int, fs: int, ls: int) -> None:
