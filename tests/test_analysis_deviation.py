@@ -234,7 +234,9 @@ def test_matched_hermite_bound_kernel_vs_numpy_and_dense_sampling(dim, closed):
     numpy form to rounding, and bounds |b(t) - a(psi(t))| sampled densely with scipy's
     CubicHermiteSpline on every span (psi maps b's parameters onto a's, point i to point i), up
     to the rounding of evaluating the two curves separately."""
+    from curvefair import _threads
     from curvefair._kernels.deviation import matched_hermite_bound_reference
+    from curvefair.analysis import _deviation as _dev
     from curvefair.analysis import matched_hermite_bound
 
     rng = np.random.default_rng(11 + dim + 7 * closed)
@@ -252,6 +254,10 @@ def test_matched_hermite_bound_kernel_vs_numpy_and_dense_sampling(dim, closed):
             ref = matched_hermite_bound_reference(a, b, pieces)
             assert got.shape == ref.shape == (len(a.params) - 1,)
             np.testing.assert_allclose(got, ref, rtol=1e-13, atol=1e-15 * float(ref.max()))
+            with pytest.MonkeyPatch.context() as mp:  # span ranges on two threads: same bits
+                mp.setattr(_threads, "THREADS", 2)
+                mp.setattr(_dev, "_PAR_MIN", 2)
+                assert matched_hermite_bound(a, b, pieces).tobytes() == got.tobytes()
         fa = CubicHermiteSpline(a.params, a.points, a.tangents)
         fb = CubicHermiteSpline(b.params, b.points, b.tangents)
         bound = matched_hermite_bound(a, b)

@@ -10,14 +10,29 @@ import pytest
 from curvefair._kernels.text import plain_rows_reference, scan_plain_rows
 
 
+@pytest.fixture(params=[False, True], ids=["whole", "halves"])
+def halves(request, monkeypatch):
+    """Long blocks as they run on two threads (cut in two halves from 2 rows on,
+    ``io._text._row_halves``), or whole."""
+    if request.param:
+        from curvefair import _threads
+        from curvefair.io import _text
+
+        monkeypatch.setattr(_threads, "THREADS", 2)
+        monkeypatch.setattr(_text, "_HALVES_MIN_ROWS", 2)
+    return request.param
+
+
 def _scan(text: str, sep: str, width: int):
+    from curvefair.io._text import _scan_rows
+
     buf = np.frombuffer(text.encode("utf-8"), dtype=np.uint8)
     nrows = text.count("\n") + 1
     values = np.empty(nrows * width)
     col_dec = np.zeros(width, dtype=np.int64)
     s0 = np.empty(nrows * width, dtype=np.int64)
     s1 = np.empty(nrows * width, dtype=np.int64)
-    nslow = scan_plain_rows(buf, ord(sep), width, nrows, values, col_dec, s0, s1)
+    nslow = _scan_rows(buf, ord(sep), width, nrows, values, col_dec, s0, s1)
     if nslow < 0:
         return None
     raw = text.encode("utf-8")
@@ -56,7 +71,7 @@ def _number(rng: np.random.Generator) -> str:
 
 @pytest.mark.parametrize("sep", [",", ";", " ", "\t"])
 @pytest.mark.parametrize("width", [2, 3])
-def test_values_and_decimals_are_pythons(sep, width):
+def test_values_and_decimals_are_pythons(sep, width, halves):
     rng = np.random.default_rng(width * 10 + ord(sep))
     rows = [sep.join(_number(rng) for _ in range(width)) for _ in range(3000)]
     text = "\n".join(rows)
@@ -73,13 +88,14 @@ def test_values_and_decimals_are_pythons(sep, width):
                                  "1.0, 2.0", "1e,2.0", "1e+,2.0", "-,2.0", ".,2.0",
                                  "1.0,2.0,", "nan,1.0", "inf,1.0", "1.2.3,4", "--1,2",
                                  "e5,1", "1.0;2.0", "1.0\r,2.0", "1\u00e9,2", "+-1,2", "1e5.0,2"])
-def test_refuses_what_the_reference_refuses(bad):
+def test_refuses_what_the_reference_refuses(bad, halves):
     rng = np.random.default_rng(5)
-    rows = [f"{rng.normal():.6f},{rng.normal():.6f}" for _ in range(50)]
-    rows[20] = bad
-    text = "\n".join(rows)
-    assert plain_rows_reference(text, ",", 2) is None
-    assert _scan(text, ",", 2) is None
+    for where in (20, 24, 25, 49) if halves else (20,):  # (halves: rows 0-24 and 25-49)
+        rows = [f"{rng.normal():.6f},{rng.normal():.6f}" for _ in range(50)]
+        rows[where] = bad
+        text = "\n".join(rows)
+        assert plain_rows_reference(text, ",", 2) is None
+        assert _scan(text, ",", 2) is None
 
 
 def test_last_row_and_row_count():
@@ -96,7 +112,7 @@ def test_last_row_and_row_count():
 
 
 @pytest.mark.parametrize("sep", [",", " ", "\t"])
-def test_block_writer_at_the_fast_paths_edges(tmp_path, monkeypatch, sep):
+def test_block_writer_at_the_fast_paths_edges(tmp_path, monkeypatch, sep, halves):
     """Rows rewritten by the compiled block writer against the row renderer (every row by
     :func:`curvefair.io._text._render_line`), with values at the edges of the writer's exact
     test: decimals at and around ``|v| 10**d = 2**49``, halfway and one-ulp-off decimals,
@@ -136,6 +152,13 @@ def test_block_writer_at_the_fast_paths_edges(tmp_path, monkeypatch, sep):
     fast = lay.render(new)
     monkeypatch.setattr(_text, "_BLOCK_MIN_ROWS", 10 ** 12)
     assert fast == lay.render(new)
+    if halves:  # the halves' texts are also those of the whole block, and their values read
+        monkeypatch.setattr(_text, "_HALVES_MIN_ROWS", 10 ** 12)
+        monkeypatch.setattr(_text, "_BLOCK_MIN_ROWS", 0)
+        assert fast == lay.render(new)
+        lay2 = parse_text(path, header=False, ncols=None)
+        assert lay2.values.tobytes() == lay.values.tobytes()
+        assert lay2.column_decimals == lay.column_decimals
     back = tmp_path / "back.txt"
     back.write_text(fast)
     np.testing.assert_array_equal(parse_text(back, header=False, ncols=None).values, new)
@@ -207,7 +230,8 @@ def test_shortest_form_is_pythons_repr():
 @pytest.mark.parametrize("newline", ["\n", "\r\n", "\r"])
 @pytest.mark.parametrize("final", [True, False])
 @pytest.mark.parametrize("around", [False, True])
-def test_whole_block_render_is_the_row_renderers(tmp_path, monkeypatch, newline, final, around):
+def test_whole_block_render_is_the_row_renderers(tmp_path, monkeypatch, newline, final, around,
+                                                halves):
     """A file whose data rows are one run of plain lines is rendered as one block, unchanged
     rows included, the header and any lines after the data joined around it: the same text as
     the row renderer, for every line ending, with and without a final newline, with comment

@@ -63,6 +63,108 @@ def chord_turns_kernel(p, closed, Lmin, out):
         out[i] = np.degrees(np.arccos(cosv))
 
 
+@njit(cache=True, inline="always")
+def _walk(p, closed, i, k, n_steps, step, lim, Lmin):
+    """Continue :func:`chord_turns_kernel`'s walk from ``i`` at ``k`` (``n_steps`` taken) to the
+    first point at least ``Lmin`` from ``p_i``: ``(k, n_steps, found)`` where it stopped (at the
+    point found, or where an open list's end or the step limit ended the walk). The same
+    distance, computed the same way, as the kernel's walk."""
+    m, dim = p.shape
+    while n_steps < lim:
+        if not closed and (k < 0 or k >= m):
+            return k, n_steps, False
+        kk = k % m
+        d2 = 0.0
+        for c in range(dim):
+            t = p[kk, c] - p[i, c]
+            d2 += t * t
+        if np.sqrt(d2) >= Lmin:
+            return k, n_steps, True
+        k += step
+        n_steps += 1
+    return k, n_steps, False
+
+
+@njit(cache=True, nogil=True)
+def corner_turns_range(p, closed, lengths, out, a, b):
+    """The first part of :func:`curvefair.io._common.corner_turning` on a noisy list, for the
+    points ``a <= i < b`` (independent ranges: two threads): the turns of
+    :func:`chord_turns_kernel` at each of the nondecreasing chord lengths ``lengths``, the
+    smallest of those reached into ``out[i]`` (0 for a point reaching fewer than two, and for
+    an open list's end points). :func:`keep_local_maxima` then keeps one corner per run.
+
+    One walk per direction serves every length: the first point at least ``L2 >= L1`` away is
+    never before the first at least ``L1`` away (every point before that is nearer than
+    ``L1``), so the walk for ``L2`` resumes where the one for ``L1`` stopped, and a walk that
+    ran into an end (or the step limit) for ``L1`` does for ``L2`` too. The angles are those of
+    :func:`chord_turns_kernel` (the same operations), so the result is that of the numpy
+    composition of its calls, bit for bit (tested)."""
+    m, dim = p.shape
+    lim = m // 2 + 1
+    ns = lengths.shape[0]
+    for i in range(a, b):
+        out[i] = 0.0
+        if not closed and (i == 0 or i == m - 1):
+            continue
+        kb = i - 1
+        sb = 1
+        okb = True
+        kf = i + 1
+        sf = 1
+        okf = True
+        best = np.inf
+        reached = 0
+        for s in range(ns):
+            L = lengths[s]
+            if okb:
+                kb, sb, okb = _walk(p, closed, i, kb, sb, -1, lim, L)
+            if okf:
+                kf, sf, okf = _walk(p, closed, i, kf, sf, 1, lim, L)
+            if not (okb and okf):
+                break
+            back = kb % m
+            fwd = kf % m
+            ab = 0.0
+            aa = 0.0
+            bb = 0.0
+            for c in range(dim):
+                u = p[i, c] - p[back, c]
+                w = p[fwd, c] - p[i, c]
+                ab += u * w
+                aa += u * u
+                bb += w * w
+            cosv = ab / (np.sqrt(aa) * np.sqrt(bb))
+            cosv = min(1.0, max(-1.0, cosv))
+            ang = np.degrees(np.arccos(cosv))
+            if ang == ang:  # (NaN: not counted, as the composition's isnan mask)
+                if ang < best:
+                    best = ang
+                reached += 1
+        if reached >= 2:
+            out[i] = best
+
+
+@njit(cache=True)
+def keep_local_maxima(out, closed):
+    """One corner per run of turning neighbours: ``out[i]`` set to 0 unless it is at least
+    both neighbours' (a closed list wraps around, an open list's ends are compared with
+    -1), every comparison with the values on entry (as ``np.roll`` of a copy)."""
+    m = out.shape[0]
+    if m == 0:
+        return
+    first = out[0]
+    prev = out[m - 1] if closed else -1.0
+    for i in range(m):
+        cur = out[i]
+        if i + 1 < m:
+            nxt = out[i + 1]
+        else:
+            nxt = first if closed else -1.0
+        if not (cur >= prev and cur >= nxt):
+            out[i] = 0.0
+        prev = cur
+
+
 def chord_turns_reference(p: FloatArray, closed: bool, Lmin: float) -> FloatArray:
     """:func:`curvefair.io._common._chord_turns` by a plain Python walk (numpy norms and dot
     products per point): the slow reference :func:`chord_turns_kernel` is tested against."""
@@ -175,6 +277,31 @@ def point_checks(p, max_magnitude, eps4):
         if d <= lim:
             return -1, -1, extent, i
     return -1, -1, extent, -1
+
+
+@njit(cache=True)
+def coord_extent(p):
+    """``np.ptp(p, axis=0).max()`` (the largest coordinate range) in one pass over the rows
+    (numpy reduces a column of a C-ordered array with a stride); NaN if any coordinate is
+    NaN, as numpy gives. The same subtractions, so the same bits."""
+    m, dim = p.shape
+    ext = -np.inf
+    for c in range(dim):
+        lo = p[0, c]
+        hi = p[0, c]
+        for i in range(1, m):
+            v = p[i, c]
+            if v != v:
+                return np.nan
+            if v < lo:
+                lo = v
+            if v > hi:
+                hi = v
+        if lo != lo:
+            return np.nan
+        if hi - lo > ext:
+            ext = hi - lo
+    return ext
 
 
 def noise_terms_reference(p: FloatArray, closed: bool) -> tuple[FloatArray, int]:

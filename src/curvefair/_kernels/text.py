@@ -98,6 +98,22 @@ def _piece_ends(buf, pos, sep, c, width, r, nrows):
 
 
 @njit(cache=True)
+def row_start(buf, r):
+    """Byte offset in ``buf`` (rows joined by ``\\n``) of row ``r``'s first byte: just past
+    the ``r``-th newline (0 for row 0), or -1 if ``buf`` has fewer. Where a block is cut in
+    two for two threads (:func:`curvefair.io._text._row_halves`)."""
+    if r == 0:
+        return 0
+    cnt = 0
+    for i in range(buf.shape[0]):
+        if buf[i] == 10:
+            cnt += 1
+            if cnt == r:
+                return i + 1
+    return -1
+
+
+@njit(cache=True, nogil=True)
 def scan_plain_rows(buf, sep, width, nrows, values, col_dec, slow_start, slow_end):
     """Read ``nrows`` rows of ``width`` numbers from ``buf`` (uint8: the rows' text joined by
     ``\\n``, no final newline), every row its numbers joined by the one byte ``sep`` and
@@ -436,7 +452,7 @@ def _exact_at(v, d):
     return 1 if np.rint(x) / POW10[d] == v else 0
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def plain_block_plan(buf, sep, k, m, new, old, col_dec, status, dec_out, tok_start,
                      tok_len, new_len, row_ok, digits):
     """Plan the rewrite of ``m`` rows of ``k`` plain fixed-point numbers (``buf``: the rows
@@ -563,7 +579,7 @@ def _shortest_pieces(short_buf, nshort):
     return start, length
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def plain_block_write(buf, sep, k, m, new, status, dec_out, tok_start, tok_len, new_len,
                       short_buf, nshort, py_buf, py_start, digits):
     """The rows planned by :func:`plain_block_plan`, as bytes joined by ``\\n``: kept tokens

@@ -676,7 +676,12 @@ def matched_hermite_bound(a: Any, b: Any, pieces: int = 4) -> FloatArray:
     pa, pb = (np.ascontiguousarray(c.points, dtype=float) for c in (a, b))
     ta, tb = (np.ascontiguousarray(c.tangents, dtype=float) for c in (a, b))
     out = np.empty(max(len(ua) - 1, 0))
-    _k.matched_bound_kernel(ua, ub, pa, pb, ta, tb, int(pieces), _k.TO_BERNSTEIN, out)
+    q = int(pieces)
+    # span ranges on two threads (each span's bound on its own: the same bits)
+    _threads.ranges(lambda lo, hi: _k.matched_bound_kernel(
+        ua[lo:hi + 1], ub[lo:hi + 1], pa[lo:hi + 1], pb[lo:hi + 1], ta[lo:hi + 1],
+        tb[lo:hi + 1], q, _k.TO_BERNSTEIN, out[lo:hi]), 0, out.shape[0], _threads.THREADS,
+        _PAR_MIN)
     return out
 
 

@@ -17,6 +17,7 @@ import tempfile
 import threading
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 from types import MappingProxyType
 from typing import Any
@@ -24,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from .._kernels import corners as _k
+from .._threads import THREADS, ranges
 from .._typing import ArrayLike, FloatArray
 from .._validate import MAX_MAGNITUDE, MIN_EXTENT
 from ..curves.bspline import BSplineCurve
@@ -570,6 +572,7 @@ _NOISE_ALTERNATION = 0.3
 _NOISE_MAX_REL = 0.01
 _NOISE_CHORDS = 6.0
 _NOISE_SCALES = (1.0, 2.0, 4.0)
+_CORNER_PAR_MIN = 100_000  # points from which the corner search runs on two threads
 
 
 _RAYLEIGH_MEDIAN = float(np.sqrt(2.0 * np.log(2.0)))  # median of a Rayleigh distribution
@@ -600,9 +603,11 @@ def noise_scale(points: FloatArray, closed: bool) -> float:
         if nr == 0:
             return 0.0
         alt = flips / ((m if closed else m - 2) - 1)
+        if alt < _NOISE_ALTERNATION:  # (not noisy: no median or extent needed)
+            return 0.0
         sigma = float(np.median(ratio[:nr])) / 0.6745
-        size = float(np.ptp(q, axis=0).max())
-        if alt < _NOISE_ALTERNATION or not sigma <= _NOISE_MAX_REL * size:
+        size = float(_k.coord_extent(q))
+        if not sigma <= _NOISE_MAX_REL * size:
             return 0.0
         return sigma
     # in space: the same figures with cross products (the normal vector across the chord)
@@ -652,6 +657,26 @@ def corner_turning(points: FloatArray, closed: bool) -> FloatArray:
     be told from noise), and of a run of neighbours turning by the same corner only the one
     turning most keeps its angle.
     """
+    p = np.asarray(points, dtype=float)
+    m = p.shape[0]
+    sigma = noise_scale(p, closed)
+    if sigma == 0.0:
+        return turning_angles(p, closed)
+    # the three lengths' turns (as _chord_turns gives them) and their minimum in one compiled
+    # pass (point ranges on two threads), then the local maxima (corner_turning_reference:
+    # the same by numpy, bit for bit)
+    lengths = np.array([mult * _NOISE_CHORDS * sigma for mult in _NOISE_SCALES])
+    q = np.ascontiguousarray(p)
+    out = np.empty(m)
+    ranges(partial(_k.corner_turns_range, q, bool(closed), lengths, out), 0, m, THREADS,
+           _CORNER_PAR_MIN)
+    _k.keep_local_maxima(out, bool(closed))
+    return out
+
+
+def corner_turning_reference(points: FloatArray, closed: bool) -> FloatArray:
+    """:func:`corner_turning` composed in numpy from :func:`_chord_turns` at each length (the
+    code :func:`curvefair._kernels.corners.corner_turns_kernel` replaced; the tests' reference)."""
     p = np.asarray(points, dtype=float)
     m = p.shape[0]
     sigma = noise_scale(p, closed)

@@ -18,6 +18,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from .. import _threads
 from .._typing import FloatArray
 from ..errors import FileFormatError
 
@@ -532,30 +533,63 @@ def _plain_block_bytes(block: str, sep: str, values: FloatArray, old: FloatArray
     new_len = np.empty(m * k, dtype=np.int64)
     row_ok = np.empty(m, dtype=bool)
     digits = np.empty(m * k, dtype=np.int64)
-    npy = plain_block_plan(buf, ord(sep), k, m, new, was, cols, status, dec, start, length,
-                           new_len, row_ok, digits)
+    sepb = ord(sep)
+    halves = _row_halves(buf, m)
+    if halves is None:
+        npy = plain_block_plan(buf, sepb, k, m, new, was, cols, status, dec, start, length,
+                               new_len, row_ok, digits)
+    else:  # two blocks of rows on two threads (each a block of its own: the same plan)
+        r1, off = halves
+        t1 = r1 * k
+
+        def plan(lo: int, hi: int, b: np.ndarray) -> int:
+            return int(plain_block_plan(b, sepb, k, hi - lo, new[lo * k:hi * k],
+                                        was[lo * k:hi * k], cols, status[lo * k:hi * k],
+                                        dec[lo * k:hi * k], start[lo * k:hi * k],
+                                        length[lo * k:hi * k], new_len[lo * k:hi * k],
+                                        row_ok[lo:hi], digits[lo * k:hi * k]))
+
+        a, b = _on_two_threads(lambda: plan(0, r1, buf[:off - 1]),
+                               lambda: plan(r1, m, buf[off:]))
+        npy = -1 if a < 0 or b < 0 else a + b
+        start[t1:] += off  # (the second block's token starts, from the whole block's start)
     if npy < 0 or not row_ok.any():
         return None
-    short = status == SHORTEST
-    nshort = int(np.count_nonzero(short)) if npy else 0
     # the shortest exact forms (:func:`_shortest`) the kernel did not decide from the repr
     # of their list, cut and trimmed in the kernel; the few values outside the kernel's
-    # exact range by the rule the row renderer follows (:func:`_plain_number`)
-    short_buf = np.frombuffer(repr(new[short].tolist())[1:-1].encode("ascii") if nshort
-                              else b"", dtype=np.uint8)
-    strs: list[str] = []
-    if npy > nshort:
-        raw = buf.tobytes()
-        for t in np.flatnonzero(status == PYTHON).tolist():
-            a = int(start[t])
-            strs.append(_plain_number(float(new[t]), raw[a:a + int(length[t])].decode("ascii"),
-                                      int(cols[t % k])))
-    py_start = np.zeros(len(strs) + 1, dtype=np.int64)
-    py_start[1:] = np.cumsum(np.fromiter(map(len, strs), np.int64, count=len(strs)))
-    py_buf = np.frombuffer("".join(strs).encode("ascii"), dtype=np.uint8)
-    out = plain_block_write(buf, ord(sep), k, m, new, status, dec, start, length, new_len,
-                            short_buf, nshort, py_buf, py_start, digits)
-    return out.tobytes().decode("ascii"), row_ok
+    # exact range by the rule the row renderer follows (:func:`_plain_number`). Written per
+    # block of rows (two blocks on two threads for a long block: its rows' texts joined by
+    # the newline between them, the same bytes)
+    raw = buf.tobytes() if npy else b""
+
+    def inputs(lo: int, hi: int) -> tuple[Any, ...]:
+        tl, th = lo * k, hi * k
+        st = status[tl:th]
+        short = st == SHORTEST
+        nshort = int(np.count_nonzero(short)) if npy else 0
+        short_buf = np.frombuffer(repr(new[tl:th][short].tolist())[1:-1].encode("ascii")
+                                  if nshort else b"", dtype=np.uint8)
+        strs: list[str] = []
+        if npy:
+            for t in (np.flatnonzero(st == PYTHON) + tl).tolist():
+                a = int(start[t])
+                strs.append(_plain_number(float(new[t]),
+                                          raw[a:a + int(length[t])].decode("ascii"),
+                                          int(cols[t % k])))
+        py_start = np.zeros(len(strs) + 1, dtype=np.int64)
+        py_start[1:] = np.cumsum(np.fromiter(map(len, strs), np.int64, count=len(strs)))
+        py_buf = np.frombuffer("".join(strs).encode("ascii"), dtype=np.uint8)
+        return (buf, sepb, k, hi - lo, new[tl:th], st, dec[tl:th], start[tl:th],
+                length[tl:th], new_len[tl:th], short_buf, nshort, py_buf, py_start,
+                digits[tl:th])
+
+    if halves is None:
+        out = plain_block_write(*inputs(0, m)).tobytes()
+    else:
+        a1, a2 = inputs(0, r1), inputs(r1, m)
+        o1, o2 = _on_two_threads(lambda: plain_block_write(*a1), lambda: plain_block_write(*a2))
+        out = b"\n".join((o1.tobytes(), o2.tobytes()))
+    return out.decode("ascii"), row_ok
 
 
 def _split_row(line: str) -> Row | None:
@@ -844,6 +878,65 @@ def parse_text(path: str | os.PathLike[str], *, header: bool = True,
                       col_dec, encoding, values, tuple(leading), notes_from, comma, fortran)
 
 
+_HALVES_MIN_ROWS = 100_000  # rows from which a plain block is scanned / planned in two halves
+
+
+def _row_halves(buf: np.ndarray, nrows: int) -> tuple[int, int] | None:
+    """Where to cut a block of ``nrows`` rows (``buf``: their bytes joined by ``\\n``) in two
+    for two threads: ``(r1, off)``, the first ``r1 = nrows // 2`` rows in ``buf[:off - 1]`` and
+    the others in ``buf[off:]``, each again rows joined by ``\\n`` without a final one; None
+    for one thread, a short block, or a block without that many rows (then the kernel on the
+    whole block says what it is)."""
+    from .._kernels.text import row_start
+
+    if _threads.THREADS < 2 or nrows < _HALVES_MIN_ROWS:
+        return None
+    r1 = nrows // 2
+    off = int(row_start(buf, r1))
+    return (r1, off) if off > 0 else None
+
+
+def _on_two_threads(first: Callable[[], Any], second: Callable[[], Any]) -> tuple[Any, Any]:
+    """``(first(), second())``, ``first`` on the worker thread meanwhile (both ``nogil``
+    compiled work on disjoint outputs)."""
+    fut = _threads.pool().submit(first)
+    try:
+        b = second()
+    finally:
+        a = fut.result()
+    return a, b
+
+
+def _scan_rows(buf: np.ndarray, sep: int, width: int, nrows: int, values: FloatArray,
+               col_dec: np.ndarray, slow_start: np.ndarray, slow_end: np.ndarray) -> int:
+    """:func:`curvefair._kernels.text.scan_plain_rows` over the whole block, a long block in
+    two halves on two threads (:func:`_row_halves`): each half is a block of rows of its
+    own, so the values are the same; the column decimals are the larger of the halves', the
+    numbers left to Python the first half's then the second's (byte ranges in ``buf``)."""
+    from .._kernels.text import scan_plain_rows
+
+    halves = _row_halves(buf, nrows)
+    if halves is None:
+        return int(scan_plain_rows(buf, sep, width, nrows, values, col_dec, slow_start,
+                                   slow_end))
+    r1, off = halves
+    t1 = r1 * width
+    cd2 = np.zeros(width, dtype=np.int64)
+    ss2 = np.empty(values.shape[0] - t1, dtype=np.int64)
+    se2 = np.empty(values.shape[0] - t1, dtype=np.int64)
+    a, b = _on_two_threads(
+        lambda: int(scan_plain_rows(buf[:off - 1], sep, width, r1, values[:t1], col_dec,
+                                    slow_start, slow_end)),
+        lambda: int(scan_plain_rows(buf[off:], sep, width, nrows - r1, values[t1:], cd2,
+                                    ss2, se2)))
+    if a < 0 or b < 0:
+        return -1
+    np.maximum(col_dec, cd2, out=col_dec)
+    slow_start[a:a + b] = ss2[:b] + off
+    slow_end[a:a + b] = se2[:b] + off
+    return a + b
+
+
 def _plain_rows(lines: list[str], start: int, width: int, body: str | None = None,
                 final: bool = False) -> tuple[FloatArray, tuple[int, ...]] | None:
     """The values (row after row) and the largest decimals per column of ``lines[start:]``
@@ -861,8 +954,6 @@ def _plain_rows(lines: list[str], start: int, width: int, body: str | None = Non
     given, is sliced from the block's first line instead of joining the lines again (the
     lines before it are as read: a reader that rewrites lines does not read in bulk); the
     kernel checks the row count either way."""
-    from .._kernels.text import scan_plain_rows
-
     nrows = len(lines) - start
     first = lines[start]
     sep = next((c for c in _PLAIN_SEPS if c in first), None)
@@ -881,7 +972,7 @@ def _plain_rows(lines: list[str], start: int, width: int, body: str | None = Non
     col_dec = np.zeros(width, dtype=np.int64)
     slow_start = np.empty(nrows * width, dtype=np.int64)
     slow_end = np.empty(nrows * width, dtype=np.int64)
-    nslow = scan_plain_rows(buf, ord(sep), width, nrows, values, col_dec, slow_start, slow_end)
+    nslow = _scan_rows(buf, ord(sep), width, nrows, values, col_dec, slow_start, slow_end)
     if nslow < 0:
         return None
     if nslow:  # the kernel's NaN marks them, in order (no NaN is read: "nan" is not a row's)
