@@ -11,6 +11,7 @@ import pytest
 import curvefair as cf
 from curvefair import _threads
 from curvefair._kernels import pairwise as kp
+from curvefair._kernels import sampling as _ksampling
 from curvefair.analysis import _analyze as _analyze_mod
 from curvefair.analysis import _sampling, fairness_figures
 
@@ -123,11 +124,37 @@ def test_long_summary_rescans_the_signs_block_by_block(monkeypatch, block, par_m
     # counts are analyze()'s (which scans the kept samples), for open planar curves whose
     # segment forms are made block by block, closed ones (the seam counted once) and twisted
     # 3-D ones (the whole power form), of size 1, 1e-15 and 1e25 (the samples' unit scales
-    # the zero bands), and the other figures unchanged
+    # the zero bands), and the other figures unchanged. The first pass counts each block's
+    # signs between its gap segments with a band from the block's own largest value and
+    # keeps the gap segments' samples; a block keeps those counts where its least nonzero
+    # value is above the final band (its gap segments then scanned with their extra
+    # samples), else it is sampled again (both happen here: "calm" curves, a line whose tiny
+    # wiggles are nonzero in its own band but zero in the final one, which the tight circle
+    # after it sets, when the circle is in another block)
     calls = []
+    gap_pieces = []  # gap segments scanned with their extra samples at the end
     real = _sampling.rescan_sign_counts
-    monkeypatch.setattr(_analyze_mod, "rescan_sign_counts",
-                        lambda *a: calls.append(1) or real(*a))
+
+    def rescan(*a):
+        calls.append(1)
+        gap_pieces.extend(pc for _, _, pieces in a[5].block_counts for q in pieces for pc in q
+                          if pc[0] == "gap")
+        return real(*a)
+
+    monkeypatch.setattr(_analyze_mod, "rescan_sign_counts", rescan)
+    passes = {True: 0, False: 0}  # sampling passes: first (full) and again (not full)
+    real_pass = _ksampling.pass_kernel
+
+    def spy(*a):
+        passes[bool(a[-1])] += 1
+        return real_pass(*a)
+
+    monkeypatch.setattr(_ksampling, "pass_kernel", spy)
+    lean_blocks = []  # the first pass's blocks (each counts dkappa/ds once)
+    real_count = _ksampling.count_block
+    monkeypatch.setattr(_ksampling, "count_block",
+                        lambda *a: (lean_blocks.append(1) if a[-1] == 2 else None)
+                        or real_count(*a))
     monkeypatch.setattr(_sampling, "STREAM_BLOCK", block)
     monkeypatch.setattr(_sampling, "PAR_MIN", par_min)
     monkeypatch.setattr(_sampling, "RESCAN_MIN", 2)
@@ -143,11 +170,16 @@ def test_long_summary_rescans_the_signs_block_by_block(monkeypatch, block, par_m
                 ring[:-1] += 1e-4 * scale * rng.normal(size=(n, 2))
                 ring[-1] = ring[0]
                 space = np.c_[P, scale * np.sin(np.linspace(0.0, 9.0, n))]
+                t = np.linspace(0.0, 100.0, n)
+                calm = scale * np.c_[t, 1e-12 * np.sin(3.0 * t)]  # |kappa| ~ 1e-11
+                b = np.linspace(0.0, 1.5 * np.pi, 12)[1:]
+                calm = np.r_[calm, calm[-1] + scale * 0.01 * np.c_[np.sin(b), 1.0 - np.cos(b)]]
                 for c in (cf.interpolate_cubic(P), cf.interpolate_quintic(P),
                           cf.interpolate_bspline(P),
                           cf.interpolate_cubic(ring, "chord", "periodic"),
                           cf.interpolate_bspline(ring[:-1], closed=True),
-                          cf.interpolate_cubic(space), cf.interpolate_quintic(space)):
+                          cf.interpolate_cubic(space), cf.interpolate_quintic(space),
+                          cf.interpolate_cubic(calm)):
                     ref = _figures(cf.analyze(c))
                     got = fairness_figures(c)
                     assert got == ref, (n, scale, type(c).__name__)
@@ -155,6 +187,44 @@ def test_long_summary_rescans_the_signs_block_by_block(monkeypatch, block, par_m
                     changes += ref["inflections"] + ref["extrema"]
     assert len(calls) == cases
     assert changes > 3000
+    # blocks kept from the first pass and (short blocks: the calm line's own) sampled again
+    assert passes[False] < 0.8 * len(lean_blocks), (passes, len(lean_blocks))
+    assert passes[False] > 0 or block > 1000
+
+
+@pytest.mark.parametrize("block", [7, 1000, 65_536])
+def test_long_summary_scans_gap_segments_with_their_extra_samples(monkeypatch, block):
+    # a long summary's first pass keeps the samples of the segments whose signs it could not
+    # settle (the gaps that get extra samples afterwards) and counts the stretches between
+    # them; the gap segments are scanned at the end with their extra samples: the counts are
+    # analyze()'s, on quintics through 20,000 noisy samples of two sines (about one segment in
+    # 3,000 has a gap), open, closed and twisted, on one thread and two
+    monkeypatch.setattr(_sampling, "STREAM_BLOCK", block)
+    monkeypatch.setattr(_sampling, "RESCAN_MIN", 2)
+    gap_pieces = []
+    real = _sampling.rescan_sign_counts
+
+    def rescan(*a):
+        gap_pieces.extend(pc for _, _, pieces in a[5].block_counts for q in pieces for pc in q
+                          if pc[0] == "gap")
+        return real(*a)
+
+    monkeypatch.setattr(_analyze_mod, "rescan_sign_counts", rescan)
+    rng = np.random.default_rng(0)
+    t = np.arange(20_000, dtype=float)
+    P = np.c_[t, 20.0 * np.sin(t / 7.0) + 50.0 * np.sin(t / 31.0)]
+    P = P + 0.05 * rng.normal(size=P.shape)
+    a = t / t.size * 2.0 * np.pi
+    ring = 3e3 * np.c_[np.cos(a), np.sin(a)] + P[:, 1:] * [1.0, 0.5]
+    space = np.c_[P, 10.0 * np.cos(t / 11.0)]
+    curves = (cf.interpolate_quintic(P), cf.interpolate_quintic(np.r_[ring, ring[:1]],
+                                                                 bc="periodic"),
+              cf.interpolate_quintic(space))
+    for threads in (1, 2):
+        monkeypatch.setattr(_threads, "THREADS", threads)
+        for c in curves:
+            assert fairness_figures(c) == _figures(cf.analyze(c))
+    assert len(gap_pieces) >= 10
 
 
 @pytest.mark.parametrize("par_min", [2, 7, 50_000])

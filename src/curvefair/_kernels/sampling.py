@@ -658,6 +658,58 @@ def refine_kernel(cw, seg, h, quad, rtol, tot, thresh, P, xk, w7, fall, speed_rt
     return used
 
 
+@njit(cache=True, inline="always")
+def _zero_band(tol, li, pi, floor, power):
+    """The half-width of the zero band of a segment (length ``li``, position ``pi``) in
+    :func:`scan_kernel`: ``max(tol, floor (li + pi) / li**(power + 1))`` (``tol`` alone for a
+    segment of length 0)."""
+    tl = tol
+    if li > 0.0:
+        fl = floor * (li + pi) / (li * li)
+        if power == 2:
+            fl /= li
+        if fl > tl:
+            tl = fl
+    return tl
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def count_block(vals, tol, ell, pos, floor, power):
+    """:func:`scan_kernel`'s count of the samples ``vals`` (m, K) alone, with a zero band
+    ``tol`` that may be lower than the final one (a long summary's first pass, which knows
+    only its block's largest value, see :func:`curvefair.analysis._sampling.sample_curve`):
+    returns ``(changes, first sign, last sign, least)``, ``least`` the smallest ``|v|`` of
+    the samples counted as nonzero (``inf``: none). A count stands for the final band
+    ``tol_f >= tol`` exactly when ``least > tol_f``: a sample classified differently has
+    ``tol < |v| <= tol_f`` (it is above its segment's rounding band, common to both). The
+    segments' extra samples are not merged (a block with any is scanned again)."""
+    m, K = vals.shape
+    n = 0
+    first_s = 0
+    last_s = 0
+    least = np.inf
+    for i in range(m):
+        tl = _zero_band(tol, ell[i], pos[i], floor, power)
+        for q in range(K):
+            v = float(vals[i, q])
+            if v > tl:
+                s = 1
+            elif v < -tl:
+                s = -1
+            else:
+                continue
+            a = abs(v)
+            if a < least:
+                least = a
+            if s != last_s:
+                if last_s == 0:
+                    first_s = s
+                else:
+                    n += 1
+                last_s = s
+    return n, first_s, last_s, least
+
+
 @njit(cache=True, nogil=True, error_model="numpy")
 def scan_kernel(vals, x, breaks, ex_seg, ex_u, ex_val, tol, ell, pos, floor, power,
                 out):
@@ -678,14 +730,7 @@ def scan_kernel(vals, x, breaks, ex_seg, ex_u, ex_val, tol, ell, pos, floor, pow
     first_t = 0.0
     first_v = 0.0
     for i in range(m):
-        tl = tol
-        li = ell[i]
-        if li > 0.0:
-            fl = floor * (li + pos[i]) / (li * li)
-            if power == 2:
-                fl /= li
-            if fl > tl:
-                tl = fl
+        tl = _zero_band(tol, ell[i], pos[i], floor, power)
         while e < ne and ex_seg[e] < i:
             e += 1
         has_extra = e < ne and ex_seg[e] == i

@@ -17,6 +17,7 @@ from ._core import bounding_diagonal, check_curve, falling, fields_to_dict
 from ._energy import segment_energies
 from ._sampling import (
     QUAD_RTOL,
+    ZERO_RTOL,
     SpanForms,
     count_sign_changes,
     rescan_sign_counts,
@@ -27,9 +28,6 @@ from ._sampling import (
 __all__ = ["Analysis", "analyze", "fairness_figures", "derivative_jumps", "ZERO_RTOL",
            "PLANAR_RTOL"]
 
-#: Noise band of the sign counts: ``|kappa| <= ZERO_RTOL * max(max|kappa|, 1/L)`` and
-#: ``|dkappa/ds| <= ZERO_RTOL * max(max|dkappa/ds|, 1/L^2)`` count as zero.
-ZERO_RTOL = 1e-9
 #: A 3-D curve is treated as planar when it deviates from its best plane by at most
 #: ``PLANAR_RTOL * L`` (measured on its power coefficients, see :func:`analyze`).
 PLANAR_RTOL = 1e-9

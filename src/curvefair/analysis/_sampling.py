@@ -23,7 +23,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from functools import lru_cache
 from math import comb
-from typing import TYPE_CHECKING, cast
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
@@ -60,6 +60,10 @@ STREAM_BLOCK = 65_536
 #: Segments: from this many on, a ``sums_only`` pass keeps no samples; the sign counts sample
 #: the curve again (:func:`rescan_sign_counts`).
 RESCAN_MIN = 1 << 21
+#: Noise band of the sign counts: ``|kappa| <= ZERO_RTOL * max(max|kappa|, 1/L)`` and
+#: ``|dkappa/ds| <= ZERO_RTOL * max(max|dkappa/ds|, 1/L^2)`` count as zero (defined here for
+#: the first pass's provisional counts; :mod:`curvefair.analysis` exports it).
+ZERO_RTOL = 1e-9
 
 # Gander & Gautschi (2000): 4-point Gauss-Lobatto and 7-point Kronrod extension on [-1, 1]
 _R23 = float(np.sqrt(2.0 / 3.0))
@@ -193,6 +197,11 @@ class Samples:
     sums: tuple[float, float, float, float, float] | None = None
     # no samples kept (kappa, dkds, ell, pos empty): count the signs by rescan_sign_counts
     rescan: bool = False
+    # with rescan: the first pass's counts per block, in curve order (see sample_curve):
+    # ``(s0, s1, pieces)``, per quantity (kappa, dkds) the block's stretches between its gap
+    # segments, ``(changes, first sign, last sign, least |value| counted nonzero)``, and its
+    # gap segments' samples, ``(segment, samples, ell, pos)``
+    block_counts: list[tuple[int, int, list[list[tuple[Any, ...]]]]] | None = None
 
 
 class SpanForms:
@@ -361,9 +370,12 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
     ``sums_only`` pass of any curve keeps no samples (``kappa``, ``dkds``, ``ell`` and
     ``pos``: 2 K float32 and two float64 a segment, 9.5 times the coordinates' bytes for a
     planar quintic, the analysis' peak at ten million segments): it runs in blocks of
-    ``STREAM_BLOCK`` segments, each writing them in its own rows, and
-    :func:`rescan_sign_counts` makes them again block by block once the zero bands (which
-    need the whole curve's largest values and size) are known. ``Samples.rescan`` says so.
+    ``STREAM_BLOCK`` segments, each writing them in its own rows and counting their sign
+    changes at once (:func:`_first_counts`) with the zero band the block's own largest value
+    gives, which is never above the final one (that needs the whole curve's largest values
+    and size), keeping the samples of its gap segments (which get extra samples later);
+    :func:`rescan_sign_counts` keeps those counts where they hold for the final bands and
+    samples only the other blocks again. ``Samples.rescan`` says so.
     """
     m, p1, dim = cw.shape
     p = p1 - 1
@@ -400,6 +412,7 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
     first = np.zeros((2, dim))  # limits at the start of segment 0 (range 0 writes them)
     ksfl = np.zeros(2)
     starts = {a: q for q, a in enumerate(_threads.bounds(0, m))}
+    block_rows: dict[int, list[Any]] = {}  # lean: each range's blocks' counts
 
     def run(a: int, b: int) -> tuple[int, float, float, np.ndarray, np.ndarray, np.ndarray,
                                      np.ndarray]:
@@ -466,6 +479,7 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
         nsing, maxk, maxks = 0, 0.0, 0.0
         bx = np.empty((2, dim))
         found: list[np.ndarray] = []
+        counted: list[tuple[int, int, list[list[tuple[Any, ...]]]]] = []
         s0 = a
         while True:
             s1 = min(s0 + STREAM_BLOCK, b)
@@ -498,6 +512,9 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
                 np.minimum(box[0], bx[0], out=box[0])
                 np.maximum(box[1], bx[1], out=box[1])
             found.append(gaps[:ngap].copy())
+            if lean:
+                counted.append((s0, s1, _first_counts(kap_b, dks_b, ell_b, pos_b, s0, s1,
+                                                      gaps[:ngap], mk, mks, unit, planar)))
             s0 = s1
             if s0 >= b:
                 break
@@ -505,6 +522,8 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
             ksfl[0] = fl[0]
         if stream:
             folds[(a, b)] = (bufs, ints, fe, mx)  # (ranges may be empty: a == b)
+        if lean and a < b:
+            block_rows[a] = counted
         return nsing, maxk, maxks, box, np.concatenate(found), endv, fl
 
     parts = _threads.ranges(run, 0, m, _threads.THREADS, PAR_MIN)
@@ -556,6 +575,7 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
         segs, us = segs[order], us[order]
         fr = _frenet_at(cw, h, segs, us)
         extra.append((segs, us, fr["kappa"] if which == 0 else fr["dkds"]))
+    block_counts = [r for a in sorted(block_rows) for r in block_rows[a]] if lean else None
     return Samples(x=plan.x, kappa=kap, dkds=dks, arc_length=float(np.sum(quad[:, 0])),
                    dkds_energy=float(np.sum(quad[:, 2])),
                    arc_length_error=float(np.sum(quad[:, 1])),
@@ -563,7 +583,43 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
                    n_singular=int(nsing), max_kappa=float(maxk),
                    max_dkds=float(maxks), knots=knots, energies=energies,
                    diagonal=float(np.sqrt(np.sum((box[1] - box[0]) ** 2))), ell=ell,
-                   pos=pos, extra=(extra[0], extra[1]), unit=unit, sums=sums, rescan=lean)
+                   pos=pos, extra=(extra[0], extra[1]), unit=unit, sums=sums, rescan=lean,
+                   block_counts=block_counts)
+
+
+def _first_counts(kap: np.ndarray, dks: np.ndarray, ell: FloatArray, pos: FloatArray, s0: int,
+                  s1: int, gaps: np.ndarray, max_k: float, max_ks: float, unit: float,
+                  planar: bool) -> list[list[tuple[Any, ...]]]:
+    """A long summary's first-pass counts of the block of segments ``s0 .. s1-1`` (its
+    samples in the rows ``0 .. s1-s0-1`` of ``kap``, ``dks``, ``ell``, ``pos``; ``gaps`` its
+    flagged gaps), per quantity: the stretches between the gap segments (which get extra
+    samples later) counted by :func:`curvefair._kernels.sampling.count_block` with the zero
+    band the final one would be if the block's largest value ``max_k`` / ``max_ks`` were the
+    curve's (the same operations as in :func:`curvefair.analysis._analyze._analyze`: rounding
+    is monotone, so never above the final band), and the gap segments' samples kept for the
+    final scan (:func:`rescan_sign_counts`). Nothing for ``kappa`` of a 3-D curve."""
+    ns = s1 - s0
+    el, ps = ell[:ns] / unit, pos[:ns] / unit
+    out: list[list[tuple[Any, ...]]] = []
+    for which, vals, big, power in ((0, kap, max_k, 1), (1, dks, max_ks, 2)):
+        pieces: list[tuple[Any, ...]] = []
+        out.append(pieces)
+        if which == 0 and not planar:
+            continue
+        tb = ZERO_RTOL * big * unit if power == 1 else ZERO_RTOL * big * unit * unit
+        lo = 0
+        segs = gaps[gaps[:, 0] == which, 1]
+        for g in np.unique(segs[(segs >= s0) & (segs < s1)]).tolist():
+            i = g - s0
+            if i > lo:
+                pieces.append(("stretch", *_k.count_block(vals[lo:i], tb, el[lo:i], ps[lo:i],
+                                                          ROUNDING_FLOOR, power)))
+            pieces.append(("gap", g, vals[i].copy(), float(el[i]), float(ps[i])))
+            lo = i + 1
+        if lo < ns:
+            pieces.append(("stretch", *_k.count_block(vals[lo:ns], tb, el[lo:ns], ps[lo:ns],
+                                                      ROUNDING_FLOOR, power)))
+    return out
 
 
 def _stream_sums(folds: dict[tuple[int, int], tuple[np.ndarray, ...]], lbe: np.ndarray,
@@ -605,11 +661,20 @@ def rescan_sign_counts(cw: FloatArray | SpanForms, h: FloatArray, breaks: FloatA
                        ) -> tuple[int, int]:
     """The sign changes of ``kappa`` and ``dkappa/ds`` (:func:`scan_sign_changes`' counts) of
     a curve whose :func:`sample_curve` pass kept no samples (``smp.rescan``; ``cw``, ``h``,
-    ``breaks`` and ``planar`` as that pass and :func:`scan_sign_changes` had them): the pass
-    runs again block by block (``STREAM_BLOCK`` segments, on the sampling's threads), each
-    block's samples scanned as they are made with the zero bands ``ktol`` and ``kstol`` and
-    the extra samples ``smp.extra`` of the block's segments (all scaled by ``smp.unit`` as
-    :func:`curvefair.analyze` scales them for :func:`scan_sign_changes`); then dropped.
+    ``breaks`` and ``planar`` as that pass and :func:`scan_sign_changes` had them), with the
+    zero bands ``ktol`` and ``kstol`` and the extra samples ``smp.extra`` (all scaled by
+    ``smp.unit`` as :func:`curvefair.analyze` scales them for :func:`scan_sign_changes`).
+
+    The first pass counted each block's stretches between its gap segments with a band no
+    wider than the final one (``smp.block_counts``): a stretch's count holds for the final
+    band exactly when no sample it counted as nonzero lies within that band (a sample
+    classified differently would have ``band_b < |v| <= band``, above its segment's
+    rounding band, which both share), i.e. when its least nonzero ``|v|`` is above it; the
+    block's gap segments are then scanned with their kept samples and extra samples
+    (:func:`_final_counts`). A block with a stretch that does not hold is sampled again
+    (the pass block by block, ``STREAM_BLOCK`` segments, the blocks in ranges on the
+    sampling's threads), its samples scanned as they are made; then dropped. Without
+    ``block_counts`` every block is.
 
     The counts are exactly the whole scan's: the samples are the first pass's bits (the same
     compiled pass over the same rows, a block re-running its lead-in segment as a range
@@ -617,10 +682,10 @@ def rescan_sign_counts(cw: FloatArray | SpanForms, h: FloatArray, breaks: FloatA
     block's scan starts with no sign, so the blocks' counts plus the changes between one
     block's last nonzero sample and the next one's first add up to the whole sequence's (and
     on a closed curve one more where the last nonzero sample's sign is not the first's, as
-    :func:`scan_sign_changes` counts the seam). Costs one more pass over the segments' forms
-    and samples (without the energies, jumps, quadratures and gap certificates: ``full``
-    off); keeps the samples (``8 K + 16`` bytes a segment) of a block instead of the whole
-    curve's.
+    :func:`scan_sign_changes` counts the seam). A block sampled again costs one more pass
+    over its segments' forms and samples (without the energies, jumps, quadratures and gap
+    certificates: ``full`` off); the samples (``8 K + 16`` bytes a segment) of a block are
+    kept instead of the whole curve's.
     """
     m, p1, dim = cw.shape
     p = p1 - 1
@@ -643,6 +708,10 @@ def rescan_sign_counts(cw: FloatArray | SpanForms, h: FloatArray, breaks: FloatA
         quantities.append((which, np.ascontiguousarray(ex[0], dtype=np.int64),
                            np.ascontiguousarray(ex[1]), np.ascontiguousarray(ex[2] * scale),
                            float(tol), power))
+
+    keep = np.zeros(2, dtype=bool)  # the quantities counted (kappa only for a planar curve)
+    for q in quantities:
+        keep[q[0]] = True
 
     def run(a: int, b: int) -> np.ndarray:
         """(n, first sign, last sign) per quantity of segments ``a .. b-1``."""
@@ -682,12 +751,53 @@ def rescan_sign_counts(cw: FloatArray | SpanForms, h: FloatArray, breaks: FloatA
         return state
 
     total = np.zeros((2, 3), dtype=np.int64)
-    for part in _threads.ranges(run, 0, m, _threads.THREADS, PAR_MIN):
+    bc = smp.block_counts
+    if bc is None:
+        parts = _threads.ranges(run, 0, m, _threads.THREADS, PAR_MIN)
+    else:
+        # the first pass's counts of a block stand where its band was the final one for
+        # every sample it counted (the least nonzero |value| above the final band); its gap
+        # segments are scanned now with their extra samples; the other blocks are sampled
+        # and scanned again, in ranges on the sampling's threads
+        parts = [_final_counts(pieces, quantities, plan.x) for _, _, pieces in bc]
+        redo = [(a, b) for (a, b, _), got in zip(bc, parts, strict=True) if got is None]
+        if redo:
+            again = iter(_threads.ranges(lambda i, j: [run(*redo[q]) for q in range(i, j)], 0,
+                                         len(redo), _threads.THREADS, 2))
+            flat = iter([st for chunk in again for st in chunk])
+            parts = [next(flat) if got is None else got for got in parts]
+    for part in parts:
         for which in (0, 1):
             _join(total[which], *part[which])
     if closed:
         _join_seam(total)
     return int(total[0, 0]), int(total[1, 0])
+
+
+def _final_counts(pieces: list[list[tuple[Any, ...]]], quantities: list[tuple[Any, ...]],
+                  x: FloatArray) -> np.ndarray | None:
+    """A block's ``(changes, first sign, last sign)`` per quantity from its first-pass
+    pieces (:func:`_first_counts`) with the final zero bands: a stretch's count stands if its
+    least nonzero |value| is above the band (else None: the block is sampled again); a gap
+    segment's kept samples are scanned with its extra samples (:func:`_scan_stretch`, the
+    whole scan's operations)."""
+    state = np.zeros((2, 3), dtype=np.int64)
+    unit_breaks = np.array([0.0, 1.0])  # (the change locations are not used)
+    for which, ex_seg, ex_u, ex_val, tol, power in quantities:
+        for kind, *pc in pieces[which]:
+            if kind == "stretch":
+                n, fs, ls, least = pc
+                if not least > tol:
+                    return None
+                _join(state[which], n, fs, ls)
+            else:  # a gap segment: its samples and extra samples, scanned now
+                g, row, el, ps = pc
+                lo, hi = np.searchsorted(ex_seg, (g, g + 1))
+                sub = (ex_seg[lo:hi] - g, ex_u[lo:hi], ex_val[lo:hi])
+                _scan_stretch(state[which], row[None, :], x, unit_breaks, 0,
+                              (sub[0], sub[1], sub[2]), tol, np.array([el]), np.array([ps]),
+                              power)
+    return state
 
 
 def count_sign_changes(vals: np.ndarray, x: FloatArray, breaks: FloatArray,
