@@ -443,56 +443,6 @@ def test_guard_on_a_hermite_curve_reports_and_keeps_the_counts():
 
 @pytest.mark.parametrize("closed", [False, True])
 @pytest.mark.parametrize("dim", [2, 3])
-@pytest.mark.parametrize("par_min", [2, 100_000])
-def test_fused_corner_turning_is_the_composition_of_chord_turns(closed, dim, par_min,
-                                                                monkeypatch):
-    """``corner_turning``'s one compiled pass (``_kernels.corners.corner_turns_kernel``: one walk
-    per direction for the three chord lengths, the minimum, the local maxima) gives the bits
-    of its numpy composition from ``_chord_turns`` at each length
-    (``corner_turning_reference``), on noisy lists with corners, repeated points, lists too
-    short for the longer chords and lists whose noise hides a corner or not; the chord walk
-    itself is checked against a plain Python walk above. Also the compiled extent against
-    ``np.ptp``. ``par_min`` 2: the point ranges on two threads from 2 points on."""
-    import curvefair.io._common as common
-    from curvefair._kernels.corners import coord_extent
-    from curvefair.io._common import corner_turning, corner_turning_reference, noise_scale
-
-    monkeypatch.setattr(common, "THREADS", 2)
-    monkeypatch.setattr(common, "_CORNER_PAR_MIN", par_min)
-
-    rng = np.random.default_rng(31 + dim + 10 * closed)
-    noisy = 0
-    for n in (10, 11, 14, 25, 60, 400, 3000):
-        for rel in (0.0, 0.1, 0.3, 1.0):  # noise per point spacing
-            sigma = rel * 2.0 * np.pi / n
-            t = np.linspace(0.0, 2.0 * np.pi, n, endpoint=not closed)
-            arc = np.c_[np.cos(t), np.sin(t)] if dim == 2 else np.c_[np.cos(t), np.sin(t), 0.3 * t]
-            legs = np.zeros((n, dim))  # two straight legs (a short list is noisy on them)
-            legs[:, 0] = t
-            legs[n // 2:, 1] = t[n // 2:] - t[n // 2]
-            for p in (arc, legs):
-                p = p.copy()
-                p[n // 3:] += 0.4 * (t[n // 3:, None] - t[n // 3])  # a corner
-                p = p + sigma * rng.standard_normal(p.shape)
-                if n >= 25:
-                    p[7] = p[6]  # a repeated point (a zero chord)
-                noisy += noise_scale(p, closed) > 0
-                # a closed list also with its corner moved to the seam (the neighbours of the
-                # first and last points wrap around)
-                for q in [p] + ([np.roll(p, -(n // 3) + r, axis=0) for r in (-1, 0, 1, 2)]
-                                if closed else []):
-                    a, b = corner_turning(q, closed), corner_turning_reference(q, closed)
-                    assert a.dtype == b.dtype and a.shape == b.shape
-                    assert a.tobytes() == b.tobytes(), (n, sigma)
-                assert coord_extent(np.ascontiguousarray(p)) == np.ptp(p, axis=0).max()
-    assert noisy >= 15  # the compiled path ran (noisy lists), not only turning_angles
-    q = rng.standard_normal((20, dim))
-    q[5, dim - 1] = np.nan
-    assert np.isnan(coord_extent(q)) and np.isnan(np.ptp(q, axis=0).max())
-
-
-@pytest.mark.parametrize("closed", [False, True])
-@pytest.mark.parametrize("dim", [2, 3])
 def test_compiled_chord_turns_match_the_plain_walk(closed, dim):
     """The compiled corner search (``_chord_turns``, ``_kernels.corners.chord_turns_kernel``)
     against its slow reference beside the kernel (numpy norms and dot products point by
