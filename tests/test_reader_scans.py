@@ -103,13 +103,14 @@ def test_check_points_names_the_row_and_line(row, value, words):
 @pytest.mark.parametrize("par_min", [2, 100_000])
 def test_fused_corner_turning_is_the_composition_of_chord_turns(closed, dim, par_min,
                                                                 monkeypatch):
-    """``corner_turning``'s one compiled pass (``_kernels.corners.corner_turns_kernel``: one walk
-    per direction for the three chord lengths, the minimum, the local maxima) gives the bits
-    of its numpy composition from ``_chord_turns`` at each length
-    (``corner_turning_reference``), on noisy lists with corners, repeated points, lists too
-    short for the longer chords and lists whose noise hides a corner or not; the chord walk
-    itself is checked against a plain Python walk above. Also the compiled extent against
-    ``np.ptp``. ``par_min`` 2: the point ranges on two threads from 2 points on."""
+    """``corner_turning``'s compiled passes (``_kernels.corners.corner_turns_range``: one walk
+    per direction for the three chord lengths and the minimum, by point ranges; then
+    ``keep_local_maxima``) give the bits of its numpy composition from ``_chord_turns`` at
+    each length (``corner_turning_reference``), on noisy lists with corners, repeated points,
+    lists too short for the longer chords and lists whose noise hides a corner or not; the
+    chord walk itself is checked against a plain Python walk in test_geom_smooth.py. Also
+    the compiled extent against ``np.ptp``. ``par_min`` 2: the point ranges on two threads
+    from 2 points on."""
     import curvefair.io._common as common
     from curvefair._kernels.corners import coord_extent
     from curvefair.io._common import corner_turning, corner_turning_reference, noise_scale

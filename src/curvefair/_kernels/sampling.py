@@ -681,8 +681,9 @@ def count_block(vals, tol, ell, pos, floor, power):
     returns ``(changes, first sign, last sign, least)``, ``least`` the smallest ``|v|`` of
     the samples counted as nonzero (``inf``: none). A count stands for the final band
     ``tol_f >= tol`` exactly when ``least > tol_f``: a sample classified differently has
-    ``tol < |v| <= tol_f`` (it is above its segment's rounding band, common to both). The
-    segments' extra samples are not merged (a block with any is scanned again)."""
+    ``tol < |v| <= tol_f`` (it is above its segment's rounding band, common to both). No
+    extra samples are merged: the caller counts the stretches between the gap segments,
+    which get them (:func:`curvefair.analysis._sampling._first_counts`)."""
     m, K = vals.shape
     n = 0
     first_s = 0

@@ -709,10 +709,6 @@ def rescan_sign_counts(cw: FloatArray | SpanForms, h: FloatArray, breaks: FloatA
                            np.ascontiguousarray(ex[1]), np.ascontiguousarray(ex[2] * scale),
                            float(tol), power))
 
-    keep = np.zeros(2, dtype=bool)  # the quantities counted (kappa only for a planar curve)
-    for q in quantities:
-        keep[q[0]] = True
-
     def run(a: int, b: int) -> np.ndarray:
         """(n, first sign, last sign) per quantity of segments ``a .. b-1``."""
         state = np.zeros((2, 3), dtype=np.int64)
@@ -793,10 +789,9 @@ def _final_counts(pieces: list[list[tuple[Any, ...]]], quantities: list[tuple[An
             else:  # a gap segment: its samples and extra samples, scanned now
                 g, row, el, ps = pc
                 lo, hi = np.searchsorted(ex_seg, (g, g + 1))
-                sub = (ex_seg[lo:hi] - g, ex_u[lo:hi], ex_val[lo:hi])
                 _scan_stretch(state[which], row[None, :], x, unit_breaks, 0,
-                              (sub[0], sub[1], sub[2]), tol, np.array([el]), np.array([ps]),
-                              power)
+                              (ex_seg[lo:hi] - g, ex_u[lo:hi], ex_val[lo:hi]), tol,
+                              np.array([el]), np.array([ps]), power)
     return state
 
 

@@ -676,7 +676,8 @@ def corner_turning(points: FloatArray, closed: bool) -> FloatArray:
 
 def corner_turning_reference(points: FloatArray, closed: bool) -> FloatArray:
     """:func:`corner_turning` composed in numpy from :func:`_chord_turns` at each length (the
-    code :func:`curvefair._kernels.corners.corner_turns_kernel` replaced; the tests' reference)."""
+    code :func:`curvefair._kernels.corners.corner_turns_range` and ``keep_local_maxima``
+    replaced; the tests' reference)."""
     p = np.asarray(points, dtype=float)
     m = p.shape[0]
     sigma = noise_scale(p, closed)
