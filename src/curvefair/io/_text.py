@@ -897,13 +897,10 @@ def _row_halves(buf: np.ndarray, nrows: int) -> tuple[int, int] | None:
 
 
 def _on_two_threads(first: Callable[[], Any], second: Callable[[], Any]) -> tuple[Any, Any]:
-    """``(first(), second())``, ``first`` on the worker thread meanwhile (both ``nogil``
-    compiled work on disjoint outputs)."""
-    fut = _threads.pool().submit(first)
-    try:
-        b = second()
-    finally:
-        a = fut.result()
+    """``(first(), second())`` as two ranges of :func:`curvefair._threads.ranges` (both
+    ``nogil`` compiled work on disjoint outputs): one on the worker thread when it is free,
+    else both on the calling thread."""
+    a, b = _threads.ranges(lambda lo, hi: first() if lo == 0 else second(), 0, 2, 2, 2, 2)
     return a, b
 
 
