@@ -20,47 +20,33 @@ def chord_turns_kernel(p, closed, Lmin, out):
     most ``m // 2`` steps; an open list's ends stop the walk), then
     ``angle = arccos(a . b / (|a| |b|))`` of the chords ``a = p_i - p_back``,
     ``b = p_fwd - p_i``, clipped to [-1, 1]; sums in coordinate order (no fastmath)."""
-    m, dim = p.shape
+    m = p.shape[0]
     lo, hi = (0, m) if closed else (1, m - 1)
     lim = m // 2 + 1
     for i in range(lo, hi):
-        back = fwd = -1
-        for e in range(2):
-            step = -1 if e == 0 else 1
-            k = i + step
-            n_steps = 1
-            found = -1
-            while n_steps < lim:
-                if not closed and (k < 0 or k >= m):
-                    break
-                kk = k % m
-                d2 = 0.0
-                for c in range(dim):
-                    t = p[kk, c] - p[i, c]
-                    d2 += t * t
-                if np.sqrt(d2) >= Lmin:
-                    found = kk
-                    break
-                k += step
-                n_steps += 1
-            if e == 0:
-                back = found
-            else:
-                fwd = found
-        if back < 0 or fwd < 0:
-            continue
-        ab = 0.0
-        aa = 0.0
-        bb = 0.0
-        for c in range(dim):
-            a = p[i, c] - p[back, c]
-            b = p[fwd, c] - p[i, c]
-            ab += a * b
-            aa += a * a
-            bb += b * b
-        cosv = ab / (np.sqrt(aa) * np.sqrt(bb))
-        cosv = min(1.0, max(-1.0, cosv))
-        out[i] = np.degrees(np.arccos(cosv))
+        kb, _, okb = _walk(p, closed, i, i - 1, 1, -1, lim, Lmin)
+        kf, _, okf = _walk(p, closed, i, i + 1, 1, 1, lim, Lmin)
+        if okb and okf:
+            out[i] = _turn(p, i, kb % m, kf % m)
+
+
+@njit(cache=True, inline="always")
+def _turn(p, i, back, fwd):
+    """The turn in degrees at ``p_i`` between the chords ``a = p_i - p_back`` and
+    ``b = p_fwd - p_i``: ``arccos(a . b / (|a| |b|))``, the cosine clipped to [-1, 1]; sums in
+    coordinate order (no fastmath)."""
+    ab = 0.0
+    aa = 0.0
+    bb = 0.0
+    for c in range(p.shape[1]):
+        u = p[i, c] - p[back, c]
+        w = p[fwd, c] - p[i, c]
+        ab += u * w
+        aa += u * u
+        bb += w * w
+    cosv = ab / (np.sqrt(aa) * np.sqrt(bb))
+    cosv = min(1.0, max(-1.0, cosv))
+    return np.degrees(np.arccos(cosv))
 
 
 @njit(cache=True, inline="always")
@@ -99,7 +85,7 @@ def corner_turns_range(p, closed, lengths, out, a, b):
     ran into an end (or the step limit) for ``L1`` does for ``L2`` too. The angles are those of
     :func:`chord_turns_kernel` (the same operations), so the result is that of the numpy
     composition of its calls, bit for bit (tested)."""
-    m, dim = p.shape
+    m = p.shape[0]
     lim = m // 2 + 1
     ns = lengths.shape[0]
     for i in range(a, b):
@@ -122,20 +108,7 @@ def corner_turns_range(p, closed, lengths, out, a, b):
                 kf, sf, okf = _walk(p, closed, i, kf, sf, 1, lim, L)
             if not (okb and okf):
                 break
-            back = kb % m
-            fwd = kf % m
-            ab = 0.0
-            aa = 0.0
-            bb = 0.0
-            for c in range(dim):
-                u = p[i, c] - p[back, c]
-                w = p[fwd, c] - p[i, c]
-                ab += u * w
-                aa += u * u
-                bb += w * w
-            cosv = ab / (np.sqrt(aa) * np.sqrt(bb))
-            cosv = min(1.0, max(-1.0, cosv))
-            ang = np.degrees(np.arccos(cosv))
+            ang = _turn(p, i, kb % m, kf % m)
             if ang == ang:  # (NaN: not counted, as the composition's isnan mask)
                 if ang < best:
                     best = ang

@@ -673,6 +673,17 @@ def _zero_band(tol, li, pi, floor, power):
     return tl
 
 
+@njit(cache=True, inline="always")
+def _sign(v, tl):
+    """The sign the scans give a sample ``v`` with the zero band ``tl``: 1 above it, -1
+    below ``-tl``, 0 within."""
+    if v > tl:
+        return 1
+    if v < -tl:
+        return -1
+    return 0
+
+
 @njit(cache=True, nogil=True, error_model="numpy")
 def count_block(vals, tol, ell, pos, floor, power):
     """:func:`scan_kernel`'s count of the samples ``vals`` (m, K) alone, with a zero band
@@ -693,11 +704,8 @@ def count_block(vals, tol, ell, pos, floor, power):
         tl = _zero_band(tol, ell[i], pos[i], floor, power)
         for q in range(K):
             v = float(vals[i, q])
-            if v > tl:
-                s = 1
-            elif v < -tl:
-                s = -1
-            else:
+            s = _sign(v, tl)
+            if s == 0:
                 continue
             a = abs(v)
             if a < least:
@@ -740,11 +748,8 @@ def scan_kernel(vals, x, breaks, ex_seg, ex_u, ex_val, tol, ell, pos, floor, pow
             # one; positions are only needed where a change happens
             for q in range(K):
                 v = float(vals[i, q])
-                if v > tl:
-                    s = 1
-                elif v < -tl:
-                    s = -1
-                else:
+                s = _sign(v, tl)
+                if s == 0:
                     continue
                 if s != last_s:
                     t = breaks[i] + (breaks[i + 1] - breaks[i]) * x[q]
@@ -771,11 +776,8 @@ def scan_kernel(vals, x, breaks, ex_seg, ex_u, ex_val, tol, ell, pos, floor, pow
                 u = x[q]
                 v = float(vals[i, q])
                 q += 1
-            if v > tl:
-                s = 1
-            elif v < -tl:
-                s = -1
-            else:
+            s = _sign(v, tl)
+            if s == 0:
                 continue
             t = t0 + hw * u
             if last_s == 0:
