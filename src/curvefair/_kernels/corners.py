@@ -51,10 +51,10 @@ def _turn(p, i, back, fwd):
 
 @njit(cache=True, inline="always")
 def _walk(p, closed, i, k, n_steps, step, lim, Lmin):
-    """Continue :func:`chord_turns_kernel`'s walk from ``i`` at ``k`` (``n_steps`` taken) to the
-    first point at least ``Lmin`` from ``p_i``: ``(k, n_steps, found)`` where it stopped (at the
-    point found, or where an open list's end or the step limit ended the walk). The same
-    distance, computed the same way, as the kernel's walk."""
+    """The chord walk of :func:`chord_turns_kernel` and :func:`corner_turns_range`: from
+    ``i``, continued at ``k`` (``n_steps`` taken, one ``step`` of +-1 at a time), to the first
+    point at least ``Lmin`` from ``p_i``; ``(k, n_steps, found)`` where it stopped (at the
+    point found, or where an open list's end or the step limit ``lim`` ended the walk)."""
     m, dim = p.shape
     while n_steps < lim:
         if not closed and (k < 0 or k >= m):

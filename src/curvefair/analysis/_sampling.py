@@ -673,8 +673,7 @@ def rescan_sign_counts(cw: FloatArray | SpanForms, h: FloatArray, breaks: FloatA
     block's gap segments are then scanned with their kept samples and extra samples
     (:func:`_final_counts`). A block with a stretch that does not hold is sampled again
     (the pass block by block, ``STREAM_BLOCK`` segments, the blocks in ranges on the
-    sampling's threads), its samples scanned as they are made; then dropped. Without
-    ``block_counts`` every block is.
+    sampling's threads), its samples scanned as they are made; then dropped.
 
     The counts are exactly the whole scan's: the samples are the first pass's bits (the same
     compiled pass over the same rows, a block re-running its lead-in segment as a range
@@ -746,23 +745,20 @@ def rescan_sign_counts(cw: FloatArray | SpanForms, h: FloatArray, breaks: FloatA
             s0 = s1
         return state
 
-    total = np.zeros((2, 3), dtype=np.int64)
     bc = smp.block_counts
-    if bc is None:
-        parts = _threads.ranges(run, 0, m, _threads.THREADS, PAR_MIN)
-    else:
-        # the first pass's counts of a block stand where its band was the final one for
-        # every sample it counted (the least nonzero |value| above the final band); its gap
-        # segments are scanned now with their extra samples; the other blocks are sampled
-        # and scanned again, in ranges on the sampling's threads
-        parts = [_final_counts(pieces, quantities, plan.x) for _, _, pieces in bc]
-        redo = [(a, b) for (a, b, _), got in zip(bc, parts, strict=True) if got is None]
-        if redo:
-            again = iter(_threads.ranges(lambda i, j: [run(*redo[q]) for q in range(i, j)], 0,
-                                         len(redo), _threads.THREADS, 2))
-            flat = iter([st for chunk in again for st in chunk])
-            parts = [next(flat) if got is None else got for got in parts]
-    for part in parts:
+    assert bc is not None  # (sample_curve counts every block of a pass that keeps nothing)
+    # the first pass's counts of a block stand where its band was the final one for every
+    # sample it counted (the least nonzero |value| above the final band); its gap segments
+    # are scanned now with their extra samples; the other blocks are sampled and scanned
+    # again, in ranges on the sampling's threads
+    parts = [_final_counts(pieces, quantities, plan.x) for _, _, pieces in bc]
+    redo = [(a, b) for (a, b, _), got in zip(bc, parts, strict=True) if got is None]
+    chunks = _threads.ranges(lambda i, j: [run(*redo[q]) for q in range(i, j)], 0, len(redo),
+                             _threads.THREADS, 2)
+    again = iter([st for chunk in chunks for st in chunk])
+    total = np.zeros((2, 3), dtype=np.int64)
+    for got in parts:
+        part = next(again) if got is None else got
         for which in (0, 1):
             _join(total[which], *part[which])
     if closed:
