@@ -421,7 +421,7 @@ def test_a_result_that_moved_nothing_is_analysed_once(monkeypatch):
     seen = []
     block_of = fair_module._analysis_block_of
     monkeypatch.setattr(fair_module, "_analysis_block_of",
-                        lambda cv: seen.append(cv) or block_of(cv))
+                        lambda cv, lean=None: seen.append(cv) or block_of(cv, lean))
     for method, kw, moved in (("knot-removal", {"tol": 1e-9}, False),
                               ("eck-hadenfeld", {"tol": 0.02, "max_steps": 0}, False),
                               ("eck-hadenfeld", {"tol": 0.02}, True)):

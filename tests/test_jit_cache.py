@@ -307,3 +307,30 @@ def test_readonly_names_must_be_parameters_and_stay_unwritten():
     k = njit(cache=False, readonly=("x",))(write)
     with pytest.raises(TypingError):
         k(np.zeros(3))
+
+
+def test_every_kernel_releases_the_gil():
+    """Every compiled kernel of the package releases the GIL (``curvefair._jit.njit``'s
+    default): fair() runs its input's analysis on the worker thread beside the method's
+    compiled loop, which would otherwise hold the GIL for its whole run and stall the
+    analysis' Python between its passes. Counted over every module that defines kernels."""
+    import importlib
+    import pkgutil
+
+    from numba.core.registry import CPUDispatcher
+
+    found, holding = 0, []
+    for info in pkgutil.walk_packages(curvefair.__path__, "curvefair."):
+        if info.name.rsplit(".", 1)[-1] in ("__main__",):
+            continue
+        try:
+            mod = importlib.import_module(info.name)
+        except ImportError:  # an optional dependency's module
+            continue
+        for name, obj in vars(mod).items():
+            if isinstance(obj, CPUDispatcher) and obj.py_func.__module__ == info.name:
+                found += 1
+                if not obj.targetoptions.get("nogil"):
+                    holding.append(f"{info.name}.{name}")
+    assert found > 100
+    assert holding == []

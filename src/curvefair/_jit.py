@@ -244,7 +244,14 @@ def njit(*args: Any, readonly: tuple[str, ...] = (), any_layout: tuple[str, ...]
     times). numba converts a writable (or contiguous) array to the
     read-only (any-layout) type of an existing machine code by itself, so after the first call
     every variant of the arguments runs the same code. Calls from other kernels are typed by
-    the caller as usual."""
+    the caller as usual.
+
+    Every kernel releases the GIL (``nogil=True`` unless a kernel says otherwise): a kernel
+    running on one thread then never holds up another thread's Python, e.g. the analysis that
+    :func:`curvefair.fair` runs on the worker thread beside a method's compiled loop (whose
+    calls otherwise hold the GIL for their whole run). It changes no machine code of the
+    kernel's body, only its entry from Python."""
+    kwargs.setdefault("nogil", True)
     if kwargs.get("cache") and _CACHE_DIR is None:
         kwargs["cache"] = False
     if not readonly and not any_layout:

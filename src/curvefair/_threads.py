@@ -6,7 +6,8 @@ worker thread. Each range writes only its own rows, so the results are bitwise t
 one thread or two, whatever the scheduling. ``CURVEFAIR_THREADS`` (1 or 2, read at import)
 sets the number of threads; the default is 2 when the process may use two or more CPUs.
 Used by the global fairing's Newton passes (:mod:`curvefair.fairing.global_fair`) and by the
-sampling pass of :func:`curvefair.analyze`.
+sampling pass of :func:`curvefair.analyze`; :class:`Background` runs one whole job (the input's
+analysis in :func:`curvefair.fair`) on the worker while the calling thread goes on.
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 __all__ = ["THREADS", "CHUNKS", "cpu_count", "thread_setting", "pool", "ranges", "ranges_start",
-           "bounds"]
+           "bounds", "Background"]
 
 
 def cpu_count() -> int:
@@ -140,3 +141,41 @@ def ranges_start(fn: Callable[[int, int], Any], lo: int, hi: int, threads: int,
         return out
 
     return finish
+
+
+class Background:
+    """``fn()`` started on the worker thread; :meth:`result` returns its value (or raises its
+    exception). If the worker has not started the job when :meth:`result` is called (busy with
+    another job, or not yet scheduled), the calling thread runs it itself: nothing ever waits
+    for a job that has not begun. ``fn`` may use :func:`ranges` (run on the worker, its passes
+    find the worker busy and do every chunk on that thread). Single-threaded
+    (``threads < 2``): ``fn`` runs in :meth:`result`."""
+
+    def __init__(self, fn: Callable[[], Any], threads: int | None = None) -> None:
+        self._fn: Callable[[], Any] | None = fn
+        self._lock = threading.Lock()
+        self._done = threading.Event()
+        self._value: Any = None
+        self._error: BaseException | None = None
+        if (THREADS if threads is None else threads) >= 2:
+            pool().submit(self._run)
+
+    def _run(self) -> None:
+        with self._lock:
+            fn, self._fn = self._fn, None  # claimed once: by the worker or by result()
+        if fn is None:
+            return
+        try:
+            self._value = fn()
+        except BaseException as exc:  # re-raised by result()
+            self._error = exc
+        finally:
+            self._done.set()
+
+    def result(self) -> Any:
+        """The job's value (run here if the worker has not started it; else waited for)."""
+        self._run()
+        self._done.wait()
+        if self._error is not None:
+            raise self._error
+        return self._value

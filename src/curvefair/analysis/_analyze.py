@@ -296,7 +296,7 @@ def analyze(curve: object, *, quad_rtol: float = QUAD_RTOL) -> Analysis:
     return out
 
 
-def fairness_figures(curve: PiecewiseCurve) -> dict[str, Any]:
+def fairness_figures(curve: PiecewiseCurve, *, lean: bool | None = None) -> dict[str, Any]:
     """The scalar figures of :func:`analyze` that a fairing report prints, bit for bit the
     same, without the per-breakpoint arrays: ``energy2``, ``energy3``, ``max_jump``,
     ``max_top_jump``, ``sapidis_sum``, ``dkds_energy``, ``inflections``, ``extrema``.
@@ -305,8 +305,14 @@ def fairness_figures(curve: PiecewiseCurve) -> dict[str, Any]:
     frozen per-breakpoint arrays of a full :class:`Analysis` (jumps, top jumps, Sapidis
     measure, their indices and parameters: 40 bytes a segment) would be made at the call's
     peak and never read.
+
+    ``lean``: keep no samples (count each block's signs as it is made, see
+    :func:`curvefair.analysis._sampling.sample_curve`), whatever the size; None: from
+    ``RESCAN_MIN`` segments on. The same figures either way; lean, the analysis holds about
+    a fifth of the memory (what :func:`curvefair.fair` asks for when the input's analysis
+    runs beside the method).
     """
-    out = _analyze(check_curve(curve), QUAD_RTOL, True)
+    out = _analyze(check_curve(curve), QUAD_RTOL, True, lean=lean)
     assert isinstance(out, dict)
     return out
 
@@ -323,8 +329,8 @@ def _span_forms(c: PiecewiseCurve) -> SpanForms | None:
     return None
 
 
-def _analyze(c: PiecewiseCurve, rtol: float, summary: bool, whole: bool = False
-             ) -> Analysis | dict[str, Any]:
+def _analyze(c: PiecewiseCurve, rtol: float, summary: bool, whole: bool = False,
+             lean: bool | None = None) -> Analysis | dict[str, Any]:
     """:func:`analyze` of a checked curve; ``summary``: :func:`fairness_figures` instead;
     ``whole``: read the whole power form even where :class:`SpanForms` could be made."""
     forms = None if whole else _span_forms(c)
@@ -352,10 +358,10 @@ def _analyze(c: PiecewiseCurve, rtol: float, summary: bool, whole: bool = False
             planar = True
             cw = np.ascontiguousarray(coeffs @ E)  # (m, p1, 2): coordinates in the plane
 
-    smp = sample_curve(cw, h, planar, closed, rtol, sums_only=summary)
+    smp = sample_curve(cw, h, planar, closed, rtol, sums_only=summary, lean=lean)
     if forms is not None and not forms.finite:
         c.piecewise  # noqa: B018 (a form beyond float64 raises the whole form's own message)
-        return _analyze(c, rtol, summary, True)
+        return _analyze(c, rtol, summary, True, lean)
     if dim == 2:
         L = smp.diagonal
     ks = slice(0 if closed else 1, m)  # the interior knots as a slice (cheaper than indexing)

@@ -336,7 +336,8 @@ def _kernel_tables(degree: int, planar: bool
 
 
 def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed: bool,
-                 rtol: float = QUAD_RTOL, sums_only: bool = False) -> Samples:
+                 rtol: float = QUAD_RTOL, sums_only: bool = False,
+                 lean: bool | None = None) -> Samples:
     """Sample ``kappa`` and ``dkappa/ds`` on every segment; integrate; certify signs.
 
     ``cw`` are power coefficients ``(m, p+1, dim)`` (``dim`` 2 for planar curves, 3 for
@@ -375,7 +376,9 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
     gives, which is never above the final one (that needs the whole curve's largest values
     and size), keeping the samples of its gap segments (which get extra samples later);
     :func:`rescan_sign_counts` keeps those counts where they hold for the final bands and
-    samples only the other blocks again. ``Samples.rescan`` says so.
+    samples only the other blocks again. ``Samples.rescan`` says so. ``lean`` (with
+    ``sums_only``): True keeps no samples at any size, False keeps them at any size, None
+    from ``RESCAN_MIN`` segments on.
     """
     m, p1, dim = cw.shape
     p = p1 - 1
@@ -388,7 +391,7 @@ def sample_curve(cw: FloatArray | SpanForms, h: FloatArray, planar: bool, closed
     forms = cw if isinstance(cw, SpanForms) else None
     unit = _unit(cast(FloatArray, cw)) if forms is None else _unit_of(forms.unit_points)
     stream = sums_only and forms is not None and not closed and m >= 2
-    lean = sums_only and m >= RESCAN_MIN
+    lean = sums_only and (m >= RESCAN_MIN if lean is None else lean)
     if lean:  # (each block's own rows, see blocks())
         kap = dks = np.empty((0, K), dtype=np.float32)
         ell = pos = np.empty(0)

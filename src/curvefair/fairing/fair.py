@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
+from .. import _threads
 from .._typing import FloatArray
 from ..curves.hermite import CubicHermite
 from ..curves.piecewise import PiecewiseCurve, readonly
@@ -433,25 +434,68 @@ class _CacheState:
 _ANALYSIS_MEMO: weakref.WeakKeyDictionary[Any, dict[str, Any]] = weakref.WeakKeyDictionary()
 
 
+#: the analyses of inputs that fair() runs on the worker thread (:func:`_start_analysis`), by
+#: curve: a method that asks for its input's figures meanwhile waits for that job instead of
+#: analysing the curve a second time
+_ANALYSIS_PENDING: weakref.WeakKeyDictionary[Any, _threads.Background] = (
+    weakref.WeakKeyDictionary())
+
+
 def analysis_block(curve: PiecewiseCurve) -> dict[str, Any]:
     """The report's figures of one curve (:func:`curvefair.analyze`): energies, largest jumps,
     Sapidis sum, ``int (dkappa/ds)^2 ds``, inflection and curvature-extremum counts (a fresh
     dict; a :class:`CubicHermite`'s are computed once per curve object)."""
+    job = _ANALYSIS_PENDING.get(curve)
+    if job is not None:
+        return dict(job.result())
+    return _memo_analysis_block(curve)
+
+
+def _memo_analysis_block(curve: PiecewiseCurve, lean: bool | None = None) -> dict[str, Any]:
     memo = type(curve) is CubicHermite
     if memo:
         got = _ANALYSIS_MEMO.get(curve)
         if got is not None:
             return dict(got)
-    block = _analysis_block_of(curve)
+    block = _analysis_block_of(curve, lean)
     if memo:
         _ANALYSIS_MEMO[curve] = dict(block)
     return block
 
 
-def _analysis_block_of(curve: PiecewiseCurve) -> dict[str, Any]:
+#: points (B-splines: control points) from which :func:`fair` analyses its input on the
+#: worker thread while the join plan and the method run on the calling thread (with two
+#: threads, ``curvefair._threads``)
+OVERLAP_MIN = 50_000
+
+
+def _start_analysis(curve: PiecewiseCurve) -> Callable[[], dict[str, Any]]:
+    """The input's :func:`analysis_block`, started on the worker thread when the curve is long
+    (:data:`OVERLAP_MIN` points, two threads): the returned function gives the figures (the
+    same bits either way: every pass of the analysis gives the same results on one thread or
+    two). The job keeps no samples (``lean``: its memory is then a small part of the method's
+    while both run); a 3-D B-spline is analysed first, as before (its analysis builds the
+    whole power form, which the call drops before the method)."""
+    if (_threads.THREADS < 2 or data_points(curve).shape[0] < OVERLAP_MIN
+            or (curve.dim == 3 and hasattr(curve, "control_points"))):
+        block = analysis_block(curve)
+        return lambda: block
+    job = _threads.Background(functools.partial(_memo_analysis_block, curve, True))
+    _ANALYSIS_PENDING[curve] = job
+
+    def result() -> dict[str, Any]:
+        try:
+            return cast("dict[str, Any]", job.result())
+        finally:
+            if _ANALYSIS_PENDING.get(curve) is job:
+                del _ANALYSIS_PENDING[curve]
+    return result
+
+
+def _analysis_block_of(curve: PiecewiseCurve, lean: bool | None = None) -> dict[str, Any]:
     from ..analysis import fairness_figures
 
-    a = fairness_figures(curve)  # analyze()'s figures, without its per-knot arrays
+    a = fairness_figures(curve, lean=lean)  # analyze()'s figures, without per-knot arrays
     return {
         "energy": a["energy2"],
         "energy3": a["energy3"],
@@ -670,11 +714,13 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
     # as the call no longer needs it: at a million points they are 72 and 56 bytes per span,
     # held by the caller's curve after the call, and at the call's peak (the result's analysis)
     cached_at_entry = _CacheState(curve)
-    before = analysis_block(curve)
-    if progress is not None:
-        progress(1, PHASES)
-    jp = (_joins.plan(curve, clamp_pair, prot, g1_deg, tol_v) if joins == "keep"
-          else _joins.JoinPlan(curve, prot, clamp_pair))
+    before_figures = _start_analysis(curve)  # (a long curve's: beside the plan and the method)
+    try:
+        jp = (_joins.plan(curve, clamp_pair, prot, g1_deg, tol_v) if joins == "keep"
+              else _joins.JoinPlan(curve, prot, clamp_pair))
+    except Exception:
+        before_figures()  # (the input's analysis raises first, as when it ran first)
+        raise
     cached_at_entry.drop_power_form(curve, method_done=False)
 
     def solve(plan: Any, tol_w: float | None) -> Outcome:
@@ -696,7 +742,14 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
             out = solve(jp, tol_v)
         return jp, out, jp.restore(out.curve)
 
-    jp, out, new = run(jp, frozenset())
+    try:
+        jp, out, new = run(jp, frozenset())
+    except Exception:
+        before_figures()  # (the input's analysis raises first, as when it ran first)
+        raise
+    before = before_figures()
+    if progress is not None:
+        progress(1, PHASES)
     if jp.corners and isinstance(curve, BSplineCurve) and math.isfinite(turn_deg):
         # a corner keeps its angle to DEFAULT_CORNER_TURN: where one turned more, fair again
         # with what fixes it held; if another turns then, with every corner's held
