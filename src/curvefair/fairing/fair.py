@@ -106,6 +106,10 @@ class MethodSpec:
         E.g. ``{"l": 3}`` for ``global`` on curves of degree >= 3.
     default_reason : str
         Why it is the default: one line with the benchmark figure (``curvefair methods``).
+    two_threads : bool
+        The method's own passes keep both threads (:mod:`curvefair._threads`) busy for most
+        of its run: :func:`fair` then analyses a long input before the method, not beside it
+        on the worker thread (which would leave the method's passes one thread).
     """
 
     name: str
@@ -122,6 +126,7 @@ class MethodSpec:
         default_factory=dict)
     default_reason: str = ""
     solver: Callable[..., Outcome] | None = None
+    two_threads: bool = False
 
     def __post_init__(self) -> None:
         if self.driver is None:  # spelled out by a caller
@@ -469,14 +474,17 @@ def _memo_analysis_block(curve: PiecewiseCurve, lean: bool | None = None) -> dic
 OVERLAP_MIN = 50_000
 
 
-def _start_analysis(curve: PiecewiseCurve) -> Callable[[], dict[str, Any]]:
+def _start_analysis(curve: PiecewiseCurve, beside: bool = True
+                    ) -> Callable[[], dict[str, Any]]:
     """The input's :func:`analysis_block`, started on the worker thread when the curve is long
-    (:data:`OVERLAP_MIN` points, two threads): the returned function gives the figures (the
+    (:data:`OVERLAP_MIN` points, two threads) and ``beside`` (the method's passes leave the
+    worker thread free, :attr:`MethodSpec.two_threads`); else computed now. The returned
+    function gives the figures (the
     same bits either way: every pass of the analysis gives the same results on one thread or
     two). The job keeps no samples (``lean``: its memory is then a small part of the method's
     while both run); a 3-D B-spline is analysed first, as before (its analysis builds the
     whole power form, which the call drops before the method)."""
-    if (_threads.THREADS < 2 or data_points(curve).shape[0] < OVERLAP_MIN
+    if (not beside or _threads.THREADS < 2 or data_points(curve).shape[0] < OVERLAP_MIN
             or (curve.dim == 3 and hasattr(curve, "control_points"))):
         block = analysis_block(curve)
         return lambda: block
@@ -714,7 +722,8 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
     # as the call no longer needs it: at a million points they are 72 and 56 bytes per span,
     # held by the caller's curve after the call, and at the call's peak (the result's analysis)
     cached_at_entry = _CacheState(curve)
-    before_figures = _start_analysis(curve)  # (a long curve's: beside the plan and the method)
+    # (a long curve's: beside the join plan and the method)
+    before_figures = _start_analysis(curve, not spec.two_threads)
     try:
         jp = (_joins.plan(curve, clamp_pair, prot, g1_deg, tol_v) if joins == "keep"
               else _joins.JoinPlan(curve, prot, clamp_pair))

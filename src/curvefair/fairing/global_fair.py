@@ -1091,6 +1091,7 @@ def _register() -> None:
         prefer=_prefer_default,
         default_options=_default_options,
         default_reason=DEFAULT_REASON,
+        two_threads=True,  # (its Newton passes and set-up run in ranges on both threads)
     ))
 
 
