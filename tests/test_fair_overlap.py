@@ -113,6 +113,36 @@ def test_overlapped_call_is_bitwise_the_sequential_one(monkeypatch, kind, method
         assert where and where[0][0].startswith("curvefair") and where[0][1] is True
 
 
+def test_long_curves_are_analysed_first(monkeypatch):
+    """From RESCAN_MIN segments on (where the analysis is lean because memory limits the
+    call) the input is analysed before the method, on the calling thread, as are short
+    curves (below OVERLAP_MIN) and everything with one thread."""
+    from curvefair.analysis import _sampling
+
+    where = []
+    inner = F._memo_analysis_block
+
+    def spy(curve, lean=None):
+        where.append((threading.current_thread().name, lean))
+        return inner(curve, lean)
+
+    monkeypatch.setattr(F, "_memo_analysis_block", spy)
+    monkeypatch.setattr(_threads, "THREADS", 2)
+    monkeypatch.setattr(F, "OVERLAP_MIN", 100)
+    for rescan_min, threads, n, beside in ((10**9, 2, 400, True), (400, 2, 400, False),
+                                           (401, 2, 400, True), (10**9, 2, 99, False),
+                                           (10**9, 1, 400, False)):
+        monkeypatch.setattr(_sampling, "RESCAN_MIN", rescan_min)
+        monkeypatch.setattr(_threads, "THREADS", threads)
+        where.clear()
+        cf.fair(_curve("bspline", n), "eck-hadenfeld", tol=0.05)
+        assert len(where) == 2  # (the input's, then the result's)
+        if beside:  # the job (the worker's, or the caller's if the worker had not begun)
+            assert where[0][1] is True
+        else:
+            assert where[0] == ("MainThread", None)
+
+
 @pytest.mark.parametrize("kind,dim,closed", [("bspline", 2, False), ("bspline", 2, True),
                                              ("bspline", 3, False), ("cubic", 2, False),
                                              ("cubic", 3, True), ("quintic", 2, False)])

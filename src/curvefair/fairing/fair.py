@@ -481,10 +481,16 @@ def _start_analysis(curve: PiecewiseCurve, beside: bool = True
     worker thread free, :attr:`MethodSpec.two_threads`); else computed now. The returned
     function gives the figures (the
     same bits either way: every pass of the analysis gives the same results on one thread or
-    two). The job keeps no samples (``lean``: its memory is then a small part of the method's
-    while both run); a 3-D B-spline is analysed first, as before (its analysis builds the
-    whole power form, which the call drops before the method)."""
-    if (not beside or _threads.THREADS < 2 or data_points(curve).shape[0] < OVERLAP_MIN
+    two). The job keeps no samples (``lean``: 52-60 bytes a segment instead of 128-228, the
+    method's memory and the analysis' add up while both run). Analysed first, as before: a 3-D
+    B-spline (its analysis builds the whole power form, which the call drops before the
+    method) and a curve of ``RESCAN_MIN`` segments or more, where the analysis is lean anyway
+    because memory is what limits the call: beside the method its 3.3-3.8 times the
+    coordinates' bytes raise the method's peak (measured at 1e7 points: docs/benchmarks.md)."""
+    from ..analysis._sampling import RESCAN_MIN
+
+    n = data_points(curve).shape[0]
+    if (not beside or _threads.THREADS < 2 or not OVERLAP_MIN <= n < RESCAN_MIN
             or (curve.dim == 3 and hasattr(curve, "control_points"))):
         block = analysis_block(curve)
         return lambda: block
