@@ -129,8 +129,9 @@ def test_long_curves_are_analysed_first(monkeypatch):
     monkeypatch.setattr(F, "_memo_analysis_block", spy)
     monkeypatch.setattr(_threads, "THREADS", 2)
     monkeypatch.setattr(F, "OVERLAP_MIN", 100)
-    for rescan_min, threads, n, beside in ((10**9, 2, 400, True), (400, 2, 400, False),
-                                           (401, 2, 400, True), (10**9, 2, 99, False),
+    m = len(_curve("bspline", 400).control_points)  # (what the limits count)
+    for rescan_min, threads, n, beside in ((10**9, 2, 400, True), (m, 2, 400, False),
+                                           (m + 1, 2, 400, True), (10**9, 2, 97, False),
                                            (10**9, 1, 400, False)):
         monkeypatch.setattr(_sampling, "RESCAN_MIN", rescan_min)
         monkeypatch.setattr(_threads, "THREADS", threads)
