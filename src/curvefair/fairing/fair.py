@@ -614,8 +614,9 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
     progress : callable, optional
         ``progress(done, total)`` after each phase of the call, ``total`` = ``PHASES``
         (4): the analysis before, the method's fairing, the analysis after (and the
-        never-worse guard), the tolerance certificate. For progress within one long curve;
-        the method itself is not interrupted.
+        never-worse guard), the tolerance certificate. (A long input's analysis runs beside
+        the method, on the worker thread: its ``1`` then comes just before the ``2``.) For
+        progress within one long curve; the method itself is not interrupted.
     **options
         Passed to the method's driver; :func:`method_options` lists each method's options and
         their defaults (e.g. ``schedule="sweep"`` for ``"eck-hadenfeld"``). An unknown name
