@@ -1,7 +1,8 @@
 """Fairness analysis: exact energies, curvature and torsion, bad-point measures, deviation.
 
 Public: :func:`energy`, :func:`curvature`, :func:`curvature_derivative`, :func:`torsion`,
-:func:`analyze` (-> :class:`Analysis`; :func:`fairness_figures`: its scalar figures only),
+:func:`analyze` (-> :class:`Analysis`; :func:`fairness_figures`: its scalar figures only;
+:func:`lean_by_default`: the sizes from which those keep no samples),
 :func:`deviation` (-> :class:`Deviation`; :func:`hermite_delta_deviation`,
 :func:`bspline_delta_deviation`: its figures for two Hermite splines on the same parameters,
 or two B-splines on the same knots, without their difference's power form),
@@ -13,7 +14,7 @@ or two B-splines on the same knots, without their difference's power form),
 curvature of Cheng & Yu lives in :mod:`curvefair.analysis.discrete`.
 """
 
-from ._analyze import Analysis, analyze, derivative_jumps, fairness_figures
+from ._analyze import Analysis, analyze, derivative_jumps, fairness_figures, lean_by_default
 from ._curvature import curvature, curvature_derivative, torsion
 from ._deviation import (
     Deviation,
@@ -38,6 +39,7 @@ __all__ = [
     "Analysis",
     "analyze",
     "fairness_figures",
+    "lean_by_default",
     "derivative_jumps",
     "curvature",
     "curvature_derivative",

@@ -318,6 +318,15 @@ def fairness_figures(curve: PiecewiseCurve, *, lean: bool | None = None) -> dict
     return out
 
 
+def lean_by_default(n_segments: int) -> bool:
+    """Whether :func:`fairness_figures` of a curve of ``n_segments`` segments keeps no samples
+    unless told (``lean=None``): from ``RESCAN_MIN`` segments on, where memory is what limits
+    a call (:func:`curvefair.fair` then analyses its input before the method, not beside it)."""
+    from ._sampling import RESCAN_MIN
+
+    return n_segments >= RESCAN_MIN
+
+
 def _span_forms(c: PiecewiseCurve) -> SpanForms | None:
     """A planar B-spline's or Hermite spline's segment forms made where the sampling reads
     them, when its whole power form is not built (else that is read), else None."""

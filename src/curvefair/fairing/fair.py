@@ -487,10 +487,10 @@ def _start_analysis(curve: PiecewiseCurve, beside: bool = True
     method) and a curve of ``RESCAN_MIN`` segments or more, where the analysis is lean anyway
     because memory is what limits the call: beside the method its 3.3-3.8 times the
     coordinates' bytes raise the method's peak (measured at 1e7 points: docs/benchmarks.md)."""
-    from ..analysis._sampling import RESCAN_MIN
+    from ..analysis import lean_by_default
 
     n = data_points(curve).shape[0]
-    if (not beside or _threads.THREADS < 2 or not OVERLAP_MIN <= n < RESCAN_MIN
+    if (not beside or _threads.THREADS < 2 or n < OVERLAP_MIN or lean_by_default(n)
             or (curve.dim == 3 and hasattr(curve, "control_points"))):
         block = analysis_block(curve)
         return lambda: block
