@@ -479,10 +479,10 @@ def _start_analysis(curve: PiecewiseCurve, beside: bool = True
     """The input's :func:`analysis_block`, started on the worker thread when the curve is long
     (:data:`OVERLAP_MIN` points, two threads) and ``beside`` (the method's passes leave the
     worker thread free, :attr:`MethodSpec.two_threads`); else computed now. The returned
-    function gives the figures (the
-    same bits either way: every pass of the analysis gives the same results on one thread or
-    two). The job keeps no samples (``lean``: 52-60 bytes a segment instead of 128-228, the
-    method's memory and the analysis' add up while both run). Analysed first, as before: a 3-D
+    function gives the figures (the same bits either way: every pass of the analysis gives
+    the same results on one thread or two). The job keeps no samples (``lean``: 52-60 bytes a
+    segment instead of 128-228, the method's memory and the analysis' add up while both
+    run). Analysed first, as before: a 3-D
     B-spline (its analysis builds the whole power form, which the call drops before the
     method) and a curve of ``RESCAN_MIN`` segments or more, where the analysis is lean anyway
     because memory is what limits the call: beside the method its 3.3-3.8 times the
