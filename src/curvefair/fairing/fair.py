@@ -729,15 +729,6 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
     # as the call no longer needs it: at a million points they are 72 and 56 bytes per span,
     # held by the caller's curve after the call, and at the call's peak (the result's analysis)
     cached_at_entry = _CacheState(curve)
-    # (a long curve's: beside the join plan and the method)
-    before_figures = _start_analysis(curve, not spec.two_threads)
-    try:
-        jp = (_joins.plan(curve, clamp_pair, prot, g1_deg, tol_v) if joins == "keep"
-              else _joins.JoinPlan(curve, prot, clamp_pair))
-    except Exception:
-        before_figures()  # (the input's analysis raises first, as when it ran first)
-        raise
-    cached_at_entry.drop_power_form(curve, method_done=False)
 
     def solve(plan: Any, tol_w: float | None) -> Outcome:
         # the method solves the problem on the join plan's curve (joins held, tol shared)
@@ -758,7 +749,12 @@ def fair(curve: PiecewiseCurve, method: str | None = None, *, tol: float | None 
             out = solve(jp, tol_v)
         return jp, out, jp.restore(out.curve)
 
+    # (a long curve's: beside the join plan and the method)
+    before_figures = _start_analysis(curve, not spec.two_threads)
     try:
+        jp = (_joins.plan(curve, clamp_pair, prot, g1_deg, tol_v) if joins == "keep"
+              else _joins.JoinPlan(curve, prot, clamp_pair))
+        cached_at_entry.drop_power_form(curve, method_done=False)
         jp, out, new = run(jp, frozenset())
     except Exception:
         before_figures()  # (the input's analysis raises first, as when it ran first)
