@@ -263,3 +263,147 @@ def test_history_buffers_grow_with_the_steps(monkeypatch, closed):
     assert np.array_equal(grown.curve.control_points, whole.curve.control_points)
     for key in whole.history:
         assert np.array_equal(grown.history[key], whole.history[key], equal_nan=True), key
+
+
+def _reference_loop(Q, Q0, W, lw, mw, closed, movable, e, eps, max_steps, allow_pair):
+    """The ranking loop written out plainly: every entry's K, t, D, flags and priority
+    recomputed after every step (the compiled loop keeps them up to date locally and ranks
+    them in a tournament tree), the top found by argmax, the move made by the public
+    compiled ``plan`` and kept by the same local drop test. The per-point quantities are the
+    kernel's own scalar functions (the same bits wherever they are evaluated), so the two
+    loops must agree step for step."""
+    from curvefair._kernels import cheng_yu as k
+
+    Q = Q.copy()
+    n, dim = Q.shape
+    planar = dim == 2
+
+    def span(lo, hi):  # distinct indices lo..hi, cyclic or clipped
+        if closed:
+            return list(range(n)) if hi - lo + 1 >= n else [j % n for j in range(lo, hi + 1)]
+        return list(range(max(lo, 0), min(hi, n - 1) + 1))
+
+    def state():
+        K = np.array([k._k_at(Q, lw, mw, i, n, closed, planar) for i in range(n)])
+        t = np.array([k._t_at(Q, i, n, closed) for i in range(n)])
+        D = np.array([k._d_at(K, t, i, n, closed) for i in range(n)])
+        return K, t, D
+
+    def local(D, idx):
+        s = 0.0
+        for j in idx:
+            if k._valid(j, n, closed):
+                s += D[j] * D[j]
+        return s
+
+    K, t, D = state()
+    x = 0.0
+    for i in range(n):
+        if k._valid(i, n, closed):
+            x += D[i] * D[i]
+    frozen = np.zeros(n, dtype=bool)
+    hist, moves = [x], []
+    while True:
+        flags = np.array([k._flags_at(K, t, i, n, closed) for i in range(n)])
+        pr = np.where((flags != 0) & movable & ~frozen, D * D, -np.inf)
+        m = int(np.argmax(pr))
+        zm = pr[m]
+        if zm == -np.inf:
+            reason = k.CONVERGED
+            if np.any(frozen & (flags != 0) & movable):
+                reason = k.NONE_LEFT
+            break
+        if zm < eps:
+            reason = k.EPS
+            break
+        if len(moves) >= max_steps:
+            reason = k.MAX_STEPS
+            break
+        first, pair = m, False
+        if allow_pair:
+            rest = pr.copy()
+            rest[m] = -np.inf
+            m2 = int(np.argmax(rest))
+            if rest[m2] != -np.inf and rest[m2] >= eps:
+                if (closed and (m2 - m) % n == 1) or (not closed and m2 == m + 1):
+                    pair = True
+                elif (closed and (m - m2) % n == 1) or (not closed and m2 == m - 1):
+                    pair, first = True, m2
+        tries = [(first, pair)] + ([(m, False)] if pair else [])
+        done = None
+        for f, p in tries:
+            new0, new1 = np.zeros(dim), np.zeros(dim)
+            k.plan(Q, Q0, W, n, closed, f, p, e, -1.0, new0, new1)
+            f1 = (f + 1) % n
+            if np.array_equal(new0, Q[f]) and (not p or np.array_equal(new1, Q[f1])):
+                continue
+            last = f + 1 if p else f
+            dr = span(f - 2, last + 2)
+            before = local(D, dr)
+            keep = Q.copy()
+            Q[f] = new0
+            if p:
+                Q[f1] = new1
+            K2, t2, D2 = state()
+            after = local(D2, dr)
+            if before - after > eps:
+                K, t, D = K2, t2, D2
+                x += after - before
+                done = (f, p, keep)
+                break
+            Q[:] = keep
+        if done is None:
+            frozen[m] = True
+            continue
+        f, p, keep = done
+        disp = np.linalg.norm(Q[f] - keep[f])
+        if p:
+            disp = max(disp, np.linalg.norm(Q[(f + 1) % n] - keep[(f + 1) % n]))
+        hist.append(x)
+        moves.append((f, 2 if p else 1, zm, disp))
+        frozen[span(f - 4, (f + 1 if p else f) + 4)] = False
+    return Q, reason, np.array(hist), np.array(moves).reshape(-1, 4)
+
+
+@pytest.mark.parametrize("case", ["open", "open3d", "closed", "closed_wrap", "closed_tiny",
+                                  "no_pair"])
+def test_compiled_loop_is_the_plain_loop(case):
+    # the compiled loop's local bookkeeping (K, t, D updated near the moved points, the
+    # neighbours re-ranked together in the tournament tree, cyclic ranges across index 0, the
+    # whole curve when the neighbourhood covers a short closed curve) against the plain loop
+    from curvefair._kernels import cheng_yu as k
+    from curvefair.analysis.discrete import corner_cut_ratios
+
+    rng = np.random.default_rng(5)
+    tol, eps, pair = 0.05, 1e-6, True
+    if case in ("open", "open3d", "no_pair"):
+        c = noisy_open(6, n=40, noise=0.05, dim=3 if case == "open3d" else 2)
+        pair = case != "no_pair"
+    else:
+        n = {"closed": 30, "closed_wrap": 12, "closed_tiny": 7}[case]
+        a = np.linspace(0, 2 * np.pi, n, endpoint=False)
+        pts = np.c_[np.cos(a), np.sin(a)] * (1 + 0.08 * rng.normal(size=(n, 1)))
+        c = interpolate_bspline(pts, closed=True)
+        tol = 0.1
+    n = c.n_ctrl
+    lw, mw = corner_cut_ratios(np.asarray(c.knots), n, c.closed)
+    Q0 = np.ascontiguousarray(c.control_points, dtype=float)
+    W = np.ascontiguousarray(c.gram_band(2), dtype=float)
+    movable = np.ones(n, dtype=bool)
+    if not c.closed:
+        movable[[0, 1, n - 2, n - 1]] = False
+    Q = Q0.copy()
+    steps, code, hist, moves = k.cy_loop(Q, Q0, W, lw, mw, bool(c.closed), Q.shape[1] == 2,
+                                         movable, tol, eps, 10_000, pair, np.zeros(2),
+                                         np.zeros((1, 4)))
+    Qr, code_r, hist_r, moves_r = _reference_loop(Q0, Q0, W, lw, mw, bool(c.closed), movable,
+                                                  tol, eps, 10_000, pair)
+    assert steps == len(moves_r) > 3 and code == code_r
+    assert np.array_equal(Q, Qr)
+    assert np.array_equal(hist[:steps + 1], hist_r)
+    assert np.array_equal(moves[:steps], moves_r)
+    if case == "closed_wrap":  # moves on both sides of index 0 (cyclic neighbourhoods)
+        firsts = moves_r[:, 0]
+        assert np.any(firsts <= 2) and np.any(firsts >= n - 3)
+    if case != "no_pair":
+        assert np.any(moves_r[:, 1] == 2) or case == "closed_tiny"

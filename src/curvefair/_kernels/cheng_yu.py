@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._jit import njit
-from .ranking import tt_build, tt_top, tt_update
+from .ranking import tt_build, tt_top, tt_update, tt_update_range
 
 _P = 3  # cubic
 _BISECT = 64
@@ -25,7 +25,7 @@ _SAMPLES = 32
 # --------------------------------------------------------------------------------------------
 # compiled kernels shared by the single step and the driver
 # --------------------------------------------------------------------------------------------
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _gram(W, n, closed, m, j):
     """``G[m, j]`` from the band ``W`` (aliased offsets of a short closed curve add up)."""
     s = 0.0
@@ -40,7 +40,7 @@ def _gram(W, n, closed, m, j):
     return s
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _residual(W, Q, n, closed, m, out):
     """``out = sum_{i != m} d_i Q_i - Q_m = -(G Q)_m / G_mm`` (eq. (8) target minus current)."""
     dim = Q.shape[1]
@@ -60,7 +60,7 @@ def _residual(W, Q, n, closed, m, out):
         out[c] = -out[c] / g
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _moves(s, r0, r1, a, b, pair, out0, out1):
     """Displacements at ``s = 1 - d``: single ``s r0``; pair ``s A(s)^-1 [r0, r1]`` (eq. (9))."""
     dim = r0.shape[0]
@@ -74,7 +74,7 @@ def _moves(s, r0, r1, a, b, pair, out0, out1):
         out1[c] = s * (r1[c] + s * b * r0[c]) / den
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _excess(Q, Q0, m0, m1, s, r0, r1, a, b, pair, e, tmp0, tmp1):
     """``max_j |Q_j + move_j(s) - Q0_j| - e`` over the moved points."""
     _moves(s, r0, r1, a, b, pair, tmp0, tmp1)
@@ -163,11 +163,21 @@ def plan(Q, Q0, W, n, closed, m0, pair, e, dfix, new0, new1):
     ``e = inf`` means no bound; ``dfix >= 0`` forces the factor.
     """
     dim = Q.shape[1]
+    return _plan_into(Q, Q0, W, n, closed, m0, pair, e, dfix, new0, new1, np.zeros(dim),
+                      np.zeros(dim), np.zeros(dim), np.zeros(dim))
+
+
+@njit(cache=True)
+def _plan_into(Q, Q0, W, n, closed, m0, pair, e, dfix, new0, new1, r0, r1, tmp0, tmp1):
+    """:func:`plan` with its work vectors (``dim`` each) given: the ranking loop calls it for
+    every attempted move, so it allocates nothing."""
+    dim = Q.shape[1]
     m1 = (m0 + 1) % n if closed else m0 + 1
-    r0 = np.zeros(dim)
-    r1 = np.zeros(dim)
-    tmp0 = np.zeros(dim)
-    tmp1 = np.zeros(dim)
+    for c in range(dim):
+        r0[c] = 0.0
+        r1[c] = 0.0
+        tmp0[c] = 0.0
+        tmp1[c] = 0.0
     _residual(W, Q, n, closed, m0, r0)
     a = 0.0
     b = 0.0
@@ -196,31 +206,39 @@ MAX_STEPS = 2
 CONVERGED = 3  # no movable bad point at all
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _k_at(Q, lw, mw, i, n, closed, planar):
-    """``K_i`` (eq. (3)); the same arithmetic as ``second_curvature_values``."""
+    """``K_i`` (eq. (3)); the same arithmetic as ``second_curvature_values`` (``dim`` 2 or 3;
+    the edge vectors in scalars: the loop evaluates it a few times per attempted move)."""
     if not closed and (i == 0 or i == n - 1):
         return 0.0
     ip = (i - 1) % n
     inx = (i + 1) % n
-    dim = Q.shape[1]
-    e0 = np.empty(dim)
-    e1 = np.empty(dim)
-    for c in range(dim):
-        e0[c] = Q[i, c] - Q[ip, c]
-        e1[c] = Q[inx, c] - Q[i, c]
+    three = Q.shape[1] == 3
+    a0 = Q[i, 0] - Q[ip, 0]
+    a1 = Q[i, 1] - Q[ip, 1]
+    b0 = Q[inx, 0] - Q[i, 0]
+    b1 = Q[inx, 1] - Q[i, 1]
+    a2 = 0.0
+    b2 = 0.0
+    if three:
+        a2 = Q[i, 2] - Q[ip, 2]
+        b2 = Q[inx, 2] - Q[i, 2]
     if planar:
-        area = 0.5 * (e0[0] * e1[1] - e0[1] * e1[0])
+        area = 0.5 * (a0 * b1 - a1 * b0)
     else:
-        cx = e0[1] * e1[2] - e0[2] * e1[1]
-        cy = e0[2] * e1[0] - e0[0] * e1[2]
-        cz = e0[0] * e1[1] - e0[1] * e1[0]
+        cx = a1 * b2 - a2 * b1
+        cy = a2 * b0 - a0 * b2
+        cz = a0 * b1 - a1 * b0
         area = 0.5 * np.sqrt(cx * cx + cy * cy + cz * cz)
     if area == 0.0:
         return 0.0
-    s = 0.0
-    for c in range(dim):
-        w = lw[i] * e0[c] + mw[i] * e1[c]
+    w = lw[i] * a0 + mw[i] * b0
+    s = w * w
+    w = lw[i] * a1 + mw[i] * b1
+    s += w * w
+    if three:
+        w = lw[i] * a2 + mw[i] * b2
         s += w * w
     wn = np.sqrt(s)
     if wn == 0.0:
@@ -228,7 +246,7 @@ def _k_at(Q, lw, mw, i, n, closed, planar):
     return area / wn**3
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _t_at(Q, i, n, closed):
     if not closed and (i == 0 or i == n - 1):
         return 0.5
@@ -249,19 +267,19 @@ def _t_at(Q, i, n, closed):
     return 0.5
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _valid(i, n, closed):
     return closed or (2 <= i <= n - 3)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _d_at(K, t, i, n, closed):
     if not closed and (i == 0 or i == n - 1):
         return 0.0
     return t[i] * K[(i - 1) % n] + (1.0 - t[i]) * K[(i + 1) % n] - K[i]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _flags_at(K, t, i, n, closed):
     """Bit mask of the bad-point kinds at ``i`` (1, 2, 4 for kinds 1, 2, 3), as in
     ``bad_point_kinds``."""
@@ -282,23 +300,26 @@ def _flags_at(K, t, i, n, closed):
 
 
 @njit(cache=True)
-def _index_range(lo, hi, n, closed):
-    """Distinct indices ``lo .. hi`` (cyclic or clipped)."""
+def _index_range(lo, hi, n, closed, out):
+    """Distinct indices ``lo .. hi`` (cyclic or clipped) written to ``out``; returns how many."""
     if closed:
         if hi - lo + 1 >= n:
-            return np.arange(n)
-        out = np.empty(hi - lo + 1, dtype=np.int64)
+            for k in range(n):
+                out[k] = k
+            return n
         for k in range(lo, hi + 1):
             out[k - lo] = k % n
-        return out
+        return hi - lo + 1
     a = max(lo, 0)
     b = min(hi, n - 1)
     if b < a:
-        return np.empty(0, dtype=np.int64)
-    return np.arange(a, b + 1)
+        return 0
+    for k in range(a, b + 1):
+        out[k - a] = k
+    return b - a + 1
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _priority(D, flags, movable, frozen, i):
     if flags[i] != 0 and movable[i] and not frozen[i]:
         return D[i] * D[i]
@@ -306,14 +327,18 @@ def _priority(D, flags, movable, frozen, i):
 
 
 @njit(cache=True)
-def _try_step(Q, Q0, W, lw, mw, K, t, D, n, closed, planar, m0, pair, e, min_drop):
+def _try_step(Q, Q0, W, lw, mw, K, t, D, n, closed, planar, m0, pair, e, min_drop, new0,
+              new1, r0, r1, tmp0, tmp1, old_k, old_t, old_d, kr, dr):
     """Move ``m0`` (and ``m0 + 1``); keep it iff ``sum D_i**2`` over the touched valid indices
-    drops by more than ``min_drop``. Returns ``(accepted, local change of x)``."""
+    drops by more than ``min_drop``. Returns ``(accepted, local change of x)``. The rest are
+    work space (``new0`` .. ``tmp1``: ``dim`` floats; ``old_*``, ``kr``, ``dr``: 6 at least):
+    the loop attempts several moves per step taken, and none allocates or makes a view."""
     dim = Q.shape[1]
     m1 = (m0 + 1) % n if closed else m0 + 1
-    new0 = np.zeros(dim)
-    new1 = np.zeros(dim)
-    plan(Q, Q0, W, n, closed, m0, pair, e, -1.0, new0, new1)
+    for c in range(dim):
+        new0[c] = 0.0
+        new1[c] = 0.0
+    _plan_into(Q, Q0, W, n, closed, m0, pair, e, -1.0, new0, new1, r0, r1, tmp0, tmp1)
     changed = False
     for c in range(dim):
         if new0[c] != Q[m0, c] or (pair and new1[c] != Q[m1, c]):
@@ -321,36 +346,50 @@ def _try_step(Q, Q0, W, lw, mw, K, t, D, n, closed, planar, m0, pair, e, min_dro
     if not changed:
         return False, 0.0
     last = m0 + 1 if pair else m0
-    kr = _index_range(m0 - 1, last + 1, n, closed)
-    dr = _index_range(m0 - 2, last + 2, n, closed)
-    old_q0 = Q[m0].copy()
-    old_q1 = Q[m1].copy() if pair else Q[m0].copy()
-    old_k = K[kr].copy()
-    old_t = t[kr].copy()
-    old_d = D[dr].copy()
+    nk = _index_range(m0 - 1, last + 1, n, closed, kr)
+    nd = _index_range(m0 - 2, last + 2, n, closed, dr)
+    old_q0 = r0  # (the plan's work vectors are free again)
+    old_q1 = r1
+    for c in range(dim):
+        old_q0[c] = Q[m0, c]
+        old_q1[c] = Q[m1, c] if pair else Q[m0, c]
+    for r in range(nk):
+        old_k[r] = K[kr[r]]
+        old_t[r] = t[kr[r]]
+    for r in range(nd):
+        old_d[r] = D[dr[r]]
     before = 0.0
-    for j in dr:
+    for r in range(nd):
+        j = dr[r]
         if _valid(j, n, closed):
             before += D[j] * D[j]
-    Q[m0] = new0
+    for c in range(dim):
+        Q[m0, c] = new0[c]
     if pair:
-        Q[m1] = new1
-    for j in kr:
+        for c in range(dim):
+            Q[m1, c] = new1[c]
+    for r in range(nk):
+        j = kr[r]
         K[j] = _k_at(Q, lw, mw, j, n, closed, planar)
         t[j] = _t_at(Q, j, n, closed)
     after = 0.0
-    for j in dr:
+    for r in range(nd):
+        j = dr[r]
         D[j] = _d_at(K, t, j, n, closed)
         if _valid(j, n, closed):
             after += D[j] * D[j]
     if before - after > min_drop:
         return True, after - before
-    Q[m0] = old_q0
+    for c in range(dim):
+        Q[m0, c] = old_q0[c]
     if pair:
-        Q[m1] = old_q1
-    K[kr] = old_k
-    t[kr] = old_t
-    D[dr] = old_d
+        for c in range(dim):
+            Q[m1, c] = old_q1[c]
+    for r in range(nk):
+        K[kr[r]] = old_k[r]
+        t[kr[r]] = old_t[r]
+    for r in range(nd):
+        D[dr[r]] = old_d[r]
     return False, 0.0
 
 
@@ -383,6 +422,21 @@ def cy_loop(Q, Q0, W, lw, mw, closed, planar, movable, e, eps, max_steps,
         flags[i] = _flags_at(K, t, i, n, closed)
         pr[i] = _priority(D, flags, movable, frozen, i)
     tv, ti = tt_build(pr)
+    # work space of the attempted moves (:func:`_try_step`) and of the neighbourhood updates
+    dim = Q.shape[1]
+    w_new0 = np.zeros(dim)
+    w_new1 = np.zeros(dim)
+    w_r0 = np.zeros(dim)
+    w_r1 = np.zeros(dim)
+    w_tmp0 = np.zeros(dim)
+    w_tmp1 = np.zeros(dim)
+    w_k = np.zeros(8)
+    w_t = np.zeros(8)
+    w_d = np.zeros(8)
+    w_kr = np.zeros(8, dtype=np.int64)
+    w_dr = np.zeros(8, dtype=np.int64)
+    q_first = np.zeros(dim)
+    q_second = np.zeros(dim)
     hist[0] = x
     steps = 0
     reason = CONVERGED
@@ -413,15 +467,21 @@ def cy_loop(Q, Q0, W, lw, mw, closed, planar, movable, e, eps, max_steps,
                 elif (closed and (m - m2) % n == 1) or (not closed and m2 == m - 1):
                     pair = True
                     first = m2
-        q_first = Q[first].copy()
-        q_second = Q[(first + 1) % n].copy()
+        for c in range(Q.shape[1]):
+            q_first[c] = Q[first, c]
+            q_second[c] = Q[(first + 1) % n, c]
         ok, dx = _try_step(Q, Q0, W, lw, mw, K, t, D, n, closed, planar, first, pair, e,
-                            eps)
+                           eps, w_new0, w_new1, w_r0, w_r1, w_tmp0, w_tmp1, w_k, w_t, w_d,
+                           w_kr, w_dr)
         if not ok and pair:
             pair = False
             first = m
-            ok, dx = _try_step(Q, Q0, W, lw, mw, K, t, D, n, closed, planar, m, np.bool_(False), e,
-                                eps)
+            # (the displacement is measured from the point moved: ``m``, not ``m - 1``)
+            for c in range(Q.shape[1]):
+                q_first[c] = Q[first, c]
+            ok, dx = _try_step(Q, Q0, W, lw, mw, K, t, D, n, closed, planar, m,
+                               np.bool_(False), e, eps, w_new0, w_new1, w_r0, w_r1, w_tmp0,
+                               w_tmp1, w_k, w_t, w_d, w_kr, w_dr)
         if not ok:
             frozen[m] = True
             tt_update(tv, ti, m, -np.inf)
@@ -453,9 +513,29 @@ def cy_loop(Q, Q0, W, lw, mw, closed, planar, movable, e, eps, max_steps,
             disp = max(disp, np.sqrt(d2))
         moves[steps - 1, 3] = disp
         last = first + 1 if pair else first
-        for j in _index_range(first - 4, last + 4, n, closed):
-            frozen[j] = False
-        for j in _index_range(first - 4, last + 4, n, closed):
+        # first - 4 .. last + 4 (10 indices at most; cyclic: at most two pieces), re-ranked
+        # together (each block rescanned and each ancestor repaired once; the tree is a
+        # function of the entries' values, so it is the tree the updates one by one made)
+        lo = first - 4
+        hi = last + 4
+        if closed and hi - lo + 1 >= n:
+            lo = 0
+            hi = n - 1
+        elif not closed:
+            lo = max(lo, 0)
+            hi = min(hi, n - 1)
+        for k in range(lo, hi + 1):
+            frozen[k % n] = False
+        for k in range(lo, hi + 1):
+            j = k % n
             flags[j] = _flags_at(K, t, j, n, closed)
-            tt_update(tv, ti, j, _priority(D, flags, movable, frozen, j))
+            pr[j] = _priority(D, flags, movable, frozen, j)
+        if lo < 0:
+            tt_update_range(tv, ti, lo + n, n - 1, pr)
+            tt_update_range(tv, ti, 0, hi, pr)
+        elif hi >= n:
+            tt_update_range(tv, ti, lo, n - 1, pr)
+            tt_update_range(tv, ti, 0, hi - n, pr)
+        else:
+            tt_update_range(tv, ti, lo, hi, pr)
     return steps, reason, hist, moves
