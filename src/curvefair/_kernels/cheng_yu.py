@@ -75,32 +75,72 @@ def _moves(s, r0, r1, a, b, pair, out0, out1):
 
 
 @njit(cache=True, inline="always")
-def _excess(Q, Q0, m0, m1, s, r0, r1, a, b, pair, e, tmp0, tmp1):
-    """``max_j |Q_j + move_j(s) - Q0_j| - e`` over the moved points."""
-    _moves(s, r0, r1, a, b, pair, tmp0, tmp1)
-    dim = Q.shape[1]
+def _excess(x, s, a, b, pair, e, three):
+    """``max_j |Q_j + move_j(s) - Q0_j| - e`` over the moved points, the move as in
+    :func:`_moves` (the same operations in the same order). ``x`` holds the rows as scalars
+    (:func:`_rows`): the bisection evaluates this about a hundred times per pair, and array
+    arguments would cost each evaluation its reference counting."""
+    (q0x, q0y, q0z, o0x, o0y, o0z, q1x, q1y, q1z, o1x, o1y, o1z,
+     r0x, r0y, r0z, r1x, r1y, r1z) = x
+    m1x = 0.0
+    m1y = 0.0
+    m1z = 0.0
+    if not pair:
+        m0x = s * r0x
+        m0y = s * r0y
+        m0z = s * r0z
+    else:
+        den = 1.0 - s * s * a * b
+        m0x = s * (r0x + s * a * r1x) / den
+        m1x = s * (r1x + s * b * r0x) / den
+        m0y = s * (r0y + s * a * r1y) / den
+        m1y = s * (r1y + s * b * r0y) / den
+        m0z = s * (r0z + s * a * r1z) / den
+        m1z = s * (r1z + s * b * r0z) / den
     d2 = 0.0
-    for c in range(dim):
-        v = Q[m0, c] + tmp0[c] - Q0[m0, c]
+    v = q0x + m0x - o0x
+    d2 += v * v
+    v = q0y + m0y - o0y
+    d2 += v * v
+    if three:
+        v = q0z + m0z - o0z
         d2 += v * v
     worst = np.sqrt(d2)
     if pair:
         d2 = 0.0
-        for c in range(dim):
-            v = Q[m1, c] + tmp1[c] - Q0[m1, c]
+        v = q1x + m1x - o1x
+        d2 += v * v
+        v = q1y + m1y - o1y
+        d2 += v * v
+        if three:
+            v = q1z + m1z - o1z
             d2 += v * v
         worst = max(worst, np.sqrt(d2))
     return worst - e
 
 
+@njit(cache=True, inline="always")
+def _rows(Q, Q0, m0, m1, r0, r1, pair):
+    """The rows :func:`_excess` reads, as a tuple of 18 floats (``dim`` 2: the third
+    coordinates 0, never read; one point: ``Q[m1]``, ``Q0[m1]`` and ``r1`` never read)."""
+    three = Q.shape[1] == 3
+    z = 2 if three else 0  # (an index that exists; its values are not used in 2-D)
+    j = m1 if pair else m0
+    return (Q[m0, 0], Q[m0, 1], Q[m0, z], Q0[m0, 0], Q0[m0, 1], Q0[m0, z],
+            Q[j, 0], Q[j, 1], Q[j, z], Q0[j, 0], Q0[j, 1], Q0[j, z],
+            r0[0], r0[1], r0[z], r1[0], r1[1], r1[z])
+
+
 @njit(cache=True)
-def _step_factor(Q, Q0, m0, m1, r0, r1, a, b, pair, e, tmp0, tmp1):
+def _step_factor(Q, Q0, m0, m1, r0, r1, a, b, pair, e):
     """Largest ``s = 1 - d`` in ``[0, 1]`` with the error bound kept on all of ``[0, s]``
     (one point: closed form; two points: sampled, then bisected). The returned ``s`` satisfies
     the bound as computed."""
     if e == np.inf:  # no bound
         return 1.0
-    e = e * (1.0 - 1e-12)  # margin: the bound then survives any re-rounding of the distance
+    e = e * (1.0 - 1e-12)
+    x = _rows(Q, Q0, m0, m1, r0, r1, pair)
+    three = Q.shape[1] == 3  # margin: the bound then survives any re-rounding of the distance
     if not pair:
         # the segment Q + s r meets the ball |x - Q0| <= e in an interval containing s = 0:
         # its upper end in closed form, |p + s r|^2 = e^2 with p = Q - Q0
@@ -124,15 +164,15 @@ def _step_factor(Q, Q0, m0, m1, r0, r1, a, b, pair, e, tmp0, tmp1):
             s = (es * es - pp) / (pr + np.sqrt(disc))
         s = min(max(s, 0.0), 1.0)
         for _ in range(60):  # guard against rounding: shrink until the computed point is inside
-            if _excess(Q, Q0, m0, m1, s, r0, r1, a, b, pair, e, tmp0, tmp1) <= 0.0:
+            if _excess(x, s, a, b, pair, e, three) <= 0.0:
                 return s
             s *= 1.0 - 1e-12
         return 0.0
-    if _excess(Q, Q0, m0, m1, 1.0, r0, r1, a, b, pair, e, tmp0, tmp1) <= 0.0:
+    if _excess(x, 1.0, a, b, pair, e, three) <= 0.0:
         # still check the path for a rational curve leaving and re-entering the ball
         ok = True
         for k in range(1, _SAMPLES):
-            if _excess(Q, Q0, m0, m1, k / _SAMPLES, r0, r1, a, b, pair, e, tmp0, tmp1) > 0.0:
+            if _excess(x, k / _SAMPLES, a, b, pair, e, three) > 0.0:
                 ok = False
                 break
         if ok:
@@ -141,7 +181,7 @@ def _step_factor(Q, Q0, m0, m1, r0, r1, a, b, pair, e, tmp0, tmp1):
     hi = 1.0
     for k in range(1, _SAMPLES + 1):
         sk = k / _SAMPLES
-        if _excess(Q, Q0, m0, m1, sk, r0, r1, a, b, pair, e, tmp0, tmp1) > 0.0:
+        if _excess(x, sk, a, b, pair, e, three) > 0.0:
             hi = sk
             break
         lo = sk
@@ -149,7 +189,7 @@ def _step_factor(Q, Q0, m0, m1, r0, r1, a, b, pair, e, tmp0, tmp1):
         mid = 0.5 * (lo + hi)
         if mid <= lo or mid >= hi:
             break
-        if _excess(Q, Q0, m0, m1, mid, r0, r1, a, b, pair, e, tmp0, tmp1) > 0.0:
+        if _excess(x, mid, a, b, pair, e, three) > 0.0:
             hi = mid
         else:
             lo = mid
@@ -188,7 +228,7 @@ def _plan_into(Q, Q0, W, n, closed, m0, pair, e, dfix, new0, new1, r0, r1, tmp0,
     if dfix >= 0.0:
         s = 1.0 - dfix
     else:
-        s = _step_factor(Q, Q0, m0, m1, r0, r1, a, b, pair, e, tmp0, tmp1)
+        s = _step_factor(Q, Q0, m0, m1, r0, r1, a, b, pair, e)
     _moves(s, r0, r1, a, b, pair, tmp0, tmp1)
     for c in range(dim):
         new0[c] = Q[m0, c] + tmp0[c]
