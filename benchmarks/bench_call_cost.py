@@ -13,6 +13,11 @@ the difference curve: for a planar result its power form is made there), the poi
 ``report.to_dict()`` (JSON-ready, what the CLI's ``--report`` pays). Ratios are against the csaps
 fit measured in the same run.
 
+Table 1b (``--methods``): the whole call ``fair(interpolate_bspline(P), m, tol=0.02)`` of each
+B-spline method ``m`` with its default options (best of ``--repeat``, each on a fresh copy of the
+curve), against one csaps fit measured in the same run (the goal: at most one csaps fit for
+every B-spline method, at most 0.5x for the default, ``global``).
+
 Table 2: ``fair(interpolate_cubic(P), "poliakoff", tol=0.005, eps=0, max_steps=s,
 guard=False)`` for two step counts; the marginal cost of a step is the difference over the
 difference of the steps taken, and its ratio to the smallest size's is printed (goal: within
@@ -23,6 +28,8 @@ the shorter run can cost more than the longer one).
 Usage::
 
     python benchmarks/bench_call_cost.py 1e3 1e4 1e5 1e6 --repeat 3
+    python benchmarks/bench_call_cost.py 1e6 --repeat 2 --skip-hermite --skip-table1 \
+        --methods eck-hadenfeld knot-removal cheng-yu global
 """
 
 from __future__ import annotations
@@ -112,6 +119,26 @@ def table1(sizes: list[int], repeat: int) -> None:
           "is asked for)")
 
 
+def table1b(sizes: list[int], methods: list[str], repeat: int) -> None:
+    from csaps import CubicSmoothingSpline
+
+    print(f"\nTable 1b: fair(interpolate_bspline(P), m, tol=0.02), default options, seconds "
+          f"(best of {repeat}); x = ratio to one csaps fit in the same run")
+    print(f"{'n':>9} {'csaps':>8}" + "".join(f" {m:>14} {'x':>6}" for m in methods))
+    for m in methods:  # compile / warm each method first (long curves take other paths)
+        for w in (300, 20_000):
+            cf.fair(cf.interpolate_bspline(data(w)[1]), m, tol=0.02)
+    for n in sizes:
+        t, P = data(n)
+        tc, _ = best(lambda t=t, P=P: CubicSmoothingSpline(t, P.T, smooth=0.5), repeat)
+        c = cf.interpolate_bspline(P)
+        line = f"{n:>9} {tc:8.3f}"
+        for m in methods:
+            tf, _ = best(lambda c=c, m=m: cf.fair(fresh(c), m, tol=0.02), repeat)
+            line += f" {tf:14.3f} {tf / tc:6.2f}"
+        print(line, flush=True)
+
+
 def table2(sizes: list[int], steps: tuple[int, int], repeat: int) -> None:
     s0, s1 = steps
     print(f"\nTable 2: fair(interpolate_cubic(P), 'poliakoff', tol=0.005, eps=0, max_steps=s, "
@@ -147,6 +174,9 @@ def main() -> None:
     ap.add_argument("--steps", type=int, nargs=2, default=(500, 2500))
     ap.add_argument("--skip-hermite", action="store_true")
     ap.add_argument("--skip-bspline", action="store_true")
+    ap.add_argument("--skip-table1", action="store_true")
+    ap.add_argument("--methods", nargs="*", default=[],
+                    help="B-spline methods whose whole call table 1b times against csaps")
     ap.add_argument("--cpu", action="store_true",
                     help="process CPU time instead of wall time (a loaded machine)")
     args = ap.parse_args()
@@ -155,8 +185,10 @@ def main() -> None:
         CLOCK = time.process_time
         print("times are process CPU seconds (--cpu)")
     sizes = [int(float(s)) for s in args.sizes]
-    if not args.skip_bspline:
+    if not args.skip_bspline and not args.skip_table1:
         table1(sizes, args.repeat)
+    if not args.skip_bspline and args.methods:
+        table1b(sizes, args.methods, args.repeat)
     if not args.skip_hermite:
         table2(sizes, tuple(args.steps), args.repeat)
 
