@@ -20,7 +20,7 @@ from curvefair import (
     interpolate_bspline,
     second_discrete_curvature,
 )
-from curvefair.analysis.discrete import bad_point_count, fairing_indicator
+from curvefair.analysis.discrete import bad_point_count, cheng_yu_figures, fairing_indicator
 
 
 def random_open(rng, n=10, dim=2, uniform=False):
@@ -284,6 +284,8 @@ def test_bad_input():
         bad_point_count(BSplineCurve(P, knots, 3))
     with pytest.raises(InputError, match="control point 3 does not exist"):
         fairing_indicator(BSplineCurve(P, knots, 3))
+    with pytest.raises(InputError, match="control point 3 does not exist"):
+        cheng_yu_figures(BSplineCurve(P, knots, 3))
 
 
 @pytest.mark.parametrize("block", [1, 2, 3, 7, 65_536])
@@ -303,4 +305,7 @@ def test_counts_and_indicator_in_blocks_are_the_whole_curves(monkeypatch, block)
         assert bad_point_count(c) == len(bad_points(c))
         # the indicator summed from blocks: the same bits as from the whole arrays
         assert fairing_indicator(c) == second_discrete_curvature(c).indicator
+        # both in one pass (what the cheng-yu method reports)
+        assert cheng_yu_figures(c) == (second_discrete_curvature(c).indicator,
+                                       len(bad_points(c)))
     assert bad_point_count(curves[-3]) > 500

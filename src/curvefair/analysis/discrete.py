@@ -487,20 +487,7 @@ def bad_point_count(curve: Any) -> int:
     without a Python object per point (what a fairing report states). An open curve is counted
     block by block (the temporaries of one block instead of several times the coordinates'
     bytes), a closed one on the whole curve."""
-    curve = check_cubic_bspline(curve, "bad_point_count")
-    if curve.closed or curve.n_ctrl < 5:
-        sdc = second_discrete_curvature(curve)
-        flags = bad_point_kinds(sdc.K, sdc.first_difference, sdc.weights, sdc.valid, True)
-        return int(np.count_nonzero(flags.any(axis=0)))
-    count = 0
-    for K, t in _open_blocks(curve):
-        dK = np.zeros_like(K)
-        dK[1:] = np.diff(K)
-        valid = np.ones(K.shape[0], dtype=bool)
-        valid[0] = valid[-1] = False
-        flags = bad_point_kinds(K, dK, t, valid, False)
-        count += int(np.count_nonzero(flags.any(axis=0)))
-    return count
+    return _indicator_and_count(curve, "bad_point_count", False, True)[1]
 
 
 def fairing_indicator(curve: Any) -> float:
@@ -508,18 +495,45 @@ def fairing_indicator(curve: Any) -> float:
     ``second_discrete_curvature(curve).indicator``, without its per-point arrays. An open
     curve's ``D_i**2`` are written block by block into one array, summed as that attribute
     sums them (numpy's pairwise sum of the same values in the same order)."""
-    curve = check_cubic_bspline(curve, "fairing_indicator")
+    return _indicator_and_count(curve, "fairing_indicator", True, False)[0]
+
+
+def cheng_yu_figures(curve: Any) -> tuple[float, int]:
+    """``(fairing_indicator(curve), bad_point_count(curve))`` in one pass over the curve: the
+    second discrete curvature of each block is computed once for both (each figure by the
+    same operations as alone, so the same bits). What the ``cheng-yu`` method reports of its
+    input and its result."""
+    return _indicator_and_count(curve, "cheng_yu_figures", True, True)
+
+
+def _indicator_and_count(curve: Any, name: str, want_x: bool,
+                         want_count: bool) -> tuple[float, int]:
+    curve = check_cubic_bspline(curve, name)
     if curve.closed or curve.n_ctrl < 5:  # (no block: the whole curve's checks)
-        return second_discrete_curvature(curve).indicator
+        sdc = second_discrete_curvature(curve)
+        count = 0
+        if want_count:
+            flags = bad_point_kinds(sdc.K, sdc.first_difference, sdc.weights, sdc.valid, True)
+            count = int(np.count_nonzero(flags.any(axis=0)))
+        return (sdc.indicator if want_x else 0.0), count
     n = curve.n_ctrl
-    z = np.empty(max(n - 4, 0))
+    z = np.empty(max(n - 4, 0) if want_x else 0)
     j = 0
+    count = 0
     for K, t in _open_blocks(curve):
-        m = K.shape[0] - 2
-        D = z[j:j + m]
-        np.multiply(t[1:-1], K[:-2], out=D)
-        D += (1.0 - t[1:-1]) * K[2:]
-        D -= K[1:-1]
-        np.multiply(D, D, out=D)
-        j += m
-    return float(np.sum(z))
+        if want_count:
+            dK = np.zeros_like(K)
+            dK[1:] = np.diff(K)
+            valid = np.ones(K.shape[0], dtype=bool)
+            valid[0] = valid[-1] = False
+            flags = bad_point_kinds(K, dK, t, valid, False)
+            count += int(np.count_nonzero(flags.any(axis=0)))
+        if want_x:
+            m = K.shape[0] - 2
+            D = z[j:j + m]
+            np.multiply(t[1:-1], K[:-2], out=D)
+            D += (1.0 - t[1:-1]) * K[2:]
+            D -= K[1:-1]
+            np.multiply(D, D, out=D)
+            j += m
+    return (float(np.sum(z)) if want_x else 0.0), count

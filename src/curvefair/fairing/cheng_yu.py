@@ -23,10 +23,9 @@ from .._kernels import cheng_yu as _k
 from .._typing import FloatArray
 from .._validate import as_nonnegative, as_step_count
 from ..analysis.discrete import (
-    bad_point_count,
     check_cubic_bspline,
+    cheng_yu_figures,
     corner_cut_ratios,
-    fairing_indicator,
 )
 from ..errors import InputError
 from .stop import StopReason
@@ -212,6 +211,9 @@ class CYResult:
         moved control point, -1 at step 0), ``"n_moved"`` (1 or 2; 0 at step 0), ``"z"`` (the
         local fairing value of the top-ranked bad point the step acted on; NaN at step 0),
         ``"displacement"`` (largest move of the step).
+    bad_points_before, bad_points_after : int
+        The number of bad control points (:func:`curvefair.analysis.discrete.bad_point_count`)
+        of the input and of the result.
     """
 
     curve: Any
@@ -221,6 +223,8 @@ class CYResult:
     indicator_after: float
     threshold: float
     history: dict[str, np.ndarray] = field(default_factory=dict)
+    bad_points_before: int = 0
+    bad_points_after: int = 0
 
 
 def cheng_yu_driver(curve: Any, *, tol: float | None = None, eps: float = 1e-8,
@@ -306,9 +310,10 @@ def _solve(problem: FairingProblem, *, pair: bool, relative: bool) -> CYResult:
     e = problem.tol
     max_steps = as_step_count(problem.max_steps, default=100 * n)
     mask = problem.movable
-    # validates (raises at a true corner); the indicator alone (second_discrete_curvature's
-    # per-point arrays are 2.5x the coordinates' bytes, its temporaries more)
-    x0 = fairing_indicator(curve)
+    # validates (raises at a true corner); the indicator and the bad points' count in one pass,
+    # without second_discrete_curvature's per-point arrays (2.5x the coordinates' bytes, its
+    # temporaries more)
+    x0, bad0 = cheng_yu_figures(curve)
     knots = np.asarray(curve.knots, dtype=float)
     lw, mw = corner_cut_ratios(knots, n, closed)
     corner = np.flatnonzero((lw == 0.0) & (mw == 0.0))
@@ -335,7 +340,7 @@ def _solve(problem: FairingProblem, *, pair: bool, relative: bool) -> CYResult:
     del Q0, W, lw, mw, mask
     out = curve.replace(control_points=Q)  # (a copy: Q is freed before the measure)
     del Q
-    x1 = fairing_indicator(out)
+    x1, bad1 = cheng_yu_figures(out)
     history = {
         "step": np.arange(steps + 1),
         "x": hist[: steps + 1].copy(),
@@ -344,7 +349,8 @@ def _solve(problem: FairingProblem, *, pair: bool, relative: bool) -> CYResult:
         "z": np.r_[np.nan, moves[:steps, 2]],
         "displacement": np.r_[0.0, moves[:steps, 3]],
     }
-    return CYResult(out, steps, _STOP[int(code)], float(x0), float(x1), float(eps_abs), history)
+    return CYResult(out, steps, _STOP[int(code)], float(x0), float(x1), float(eps_abs), history,
+                    bad0, bad1)
 
 
 # --------------------------------------------------------------------------------------------
@@ -366,8 +372,8 @@ def solve(problem: FairingProblem, *, pair: bool = True, relative: bool = True) 
         "indicator_before": res.indicator_before,
         "indicator_after": res.indicator_after,
         "pair_steps": int(np.sum(h["n_moved"] == 2)),
-        "bad_points_before": bad_point_count(problem.curve),
-        "bad_points_after": bad_point_count(res.curve),
+        "bad_points_before": res.bad_points_before,
+        "bad_points_after": res.bad_points_after,
     }
     epsv = (1e-8 if relative else 0.0) if problem.eps is None else problem.eps
     n = problem.curve.n_ctrl  # type: ignore[attr-defined]
