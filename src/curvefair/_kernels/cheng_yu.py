@@ -97,26 +97,25 @@ def _excess(x, s, a, b, pair, e, three):
         m1y = s * (r1y + s * b * r0y) / den
         m0z = s * (r0z + s * a * r1z) / den
         m1z = s * (r1z + s * b * r0z) / den
+    worst = _moved_distance(q0x, q0y, q0z, m0x, m0y, m0z, o0x, o0y, o0z, three)
+    if pair:
+        worst = max(worst, _moved_distance(q1x, q1y, q1z, m1x, m1y, m1z, o1x, o1y, o1z,
+                                           three))
+    return worst - e
+
+
+@njit(cache=True, inline="always")
+def _moved_distance(qx, qy, qz, mx, my, mz, ox, oy, oz, three):
+    """``|q + m - o|`` (``dim`` 2 unless ``three``), summed as :func:`_excess` always has."""
     d2 = 0.0
-    v = q0x + m0x - o0x
+    v = qx + mx - ox
     d2 += v * v
-    v = q0y + m0y - o0y
+    v = qy + my - oy
     d2 += v * v
     if three:
-        v = q0z + m0z - o0z
+        v = qz + mz - oz
         d2 += v * v
-    worst = np.sqrt(d2)
-    if pair:
-        d2 = 0.0
-        v = q1x + m1x - o1x
-        d2 += v * v
-        v = q1y + m1y - o1y
-        d2 += v * v
-        if three:
-            v = q1z + m1z - o1z
-            d2 += v * v
-        worst = max(worst, np.sqrt(d2))
-    return worst - e
+    return np.sqrt(d2)
 
 
 @njit(cache=True, inline="always")
