@@ -120,8 +120,9 @@ def _moved_distance(qx, qy, qz, mx, my, mz, ox, oy, oz, three):
 
 @njit(cache=True, inline="always")
 def _rows(Q, Q0, m0, m1, r0, r1, pair):
-    """The rows :func:`_excess` reads, as a tuple of 18 floats (``dim`` 2: the third
-    coordinates 0, never read; one point: ``Q[m1]``, ``Q0[m1]`` and ``r1`` never read)."""
+    """The rows :func:`_excess` reads, as a tuple of 18 floats (``dim`` 2: the first
+    coordinates again in the third places, never read; one point: ``Q[m0]`` and ``Q0[m0]``
+    again in the second point's places and ``r1``, never read)."""
     three = Q.shape[1] == 3
     z = 2 if three else 0  # (an index that exists; its values are not used in 2-D)
     j = m1 if pair else m0
@@ -137,9 +138,9 @@ def _step_factor(Q, Q0, m0, m1, r0, r1, a, b, pair, e):
     the bound as computed."""
     if e == np.inf:  # no bound
         return 1.0
-    e = e * (1.0 - 1e-12)
+    e = e * (1.0 - 1e-12)  # margin: the bound then survives any re-rounding of the distance
     x = _rows(Q, Q0, m0, m1, r0, r1, pair)
-    three = Q.shape[1] == 3  # margin: the bound then survives any re-rounding of the distance
+    three = Q.shape[1] == 3
     if not pair:
         # the segment Q + s r meets the ball |x - Q0| <= e in an interval containing s = 0:
         # its upper end in closed form, |p + s r|^2 = e^2 with p = Q - Q0
