@@ -61,42 +61,37 @@ def _residual(W, Q, n, closed, m, out):
 
 
 @njit(cache=True, inline="always")
-def _moves(s, r0, r1, a, b, pair, out0, out1):
-    """Displacements at ``s = 1 - d``: single ``s r0``; pair ``s A(s)^-1 [r0, r1]`` (eq. (9))."""
-    dim = r0.shape[0]
+def _move_of(s, r0c, r1c, a, b, pair):
+    """One coordinate of the displacements at ``s = 1 - d``: single ``s r0``; pair
+    ``s A(s)^-1 [r0, r1]`` (eq. (9)). The one formula of both the moves made (:func:`_moves`)
+    and the bound checked along the way (:func:`_excess`), so the two cannot differ."""
     if not pair:
-        for c in range(dim):
-            out0[c] = s * r0[c]
-        return
+        return s * r0c, 0.0
     den = 1.0 - s * s * a * b
-    for c in range(dim):
-        out0[c] = s * (r0[c] + s * a * r1[c]) / den
-        out1[c] = s * (r1[c] + s * b * r0[c]) / den
+    return s * (r0c + s * a * r1c) / den, s * (r1c + s * b * r0c) / den
+
+
+@njit(cache=True, inline="always")
+def _moves(s, r0, r1, a, b, pair, out0, out1):
+    """Displacements at ``s`` (:func:`_move_of`) into ``out0`` (and ``out1`` if ``pair``)."""
+    for c in range(r0.shape[0]):
+        m0, m1 = _move_of(s, r0[c], r1[c], a, b, pair)
+        out0[c] = m0
+        if pair:
+            out1[c] = m1
 
 
 @njit(cache=True, inline="always")
 def _excess(x, s, a, b, pair, e, three):
-    """``max_j |Q_j + move_j(s) - Q0_j| - e`` over the moved points, the move as in
-    :func:`_moves` (the same operations in the same order). ``x`` holds the rows as scalars
+    """``max_j |Q_j + move_j(s) - Q0_j| - e`` over the moved points (the move by
+    :func:`_move_of`, as :func:`_moves` makes it). ``x`` holds the rows as scalars
     (:func:`_rows`): the bisection evaluates this about a hundred times per pair, and array
     arguments would cost each evaluation its reference counting."""
     (q0x, q0y, q0z, o0x, o0y, o0z, q1x, q1y, q1z, o1x, o1y, o1z,
      r0x, r0y, r0z, r1x, r1y, r1z) = x
-    m1x = 0.0
-    m1y = 0.0
-    m1z = 0.0
-    if not pair:
-        m0x = s * r0x
-        m0y = s * r0y
-        m0z = s * r0z
-    else:
-        den = 1.0 - s * s * a * b
-        m0x = s * (r0x + s * a * r1x) / den
-        m1x = s * (r1x + s * b * r0x) / den
-        m0y = s * (r0y + s * a * r1y) / den
-        m1y = s * (r1y + s * b * r0y) / den
-        m0z = s * (r0z + s * a * r1z) / den
-        m1z = s * (r1z + s * b * r0z) / den
+    m0x, m1x = _move_of(s, r0x, r1x, a, b, pair)
+    m0y, m1y = _move_of(s, r0y, r1y, a, b, pair)
+    m0z, m1z = _move_of(s, r0z, r1z, a, b, pair)
     worst = _moved_distance(q0x, q0y, q0z, m0x, m0y, m0z, o0x, o0y, o0z, three)
     if pair:
         worst = max(worst, _moved_distance(q1x, q1y, q1z, m1x, m1y, m1z, o1x, o1y, o1z,
