@@ -62,6 +62,24 @@ COMPILED_FILES = frozenset({
     "test_pairwise_sums.py",
 })
 
+#: tests of those files that are not marked ``compiled``: behaviour of the whole pipeline
+#: (never-worse guards on rebuilt curves, the command line, environment variables) on long
+#: inputs, whose kernels the kernel tests of the same files already drive under CI's second
+#: instruction set. Left out of that run because they cost ~100 s of its CPU time there
+#: (measured with ``--durations``) and check nothing that depends on the instruction set.
+PIPELINE_TESTS = frozenset({
+    ("test_points_l1.py", "test_point_data_whose_every_tube_rebuilds_worse_keep_the_input"),
+    ("test_points_l1.py", "test_point_data_back_off_judges_the_curve_rebuilt_from_the_written_"
+                          "points"),
+    ("test_points_l1.py", "test_fair_guard_judges_the_curve_rebuilt_from_the_points_of_any_"
+                          "method"),
+    ("test_points_l1.py", "test_long_lists_shrink_the_tube_only_near_a_rebuilt_curve_excess"),
+    ("test_points_l1.py", "test_cli_writes_a_point_file_whose_rebuilt_curve_is_not_worse"),
+    ("test_points_l1.py", "test_fair_guard_catches_a_poliakoff_result_that_rebuilds_worse"),
+    ("test_points_l1_closed.py", "test_small_polygons_do_not_collapse_real_svg"),
+    ("test_global_fair.py", "test_curvefair_threads_environment_variable"),
+})
+
 #: test files whose tests each take more than ~20 s (marked ``slow``); measured with
 #: ``pytest --durations=30``
 SLOW_FILES = frozenset({
@@ -94,8 +112,44 @@ LATE_FILES = frozenset({
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     for item in items:
-        if item.path.name in COMPILED_FILES:
+        name = getattr(item, "originalname", item.name)
+        if item.path.name in COMPILED_FILES and (item.path.name, name) not in PIPELINE_TESTS:
             item.add_marker(pytest.mark.compiled)
         if item.path.name in SLOW_FILES:
             item.add_marker(pytest.mark.slow)
     items.sort(key=lambda it: it.path.name in LATE_FILES)  # stable: the order within is kept
+
+
+#: the kernel families whose compiles take minutes on a cold cache (the Hermite loop ``drive``
+#: 80-160 s alone, the B-spline deviation kernels 60-130 s), each started by a tiny call
+_PREWARM: list[tuple[str, str]] = [  # (method, interpolation)
+    ("poliakoff", "interpolate_cubic"),
+    ("eck-hadenfeld", "interpolate_bspline"),
+    ("knot-removal", "interpolate_bspline"),
+    ("global", "interpolate_bspline"),
+]
+#: a whole-suite run (CI's ``make test``: 2,600 tests, its second pass: 1,000) from this many
+#: tests on; a run of a few files compiles only what its tests need
+_PREWARM_MIN_TESTS = 500
+
+
+def pytest_collection_finish(session: pytest.Session) -> None:
+    """On a cold kernel cache, the worker processes of a whole-suite run (pytest-xdist) begin
+    by compiling different kernel families, ``gw0`` the first, ``gw1`` the second, and so on
+    round the families. Left to the tests, every worker's first tests need the same big
+    kernels at once: each waited for the other's compile (``curvefair._jit`` compiles a
+    kernel once between the processes sharing a cache) or, before that lock, compiled it
+    again (265 of the 940 s of compile time of CI's second pass). On a warm cache each call
+    loads its kernels in well under a second."""
+    worker = os.environ.get("PYTEST_XDIST_WORKER", "")
+    count = int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1") or 1)
+    if not worker.startswith("gw") or count < 2 or len(session.items) < _PREWARM_MIN_TESTS:
+        return
+    import numpy as np
+
+    import curvefair as cf
+
+    x = np.linspace(0.0, 6.0, 40)
+    P = np.c_[x, np.sin(x)]  # noqa: N806
+    for method, make in _PREWARM[int(worker[2:]) % count::count]:
+        cf.fair(getattr(cf, make)(P), method, tol=0.05)

@@ -119,6 +119,41 @@ def test_shared_cache_folder_keeps_other_versions(tmp_path):
     assert again == {**a, "hits": 1, "misses": 0}
 
 
+@pytest.mark.skipif(sys.platform == "win32", reason="no fcntl: each process compiles")
+def test_a_process_waits_for_anothers_compile_and_loads_its_machine_code(tmp_path):
+    # processes sharing a cache compile each kernel once: while the kernel's lock file is held
+    # (here by this test, as a compiling process would hold it), a process that needs the
+    # kernel waits; a process that saved it meanwhile (the lock replaced by a null context in
+    # it) is what the waiting one then loads from the cache instead of compiling
+    import fcntl
+    import json
+    import time
+
+    root = _copy_package(tmp_path)
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("CURVEFAIR_", "NUMBA_"))}
+    env.update({"PYTHONPATH": str(root), "PYTHONDONTWRITEBYTECODE": "1",
+                "CURVEFAIR_CACHE_DIR": str(tmp_path / "cache")})
+    where, _ = _run(root, {"CURVEFAIR_CACHE_DIR": env["CURVEFAIR_CACHE_DIR"]},
+                    "import json; from curvefair import _jit; "
+                    "print(json.dumps({'dir': _jit.cache_dir()}))")
+    lock = Path(where["dir"]) / "locks" / "curvefair._probe_caller.kernel.lock"
+    lock.parent.mkdir(parents=True, exist_ok=True)
+    with open(lock, "w") as held:
+        fcntl.flock(held, fcntl.LOCK_EX)
+        waiting = subprocess.Popen([sys.executable, "-c", RUN], stdout=subprocess.PIPE,
+                                   stderr=subprocess.PIPE, text=True, env=env, cwd=root)
+        unlocked = ("import contextlib; from curvefair import _jit; "
+                    "_jit._kernel_lock = lambda path: contextlib.nullcontext()\n" + RUN)
+        saver, _ = _run(root, {"CURVEFAIR_CACHE_DIR": env["CURVEFAIR_CACHE_DIR"]}, unlocked)
+        assert saver["misses"] == 1 and saver["value"] == 20.0  # compiled and saved
+        time.sleep(0.5)
+        assert waiting.poll() is None  # still waiting for the lock
+    out, err = waiting.communicate(timeout=600)
+    assert waiting.returncode == 0, err
+    got = json.loads(out.strip().splitlines()[-1])
+    assert got == {**saver, "hits": 1, "misses": 0}  # loaded what the other process saved
+
+
 def test_bounds_checking_gets_its_own_cache(tmp_path):
     # NUMBA_BOUNDSCHECK changes the machine code but not numba's own cache key
     root = _copy_package(tmp_path)

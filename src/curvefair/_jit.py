@@ -27,6 +27,15 @@ the same sources under other compile options are kept.
 The first compilation into a new cache directory prints one line to stderr saying so
 (set ``CURVEFAIR_QUIET=1`` to silence it).
 
+Processes sharing a cache directory compile each kernel once between them: a kernel's compile
+holds a lock file in ``<cache>/locks`` (``fcntl.flock``; released by the system when its
+process ends), and a process that finds the lock held waits for it and then loads the machine
+code the other one saved, instead of compiling the same kernel beside it. Without that, the
+workers of a process pool on a cold cache (``curvefair batch``, the test suite's processes)
+each compiled every kernel they ran: the same minutes of CPU time once per process. A wait
+longer than ``LOCK_WAIT`` seconds compiles anyway; on systems without ``fcntl`` (Windows)
+every process compiles for itself, as before.
+
 This is the one module of curvefair that imports numba (and llvmlite): kernels elsewhere use
 :func:`njit` and :func:`prefetch` from here (``tests/test_numba_layering.py`` checks it), so a
 change of numba's API is met in one file.
@@ -57,8 +66,15 @@ from numba import njit as _numba_njit
 from numba import types as _types
 from numba.core import caching as _caching
 from numba.core import cgutils as _cgutils
+from numba.core import sigutils as _sigutils
+from numba.core.compiler_lock import global_compiler_lock as _compiler_lock
 from numba.core.dispatcher import OmittedArg as _OmittedArg
 from numba.extending import intrinsic as _intrinsic
+
+try:
+    import fcntl as _fcntl
+except ImportError:  # pragma: no cover - Windows: every process compiles for itself
+    _fcntl = None  # type: ignore[assignment]
 
 __all__ = ["njit", "prefetch", "cache_dir", "cache_key"]
 
@@ -254,20 +270,95 @@ def njit(*args: Any, readonly: tuple[str, ...] = (), any_layout: tuple[str, ...]
     kwargs.setdefault("nogil", True)
     if kwargs.get("cache") and _CACHE_DIR is None:
         kwargs["cache"] = False
-    if not readonly and not any_layout:
-        return _numba_njit(*args, **kwargs)
 
     def decorate(fn: Callable[..., Any]) -> Any:
         disp = _numba_njit(**kwargs)(fn)
-        names = list(inspect.signature(fn).parameters)
-        unknown = [x for x in (*readonly, *any_layout) if x not in names]
-        if unknown:
-            raise TypeError(f"njit({fn.__qualname__}): no parameter named {unknown}")
-        _canonical_types(disp, [names.index(x) for x in readonly],
-                         [names.index(x) for x in any_layout])
+        if readonly or any_layout:
+            names = list(inspect.signature(fn).parameters)
+            unknown = [x for x in (*readonly, *any_layout) if x not in names]
+            if unknown:
+                raise TypeError(f"njit({fn.__qualname__}): no parameter named {unknown}")
+            _canonical_types(disp, [names.index(x) for x in readonly],
+                             [names.index(x) for x in any_layout])
+        if kwargs.get("cache"):
+            _one_compile_at_a_time(disp)
         return disp
 
     return decorate(args[0]) if args and callable(args[0]) else decorate
+
+
+#: the longest a process waits for another one's compile of a kernel before compiling it too (s)
+LOCK_WAIT = 900.0
+#: lock files this process holds, with their depth (a kernel whose compile types a call to
+#: itself takes its own lock again: a second ``flock`` on another descriptor would wait forever)
+_held: dict[str, tuple[int, int]] = {}
+
+
+@contextlib.contextmanager
+def _kernel_lock(path: str) -> Any:
+    """Hold the lock file ``path`` across processes (re-entrant within this one, whose compiles
+    are serialised by numba's compiler lock); after ``LOCK_WAIT`` s, or if the file cannot be
+    made, go on without it."""
+    if path in _held:
+        fd, depth = _held[path]
+        _held[path] = (fd, depth + 1)
+        try:
+            yield
+        finally:
+            _held[path] = (fd, _held[path][1] - 1)
+        return
+    try:
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o666)
+    except OSError:
+        yield
+        return
+    deadline = time.monotonic() + LOCK_WAIT
+    locked = False
+    try:
+        while True:
+            try:
+                _fcntl.flock(fd, _fcntl.LOCK_EX | _fcntl.LOCK_NB)
+                locked = True
+                break
+            except OSError:
+                if time.monotonic() > deadline:
+                    break
+                time.sleep(0.05)
+        _held[path] = (fd, 1)
+        try:
+            yield
+        finally:
+            del _held[path]
+    finally:
+        if locked:
+            _fcntl.flock(fd, _fcntl.LOCK_UN)
+        os.close(fd)
+
+
+def _one_compile_at_a_time(disp: Any) -> None:
+    """Make ``disp``'s compiles hold a lock file per kernel in the cache directory (see the
+    module docstring), so that processes sharing the cache compile it once: numba's
+    ``Dispatcher.compile`` looks in the disk cache before it compiles, so a process that waited
+    loads what the other one saved. The compiler lock is taken first: the threads of one
+    process then never hold a kernel's lock file while waiting for numba's lock, and the lock
+    files are taken in the order of the kernels' calls (a caller's before its callees'), which
+    has no cycle across processes."""
+    if _fcntl is None or _CACHE_DIR is None:
+        return
+    plain = disp.compile
+    fn = disp.py_func
+    path = os.path.join(_CACHE_DIR, "locks", f"{fn.__module__}.{fn.__qualname__}.lock")
+
+    def compile(sig: Any) -> Any:  # noqa: A001 (numba's method name)
+        with _compiler_lock:
+            args, _ = _sigutils.normalize_signature(sig)
+            if tuple(args) in disp.overloads:  # compiled or loaded here already: no wait
+                return plain(sig)
+            with _kernel_lock(path):
+                return plain(sig)
+
+    disp.compile = compile
 
 
 def _canonical_types(disp: Any, ro: list[int], anyl: list[int]) -> None:

@@ -212,10 +212,11 @@ def _bspline_delta_row(knots, p, s, ctrl, base, closed, prev, have, ndu, left, r
 
 
 @njit(cache=True, inline="always")
-def _bspline_delta_body(knots, p, spans, ctrl, base, closed, breaks, M, U, lo, hi, idx, out,
-                        rows):
-    """The pieces ``lo .. hi - 1`` (``rows`` False: :func:`first_pass` on each, as
-    :func:`hermite_delta_pass`) or the rows ``idx`` into ``out`` (``rows`` True)."""
+def _bspline_delta_body(knots, p, spans, ctrl, base, closed, breaks, M, U, lo, hi):
+    """:func:`first_pass` on the pieces ``lo .. hi - 1`` (as :func:`hermite_delta_pass`).
+    Kept apart from :func:`_bspline_delta_rows_body`: each kernel inlines only the loop it
+    runs (numba copies an inlined body's IR block by block, so what is inlined and never run
+    still costs compile time)."""
     dim = ctrl.shape[1]
     ndu, left, right, a, d, fact, prev, have = _basis_work(p)
     best = -1.0
@@ -223,11 +224,6 @@ def _bspline_delta_body(knots, p, spans, ctrl, base, closed, breaks, M, U, lo, h
     bf = 0.0
     scale = 0.0
     finite = True
-    if rows:
-        for r in range(idx.shape[0]):
-            have = _bspline_delta_row(knots, p, spans[idx[r]], ctrl, base, closed, prev, have,
-                                      ndu, left, right, a, d, fact, out, r)
-        return best, bi, bf, scale, finite
     row = np.empty((1, p + 1, dim))
     ds = np.empty((p + 1, dim))
     for i in range(lo, hi):
@@ -238,34 +234,34 @@ def _bspline_delta_body(knots, p, spans, ctrl, base, closed, breaks, M, U, lo, h
     return best, bi, bf, scale, finite
 
 
+@njit(cache=True, inline="always")
+def _bspline_delta_rows_body(knots, p, spans, ctrl, base, closed, idx, out):
+    """The rows ``idx`` of :func:`_bspline_delta_body`'s pieces into ``out``."""
+    ndu, left, right, a, d, fact, prev, have = _basis_work(p)
+    for r in range(idx.shape[0]):
+        have = _bspline_delta_row(knots, p, spans[idx[r]], ctrl, base, closed, prev, have,
+                                  ndu, left, right, a, d, fact, out, r)
+
+
 @njit(cache=True, nogil=True, error_model="numpy")
 def bspline_delta_pass(knots, p, spans, ctrl, base, closed, breaks, M, U, lo, hi):
     """:func:`first_pass` on the pieces ``lo .. hi - 1`` of the difference curve of two
     B-splines on the same knots (control points ``ctrl - base``), bit for bit as on its whole
     power form, without that form; the returns of :func:`hermite_delta_pass`. A cubic runs a
     copy compiled for degree 3 (the same operations, as in ``power_form_kernel``)."""
-    idx = np.empty(0, dtype=np.int64)
-    out = np.empty((0, 1, 1))
     if p == 3:
-        return _bspline_delta_body(knots, 3, spans, ctrl, base, closed, breaks, M, U, lo, hi,
-                                   idx, out, False)
-    return _bspline_delta_body(knots, p, spans, ctrl, base, closed, breaks, M, U, lo, hi,
-                               idx, out, False)
+        return _bspline_delta_body(knots, 3, spans, ctrl, base, closed, breaks, M, U, lo, hi)
+    return _bspline_delta_body(knots, p, spans, ctrl, base, closed, breaks, M, U, lo, hi)
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
 def bspline_delta_rows(knots, p, spans, ctrl, base, closed, idx, out):
     """``out[r]`` = the power coefficients of piece ``idx[r]`` of :func:`bspline_delta_pass`'s
     difference curve (the same bits)."""
-    U = np.empty(0)
-    M = np.empty((0, 0))
-    breaks = np.empty(0)
     if p == 3:
-        _bspline_delta_body(knots, 3, spans, ctrl, base, closed, breaks, M, U, 0, 0, idx, out,
-                            True)
+        _bspline_delta_rows_body(knots, 3, spans, ctrl, base, closed, idx, out)
     else:
-        _bspline_delta_body(knots, p, spans, ctrl, base, closed, breaks, M, U, 0, 0, idx, out,
-                            True)
+        _bspline_delta_rows_body(knots, p, spans, ctrl, base, closed, idx, out)
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
