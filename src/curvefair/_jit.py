@@ -202,7 +202,7 @@ def _notice_first_compile(path: str) -> None:
         return  # said before (or the directory went away): stay quiet
     os.close(fd)
     sys.stderr.write("curvefair: compiling its numerical kernels for this machine "
-                     f"(once, about 20-60 s; cached in {path})\n")
+                     f"(once, about a minute per method used; cached in {path})\n")
 
 
 class _CurvefairCacheLocator(_caching._CacheLocator):
