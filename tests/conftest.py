@@ -65,7 +65,7 @@ COMPILED_FILES = frozenset({
 #: tests of those files that are not marked ``compiled``: behaviour of the whole pipeline
 #: (never-worse guards on rebuilt curves, the command line, environment variables) on long
 #: inputs, whose kernels the kernel tests of the same files already drive under CI's second
-#: instruction set. Left out of that run because they cost ~100 s of its CPU time there
+#: instruction set. Left out of that run because they cost 65 s of its CPU time there
 #: (measured with ``--durations``) and check nothing that depends on the instruction set.
 PIPELINE_TESTS = frozenset({
     ("test_points_l1.py", "test_point_data_whose_every_tube_rebuilds_worse_keep_the_input"),
