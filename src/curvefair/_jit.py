@@ -289,9 +289,9 @@ def njit(*args: Any, readonly: tuple[str, ...] = (), any_layout: tuple[str, ...]
 
 #: the longest a process waits for another one's compile of a kernel before compiling it too (s)
 LOCK_WAIT = 900.0
-#: lock files this process holds, with their depth (a kernel whose compile types a call to
-#: itself takes its own lock again: a second ``flock`` on another descriptor would wait forever)
-_held: dict[str, tuple[int, int]] = {}
+#: lock files this process holds (a kernel whose compile types a call to itself asks for its own
+#: lock again: a second ``flock`` on another descriptor would wait forever)
+_held: set[str] = set()
 
 
 @contextlib.contextmanager
@@ -299,13 +299,8 @@ def _kernel_lock(path: str) -> Any:
     """Hold the lock file ``path`` across processes (re-entrant within this one, whose compiles
     are serialised by numba's compiler lock); after ``LOCK_WAIT`` s, or if the file cannot be
     made, go on without it."""
-    if path in _held:
-        fd, depth = _held[path]
-        _held[path] = (fd, depth + 1)
-        try:
-            yield
-        finally:
-            _held[path] = (fd, _held[path][1] - 1)
+    if path in _held:  # held by an outer compile of this process
+        yield
         return
     try:
         os.makedirs(os.path.dirname(path), exist_ok=True)
@@ -325,11 +320,11 @@ def _kernel_lock(path: str) -> Any:
                 if time.monotonic() > deadline:
                     break
                 time.sleep(0.05)
-        _held[path] = (fd, 1)
+        _held.add(path)
         try:
             yield
         finally:
-            del _held[path]
+            _held.discard(path)
     finally:
         if locked:
             _fcntl.flock(fd, _fcntl.LOCK_UN)
