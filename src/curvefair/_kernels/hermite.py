@@ -753,11 +753,39 @@ def _rhs_for_move(nd, closed, h, K0, pe, q, nb, k, dr, idx, L, fixed, R, pw):
 def _window_solve(nd, closed, h, K0, pe, q, nb, dim, fixed, idx, L, k, dr, Bd, Cu, R, X, Bp, Y,
                   pw, inv, W):
     """The change ``X`` of the window's derivative data when point ``k`` moves by ``dr``:
-    assemble, right-hand side, block Thomas. Inlined, so that a caller passing constant
-    ``nb`` and ``dim`` gets their loops unrolled."""
+    assemble, right-hand side, block Thomas. Inlined (into the loop, and into the
+    ``_window_solve_*`` kernels below), so that a caller passing constant ``nb`` and ``dim``
+    gets their loops unrolled."""
     _assemble_window(nd, closed, h, K0, pe, q, nb, fixed, idx, L, Bd, Cu, pw)
     _rhs_for_move(nd, closed, h, K0, pe, q, nb, k, dr, idx, L, fixed, R, pw)
     _block_thomas(L, nb, dim, Bd, Cu, R, X, Bp, Y, inv, W)
+
+
+# The loop calls the window solve of cubic curves through these kernels (the coordinate count
+# constant in the first two) rather than inlining it: the same operations, but each inlined copy
+# made the loop's compile 6-7 s longer (a cold Hermite call compiled 66 s, 33 s of it the loop
+# with four copies inside; now 12 s with one, and 4 s for each kernel here). The quintic one
+# (``nb == 2``, planar) stays inlined: through a kernel of its own, wang-quintic's whole call at
+# 1e6 points was 2-4 % slower (fresh processes alternated), the cubic methods' within 1.5 %.
+@njit(cache=True)
+def _window_solve_1_2(nd, closed, h, K0, pe, q, fixed, idx, L, k, dr, Bd, Cu, R, X, Bp, Y, pw,
+                      inv, W):
+    _window_solve(nd, closed, h, K0, pe, q, 1, 2, fixed, idx, L, k, dr, Bd, Cu, R, X, Bp, Y,
+                  pw, inv, W)
+
+
+@njit(cache=True)
+def _window_solve_1_3(nd, closed, h, K0, pe, q, fixed, idx, L, k, dr, Bd, Cu, R, X, Bp, Y, pw,
+                      inv, W):
+    _window_solve(nd, closed, h, K0, pe, q, 1, 3, fixed, idx, L, k, dr, Bd, Cu, R, X, Bp, Y,
+                  pw, inv, W)
+
+
+@njit(cache=True)
+def _window_solve_any(nd, closed, h, K0, pe, q, nb, dim, fixed, idx, L, k, dr, Bd, Cu, R, X, Bp,
+                      Y, pw, inv, W):
+    _window_solve(nd, closed, h, K0, pe, q, nb, dim, fixed, idx, L, k, dr, Bd, Cu, R, X, Bp, Y,
+                  pw, inv, W)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -1050,19 +1078,20 @@ def drive(P, D, h, orig, closed, degree, method, spline, hstep, eligible, tol, e
                         left_open = lo > 0
                         right_open = hi < nd - 1
                     # the block and coordinate counts as constants where they are the common
-                    # ones, so that the compiler unrolls their loops (the same operations)
+                    # ones, so that the compiler unrolls their loops (the same operations); see
+                    # _window_solve_1_2 for which is inlined
                     if nb == 1 and dim == 2:
-                        _window_solve(nd, closed, h, K0, pe, q, 1, 2, fixed, idx, L, k, delta,
-                                      Bd, Cu, R, X, Bp, Y, pw, inv2, W2)
+                        _window_solve_1_2(nd, closed, h, K0, pe, q, fixed, idx, L, k, delta,
+                                          Bd, Cu, R, X, Bp, Y, pw, inv2, W2)
                     elif nb == 1 and dim == 3:
-                        _window_solve(nd, closed, h, K0, pe, q, 1, 3, fixed, idx, L, k, delta,
-                                      Bd, Cu, R, X, Bp, Y, pw, inv2, W2)
+                        _window_solve_1_3(nd, closed, h, K0, pe, q, fixed, idx, L, k, delta,
+                                          Bd, Cu, R, X, Bp, Y, pw, inv2, W2)
                     elif nb == 2 and dim == 2:
                         _window_solve(nd, closed, h, K0, pe, q, 2, 2, fixed, idx, L, k, delta,
                                       Bd, Cu, R, X, Bp, Y, pw, inv2, W2)
                     else:
-                        _window_solve(nd, closed, h, K0, pe, q, nb, dim, fixed, idx, L, k,
-                                      delta, Bd, Cu, R, X, Bp, Y, pw, inv2, W2)
+                        _window_solve_any(nd, closed, h, K0, pe, q, nb, dim, fixed, idx, L, k,
+                                          delta, Bd, Cu, R, X, Bp, Y, pw, inv2, W2)
                     ok = True
                     for e in range(nb):
                         big = 0.0
