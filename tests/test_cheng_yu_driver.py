@@ -401,7 +401,11 @@ def test_compiled_loop_is_the_plain_loop(case):
     assert steps == len(moves_r) > 3 and code == code_r
     assert np.array_equal(Q, Qr)
     assert np.array_equal(hist[:steps + 1], hist_r)
-    assert np.array_equal(moves[:steps], moves_r)
+    # indices, kinds and priorities bit for bit; the displacement (a report figure) to 4 ulps:
+    # the reference's np.linalg.norm is BLAS's dot, whose rounding depends on the CPU's BLAS
+    # kernel (1 ulp from the kernel's sum of squares on an AVX-512 Xeon)
+    assert np.array_equal(moves[:steps, :3], moves_r[:, :3])
+    assert np.allclose(moves[:steps, 3], moves_r[:, 3], rtol=4 * np.finfo(float).eps, atol=0)
     if case == "closed_wrap":  # moves on both sides of index 0 (cyclic neighbourhoods)
         firsts = moves_r[:, 0]
         assert np.any(firsts <= 2) and np.any(firsts >= n - 3)
