@@ -731,10 +731,15 @@ def _solve_balls(system: _System, g0: FloatArray, free: np.ndarray, tol: float, 
 
 _SWITCH_GAP = 1e-5
 _RETRACT = True
-# ADMM warm start: 20 iterations, rho adapted once (after 10). A short warm start trades a
-# Newton factorisation at most for fewer O(n) sweeps and ADMM refactorisations (the measured
-# choice: CHANGELOG.md, docs/benchmarks.md)
-_ADMM_ITERS = 20  # 0: no ADMM warm start
+# ADMM warm start: 40 iterations, rho adapted every 10 (at most 10x each time). On curves with
+# most points active rho reaches the median curvature of the projected points only at the second
+# adaptation, after 20 iterations: a 20-iteration start ran with rho 4-40x too small and left the
+# Newton iteration a long damped phase (21 steps on bench_call_cost.py's 1e6 points, 3.6 s,
+# against 7 steps, 2.3 s, with 40). An ADMM sweep costs about a tenth of a Newton step (more on
+# closed curves); where fewer points are active the extra 20 sweeps gain nothing (3-25 % slower
+# on 14 of 37 curves measured over sizes, noise levels, open/closed, 2-D/3-D, degrees 3 and 5,
+# up to 4x faster on others: docs/benchmarks.md, session 41).
+_ADMM_ITERS = 40  # 0: no ADMM warm start
 _ADMM_ADAPT = 10
 _ADMM_RHO0 = 0.03
 _ADMM_ALPHA = 1.6
