@@ -766,6 +766,60 @@ def _band_solve7(L, N, x):
         x1 = v
 
 
+@njit(cache=True)
+def band_solve_columns(L, N, X):
+    """:func:`band_solve` of every column of ``X`` (``(N', m)``, first ``N`` rows) at once: per
+    column the same operations in the same order (so the same bits as ``m`` calls), but the
+    ``m`` recurrences run side by side, which a substitution bound by the latency of its
+    chain of multiply-subtracts and divisions gains from (used for the ``kd`` coupling columns
+    of :func:`cyclic_cholesky`)."""
+    kd = L.shape[1] - 1
+    m = X.shape[1]
+    if kd == 7 and N > 7:
+        for j in range(7):
+            for c in range(m):
+                s = X[j, c]
+                for k in range(1, j + 1):
+                    s -= L[j - k, k] * X[j - k, c]
+                X[j, c] = s / L[j, 0]
+        for j in range(7, N):
+            r = 1.0 / L[j, 0]
+            for c in range(m):
+                s = (X[j, c] - L[j - 7, 7] * X[j - 7, c] - L[j - 6, 6] * X[j - 6, c]
+                     - L[j - 5, 5] * X[j - 5, c] - L[j - 4, 4] * X[j - 4, c]
+                     - L[j - 3, 3] * X[j - 3, c] - L[j - 2, 2] * X[j - 2, c])
+                X[j, c] = (s - L[j - 1, 1] * X[j - 1, c]) * r
+        for i in range(N - 1, N - 8, -1):
+            for c in range(m):
+                s = X[i, c]
+                for k in range(1, N - i):
+                    s -= L[i, k] * X[i + k, c]
+                X[i, c] = s / L[i, 0]
+        for i in range(N - 8, -1, -1):
+            r = 1.0 / L[i, 0]
+            for c in range(m):
+                s = (X[i, c] - L[i, 7] * X[i + 7, c] - L[i, 6] * X[i + 6, c]
+                     - L[i, 5] * X[i + 5, c] - L[i, 4] * X[i + 4, c] - L[i, 3] * X[i + 3, c]
+                     - L[i, 2] * X[i + 2, c])
+                X[i, c] = (s - L[i, 1] * X[i + 1, c]) * r
+        return
+    for j in range(N):
+        kmax = min(kd, N - 1 - j)
+        for c in range(m):
+            v = X[j, c] / L[j, 0]
+            X[j, c] = v
+            if v != 0.0:
+                for k in range(1, kmax + 1):
+                    X[j + k, c] -= L[j, k] * v
+    for i in range(N - 1, -1, -1):
+        kmax = min(kd, N - 1 - i)
+        for c in range(m):
+            s = X[i, c]
+            for k in range(1, kmax + 1):
+                s -= L[i, k] * X[i + k, c]
+            X[i, c] = s / L[i, 0]
+
+
 # ------------------------------------------------------------------------------------------
 # cyclic band (closed curves): bordering
 # ------------------------------------------------------------------------------------------
@@ -803,23 +857,25 @@ def cyclic_cholesky(L, Y, S):
             if R < N:
                 S[R - nI, r - nI] = L[r, k]
                 S[r - nI, R - nI] = L[r, k]
-    # save the coupling block, then factorise the interior
+    # save the coupling block (nonzero in its first and last kd rows only), then factorise
+    # the interior
     info = band_cholesky(L, nI)
     if info:
         return info
-    Cb = Y.copy()
-    col = np.empty(nI)
-    for c in range(kd):
-        for r in range(nI):
-            col[r] = Y[r, c]
-        band_solve(L, nI, col)
-        for r in range(nI):
-            Y[r, c] = col[r]
+    Cb = np.empty((2 * kd, kd))
+    for r in range(kd):
+        for c in range(kd):
+            Cb[r, c] = Y[r, c]
+            Cb[kd + r, c] = Y[nI - kd + r, c]
+    band_solve_columns(L, nI, Y)
+    # S -= M_IB^T Y over the nonzero rows of M_IB, in row order (the zero rows add exact zeros)
     for c in range(kd):
         for c2 in range(kd):
             acc = 0.0
-            for r in range(nI):
+            for r in range(kd):
                 acc += Cb[r, c] * Y[r, c2]
+            for r in range(kd):
+                acc += Cb[kd + r, c] * Y[nI - kd + r, c2]
             S[c, c2] -= acc
     # dense Cholesky of S (lower), in place
     for j in range(kd):
@@ -873,6 +929,46 @@ def cyclic_solve_full(L, Y, S, x):
         x[r] -= acc
     for c in range(kd):
         x[nI + c] = xb[c]
+
+
+@njit(cache=True)
+def cyclic_solve_columns(L, Y, S, X):
+    """:func:`cyclic_solve_full` of every column of ``X`` (``(N, m)``) at once, per column the
+    same operations in the same order (the same bits as ``m`` calls; the substitutions of the
+    columns run side by side, :func:`band_solve_columns`). The ADMM start of closed curves
+    solves its coordinates so."""
+    N = L.shape[0]
+    kd = L.shape[1] - 1
+    nI = N - kd
+    m = X.shape[1]
+    xb = np.empty((kd, m))
+    for c in range(kd):
+        for a in range(m):
+            acc = X[nI + c, a]
+            for r in range(nI):
+                acc -= Y[r, c] * X[r, a]
+            xb[c, a] = acc
+    for a in range(m):
+        for i in range(kd):
+            v = xb[i, a]
+            for j in range(i):
+                v -= S[i, j] * xb[j, a]
+            xb[i, a] = v / S[i, i]
+        for i in range(kd - 1, -1, -1):
+            v = xb[i, a]
+            for j in range(i + 1, kd):
+                v -= S[j, i] * xb[j, a]
+            xb[i, a] = v / S[i, i]
+    band_solve_columns(L, nI, X)
+    for r in range(nI):
+        for a in range(m):
+            acc = 0.0
+            for c in range(kd):
+                acc += Y[r, c] * xb[c, a]
+            X[r, a] -= acc
+    for c in range(kd):
+        for a in range(m):
+            X[nI + c, a] = xb[c, a]
 
 
 # ------------------------------------------------------------------------------------------
