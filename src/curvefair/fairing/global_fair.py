@@ -462,10 +462,11 @@ def global_fair(curve: BSplineCurve, *, tol: float | None = None, l: Any = 2,  #
 
     0. warm start by over-relaxed ADMM (Boyd et al., *Distributed Optimization
        and Statistical Learning via ADMM*, 2011, sec. 3.4.3 / 5.1; ``alpha = 1.6``) on the
-       splitting ``x = z``, ``z`` in the balls: 20 iterations, each one banded solve with the
+       splitting ``x = z``, ``z`` in the balls: 40 iterations, each one banded solve with the
        single ``n x n`` factor of ``2G/E(o) + rho I`` (shared by the coordinates; closed
        curves: the cyclic band, bordered, except tiny ones) and a projection, ``rho`` reset
-       after 10 iterations to the median ``lambda_i / tol^2`` of the projected points; then
+       every 10 iterations towards the median ``lambda_i / tol^2`` of the projected points (at
+       most 10x each time); then
        step 3 directly (at most 15 iterations, 30 once damped; if it does not converge,
        steps 1-3 follow from scratch). From this start a Newton step that
        moves an inactive point further than ``tol`` (an active one further than ``2 tol``)
