@@ -904,12 +904,14 @@ def cyclic_solve_full(L, Y, S, x):
     kd = L.shape[1] - 1
     nI = N - kd
     xb = np.empty(kd)
-    # x_B - M_IB^T M_II^{-1} x_I = x_B - Y^T x_I  (Y = M_II^{-1} M_IB, M_II symmetric)
+    # x_B - M_IB^T M_II^{-1} x_I = x_B - Y^T x_I  (Y = M_II^{-1} M_IB, M_II symmetric): one
+    # pass over the rows of Y, each entry's sum in row order
     for c in range(kd):
-        acc = x[nI + c]
-        for r in range(nI):
-            acc -= Y[r, c] * x[r]
-        xb[c] = acc
+        xb[c] = x[nI + c]
+    for r in range(nI):
+        xr = x[r]
+        for c in range(kd):
+            xb[c] -= Y[r, c] * xr
     # S z = xb
     for i in range(kd):
         v = xb[i]
@@ -944,10 +946,11 @@ def cyclic_solve_columns(L, Y, S, X):
     xb = np.empty((kd, m))
     for c in range(kd):
         for a in range(m):
-            acc = X[nI + c, a]
-            for r in range(nI):
-                acc -= Y[r, c] * X[r, a]
-            xb[c, a] = acc
+            xb[c, a] = X[nI + c, a]
+    for r in range(nI):  # one pass over the rows of Y, each entry's sum in row order
+        for c in range(kd):
+            for a in range(m):
+                xb[c, a] -= Y[r, c] * X[r, a]
     for a in range(m):
         for i in range(kd):
             v = xb[i, a]

@@ -462,12 +462,12 @@ def global_fair(curve: BSplineCurve, *, tol: float | None = None, l: Any = 2,  #
 
     0. warm start by over-relaxed ADMM (Boyd et al., *Distributed Optimization
        and Statistical Learning via ADMM*, 2011, sec. 3.4.3 / 5.1; ``alpha = 1.6``) on the
-       splitting ``x = z``, ``z`` in the balls: 40 iterations, each one banded solve with the
-       single ``n x n`` factor of ``2G/E(o) + rho I`` (shared by the coordinates; closed
-       curves: the cyclic band, bordered, except tiny ones) and a projection, ``rho`` reset
-       every 10 iterations towards the median ``lambda_i / tol^2`` of the projected points (at
-       most 10x each time); then
-       step 3 directly (at most 15 iterations, 30 once damped; if it does not converge,
+       splitting ``x = z``, ``z`` in the balls: 20 iterations (40 from 10,000 control points
+       on), each one banded solve with the single ``n x n`` factor of ``2G/E(o) + rho I``
+       (shared by the coordinates; closed curves: the cyclic band, bordered, except tiny ones)
+       and a projection, ``rho`` reset every 10 iterations towards the median
+       ``lambda_i / tol^2`` of the projected points (at most 10x each time); then step 3
+       directly (at most 15 iterations, 30 once damped; if it does not converge,
        steps 1-3 follow from scratch). From this start a Newton step that
        moves an inactive point further than ``tol`` (an active one further than ``2 tol``)
        is rejected and solved again with a Levenberg-Marquardt term ``mu I`` added to the
@@ -732,15 +732,21 @@ def _solve_balls(system: _System, g0: FloatArray, free: np.ndarray, tol: float, 
 
 _SWITCH_GAP = 1e-5
 _RETRACT = True
-# ADMM warm start: 40 iterations, rho adapted every 10 (at most 10x each time). On curves with
-# most points active rho reaches the median curvature of the projected points only at the second
-# adaptation, after 20 iterations: a 20-iteration start ran with rho 4-40x too small and left the
-# Newton iteration a long damped phase (21 steps on bench_call_cost.py's 1e6 points, 3.6 s,
-# against 7 steps, 2.3 s, with 40). An ADMM sweep costs about a tenth of a Newton step (more on
-# closed curves); where fewer points are active the extra 20 sweeps gain nothing (3-25 % slower
-# on 14 of 37 curves measured over sizes, noise levels, open/closed, 2-D/3-D, degrees 3 and 5,
-# up to 4x faster on others: docs/benchmarks.md, session 41).
-_ADMM_ITERS = 40  # 0: no ADMM warm start
+# ADMM warm start: 20 iterations, 40 from _ADMM_LONG control points on (_admm_iters), rho
+# adapted every 10 (at most 10x each time). On curves with most points active rho reaches the
+# median curvature of the projected points only at the second adaptation, after 20 iterations:
+# a 20-iteration start ran with rho 4-40x too small and left the Newton iteration a long damped
+# phase (21 steps on bench_call_cost.py's 1e6 points, 3.6 s, against 7 steps, 2.3 s, with 40).
+# An ADMM sweep costs about a tenth of a Newton step (more on closed curves); where fewer points
+# are active the extra 20 sweeps gain nothing (3-25 % slower on 14 of 37 curves measured over
+# sizes, noise levels, open/closed, 2-D/3-D, degrees 3 and 5, up to 4x faster on others:
+# docs/benchmarks.md, session 41). Below _ADMM_LONG the call is mostly fixed costs (1e3 points:
+# the same times either way), and where the energy does not determine the minimiser (a glyph
+# outline held at its corners) another start lands on another one of the same energy: small
+# curves keep the 20-iteration start, and the results they had.
+_ADMM_ITERS = 20  # 0: no ADMM warm start
+_ADMM_ITERS_LONG = 40
+_ADMM_LONG = 10_000
 _ADMM_ADAPT = 10
 _ADMM_RHO0 = 0.03
 _ADMM_ALPHA = 1.6
@@ -763,6 +769,11 @@ _DAMP_MIN_ACTIVE = 0.02  # damping only with at least this fraction of free poin
 _DAMP_MIN_POINTS = 100  # and at least this many
 
 
+def _admm_iters(n: int) -> int:
+    """The ADMM warm start's iteration count for ``n`` control points (see ``_ADMM_ITERS``)."""
+    return _ADMM_ITERS_LONG if _ADMM_ITERS > 0 and n >= _ADMM_LONG else _ADMM_ITERS
+
+
 def _admm_start(K: FloatArray, ks: float, p: int, g0: FloatArray, free: np.ndarray, tol: float,
                 scratch: FloatArray | None = None) -> tuple[FloatArray, FloatArray, float] | None:
     """Approximate solution ``(v, lambda, kappa)`` of the ball-constrained QP (open curves)
@@ -777,6 +788,7 @@ def _admm_start(K: FloatArray, ks: float, p: int, g0: FloatArray, free: np.ndarr
     the Newton iteration factorises) if it is large enough; the returned ``v`` may be a view
     of it. None if the factorisation fails."""
     n, dim = g0.shape
+    iters = _admm_iters(n)
     t2 = tol * tol
     rho = _ADMM_RHO0 * float((K[:, p] * ks).mean())
     if not rho > 0.0:
@@ -805,12 +817,12 @@ def _admm_start(K: FloatArray, ks: float, p: int, g0: FloatArray, free: np.ndarr
 
     if not factor(rho):
         return None
-    for it in range(1, _ADMM_ITERS + 1):
+    for it in range(1, iters + 1):
         if cubic:
             _k.admm_sweep_t(L, y, z, u, g, rho, t2, free, _ADMM_ALPHA)
         else:
             _k.admm_sweep(L, y, z, u, g, rho, r2, _ADMM_ALPHA)
-        if it % _ADMM_ADAPT == 0 and it < _ADMM_ITERS:
+        if it % _ADMM_ADAPT == 0 and it < iters:
             m = _k.admm_active_norms(up, free, un)
             if m:
                 new = float(np.median(un[:m])) * rho / tol
@@ -837,6 +849,7 @@ def _admm_start_closed(K: FloatArray, ks: float, p: int, g0: FloatArray, free: n
     bordered band Cholesky of :class:`_System` (one unknown per point, shared by the
     coordinates); the point updates vectorised. None if the factorisation fails."""
     n, dim = g0.shape
+    iters = _admm_iters(n)
     t2 = tol * tol
     rho = _ADMM_RHO0 * float((K[:, p] * ks).mean())
     if not rho > 0.0:
@@ -856,7 +869,7 @@ def _admm_start_closed(K: FloatArray, ks: float, p: int, g0: FloatArray, free: n
     x = np.empty((n, dim))
     un = np.empty(n)
     a1 = 1.0 - _ADMM_ALPHA
-    for it in range(1, _ADMM_ITERS + 1):
+    for it in range(1, iters + 1):
         # x = (K + rho I)^{-1} y, the coordinates side by side (sysA has no fixed points)
         np.subtract(rho * (z - u), g0, out=x)
         _k.cyclic_solve_columns(sysA.L, sysA.Y, sysA.S, x)
@@ -866,7 +879,7 @@ def _admm_start_closed(K: FloatArray, ks: float, p: int, g0: FloatArray, free: n
             f = np.where(q2 > r2, np.sqrt(r2 / q2), 1.0)
         np.multiply(w, f[:, None], out=z)  # projection onto the balls
         np.subtract(w, z, out=u)
-        if it % _ADMM_ADAPT == 0 and it < _ADMM_ITERS:
+        if it % _ADMM_ADAPT == 0 and it < iters:
             m = _k.admm_active_norms(u, free, un)
             if m:
                 new = float(np.median(un[:m])) * rho / tol
