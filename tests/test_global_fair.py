@@ -333,7 +333,6 @@ def test_column_solves_are_the_single_solves_side_by_side(kd, N, m):
     np.testing.assert_allclose(X, np.linalg.solve(M, B), rtol=1e-10, atol=1e-12)
 
 
-
 @pytest.mark.parametrize("closed", [False, True])
 def test_band_residual_and_energy_match_gram_matrix(closed):
     from curvefair._kernels.bspline import band_energy, band_residual
