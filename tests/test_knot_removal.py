@@ -250,11 +250,13 @@ def test_stop_reason_tolerance_when_only_blocked_knots_are_above_eps():
 
 @pytest.mark.parametrize("degree,closed", [(3, False), (3, True), (5, False), (2, True)])
 def test_knot_data_in_blocks_is_bitwise_one_block(monkeypatch, degree, closed):
-    """The per-knot basis tables are built in blocks of knots (bounded fresh memory on long
-    curves); each knot's values are its own, so blocks of 7 give bitwise the tables, the
-    measure and the faired result of one block. The report lists the blocked knots as plain
+    """The per-knot tables are built in blocks of knots (bounded fresh memory on long
+    curves) and, on long curves, in ranges on two threads; each knot's values are its own, so
+    blocks of 7 and 16 ranges shared by two threads give bitwise the tables, the measure and
+    the faired result of one block on one thread. The report lists the blocked knots as plain
     ints, like KRResult.blocked."""
     import curvefair as cf
+    from curvefair import _threads
     from curvefair.fairing import knot_removal as KR
 
     rng = np.random.default_rng(degree)
@@ -263,7 +265,10 @@ def test_knot_data_in_blocks_is_bitwise_one_block(monkeypatch, degree, closed):
                             degree=degree, closed=closed)
     one = KR._KnotData(c)
     r1 = cf.fair(c, "knot-removal", tol=0.01)
+    assert c.n_ctrl < KR.TABLES_PAR_MIN  # ``one`` was made on the calling thread alone
     monkeypatch.setattr(KR, "_KNOT_BLOCK", 7)
+    monkeypatch.setattr(KR, "TABLES_PAR_MIN", 2)
+    monkeypatch.setattr(_threads, "THREADS", 2)
     many = KR._KnotData(c)
     for name in ("c", "right", "left2", "ctrl", "js"):
         assert np.array_equal(getattr(one, name), getattr(many, name)), name

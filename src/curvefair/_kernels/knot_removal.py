@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._jit import njit
+from .bspline import _ders_one
 from .pairwise import pw_sum
 from .ranking import tt_update, tt_update_range
 
@@ -115,7 +116,55 @@ def _measure_parts(d, k, p, ctrl, C, right, left2):
     return v, speed
 
 
-@njit(cache=True, readonly=('d',))
+@njit(cache=True, inline="always")
+def _knot_tables_body(knots, p, js, lo, hi, nder, two, c, right, left2):
+    """The loop of :func:`knot_tables`, inlined with ``p`` and ``nder`` as passed (constants:
+    the loops unrolled, the same operations in the same order)."""
+    ndu = np.empty((p + 1, p + 1))
+    lw = np.empty(p + 1)
+    rw = np.empty(p + 1)
+    a = np.empty((2, p + 1))
+    R = np.empty((1, nder + 1, p + 1))
+    L = np.empty((1, nder + 1, p + 1))
+    q0 = np.intp(0)
+    for q in range(lo, hi):
+        j = js[q]
+        # right limit at t_j: span j at local offset 0; left limit: span j - 1 at offset
+        # t_j - t_{j-1} (both local: equal knot patterns give equal values)
+        _ders_one(knots, p, j, 0.0, knots[j], nder, ndu, lw, rw, a, R, q0)
+        _ders_one(knots, p, j - 1, knots[j] - knots[j - 1], knots[j - 1], nder, ndu, lw, rw,
+                  a, L, q0)
+        for i in range(p + 2):
+            c[q, i] = 0.0
+        for i in range(p + 1):
+            c[q, i + 1] += R[0, p, i]
+        for i in range(p + 1):
+            c[q, i] -= L[0, p, i]
+        for i in range(p + 1):
+            right[q, 0, i] = R[0, 1, i]
+            if two:
+                right[q, 1, i] = R[0, 2, i]
+            if p == 2:
+                left2[q, i] = L[0, 2, i]
+
+
+@njit(cache=True, nogil=True, readonly=('knots', 'js'))
+def knot_tables(knots, p, js, lo, hi, nder, two, c, right, left2):
+    """Per-knot basis tables of the Sapidis-Farin measure for knots ``js[lo:hi]`` (rows
+    ``lo .. hi - 1`` of the outputs; the ranges are independent, for two threads):
+    ``c[q]`` the jump coefficients of the ``p``-th derivative at ``t_j`` (basis functions
+    ``j - p - 1 .. j``: right limit minus left limit), ``right[q]`` the right limits of the
+    first (and, ``two``, second) derivatives, ``left2[q]`` (``p = 2``) the left limit of the
+    second. Piegl & Tiller A2.3 up to derivative ``nder`` (:func:`curvefair._kernels.bspline.
+    _ders_one`, whose values do not depend on the highest derivative asked); a cubic's loop is
+    compiled for ``p = 3``."""
+    if p == 3 and nder == 3:
+        _knot_tables_body(knots, 3, js, lo, hi, 3, two, c, right, left2)
+    else:
+        _knot_tables_body(knots, p, js, lo, hi, nder, two, c, right, left2)
+
+
+@njit(cache=True, nogil=True, readonly=('d',))
 def measure_all(d, ks, p, ctrl, C, right, left2, out):
     for u in range(ks.shape[0]):
         out[u] = knot_measure(d, ks[u], p, ctrl, C, right, left2)

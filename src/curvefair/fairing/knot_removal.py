@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any, Literal, cast
 
 import numpy as np
 
+from .. import _threads
 from .._kernels import knot_removal as _k
 from .._kernels.ranking import tt_build
 from .._typing import FloatArray
@@ -202,7 +203,9 @@ def knot_removal(curve: BSplineCurve, j: int, variant: Variant = "one-point") ->
 # ------------------------------------------------------------------------------------------
 # the Sapidis-Farin measure
 # ------------------------------------------------------------------------------------------
-_KNOT_BLOCK = 65536  # knots per block of basis tables in _KnotData
+_KNOT_BLOCK = 65536  # knots per block of control indices in _KnotData
+#: knots from which :class:`_KnotData`'s basis tables are made on two threads
+TABLES_PAR_MIN = 50_000
 
 
 class _KnotData:
@@ -216,28 +219,23 @@ class _KnotData:
         js = self.js
         # one-sided basis derivatives at t_j up to order max(p, 2) (each order is bitwise the
         # same whatever the highest one asked): right limit from span j (N_{j-p..j}), left
-        # limit from span j-1 (N_{j-1-p..j-1})
-        # (in blocks of knots: the full (k, nder+1, p+1) tables of both sides would be 256
-        # bytes per knot of fresh memory, 2.6 GB at 1e7 knots; each knot's values are its own)
+        # limit from span j-1 (N_{j-1-p..j-1}); per knot, compiled, on two threads for long
+        # curves (:func:`curvefair._kernels.knot_removal.knot_tables`: each knot's rows are its
+        # own, so one thread or two give the same bits)
         nder = max(p, 2)
         k = js.size
-        c = np.zeros((k, p + 2))  # as _jump_coefficients
+        c = np.empty((k, p + 2))  # as _jump_coefficients
         # the measure (sapidis_measure) reads r'' only for a quadratic (both sides) or a 3-D
         # curve (the right one, for the binormal): a planar curve of degree >= 3 keeps r' alone
         # (32 bytes a knot instead of 96 for a cubic; the kernel then reads no other row)
         two = p == 2 or curve.dim == 3
         self.right = np.empty((k, 2 if two else 1, p + 1))  # r'[, r''] (right limits)
         self.left2 = np.empty((k if p == 2 else 0, p + 1))  # r'' (left limit)
-        for a in range(0, k, _KNOT_BLOCK):
-            b = min(a + _KNOT_BLOCK, k)
-            jb = js[a:b]
-            right = basis_derivatives(t, p, jb, np.zeros(b - a), nder, local=True)
-            left = basis_derivatives(t, p, jb - 1, t[jb] - t[jb - 1], nder, local=True)
-            c[a:b, 1:] += right[:, p, :]
-            c[a:b, :-1] -= left[:, p, :]
-            self.right[a:b] = right[:, 1:3 if two else 2, :]
-            if p == 2:
-                self.left2[a:b] = left[:, 2, :]
+        tk = np.ascontiguousarray(t, dtype=np.float64)
+        jsk = np.ascontiguousarray(js, dtype=np.int64)
+        _threads.ranges(lambda a, b: _k.knot_tables(tk, p, jsk, a, b, nder, two, c, self.right,
+                                                    self.left2),
+                        0, k, _threads.THREADS, TABLES_PAR_MIN)
         self.c = c  # (k, p+2)
         # (k, p+2) control point indices, int32 below 2**31 control points: 20 bytes a knot
         # less at a cubic's ten million knots (the kernels only index with them); made in the
@@ -255,8 +253,11 @@ class _KnotData:
         updated one agree bitwise and neither depends on the CPU's SIMD width."""
         ks = np.ascontiguousarray(np.arange(self.js.size)[k], dtype=np.int64)
         out = np.empty(ks.size)
-        _k.measure_all(np.ascontiguousarray(d, dtype=np.float64), ks, self.p, self.ctrl, self.c,
-                     self.right, self.left2, out)
+        dc = np.ascontiguousarray(d, dtype=np.float64)
+        # each knot's measure is its own: on two threads for long curves, the same bits
+        _threads.ranges(lambda a, b: _k.measure_all(dc, ks[a:b], self.p, self.ctrl, self.c,
+                                                    self.right, self.left2, out[a:b]),
+                        0, ks.size, _threads.THREADS, TABLES_PAR_MIN)
         return out
 
 
