@@ -50,7 +50,8 @@ def wants_batch(paths: Sequence[str], out: str | None, method: str | None,
         return True
     if method is not None and "=" in method:
         return True
-    return any(bool(v) for v in extra.values())
+    # --jobs alone: one file's curves on that many processes (the single-file path)
+    return any(bool(v) for k, v in extra.items() if k != "jobs")
 
 
 def _fmt(v: Any, digits: int = 4) -> str:
@@ -412,8 +413,8 @@ def batch_options(f: Any) -> Any:
                      help="--hold-shared: points closer than D coincide [default: 1e-9 times "
                           "the drawing's diagonal].")(f)
     f = click.option("--jobs", "-j", type=click.IntRange(min=1), metavar="N",
-                     help="Fair N files at a time in separate processes [default: the "
-                          "number of cores].")(f)
+                     help="Fair N files (one file: N of its curves) at a time in separate "
+                          "processes [default: the number of cores].")(f)
     f = click.option("--resume", is_flag=True,
                      help="Skip a file whose output exists and matches: its per-file report "
                           "records the same input SHA-256, the same options and the output's "

@@ -18,6 +18,7 @@ import math
 import os
 import sys
 import time
+import warnings
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any, cast
@@ -1048,6 +1049,10 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
     IN... may be several files, folders and glob patterns (quote them), or '-' for stdin;
     then OUT is a folder and every file is faired on its own (--jobs processes, or Dask
     workers with --scheduler); one failing file does not stop the others (exit 1).
+
+    A file with many curves (a drawing's entities, a font's glyphs) has its curves faired on
+    --jobs processes (default: one per core) once the first ones show that the rest would take
+    a few seconds; the file written is the same.
     """
     from ._batch_cli import fair_many, wants_batch
 
@@ -1127,7 +1132,7 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
     from .io import read_columns, reads_polylines, write_checked
 
     rows: list[dict[str, Any]] = []
-    faired = []
+    faired: list[Any] = []
     t0 = time.perf_counter()
     show_progress = not quiet and sys.stderr.isatty()
     from ._batch_cli import PHASE_NAMES
@@ -1136,7 +1141,27 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
     # one bar: PHASES steps per curve (curvefair.fair's progress) and one for the write
     bar = contextlib.ExitStack()
     prog = bar.enter_context(_progress(len(records) * PHASES + 1, show_progress))
-    with contextlib.nullcontext():
+    from . import _records
+
+    # many curves: once the first ones have shown what the rest would take, the rest are
+    # faired on a pool of processes (curvefair._records: the same bits, so the same file)
+    jobs = batch.get("jobs")
+    workers = _records.default_workers() if jobs is None else int(jobs)
+    pool: _records.Pool | None = None
+    pending: list[tuple[int, Any]] = []  # (record index, result getter) of pooled curves
+    done_here = 0
+
+    def finish(i: int, row: dict[str, Any], rec: Any, res: Any, error: str | None) -> None:
+        if error is not None:
+            row.update(status="failed", error=error)
+            faired[i] = rec
+            return
+        row.update(status="ok", report=res.report)
+        if history:
+            row["history"] = res.history.to_dict()
+        faired[i] = rec.with_curve(res.curve)
+
+    try:
         for i, rec in enumerate(records):
             phase = None
             if prog is not None:
@@ -1147,34 +1172,60 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
             label = _record_label(rec, i)
             row: dict[str, Any] = {"index": i, "label": label, "name": rec.name,
                                    "kind": rec.kind}
+            rows.append(row)
+            faired.append(rec)
             if _nothing_to_fair(rec):
                 row.update(status="nothing to fair",
                            note="two points (a straight piece between corners): no interior "
                                 "point to move; written back unchanged")
-                faired.append(rec)
-                rows.append(row)
                 if prog is not None:
                     prog[0].update(prog[1], completed=(i + 1) * PHASES)
+                continue
+            kwargs = dict(tol=tol, eps=eps, max_steps=max_steps, clamp=clamp,
+                          protect=_local_protect(rec, user_protect), mode=mode, **options)
+            if pool is None and _records.worth_a_pool(time.perf_counter() - t0, done_here,
+                                                      len(records) - i, workers):
+                pool = _records.Pool(workers)
+            if pool is not None:
+                pending.append((i, pool.submit(rec.curve, method, kwargs)))
                 continue
             notes: list[str] = []
             try:
                 with _warnings_to_stderr(quiet, f"{infile}: curve {i} ({label}): ", notes):
-                    res = fair(rec.curve, method, tol=tol, eps=eps, max_steps=max_steps,
-                               clamp=clamp, protect=_local_protect(rec, user_protect),
-                               mode=mode, progress=phase, **options)
+                    res = fair(rec.curve, method, progress=phase, **kwargs)
             except CurvefairError as exc:
-                row.update(status="failed", error=str(exc))
-                faired.append(rec)
+                finish(i, row, rec, None, str(exc))
             else:
-                row.update(status="ok", report=res.report)
+                finish(i, row, rec, res, None)
                 if notes:
                     row["warnings"] = notes
-                if history:
-                    row["history"] = res.history.to_dict()
-                faired.append(rec.with_curve(res.curve))
-            rows.append(row)
+            done_here += 1
             if prog is not None:
                 prog[0].update(prog[1], completed=(i + 1) * PHASES)
+        for i, get in pending:
+            row, rec = rows[i], records[i]
+            status, value, caught = get()
+            notes = []
+            with _warnings_to_stderr(quiet, f"{infile}: curve {i} ({row['label']}): ", notes):
+                for category, message in caught:  # the worker's warnings, shown as here
+                    warnings.warn(message, category, stacklevel=1)
+                if status == "crashed":  # the error as it would surface without a pool
+                    try:
+                        value = fair(rec.curve, method, tol=tol, eps=eps, max_steps=max_steps,
+                                     clamp=clamp, protect=_local_protect(rec, user_protect),
+                                     mode=mode, **options)
+                        status = "ok"
+                    except CurvefairError as exc:
+                        status, value = "failed", str(exc)
+            finish(i, row, rec, value if status == "ok" else None,
+                   value if status == "failed" else None)
+            if notes and status == "ok":
+                row["warnings"] = notes
+            if prog is not None:
+                prog[0].update(prog[1], completed=(i + 1) * PHASES)
+    finally:
+        if pool is not None:
+            pool.close()
     if prog is not None:
         prog[0].update(prog[1], description="write and read back")
     failures = [r for r in rows if r["status"] == "failed"]
