@@ -499,3 +499,105 @@ def moved_points_kernel(p0, p1, idx, disp):  # pragma: no cover - compiled
                 k += 1
                 break
     return k
+
+
+# ------------------------------------------------------------------------------------------
+# nearest points of a piecewise polynomial (the geometric distance of curvefair.deviation)
+# ------------------------------------------------------------------------------------------
+@njit(cache=True, inline="always")
+def _segment_of(breaks, u):  # pragma: no cover - compiled
+    """``PiecewisePolynomial.segment_of``: ``searchsorted(breaks, u, "right") - 1`` clipped to
+    the segments (NaN sorts last, as in numpy)."""
+    m = breaks.shape[0]
+    if u != u:
+        i = m
+    else:
+        lo = 0
+        hi = m
+        while lo < hi:  # the first index whose break is greater than u
+            mid = (lo + hi) >> 1
+            if breaks[mid] <= u:
+                lo = mid + 1
+            else:
+                hi = mid
+        i = lo
+    i -= 1
+    if i > m - 2:
+        i = m - 2
+    if i < 0:
+        i = 0
+    return i
+
+
+@njit(cache=True, inline="always")
+def _horner(coeffs, seg, s, nu, e, fac):  # pragma: no cover - compiled
+    """Coordinate ``e`` of the ``nu``-th derivative on segment ``seg`` at local offset ``s``:
+    the derivative's coefficients ``coeffs[seg, j, e] * j! / (j - nu)!`` by Horner's rule, the
+    operations of ``PiecewisePolynomial.evaluate`` (a multiplication and an addition a
+    coefficient, each rounded)."""
+    p1 = coeffs.shape[1]
+    if nu >= p1:
+        return 0.0
+    out = coeffs[seg, p1 - 1, e] * fac[nu, p1 - 1]
+    for j in range(p1 - 2, nu - 1, -1):
+        out = out * s
+        out = out + coeffs[seg, j, e] * fac[nu, j]
+    return out
+
+
+@njit(cache=True, error_model="numpy")
+def nearest_newton(breaks, coeffs, fac, u, x, j, d0, iters, best_d, best_s):
+    """Safeguarded Newton for the nearest point of the curve (power form ``breaks``,
+    ``coeffs``) to each row of ``x``, from the dense sample ``u[j]`` (distance ``d0``),
+    bracketed by the samples on either side: ``iters`` steps minimising ``|r(s) - x|^2``
+    (``g = (r - x).r'``, ``h = |r'|^2 + (r - x).r''``), a step out of the bracket or at
+    ``h <= 0`` replaced by bisection; the best distance seen and its parameter into ``best_d``,
+    ``best_s``. ``fac[nu, k] = k! / (k - nu)!`` (``nu`` 0-2). The loop of
+    ``curvefair.analysis._deviation._Nearest._newton`` per point (its numpy form is the
+    reference it is tested against); sums over the coordinates in their order."""
+    dim = x.shape[1]
+    nu_last = u.shape[0] - 1
+    r = np.empty(dim)
+    for q in range(x.shape[0]):
+        jq = j[q]
+        lo = u[jq - 1 if jq >= 1 else 0]
+        hi = u[jq + 1 if jq + 1 <= nu_last else nu_last]
+        s = u[jq]
+        bd = d0[q]
+        bs = s
+        for _ in range(iters):
+            seg = _segment_of(breaks, s)
+            t = s - breaks[seg]
+            g = 0.0
+            h1 = 0.0
+            h2 = 0.0
+            for e in range(dim):
+                r[e] = _horner(coeffs, seg, t, 0, e, fac) - x[q, e]
+            for e in range(dim):
+                d1 = _horner(coeffs, seg, t, 1, e, fac)
+                d2 = _horner(coeffs, seg, t, 2, e, fac)
+                g += r[e] * d1
+                h1 += d1 * d1
+                h2 += r[e] * d2
+            h = h1 + h2
+            step = g / h if h > 0 else 0.0
+            new = s - step
+            if g > 0:
+                hi = s
+            else:
+                lo = s
+            if h <= 0 or new < lo or new > hi or not np.isfinite(new):
+                new = 0.5 * (lo + hi)
+            s = new
+            seg = _segment_of(breaks, s)
+            t = s - breaks[seg]
+            d2s = 0.0
+            for e in range(dim):
+                v = _horner(coeffs, seg, t, 0, e, fac) - x[q, e]
+                d2s += v * v
+            dist = np.sqrt(d2s)
+            if dist < bd:
+                bd = dist
+                bs = s
+        best_d[q] = bd
+        best_s[q] = bs

@@ -497,6 +497,25 @@ def _dense_params(c: PiecewiseCurve) -> FloatArray:
     return np.r_[np.concatenate(parts), br[-1]]
 
 
+_FACTORIALS: dict[int, FloatArray] = {}
+
+
+def _falling_factorials(p1: int) -> FloatArray:
+    """``f[nu, k] = k! / (k - nu)!`` for ``nu`` 0-2 and ``k < p1`` (0 where ``k < nu``): the
+    factors of ``derivative_coefficients``, made once per degree."""
+    f = _FACTORIALS.get(p1)
+    if f is None:
+        from math import factorial
+
+        f = np.zeros((3, p1))
+        for nu in range(3):
+            for k in range(nu, p1):
+                f[nu, k] = float(factorial(k) // factorial(k - nu))
+        f.setflags(write=False)
+        _FACTORIALS[p1] = f
+    return f
+
+
 class _Nearest:
     """Nearest point of a curve to query points: dense samples + safeguarded Newton."""
 
@@ -524,6 +543,26 @@ class _Nearest:
 
     def _newton(self, x: FloatArray, j: np.ndarray, d0: FloatArray
                 ) -> tuple[FloatArray, FloatArray]:
+        """Safeguarded Newton from the samples ``u[j]`` (:func:`curvefair._kernels.deviation.
+        nearest_newton`, compiled: the geometric distance calls this some 70 times per curve
+        pair, on a few rows each for a short curve); a curve evaluated by its own
+        representation (:attr:`PiecewisePolynomial.evaluator`) takes :meth:`_newton_numpy`."""
+        pp = self.c.piecewise
+        if pp.evaluator is not None:
+            return self._newton_numpy(x, j, d0)
+        best_d = np.empty(x.shape[0])
+        best_s = np.empty(x.shape[0])
+        p1 = pp.coeffs.shape[1]
+        _k.nearest_newton(pp.breaks, pp.coeffs, _falling_factorials(p1), self.u,
+                          np.ascontiguousarray(x, dtype=np.float64),
+                          np.ascontiguousarray(j, dtype=np.int64),
+                          np.ascontiguousarray(d0, dtype=np.float64), _GEO_NEWTON, best_d,
+                          best_s)
+        return best_d, best_s
+
+    def _newton_numpy(self, x: FloatArray, j: np.ndarray, d0: FloatArray
+                      ) -> tuple[FloatArray, FloatArray]:
+        """:meth:`_newton` in numpy (whole arrays a step; the reference of the kernel)."""
         pp = self.c.piecewise
         u = self.u
         lo = u[np.maximum(j - 1, 0)]
