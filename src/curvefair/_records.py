@@ -4,14 +4,16 @@ A drawing with thousands of entities or a font with hundreds of glyphs is many s
 :func:`curvefair.fair` calls: each takes milliseconds and holds the interpreter (numpy and
 Python-level work between the compiled loops), so threads cannot share them; processes can.
 Each call depends only on its curve and options and gives the same bits in any process (the
-compiled kernels are the same code, their passes the same on one thread or two), so the file
-written is byte for byte the one a single process writes.
+compiled kernels are the same code, their passes the same on one thread or two), so the curves
+written are bit for bit those a single process writes.
 
 A pool costs its start: every worker imports curvefair and loads its compiled kernels (about
-1-1.5 s, measured in docs/benchmarks.md). The command therefore fairs the first curves itself
-and starts the pool only when the rest, projected from the time those took, would take
-:data:`MIN_SECONDS` or more and enough curves are left for every worker
-(:func:`worth_a_pool`). Small files never start one.
+1 s). The command therefore fairs the first curves itself and starts the pool only when the
+rest, projected from the time those took, would take :data:`MIN_SECONDS` or more and enough
+curves are left for every process (:func:`worth_a_pool`); small files never start one. With
+``jobs`` processes asked for, the pool has ``jobs - 1`` workers and the calling process is the
+last: while the workers start and then work from the front of the list, it takes curves from
+the end (:meth:`Task.take`) until it meets one a worker has begun.
 """
 
 from __future__ import annotations
@@ -19,32 +21,33 @@ from __future__ import annotations
 import concurrent.futures as cf
 import multiprocessing as mp
 import warnings
-from collections.abc import Callable
-from typing import Any
+from typing import Any, cast
 
 from ._threads import cpu_count
 from .errors import CurvefairError
 
 __all__ = ["PROBE_SECONDS", "MIN_SECONDS", "MIN_PER_WORKER", "default_workers", "worth_a_pool",
-           "fair_record", "Pool"]
+           "fair_record", "Task", "Pool"]
 
 #: the command fairs curves itself for at least this long before it considers a pool
 PROBE_SECONDS = 1.0
 #: the projected time of the curves left from which a pool is started (its workers' start,
-#: 1-1.5 s each and side by side, is then a small part of what they save)
+#: about 1 s each and side by side, is then a small part of what they save)
 MIN_SECONDS = 4.0
-#: curves left per worker, at least, for a pool to be started
+#: curves left per process, at least, for a pool to be started
 MIN_PER_WORKER = 4
 
 
 def default_workers() -> int:
-    """Worker processes for one file's curves: the CPUs this process may run on."""
+    """Processes for one file's curves (the calling one included): the CPUs this process may
+    run on."""
     return max(1, cpu_count())
 
 
 def worth_a_pool(elapsed: float, done: int, left: int, workers: int) -> bool:
-    """Whether the ``left`` curves should go to a pool of ``workers`` processes, after ``done``
-    curves took ``elapsed`` seconds here: only with two workers or more, after
+    """Whether the ``left`` curves should be shared by ``workers`` processes (a pool of
+    ``workers - 1`` and this one), after ``done`` curves took ``elapsed`` seconds here: only
+    with two or more, after
     :data:`PROBE_SECONDS`, with :data:`MIN_PER_WORKER` curves per worker left and the rest
     projected to take :data:`MIN_SECONDS` or more."""
     if workers < 2 or done < 1 or elapsed < PROBE_SECONDS or left < MIN_PER_WORKER * workers:
@@ -76,32 +79,54 @@ def fair_record(curve: Any, method: str | None, kwargs: dict[str, Any]
     return status, value, [(w.category, str(w.message)) for w in caught]
 
 
+_Outcome = tuple[str, Any, list[tuple[type[Warning], str]]]
+
+
+class Task:
+    """One curve given to a :class:`Pool`: :meth:`take` claims it for the calling process if
+    no worker has started it (the calling process works from the end of the list while the
+    workers start and work from the front), :meth:`result` gives :func:`fair_record`'s
+    outcome, computed here if the task was taken or the pool broke (a worker died)."""
+
+    def __init__(self, pool: Pool, fut: Any, args: tuple[Any, str | None, dict[str, Any]]
+                 ) -> None:
+        self._pool, self._fut, self._args = pool, fut, args
+        self._here: _Outcome | None = None
+
+    def take(self) -> bool:
+        """Cancel the task in the pool (False once a worker has it) and fair it here."""
+        if self._fut is not None and not self._fut.cancel():
+            return False
+        self._here = fair_record(*self._args)
+        self._pool.here += 1
+        return True
+
+    def result(self) -> _Outcome:
+        if self._here is None:
+            try:
+                return cast("_Outcome", self._fut.result())
+            except (cf.process.BrokenProcessPool, cf.CancelledError, AttributeError):
+                self._pool.redone += 1
+                self._here = fair_record(*self._args)
+        return self._here
+
+
 class Pool:
     """A process pool (``spawn``: no fork of a process with threads) for
-    :func:`fair_record`; :meth:`submit` returns a function that gives the task's result,
-    running the task in this process if the pool has broken (a worker died)."""
+    :func:`fair_record`; :meth:`submit` returns the curve's :class:`Task`."""
 
     def __init__(self, workers: int) -> None:
         self._pool = cf.ProcessPoolExecutor(max_workers=workers,
                                             mp_context=mp.get_context("spawn"))
+        self.here = 0  # tasks taken back by the calling process
         self.redone = 0  # tasks run in this process after the pool broke
 
-    def submit(self, curve: Any, method: str | None, kwargs: dict[str, Any]
-               ) -> Callable[[], tuple[str, Any, list[tuple[type[Warning], str]]]]:
+    def submit(self, curve: Any, method: str | None, kwargs: dict[str, Any]) -> Task:
         try:
             fut = self._pool.submit(fair_record, curve, method, kwargs)
         except cf.process.BrokenProcessPool:
             fut = None
-
-        def result() -> tuple[str, Any, list[tuple[type[Warning], str]]]:
-            if fut is not None:
-                try:
-                    return fut.result()
-                except cf.process.BrokenProcessPool:
-                    pass
-            self.redone += 1
-            return fair_record(curve, method, kwargs)
-        return result
+        return Task(self, fut, (curve, method, kwargs))
 
     def close(self) -> None:
         self._pool.shutdown(wait=True, cancel_futures=True)

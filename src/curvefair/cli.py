@@ -1148,7 +1148,7 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
     jobs = batch.get("jobs")
     workers = _records.default_workers() if jobs is None else int(jobs)
     pool: _records.Pool | None = None
-    pending: list[tuple[int, Any]] = []  # (record index, result getter) of pooled curves
+    pending: list[tuple[int, _records.Task]] = []  # (record index, task) of pooled curves
     done_here = 0
 
     def finish(i: int, row: dict[str, Any], rec: Any, res: Any, error: str | None) -> None:
@@ -1185,7 +1185,7 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
                           protect=_local_protect(rec, user_protect), mode=mode, **options)
             if pool is None and _records.worth_a_pool(time.perf_counter() - t0, done_here,
                                                       len(records) - i, workers):
-                pool = _records.Pool(workers)
+                pool = _records.Pool(workers - 1)
             if pool is not None:
                 pending.append((i, pool.submit(rec.curve, method, kwargs)))
                 continue
@@ -1202,9 +1202,20 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
             done_here += 1
             if prog is not None:
                 prog[0].update(prog[1], completed=(i + 1) * PHASES)
-        for i, get in pending:
+        # while the workers start and work from the front, this process takes curves from
+        # the end until it meets one a worker has begun
+        taken = set()
+        for i, task in reversed(pending):
+            if not task.take():
+                break
+            taken.add(i)
+            if prog is not None:
+                prog[0].advance(prog[1], PHASES)
+        for i, task in pending:
             row, rec = rows[i], records[i]
-            status, value, caught = get()
+            status, value, caught = task.result()
+            if prog is not None and i not in taken:
+                prog[0].advance(prog[1], PHASES)
             notes = []
             with _warnings_to_stderr(quiet, f"{infile}: curve {i} ({row['label']}): ", notes):
                 for category, message in caught:  # the worker's warnings, shown as here
@@ -1221,8 +1232,6 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
                    value if status == "failed" else None)
             if notes and status == "ok":
                 row["warnings"] = notes
-            if prog is not None:
-                prog[0].update(prog[1], completed=(i + 1) * PHASES)
     finally:
         if pool is not None:
             pool.close()
