@@ -1148,7 +1148,8 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
     jobs = batch.get("jobs")
     workers = _records.default_workers() if jobs is None else int(jobs)
     pool: _records.Pool | None = None
-    pending: list[tuple[int, _records.Task]] = []  # (record index, task) of pooled curves
+    # (record index, fair() arguments, task) of the curves given to the pool
+    pending: list[tuple[int, dict[str, Any], _records.Task]] = []
     done_here = 0
 
     def finish(i: int, row: dict[str, Any], rec: Any, res: Any, error: str | None) -> None:
@@ -1187,7 +1188,7 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
                                                       len(records) - i, workers):
                 pool = _records.Pool(workers - 1)
             if pool is not None:
-                pending.append((i, pool.submit(rec.curve, method, kwargs)))
+                pending.append((i, kwargs, pool.submit(rec.curve, method, kwargs)))
                 continue
             notes: list[str] = []
             try:
@@ -1205,13 +1206,13 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
         # while the workers start and work from the front, this process takes curves from
         # the end until it meets one a worker has begun
         taken = set()
-        for i, task in reversed(pending):
+        for i, _, task in reversed(pending):
             if not task.take():
                 break
             taken.add(i)
             if prog is not None:
                 prog[0].advance(prog[1], PHASES)
-        for i, task in pending:
+        for i, kwargs, task in pending:
             row, rec = rows[i], records[i]
             status, value, caught = task.result()
             if prog is not None and i not in taken:
@@ -1222,9 +1223,7 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
                     warnings.warn(message, category, stacklevel=1)
                 if status == "crashed":  # the error as it would surface without a pool
                     try:
-                        value = fair(rec.curve, method, tol=tol, eps=eps, max_steps=max_steps,
-                                     clamp=clamp, protect=_local_protect(rec, user_protect),
-                                     mode=mode, **options)
+                        value = fair(rec.curve, method, **kwargs)
                         status = "ok"
                     except CurvefairError as exc:
                         status, value = "failed", str(exc)
