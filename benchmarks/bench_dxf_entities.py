@@ -9,7 +9,8 @@ The file is built with ezdxf (seeded): ``N`` entities in the model space, altern
   record (default method of each curve type), ``write_curves(dst, faired, template=src)``
   (which reads the file back and checks it), each part and the whole;
 - with ``--cli``: ``curvefair fair src -o dst --tol TOL --polylines`` as a subprocess (its
-  start-up included).
+  start-up included; since session 42 it shares a long file's curves with worker processes,
+  one per core: ``curvefair._records``; the Python columns stay on one process).
 
 The polylines are noisy samples of a curve, so they are read as point data (``polylines=True``;
 since session 28 DXF polylines are drawn shapes, left as drawn, by default).
