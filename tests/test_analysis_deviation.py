@@ -400,3 +400,24 @@ def test_nearest_point_newton_kernel_vs_numpy_and_dense_sampling(dim):
         best = got[0].reshape(-1, k).min(axis=1)
         assert np.all(best <= dd + 1e-12)
         np.testing.assert_allclose(best, dd, atol=1e-6, rtol=0)
+
+
+def test_points_for_the_golden_search_are_the_curves_own():
+    """``_at`` (the compiled Horner evaluation of the geometric distance's search) gives the
+    curve's own ``c(t)`` bit for bit: open and closed, 2-D and 3-D, cubic Hermite and cubic /
+    quintic B-splines, at random parameters, the domain's ends and every breakpoint (where
+    the segment chosen matters)."""
+    from curvefair.analysis._deviation import _at
+
+    rng = np.random.default_rng(3)
+    for trial in range(24):
+        dim, closed = 2 + trial % 2, trial % 3 == 0
+        P = rng.normal(size=(int(rng.integers(8, 40)), dim)).cumsum(axis=0)
+        if trial % 4 < 2:
+            c = cf.interpolate_cubic(np.vstack([P, P[:1]]) if closed else P,
+                                     bc="periodic" if closed else "natural")
+        else:
+            c = cf.interpolate_bspline(P, degree=3 + 2 * (trial % 2), closed=closed)
+        t0, t1 = c.domain
+        t = np.r_[rng.uniform(t0, t1, 50), t0, t1, np.asarray(c.piecewise.breaks)]
+        np.testing.assert_array_equal(_at(c, t), np.asarray(c(t)))

@@ -516,6 +516,23 @@ def _falling_factorials(p1: int) -> FloatArray:
     return f
 
 
+def _at(c: PiecewiseCurve, t: FloatArray) -> FloatArray:
+    """``c(t)`` bit for bit, shape ``(len(t), dim)``, for parameters ``t`` in the curve's
+    domain (a closed curve's wrapped as ``__call__`` wraps them, an open one's clipped to it):
+    the power form evaluated by :func:`curvefair._kernels.deviation.power_values`, or by the
+    curve itself when it has its own evaluator."""
+    pp = c.piecewise
+    t = np.asarray(t, dtype=np.float64).reshape(-1)
+    if pp.evaluator is not None:
+        return np.asarray(c(t), dtype=float).reshape(t.shape[0], -1)
+    t0, t1 = c.domain
+    u = t0 + np.mod(t - t0, t1 - t0) if c.closed else np.clip(t, t0, t1)
+    out = np.empty((u.shape[0], pp.coeffs.shape[2]))
+    _k.power_values(pp.breaks, pp.coeffs, _falling_factorials(pp.coeffs.shape[1]),
+                    np.ascontiguousarray(u), out)
+    return out
+
+
 class _Nearest:
     """Nearest point of a curve to query points: dense samples + safeguarded Newton."""
 
@@ -635,7 +652,7 @@ def _directed(a: PiecewiseCurve, near_b: _Nearest, spans: np.ndarray | None = No
     g = (math.sqrt(5.0) - 1.0) / 2.0
 
     def dist(t: FloatArray) -> tuple[FloatArray, FloatArray]:
-        return near_b(np.asarray(a(t), dtype=float).reshape(t.shape[0], -1))
+        return near_b(_at(a, t))
 
     x1 = hi - g * (hi - lo)
     x2 = lo + g * (hi - lo)

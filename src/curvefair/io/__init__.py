@@ -389,7 +389,7 @@ def write_curves(path: str | os.PathLike[str], curves: CurveRecord | PiecewiseCu
     fmt = detect_format(path, format)
     records = _as_records(curves)
     tpath = _template_path(template)
-    inputs = [tpath] + [r.path for r in records]
+    inputs = list(dict.fromkeys([tpath] + [r.path for r in records]))  # each path once
     if not overwrite and any(p is not None and same_path(path, p) for p in inputs):
         raise InputError(f"path {os.fspath(path)!r} is one of the input files; pass "
                          "overwrite=True to replace it")
