@@ -202,3 +202,57 @@ def test_tasks_taken_back_from_the_pool_give_the_workers_results():
         ref = _records.fair_record(c, None, {"tol": TOL})
         assert status == ref[0] == "ok" and caught == []
         assert np.array_equal(res.curve.control_points, ref[1].curve.control_points)
+
+
+_KILLED_PARENT = r"""
+import os, signal, sys, time
+import numpy as np
+import curvefair as cf
+from curvefair import _records
+
+if __name__ == "__main__":
+    pool = _records.Pool(2)
+    c = cf.interpolate_bspline(np.c_[np.linspace(0, 4, 30), np.sin(np.linspace(0, 4, 30))])
+    tasks = [pool.submit(c, None, {"tol": 0.01}) for _ in range(4)]
+    tasks[0].result()  # the workers are up
+    print(" ".join(str(p) for p in pool._pool._processes), flush=True)
+    os.kill(os.getpid(), signal.SIGKILL)  # no finally, no atexit: the workers are orphans
+"""
+
+
+def test_workers_exit_when_the_command_is_killed(tmp_path: Path):
+    """A command killed outright (SIGKILL, or SIGTERM's default action) runs no ``finally``:
+    its pool's workers would wait on their queue forever. They watch their parent and exit."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    if not hasattr(signal, "SIGKILL"):
+        pytest.skip("no SIGKILL here")
+    script = tmp_path / "killed.py"
+    script.write_text(_KILLED_PARENT)
+    # output to files, not pipes: orphans holding a pipe would keep run() waiting
+    out, err = tmp_path / "out.txt", tmp_path / "err.txt"
+    with open(out, "w") as fo, open(err, "w") as fe:
+        p = subprocess.run([sys.executable, str(script)], stdout=fo, stderr=fe, timeout=300)
+    assert p.returncode == -signal.SIGKILL, err.read_text()
+    pids = [int(x) for x in out.read_text().split()]
+    assert len(pids) == 2
+
+    def alive(pid: int) -> bool:
+        try:
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            return False
+        # a zombie (exited, not yet reaped by init) counts as gone
+        try:
+            with open(f"/proc/{pid}/stat") as f:
+                return f.read().split(") ")[1][0] != "Z"
+        except OSError:
+            return True
+    deadline = time.monotonic() + 20.0
+    while any(alive(pid) for pid in pids) and time.monotonic() < deadline:
+        time.sleep(0.2)
+    assert not any(alive(pid) for pid in pids)

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import concurrent.futures as cf
 import multiprocessing as mp
+import os
 import warnings
 from typing import Any, cast
 
@@ -82,6 +83,27 @@ def fair_record(curve: Any, method: str | None, kwargs: dict[str, Any]
 _Outcome = tuple[str, Any, list[tuple[type[Warning], str]]]
 
 
+def _worker_start(parent: int) -> None:
+    """A worker ignores Ctrl-C (the command's process is interrupted and stops the pool; a
+    worker's own KeyboardInterrupt would print a traceback from a process the user never
+    started) and exits when the command's process is gone (killed by a signal, no ``finally``
+    ran: the pool's queue keeps a worker waiting forever otherwise): a daemon thread looks at
+    the parent every half second."""
+    import os
+    import signal
+    import threading
+    import time
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+    def watch() -> None:
+        while True:
+            time.sleep(0.5)
+            if os.getppid() != parent:
+                os._exit(1)
+    threading.Thread(target=watch, name="curvefair-parent-watch", daemon=True).start()
+
+
 class Task:
     """One curve given to a :class:`Pool`: :meth:`take` claims it for the calling process if
     no worker has started it (the calling process works from the end of the list while the
@@ -105,7 +127,8 @@ class Task:
         if self._here is None:
             try:
                 return cast("_Outcome", self._fut.result())
-            except (cf.process.BrokenProcessPool, cf.CancelledError, AttributeError):
+            except Exception:  # noqa: BLE001 - the pool failed (a worker died, a result that
+                # would not unpickle, ...): the curve is faired here, as without a pool
                 self._pool.redone += 1
                 self._here = fair_record(*self._args)
         return self._here
@@ -117,16 +140,20 @@ class Pool:
 
     def __init__(self, workers: int) -> None:
         self._pool = cf.ProcessPoolExecutor(max_workers=workers,
-                                            mp_context=mp.get_context("spawn"))
+                                            mp_context=mp.get_context("spawn"),
+                                            initializer=_worker_start,
+                                            initargs=(os.getpid(),))
         self.here = 0  # tasks taken back by the calling process
         self.redone = 0  # tasks run in this process after the pool broke
 
     def submit(self, curve: Any, method: str | None, kwargs: dict[str, Any]) -> Task:
         try:
             fut = self._pool.submit(fair_record, curve, method, kwargs)
-        except cf.process.BrokenProcessPool:
-            fut = None
+        except Exception:  # noqa: BLE001 - no pool (broken, or a worker could not start):
+            fut = None  # the task runs here
         return Task(self, fut, (curve, method, kwargs))
 
-    def close(self) -> None:
-        self._pool.shutdown(wait=True, cancel_futures=True)
+    def close(self, wait: bool = True) -> None:
+        """Stop the workers: after the last task (``wait``), or now (an interrupted command:
+        the tasks not begun are cancelled, the workers finish the one they have and exit)."""
+        self._pool.shutdown(wait=wait, cancel_futures=True)

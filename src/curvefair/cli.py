@@ -1232,8 +1232,8 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
             if notes and status == "ok":
                 row["warnings"] = notes
     finally:
-        if pool is not None:
-            pool.close()
+        if pool is not None:  # interrupted: the workers are not waited for
+            pool.close(wait=sys.exc_info()[0] is None)
     if prog is not None:
         prog[0].update(prog[1], description="write and read back")
     failures = [r for r in rows if r["status"] == "failed"]
