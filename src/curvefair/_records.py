@@ -48,9 +48,8 @@ def default_workers() -> int:
 def worth_a_pool(elapsed: float, done: int, left: int, workers: int) -> bool:
     """Whether the ``left`` curves should be shared by ``workers`` processes (a pool of
     ``workers - 1`` and this one), after ``done`` curves took ``elapsed`` seconds here: only
-    with two or more, after
-    :data:`PROBE_SECONDS`, with :data:`MIN_PER_WORKER` curves per worker left and the rest
-    projected to take :data:`MIN_SECONDS` or more."""
+    with two or more, after :data:`PROBE_SECONDS`, with :data:`MIN_PER_WORKER` curves per
+    process left and the rest projected to take :data:`MIN_SECONDS` or more."""
     if workers < 2 or done < 1 or elapsed < PROBE_SECONDS or left < MIN_PER_WORKER * workers:
         return False
     return elapsed / done * left >= MIN_SECONDS
@@ -89,7 +88,6 @@ def _worker_start(parent: int) -> None:
     started) and exits when the command's process is gone (killed by a signal, no ``finally``
     ran: the pool's queue keeps a worker waiting forever otherwise): a daemon thread looks at
     the parent every half second."""
-    import os
     import signal
     import threading
     import time

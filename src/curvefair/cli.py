@@ -1052,7 +1052,7 @@ def fair_cmd(paths: tuple[str, ...], out: str | None, in_place: bool, method: st
 
     A file with many curves (a drawing's entities, a font's glyphs) has its curves faired on
     --jobs processes (default: one per core) once the first ones show that the rest would take
-    a few seconds; the file written is the same.
+    a few seconds; the curves written are the same.
     """
     from ._batch_cli import fair_many, wants_batch
 
