@@ -151,7 +151,7 @@ def test_worker_reports_warnings_and_errors():
     status, msg, _ = _records.fair_record(c, "no-such-method", {"tol": TOL})
     assert status == "failed" and "no-such-method" in msg
     status, value, _ = _records.fair_record(c, None, {"tol": TOL, "no_such_option": 1})
-    assert status in ("failed", "crashed")
+    assert status == "failed" and "no_such_option" in value
 
     orig = cf.fair
 
@@ -164,6 +164,15 @@ def test_worker_reports_warnings_and_errors():
     finally:
         cf.fair = orig
     assert status == "ok" and caught == [(UserWarning, "a note from fair")]
+
+    def broken_fair(curve, method=None, **kw):
+        raise RuntimeError("a bug")
+    try:
+        cf.fair = broken_fair
+        status, value, _ = _records.fair_record(c, None, {"tol": TOL})
+    finally:
+        cf.fair = orig
+    assert (status, value) == ("crashed", None)  # the command then refairs it itself
 
 
 @pytest.mark.parametrize("elapsed,done,left,workers,want", [

@@ -518,15 +518,14 @@ def _falling_factorials(p1: int) -> FloatArray:
 
 def _at(c: PiecewiseCurve, t: FloatArray) -> FloatArray:
     """``c(t)`` bit for bit, shape ``(len(t), dim)``, for parameters ``t`` in the curve's
-    domain (a closed curve's wrapped as ``__call__`` wraps them, an open one's clipped to it):
-    the power form evaluated by :func:`curvefair._kernels.deviation.power_values`, or by the
-    curve itself when it has its own evaluator."""
+    domain (taken as ``__call__`` takes them, :meth:`PiecewiseCurve._in_domain`): the power
+    form evaluated by :func:`curvefair._kernels.deviation.power_values`, or by the curve
+    itself when it has its own evaluator."""
     pp = c.piecewise
     t = np.asarray(t, dtype=np.float64).reshape(-1)
     if pp.evaluator is not None:
         return np.asarray(c(t), dtype=float).reshape(t.shape[0], -1)
-    t0, t1 = c.domain
-    u = t0 + np.mod(t - t0, t1 - t0) if c.closed else np.clip(t, t0, t1)
+    u = c._in_domain(t)
     out = np.empty((u.shape[0], pp.coeffs.shape[2]))
     _k.power_values(pp.breaks, pp.coeffs, _falling_factorials(pp.coeffs.shape[1]),
                     np.ascontiguousarray(u), out)

@@ -322,18 +322,21 @@ class PiecewiseCurve(abc.ABC):
         if (isinstance(nu, bool) or not isinstance(nu, (int, np.integer)) or nu < 0
                 or nu > self.max_derivative):
             raise InputError(f"nu must be an integer in [0, {self.max_derivative}], got {nu!r}")
-        u = as_eval_params(u, "u")
+        return self._evaluate(self._in_domain(as_eval_params(u, "u")), int(nu))
+
+    def _in_domain(self, u: FloatArray) -> FloatArray:
+        """Parameters as :meth:`__call__` evaluates them: a closed curve's wrapped around
+        periodically, an open one's clipped to the domain (farther out than rounding:
+        :class:`~curvefair.errors.InputError`)."""
         t0, t1 = self.domain
         if self.closed:
-            u = t0 + np.mod(u - t0, t1 - t0)
-        else:
-            slack = 1e-12 * (t1 - t0)
-            bad = (u < t0 - slack) | (u > t1 + slack)
-            if np.any(bad):
-                v = u.reshape(-1)[np.flatnonzero(bad.reshape(-1))[0]]
-                raise InputError(f"u = {v!r} is outside the curve's domain [{t0!r}, {t1!r}]")
-            u = np.clip(u, t0, t1)
-        return self._evaluate(u, int(nu))
+            return t0 + np.mod(u - t0, t1 - t0)
+        slack = 1e-12 * (t1 - t0)
+        bad = (u < t0 - slack) | (u > t1 + slack)
+        if np.any(bad):
+            v = u.reshape(-1)[np.flatnonzero(bad.reshape(-1))[0]]
+            raise InputError(f"u = {v!r} is outside the curve's domain [{t0!r}, {t1!r}]")
+        return np.clip(u, t0, t1)
 
     def _evaluate(self, u: FloatArray, nu: int) -> FloatArray:
         """:meth:`__call__` on parameters already in the domain. A few parameters of a long
